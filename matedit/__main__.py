@@ -1,0 +1,3 @@
+from matedit.cli import main
+
+raise SystemExit(main())

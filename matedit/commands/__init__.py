@@ -1,0 +1,10 @@
+"""Subcommands of the `matedit` command line, one module each.
+
+Each module exposes `register(subparsers)`, which adds its parser and sets
+`run=` to a function of the parsed arguments returning the exit status.
+Bad input raises `matedit.cli.UsageError` (one line, exit 2).
+"""
+
+from matedit.commands import validate
+
+REGISTRY = [validate.register]

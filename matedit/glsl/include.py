@@ -1,0 +1,133 @@
+"""A small `#include` mechanism for GLSL that keeps `#line` mapping.
+
+`#include "name.glsl"` is resolved relative to the including file, then to the
+library roots. Each file is spliced once (like `#pragma once`). Every spliced
+run of lines is preceded by `#line N S`, where S is the file's source-string
+number, so a driver's error message (`S:N(col): error ...`) names the real file
+and line; `Assembly.locate` turns such a pair back into a path.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from matedit.resources import shaders_dir
+
+_INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
+# Mesa: "0:12(3): error: ...", glslang: "ERROR: 0:12: ...", others "0(12) : error".
+_ERROR_LOC = re.compile(r"(?P<src>\d+):(?P<line>\d+)\(\d+\)|(?P<src2>\d+):(?P<line2>\d+):|(?P<src3>\d+)\((?P<line3>\d+)\)")
+
+
+class IncludeError(Exception):
+    """A missing or circular include, naming the file and line that asked for it."""
+
+
+@dataclass
+class Assembly:
+    """GLSL text with its provenance: source-string number -> file name."""
+
+    text: str
+    sources: list[str] = field(default_factory=list)
+
+    def locate(self, source: int, line: int) -> tuple[str, int]:
+        if 0 <= source < len(self.sources):
+            return self.sources[source], line
+        return f"<source {source}>", line
+
+    def map_log(self, log: str) -> str:
+        """Rewrite `S:N` locations in a compiler log as `file:N`."""
+
+        def repl(m: re.Match) -> str:
+            src = m.group("src") or m.group("src2") or m.group("src3")
+            line = m.group("line") or m.group("line2") or m.group("line3")
+            name, n = self.locate(int(src), int(line))
+            return f"{name}:{n}"
+
+        return _ERROR_LOC.sub(repl, log)
+
+
+class Assembler:
+    """Splices includes; one instance per generated shader (source numbering is per shader)."""
+
+    def __init__(self, roots: list[Path] | None = None, first_source: int = 0) -> None:
+        self.roots = [Path(r) for r in (roots or [shaders_dir()])]
+        self.sources: list[str] = [f"<generated {i}>" for i in range(first_source)]
+        self._seen: set[Path] = set()
+
+    def _name(self, path: Path) -> str:
+        for root in self.roots:
+            try:
+                return path.resolve().relative_to(root.resolve()).as_posix()
+            except ValueError:
+                continue
+        return str(path)
+
+    def _resolve(self, name: str, base: Path | None, where: str) -> Path:
+        candidates = ([base / name] if base else []) + [r / name for r in self.roots]
+        for c in candidates:
+            if c.is_file():
+                return c.resolve()
+        raise IncludeError(f'{where}: cannot find include "{name}"')
+
+    def source_number(self, name: str) -> int:
+        self.sources.append(name)
+        return len(self.sources) - 1
+
+    def include(self, name: str) -> str:
+        """The text of a library file (and what it includes), if not already spliced."""
+        return self._splice(self._resolve(name, None, "<assembler>"), stack=())
+
+    def expand(self, text: str, name: str, base: Path | None = None) -> str:
+        """Expand includes inside generated text, numbering it as its own source string."""
+        return self._expand_lines(text, name, base, stack=())
+
+    def _splice(self, path: Path, stack: tuple[Path, ...]) -> str:
+        if path in stack:
+            chain = " -> ".join(self._name(p) for p in (*stack, path))
+            raise IncludeError(f"circular include: {chain}")
+        if path in self._seen:
+            return ""
+        self._seen.add(path)
+        return self._expand_lines(path.read_text(), self._name(path), path.parent, (*stack, path))
+
+    def _expand_lines(self, text: str, name: str, base: Path | None, stack: tuple) -> str:
+        src = self.source_number(name)
+        out = [f"#line 1 {src}"]
+        for i, line in enumerate(text.splitlines(), start=1):
+            m = _INCLUDE.match(line)
+            if not m:
+                out.append(line)
+                continue
+            target = self._resolve(m.group(1), base, f"{name}:{i}")
+            spliced = self._splice(target, stack)
+            if spliced:
+                out.append(spliced)
+            # Back in this file: the next line is line i + 1 (GLSL >= 330 semantics).
+            out.append(f"#line {i + 1} {src}")
+        return "\n".join(out)
+
+    def assembly(self, text: str) -> Assembly:
+        return Assembly(text=text, sources=list(self.sources))
+
+
+def assemble(
+    body: str,
+    version: str = "330 core",
+    includes: list[str] | None = None,
+    name: str = "<main>",
+    roots: list[Path] | None = None,
+    prelude: str = "",
+) -> Assembly:
+    """`#version`, an optional prelude (defines, precision), library includes, then `body`."""
+    asm = Assembler(roots)
+    parts = [f"#version {version}"]
+    if prelude:
+        parts.append(asm.expand(prelude, "<prelude>"))
+    for inc in includes or []:
+        spliced = asm.include(inc)
+        if spliced:
+            parts.append(spliced)
+    parts.append(asm.expand(body, name))
+    return asm.assembly("\n".join(parts) + "\n")

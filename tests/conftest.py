@@ -1,0 +1,28 @@
+"""Shared fixtures: a headless OpenGL context over EGL, checked for errors after each test."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "false")
+
+
+@pytest.fixture(scope="session")
+def gl_ctx():
+    moderngl = pytest.importorskip("moderngl")
+    try:
+        ctx = moderngl.create_standalone_context(require=330, backend="egl")
+    except Exception as exc:  # pragma: no cover - depends on the machine
+        pytest.fail(f"cannot create a headless EGL context: {exc}")
+    yield ctx
+    ctx.release()
+
+
+@pytest.fixture
+def ctx(gl_ctx):
+    """The session context; fails the test if it leaves a GL error behind."""
+    gl_ctx.error  # clear any stale error
+    yield gl_ctx
+    assert gl_ctx.error == "GL_NO_ERROR"
