@@ -29,9 +29,13 @@ void tangentFrame(vec3 N, out vec3 T, out vec3 B) {
 // GGX half vector around N for a uniform point Xi; `a` is alpha = roughness².
 vec3 importanceSampleGGX(vec2 Xi, float a, vec3 N) {
     // Karis 2013, "Real Shading in Unreal Engine 4", ImportanceSampleGGX
+    // 1 + (a^2 - 1) y is summed as (1 - y) + a^2 y, and sin^2 = a^2 y / that, exactly:
+    // no cancellation when y -> 1 or the lobe is narrow (float32 keeps ~1e-7 relative).
     float phi = 2.0 * PI * Xi.x;
-    float cosTheta = sqrt((1.0 - Xi.y) / (1.0 + (a * a - 1.0) * Xi.y));
-    float sinTheta = sqrt(max(0.0, 1.0 - cosTheta * cosTheta));
+    float a2y = a * a * Xi.y;
+    float denom = max((1.0 - Xi.y) + a2y, 1e-30);
+    float cosTheta = sqrt((1.0 - Xi.y) / denom);
+    float sinTheta = sqrt(a2y / denom);
     vec3 H = vec3(sinTheta * cos(phi), sinTheta * sin(phi), cosTheta);
     vec3 T;
     vec3 B;

@@ -2,9 +2,11 @@
 
 `#include "name.glsl"` is resolved relative to the including file, then to the
 library roots. Each file is spliced once (like `#pragma once`). Every spliced
-run of lines is preceded by `#line N S`, where S is the file's source-string
-number, so a driver's error message (`S:N(col): error ...`) names the real file
-and line; `Assembly.locate` turns such a pair back into a path.
+run of lines is preceded by `#line L S`, where S is the file's source-string
+number and L = S * LINE_STRIDE + N encodes the source in the line as well: Mesa
+loses the source number of many diagnostics (its parser's default location
+resets it to 0) but always keeps the line. `Assembly.locate` / `map_log` turn a
+driver's `S:L` back into `file:N` (GLSL >= 330 / ESSL 300 `#line` semantics).
 """
 
 from __future__ import annotations
@@ -16,8 +18,21 @@ from pathlib import Path
 from matedit.resources import shaders_dir
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"\s*$')
-# Mesa: "0:12(3): error: ...", glslang: "ERROR: 0:12: ...", others "0(12) : error".
-_ERROR_LOC = re.compile(r"(?P<src>\d+):(?P<line>\d+)\(\d+\)|(?P<src2>\d+):(?P<line2>\d+):|(?P<src3>\d+)\((?P<line3>\d+)\)")
+# Locations at the start of a log line: Mesa "0:12(3): error: ...", glslang
+# "ERROR: 0:12: ...", NVIDIA-style "0(12) : error ...". Anchored so that code quoted
+# inside a message (say `vec3(1)`) is never rewritten.
+_ERROR_LOC = re.compile(
+    r"^(?P<lead>\s*(?:(?:ERROR|WARNING|error|warning):\s*)?)"
+    r"(?:(?P<src>\d+):(?P<line>\d+)(?=\(\d+\)|:)|(?P<src3>\d+)\((?P<line3>\d+)\))",
+    re.MULTILINE,
+)
+# Lines per source string in the encoded `#line` numbers (files are far shorter).
+LINE_STRIDE = 100_000
+
+
+def _line_directive(line: int, source: int) -> str:
+    """`#line` making the next line `line` of source string `source`, source also encoded."""
+    return f"#line {source * LINE_STRIDE + line} {source}"
 
 
 class IncludeError(Exception):
@@ -32,18 +47,21 @@ class Assembly:
     sources: list[str] = field(default_factory=list)
 
     def locate(self, source: int, line: int) -> tuple[str, int]:
+        """(file, line) of a driver's (source string, line); the line's encoding wins."""
+        if line >= LINE_STRIDE:
+            source, line = divmod(line, LINE_STRIDE)
         if 0 <= source < len(self.sources):
             return self.sources[source], line
         return f"<source {source}>", line
 
     def map_log(self, log: str) -> str:
-        """Rewrite `S:N` locations in a compiler log as `file:N`."""
+        """Rewrite the `S:N` location that starts each compiler log line as `file:N`."""
 
         def repl(m: re.Match) -> str:
-            src = m.group("src") or m.group("src2") or m.group("src3")
-            line = m.group("line") or m.group("line2") or m.group("line3")
+            src = m.group("src") or m.group("src3")
+            line = m.group("line") or m.group("line3")
             name, n = self.locate(int(src), int(line))
-            return f"{name}:{n}"
+            return f"{m.group('lead')}{name}:{n}"
 
         return _ERROR_LOC.sub(repl, log)
 
@@ -94,7 +112,7 @@ class Assembler:
 
     def _expand_lines(self, text: str, name: str, base: Path | None, stack: tuple) -> str:
         src = self.source_number(name)
-        out = [f"#line 1 {src}"]
+        out = [_line_directive(1, src)]
         for i, line in enumerate(text.splitlines(), start=1):
             m = _INCLUDE.match(line)
             if not m:
@@ -105,7 +123,7 @@ class Assembler:
             if spliced:
                 out.append(spliced)
             # Back in this file: the next line is line i + 1 (GLSL >= 330 semantics).
-            out.append(f"#line {i + 1} {src}")
+            out.append(_line_directive(i + 1, src))
         return "\n".join(out)
 
     def assembly(self, text: str) -> Assembly:

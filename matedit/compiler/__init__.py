@@ -1,0 +1,1 @@
+"""Graph to GLSL: typed IR, optimisation, emission per target, reflection, CPU evaluator."""

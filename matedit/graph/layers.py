@@ -1,0 +1,129 @@
+"""The layer stack of a material: a view over a `layer_stack` node that makes edits.
+
+The stack lives in the graph (the node's `layers` setting, base layer first),
+so the layer panel and the canvas can never disagree. Each edit is a command;
+edits that remove ports also remove the links into them, in the same macro.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+
+from matedit.graph.commands import Command, CommandError, Disconnect, Macro, SetSetting
+from matedit.graph.model import MaterialGraph
+from matedit.graph.ports import LAYER_BLENDS, layer_entries
+
+
+@dataclass
+class Layer:
+    id: str
+    function: str
+    name: str = ""
+    blend: str = "alpha"
+    visible: bool = True
+
+    def to_json(self) -> dict:
+        return {"id": self.id, "function": self.function, "name": self.name or self.id,
+                "blend": self.blend, "visible": self.visible}
+
+
+class LayerStack:
+    """Layers of the `layer_stack` node `node_id`, bottom (base) first."""
+
+    def __init__(self, graph: MaterialGraph, node_id: str) -> None:
+        if graph.nodes.get(node_id) is None or graph.nodes[node_id].kind != "layer_stack":
+            raise ValueError(f"{node_id!r} is not a layer_stack node")
+        self.graph = graph
+        self.node_id = node_id
+
+    @classmethod
+    def find(cls, graph: MaterialGraph) -> LayerStack | None:
+        ids = sorted(n.id for n in graph.nodes.values() if n.kind == "layer_stack")
+        return cls(graph, ids[0]) if ids else None
+
+    @property
+    def layers(self) -> list[Layer]:
+        out = []
+        for e in layer_entries(self.graph.nodes[self.node_id]):
+            out.append(Layer(e["id"], e["function"], e.get("name", e["id"]),
+                             e.get("blend", "alpha"), bool(e.get("visible", True))))
+        return out
+
+    def _entries(self) -> list[dict]:
+        return copy.deepcopy(layer_entries(self.graph.nodes[self.node_id]))
+
+    def _set(self, entries: list[dict], text: str, drop_ports_of=frozenset()) -> Command:
+        cmds: list[Command] = []
+        for link in sorted(self.graph.links):
+            if link.dst == self.node_id and any(link.dst_port.startswith(f"{lid}_")
+                                                for lid in drop_ports_of):
+                cmds.append(Disconnect(link))
+        cmds.append(SetSetting(self.node_id, "layers", entries))
+        return Macro(cmds, text=text)
+
+    def new_layer_id(self, stem: str = "layer") -> str:
+        taken = {e["id"] for e in self._entries()}
+        stem = "".join(c for c in stem if c.isalnum()) or "layer"
+        if not stem[0].isalpha():
+            stem = "l" + stem
+        i = 1
+        while f"{stem}{i}" in taken:
+            i += 1
+        return f"{stem}{i}"
+
+    def add(self, layer: Layer, index: int | None = None) -> Command:
+        entries = self._entries()
+        if any(e["id"] == layer.id for e in entries):
+            raise CommandError(f"a layer with id {layer.id!r} already exists")
+        _check_blend(layer.blend)
+        entries.insert(len(entries) if index is None else index, layer.to_json())
+        return self._set(entries, f"add layer {layer.name or layer.id}")
+
+    def remove(self, layer_id: str) -> Command:
+        entries = self._entries()
+        if not any(e["id"] == layer_id for e in entries):
+            raise CommandError(f"no layer {layer_id!r}")
+        entries = [e for e in entries if e["id"] != layer_id]
+        return self._set(entries, f"remove layer {layer_id}", {layer_id})
+
+    def move(self, layer_id: str, index: int) -> Command:
+        """Moves a layer to `index` (0 = base). Links into blend ports that vanish are cut."""
+        entries = self._entries()
+        old = next((i for i, e in enumerate(entries) if e["id"] == layer_id), None)
+        if old is None:
+            raise CommandError(f"no layer {layer_id!r}")
+        if not 0 <= index < len(entries):
+            raise CommandError(f"layer index {index} out of range 0..{len(entries) - 1}")
+        entry = entries.pop(old)
+        entries.insert(index, entry)
+        # Whichever layer becomes or stops being the base gains or loses blend ports.
+        touched = {entries[0]["id"]} if old == 0 or index == 0 else set()
+        drop = set()
+        if touched:
+            blend_suffixes = ("_mask", "_opacity", "_base_height", "_contrast")
+            for link in self.graph.links:
+                if link.dst == self.node_id and link.dst_port.startswith(f"{entries[0]['id']}_") \
+                        and link.dst_port.endswith(blend_suffixes):
+                    drop.add(entries[0]["id"])
+        return self._set(entries, f"move layer {layer_id}", drop)
+
+    def set(self, layer_id: str, **changes) -> Command:
+        """Changes a layer's name, blend, visibility or function."""
+        entries = self._entries()
+        entry = next((e for e in entries if e["id"] == layer_id), None)
+        if entry is None:
+            raise CommandError(f"no layer {layer_id!r}")
+        for key, value in changes.items():
+            if key not in ("name", "blend", "visible", "function"):
+                raise CommandError(f"a layer has no property {key!r}")
+            if key == "blend":
+                _check_blend(value)
+            entry[key] = value
+        drop = {layer_id} if ("blend" in changes or "function" in changes) else set()
+        return self._set(entries, f"edit layer {layer_id}", drop)
+
+
+def _check_blend(blend: str) -> None:
+    if blend not in LAYER_BLENDS and not (isinstance(blend, str) and blend.endswith(".json")):
+        raise CommandError(f"unknown blend {blend!r}: alpha, height or a blend function file")

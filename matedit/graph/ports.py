@@ -1,0 +1,295 @@
+"""The ports of a node: static ones from its definition, dynamic ones from its settings,
+from the material function it calls, or from its layer stack.
+
+Material functions are found through a `FunctionResolver` the caller provides
+(the format layer resolves paths relative to the file that uses them).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from matedit.graph import nodes
+from matedit.graph.model import MaterialDocument, Node
+from matedit.graph.nodes import GENERIC, MA
+from matedit.graph.types import PortType, parse_type
+
+
+@dataclass(frozen=True)
+class PortSpec:
+    name: str
+    type: str  # a PortType value or "T"
+    default: Any = None
+    range: tuple[float, float] | None = None
+    doc: str = ""
+    required: bool = False
+
+
+@dataclass(frozen=True)
+class NodePorts:
+    inputs: tuple[PortSpec, ...]
+    outputs: tuple[PortSpec, ...]
+
+    def input(self, name: str) -> PortSpec | None:
+        return next((p for p in self.inputs if p.name == name), None)
+
+    def output(self, name: str) -> PortSpec | None:
+        return next((p for p in self.outputs if p.name == name), None)
+
+
+class PortError(ValueError):
+    """A node whose settings do not define valid ports (names the setting)."""
+
+    def __init__(self, node_id: str, field: str, message: str) -> None:
+        super().__init__(message)
+        self.node_id = node_id
+        self.field = field
+
+
+class FunctionResolver(Protocol):
+    def resolve(self, ref: str, owner: MaterialDocument | None) -> MaterialDocument:
+        """The function document `ref` names, relative to `owner`; raise LookupError if missing."""
+        ...
+
+
+def _spec(d: nodes.InputDef | nodes.OutputDef) -> PortSpec:
+    if isinstance(d, nodes.InputDef):
+        return PortSpec(d.name, d.type, d.default, d.range, d.doc, d.required)
+    return PortSpec(d.name, d.type, None, None, d.doc)
+
+
+LAYER_BLENDS = ("alpha", "height")
+_VALID_CHANNELS = "xyzw"
+_CHANNEL_ALIASES = str.maketrans("rgba", "xyzw")
+
+
+def normalize_channels(channels: object) -> str:
+    if not isinstance(channels, str) or not 1 <= len(channels) <= 4:
+        raise ValueError(f"channels must be 1 to 4 letters of xyzw or rgba, got {channels!r}")
+    norm = channels.lower().translate(_CHANNEL_ALIASES)
+    if any(c not in _VALID_CHANNELS for c in norm):
+        raise ValueError(f"channels must be letters of xyzw or rgba, got {channels!r}")
+    return norm
+
+
+def function_interface(doc: MaterialDocument) -> NodePorts:
+    """A function's inputs and outputs, from its function_input/function_output nodes."""
+    ins, outs = [], []
+    for node in doc.graph.nodes.values():
+        if node.kind not in ("function_input", "function_output"):
+            continue
+        s = {**nodes.REGISTRY[node.kind].setting_defaults(), **node.settings}
+        try:
+            t = parse_type(str(s["type"])).value
+        except ValueError as exc:
+            raise PortError(node.id, "type", str(exc)) from None
+        order = s.get("order", 0)
+        order = order if isinstance(order, (int, float)) else 0
+        key = (order, str(s["name"]), node.id)
+        if node.kind == "function_input":
+            ins.append((key, PortSpec(str(s["name"]), t, s.get("default"), None,
+                                      f"function input {s['name']}", t in (MA, "texture2d")
+                                      and s.get("default") is None)))
+        else:
+            outs.append((key, PortSpec(str(s["name"]), t)))
+    return NodePorts(tuple(p for _, p in sorted(ins, key=lambda kp: kp[0])),
+                     tuple(p for _, p in sorted(outs, key=lambda kp: kp[0])))
+
+
+def layer_entries(node: Node) -> list[dict]:
+    layers = node.settings.get("layers", [])
+    return layers if isinstance(layers, list) else []
+
+
+def node_ports(
+    node: Node, resolver: FunctionResolver | None = None, owner: MaterialDocument | None = None
+) -> NodePorts:
+    """The ports of `node`; raises PortError/LookupError when they cannot be determined."""
+    d = nodes.REGISTRY.get(node.kind)
+    if d is None:
+        raise PortError(node.id, "kind", f"unknown node kind {node.kind!r}")
+    ins = tuple(_spec(i) for i in d.inputs)
+    outs = tuple(_spec(o) for o in d.outputs)
+    rule = d.ports_rule
+    s = {**d.setting_defaults(), **node.settings}
+    if rule is None or rule in ("component_mask", "split", "append", "reroute"):
+        return NodePorts(ins, outs)
+    if rule == "constant":
+        try:
+            t = parse_type(str(s["type"]))
+        except ValueError as exc:
+            raise PortError(node.id, "type", str(exc)) from None
+        if not t.is_numeric:
+            raise PortError(node.id, "type", "a constant must be float, vec2, vec3 or vec4")
+        return NodePorts((), (PortSpec("value", t.value),))
+    if rule == "function_input":
+        try:
+            t = parse_type(str(s["type"])).value
+        except ValueError as exc:
+            raise PortError(node.id, "type", str(exc)) from None
+        return NodePorts((), (PortSpec("value", t),))
+    if rule == "function_output":
+        try:
+            t = parse_type(str(s["type"])).value
+        except ValueError as exc:
+            raise PortError(node.id, "type", str(exc)) from None
+        return NodePorts((PortSpec("value", t, None, required=True),), ())
+    if rule == "set_attributes":
+        fields = s.get("fields")
+        if not isinstance(fields, list) or not all(isinstance(f, str) for f in fields):
+            raise PortError(node.id, "fields", "fields must be a list of attribute names")
+        extra = []
+        for f in fields:
+            fd = next((a for a in nodes.ATTRIBUTE_FIELDS if a.name == f), None)
+            if fd is None:
+                raise PortError(node.id, "fields", f"unknown attribute {f!r} (expected one of "
+                                f"{', '.join(nodes.ATTRIBUTE_NAMES)})")
+            extra.append(_spec(fd))
+        return NodePorts(ins + tuple(extra), outs)
+    if rule == "function_call":
+        ref = s.get("function")
+        if not ref or not isinstance(ref, str):
+            raise PortError(node.id, "function", "no function file chosen")
+        if resolver is None:
+            raise LookupError(f"cannot resolve function {ref!r} without a resolver")
+        fn = resolver.resolve(ref, owner)
+        return function_interface(fn)
+    if rule == "layer_stack":
+        return NodePorts(tuple(_layer_stack_inputs(node, resolver, owner)), outs)
+    raise PortError(node.id, "kind", f"node kind {node.kind!r} has an unknown ports rule")
+
+
+def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
+    ports: list[PortSpec] = []
+    seen: set[str] = set()
+    for index, layer in enumerate(layer_entries(node)):
+        if not isinstance(layer, dict):
+            raise PortError(node.id, f"layers[{index}]", "a layer must be an object")
+        lid = layer.get("id")
+        if not isinstance(lid, str) or not lid.isidentifier() or lid in seen:
+            raise PortError(node.id, f"layers[{index}].id", f"bad or duplicate layer id {lid!r}")
+        seen.add(lid)
+        ref = layer.get("function")
+        if not isinstance(ref, str) or not ref:
+            raise PortError(node.id, f"layers[{index}].function", "no layer function chosen")
+        if resolver is None:
+            raise LookupError(f"cannot resolve layer {ref!r} without a resolver")
+        iface = function_interface(resolver.resolve(ref, owner))
+        if not any(o.type == MA for o in iface.outputs):
+            raise PortError(node.id, f"layers[{index}].function",
+                            f"{ref} is not a material layer: it has no MaterialAttributes output")
+        for p in iface.inputs:
+            ports.append(PortSpec(f"{lid}_{p.name}", p.type, p.default, p.range,
+                                  f"{layer.get('name', lid)}: {p.doc or p.name}", p.required))
+        if index == 0:
+            continue
+        blend = layer.get("blend", "alpha")
+        label = layer.get("name", lid)
+        ports.append(PortSpec(f"{lid}_opacity", "float", 1.0, (0.0, 1.0),
+                              f"{label}: overall strength"))
+        if blend == "alpha":
+            ports.append(PortSpec(f"{lid}_mask", "float", 1.0, (0.0, 1.0),
+                                  f"{label}: where the layer covers the ones below"))
+        elif blend == "height":
+            ports.append(PortSpec(f"{lid}_mask", "float", 0.5, (0.0, 1.0),
+                                  f"{label}: layer height"))
+            ports.append(PortSpec(f"{lid}_base_height", "float", 0.5, (0.0, 1.0),
+                                  f"{label}: height of the layers below"))
+            ports.append(PortSpec(f"{lid}_contrast", "float", 0.1, (0.001, 1.0),
+                                  f"{label}: transition width"))
+        elif isinstance(blend, str) and blend.endswith(".json"):
+            if resolver is None:
+                raise LookupError(f"cannot resolve blend {blend!r} without a resolver")
+            biface = function_interface(resolver.resolve(blend, owner))
+            mas = [p for p in biface.inputs if p.type == MA]
+            if len(mas) < 2 or not any(o.type == MA for o in biface.outputs):
+                raise PortError(node.id, f"layers[{index}].blend",
+                                f"{blend} is not a layer blend: it needs two MaterialAttributes "
+                                "inputs and a MaterialAttributes output")
+            for p in biface.inputs:
+                if p.type != MA:
+                    ports.append(PortSpec(f"{lid}_{p.name}", p.type, p.default, p.range,
+                                          f"{label}: {p.name}"))
+        else:
+            raise PortError(node.id, f"layers[{index}].blend",
+                            f"unknown blend {blend!r} (alpha, height, or a blend function file)")
+    return ports
+
+
+# --- generic type resolution ----------------------------------------------------------------
+
+def _default_type(value: Any) -> PortType:
+    if isinstance(value, (list, tuple)) and 2 <= len(value) <= 4:
+        return {2: PortType.VEC2, 3: PortType.VEC3, 4: PortType.VEC4}[len(value)]
+    return PortType.FLOAT
+
+
+def resolve_types(
+    node: Node, ports: NodePorts, connected: dict[str, PortType]
+) -> tuple[dict[str, PortType], dict[str, PortType]]:
+    """Concrete input and output types for `node` given the types wired into it.
+
+    Raises ValueError with a reason an artist can act on (e.g. vec2 into a vec3 add).
+    """
+    d = nodes.REGISTRY[node.kind]
+    rule = d.ports_rule
+
+    def concrete(spec: PortSpec) -> PortType | None:
+        return None if spec.type == GENERIC else PortType(spec.type)
+
+    in_types: dict[str, PortType] = {}
+    if rule == "append":
+        sizes = {}
+        for p in ports.inputs:
+            t = connected.get(p.name) or _default_type(node.values.get(p.name, p.default))
+            if not t.is_numeric:
+                raise ValueError(f"append takes floats or vectors, got {t} on {p.name}")
+            in_types[p.name] = t
+            sizes[p.name] = t.components
+        total = sum(sizes.values())
+        if total > 4:
+            raise ValueError(f"append makes at most 4 components, got {total}")
+        return in_types, {"result": {2: PortType.VEC2, 3: PortType.VEC3,
+                                     4: PortType.VEC4}[total]}
+    if rule == "reroute":
+        t = connected.get("value") or _default_type(node.values.get("value", 0.0))
+        return {"value": t}, {"value": t}
+
+    generic_inputs = [p for p in ports.inputs if p.type == GENERIC]
+    widest: PortType | None = None
+    for p in generic_inputs:
+        t = connected.get(p.name)
+        if t is None:
+            t = _default_type(node.values.get(p.name, p.default))
+        if not t.is_numeric:
+            raise ValueError(f"{p.name} takes a float or a vector, got {t}")
+        if t == PortType.FLOAT:
+            continue
+        if widest is None:
+            widest = t
+        elif widest != t:
+            raise ValueError(
+                f"mixed vector sizes: {widest} and {t} ({p.name}); "
+                "use a Component Mask or Append node")
+    generic = widest or PortType.FLOAT
+    for p in ports.inputs:
+        in_types[p.name] = generic if p.type == GENERIC else PortType(p.type)
+
+    out_types: dict[str, PortType] = {}
+    if rule == "component_mask":
+        channels = normalize_channels(node.settings.get("channels", "xy"))
+        n = generic.components
+        if any(_VALID_CHANNELS.index(c) >= n for c in channels):
+            raise ValueError(f"channels {channels!r} need more than the {n} of a {generic}")
+        out_types["result"] = {1: PortType.FLOAT, 2: PortType.VEC2, 3: PortType.VEC3,
+                               4: PortType.VEC4}[len(channels)]
+        return in_types, out_types
+    if rule == "split":
+        t = connected.get("value") or PortType.VEC4
+        if not t.is_numeric:
+            raise ValueError(f"split takes a float or a vector, got {t}")
+        in_types["value"] = t
+    for p in ports.outputs:
+        out_types[p.name] = generic if p.type == GENERIC else (concrete(p) or generic)
+    return in_types, out_types

@@ -1,0 +1,120 @@
+"""Port types and the implicit conversions between them.
+
+A float splats to any vector; nothing else converts silently. `T` in a node
+definition is a generic float-or-vector type resolved per node from what is
+connected (see `matedit.graph.nodes`).
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+
+class PortType(str, Enum):
+    FLOAT = "float"
+    VEC2 = "vec2"
+    VEC3 = "vec3"
+    VEC4 = "vec4"
+    MATERIAL = "MaterialAttributes"
+    TEXTURE = "texture2d"
+
+    def __str__(self) -> str:
+        return self.value
+
+    @property
+    def components(self) -> int:
+        """Number of float components (0 for the struct and textures)."""
+        return _COMPONENTS[self]
+
+    @property
+    def is_numeric(self) -> bool:
+        return self.components > 0
+
+    @property
+    def glsl(self) -> str:
+        return _GLSL[self]
+
+
+_COMPONENTS = {
+    PortType.FLOAT: 1,
+    PortType.VEC2: 2,
+    PortType.VEC3: 3,
+    PortType.VEC4: 4,
+    PortType.MATERIAL: 0,
+    PortType.TEXTURE: 0,
+}
+_GLSL = {
+    PortType.FLOAT: "float",
+    PortType.VEC2: "vec2",
+    PortType.VEC3: "vec3",
+    PortType.VEC4: "vec4",
+    PortType.MATERIAL: "MaterialAttributes",
+    PortType.TEXTURE: "sampler2D",
+}
+VECTOR_BY_SIZE = {1: PortType.FLOAT, 2: PortType.VEC2, 3: PortType.VEC3, 4: PortType.VEC4}
+NUMERIC = (PortType.FLOAT, PortType.VEC2, PortType.VEC3, PortType.VEC4)
+
+
+def parse_type(name: str) -> PortType:
+    """A PortType from its file spelling; ValueError naming the choices otherwise."""
+    try:
+        return PortType(name)
+    except ValueError:
+        choices = ", ".join(t.value for t in PortType)
+        raise ValueError(f"unknown type {name!r} (expected one of {choices})") from None
+
+
+def can_convert(src: PortType, dst: PortType) -> bool:
+    """Whether a value of type `src` may flow into a port of type `dst` without a node."""
+    return src == dst or (src == PortType.FLOAT and dst in NUMERIC)
+
+
+def conversion_reason(src: PortType, dst: PortType) -> str | None:
+    """None when the link is allowed, else a sentence an artist can act on."""
+    if can_convert(src, dst):
+        return None
+    if src.is_numeric and dst.is_numeric:
+        return (
+            f"cannot connect {src} to {dst}: only a float converts implicitly; "
+            f"use a Component Mask or Append node"
+        )
+    return f"cannot connect {src} to {dst}"
+
+
+def default_value(t: PortType) -> float | list[float] | None:
+    """The zero value of a numeric type as stored in files (None for struct/texture)."""
+    n = t.components
+    if n == 0:
+        return None
+    return 0.0 if n == 1 else [0.0] * n
+
+
+def coerce_value(t: PortType, value: object) -> float | list[float]:
+    """Check and normalise a stored value for a numeric port; a number splats to a vector.
+
+    Raises ValueError with a short reason; callers add the file, node and field.
+    """
+    n = t.components
+    if n == 0:
+        raise ValueError(f"a {t} port holds no value")
+    if isinstance(value, bool) or value is None:
+        raise ValueError(f"expected a number or {n} numbers, got {value!r}")
+    if isinstance(value, (int, float)):
+        v = float(value)
+        _check_finite(v)
+        return v if n == 1 else [v] * n
+    if isinstance(value, (list, tuple)):
+        if len(value) != n or not all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) for x in value
+        ):
+            raise ValueError(f"expected {n} numbers for {t}, got {value!r}")
+        vals = [float(x) for x in value]
+        for v in vals:
+            _check_finite(v)
+        return vals[0] if n == 1 else vals
+    raise ValueError(f"expected a number or {n} numbers, got {type(value).__name__}")
+
+
+def _check_finite(v: float) -> None:
+    if v != v or v in (float("inf"), float("-inf")):
+        raise ValueError(f"value {v} is not finite")

@@ -1,0 +1,353 @@
+"""Validation of material documents with networkx: a list of diagnostics, never an exception.
+
+Checks unknown node kinds, bad settings, links to missing nodes or ports, type
+mismatches, missing required links, cycles (inside a graph, and through
+function calls across files), calls to missing functions, and the document's
+output nodes. `check_connect` answers, before a link is made, whether it may be.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from pathlib import Path
+
+import networkx as nx
+
+from matedit.graph import nodes
+from matedit.graph.model import Link, MaterialDocument
+from matedit.graph.ports import (
+    FunctionResolver,
+    NodePorts,
+    PortError,
+    layer_entries,
+    node_ports,
+    resolve_types,
+)
+from matedit.graph.types import PortType, coerce_value, conversion_reason
+
+
+class Severity(str, Enum):
+    ERROR = "error"
+    WARNING = "warning"
+
+
+@dataclass(frozen=True)
+class Diagnostic:
+    severity: Severity
+    message: str
+    node_id: str | None = None
+    port: str | None = None
+    file: str | None = None
+
+    def format(self) -> str:
+        where = []
+        if self.node_id:
+            where.append(f"node {self.node_id}")
+        if self.port:
+            where.append(f"field {self.port}")
+        loc = (", ".join(where) + ": ") if where else ""
+        return f"{loc}{self.message}"
+
+
+def error(msg, node=None, port=None, file=None) -> Diagnostic:
+    return Diagnostic(Severity.ERROR, msg, node, port, file)
+
+
+def warning(msg, node=None, port=None, file=None) -> Diagnostic:
+    return Diagnostic(Severity.WARNING, msg, node, port, file)
+
+
+@dataclass
+class Analysis:
+    """What validation learned: ports and concrete types of every node, in evaluation order."""
+
+    ports: dict[str, NodePorts]
+    in_types: dict[str, dict[str, PortType]]
+    out_types: dict[str, dict[str, PortType]]
+    order: list[str]
+    diagnostics: list[Diagnostic]
+
+    @property
+    def ok(self) -> bool:
+        return not any(d.severity == Severity.ERROR for d in self.diagnostics)
+
+
+def _file(doc: MaterialDocument) -> str | None:
+    return str(doc.path) if doc.path else None
+
+
+def dependency_graph(doc: MaterialDocument) -> nx.DiGraph:
+    g = nx.DiGraph()
+    g.add_nodes_from(doc.graph.nodes)
+    for link in doc.graph.links:
+        g.add_edge(link.src, link.dst)
+    return g
+
+
+def stable_order(g: nx.DiGraph) -> list[str]:
+    """Topological order, ties broken by id, so emission is the same whatever the file order."""
+    return list(nx.lexicographical_topological_sort(g))
+
+
+def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None) -> Analysis:
+    f = _file(doc)
+    diags: list[Diagnostic] = []
+    graph = doc.graph
+    ports: dict[str, NodePorts] = {}
+
+    # Node kinds, settings and ports.
+    for nid in sorted(graph.nodes):
+        node = graph.nodes[nid]
+        if node.kind not in nodes.REGISTRY:
+            diags.append(error(f"unknown node kind {node.kind!r}", nid, "kind", f))
+            continue
+        try:
+            ports[nid] = node_ports(node, resolver, doc)
+        except PortError as exc:
+            diags.append(error(str(exc), nid, exc.field, f))
+        except LookupError as exc:
+            diags.append(error(f"missing function: {exc}", nid, "function", f))
+        except ValueError as exc:
+            diags.append(error(str(exc), nid, None, f))
+
+    # Links: ends exist, ports exist, one link per input.
+    incoming: dict[str, dict[str, Link]] = {nid: {} for nid in graph.nodes}
+    good_links: list[Link] = []
+    for link in sorted(graph.links):
+        if link.src not in graph.nodes or link.dst not in graph.nodes:
+            missing = link.src if link.src not in graph.nodes else link.dst
+            diags.append(error(f"link refers to missing node {missing!r}",
+                               link.dst if link.dst in graph.nodes else None, link.dst_port, f))
+            continue
+        if link.src in ports and ports[link.src].output(link.src_port) is None:
+            diags.append(error(f"node {link.src} has no output {link.src_port!r}", link.src,
+                               link.src_port, f))
+            continue
+        if link.dst in ports and ports[link.dst].input(link.dst_port) is None:
+            diags.append(error(f"node {link.dst} has no input {link.dst_port!r}", link.dst,
+                               link.dst_port, f))
+            continue
+        if link.dst_port in incoming[link.dst]:
+            diags.append(error("input has more than one link", link.dst, link.dst_port, f))
+            continue
+        incoming[link.dst][link.dst_port] = link
+        good_links.append(link)
+
+    # Cycles.
+    g = nx.DiGraph()
+    g.add_nodes_from(graph.nodes)
+    g.add_edges_from((l.src, l.dst) for l in good_links)
+    order: list[str] = []
+    try:
+        order = stable_order(g)
+    except nx.NetworkXUnfeasible:
+        cycle = nx.find_cycle(g)
+        path = " -> ".join([a for a, _ in cycle] + [cycle[0][0]])
+        diags.append(error(f"cycle: {path}", cycle[0][0], None, f))
+
+    # Types, in evaluation order.
+    in_types: dict[str, dict[str, PortType]] = {}
+    out_types: dict[str, dict[str, PortType]] = {}
+    for nid in order:
+        if nid not in ports:
+            continue
+        node = graph.nodes[nid]
+        p = ports[nid]
+        connected: dict[str, PortType] = {}
+        blocked = False
+        for port, link in incoming[nid].items():
+            t = out_types.get(link.src, {}).get(link.src_port)
+            if t is None:
+                blocked = True  # upstream already reported
+                continue
+            connected[port] = t
+        try:
+            ins, outs = resolve_types(node, p, connected)
+        except ValueError as exc:
+            diags.append(error(str(exc), nid, None, f))
+            continue
+        in_types[nid], out_types[nid] = ins, outs
+        for port, t in connected.items():
+            reason = conversion_reason(t, ins[port])
+            if reason:
+                diags.append(error(reason, nid, port, f))
+        for spec in p.inputs:
+            if spec.name in incoming[nid]:
+                continue
+            t = ins.get(spec.name)
+            if spec.required or (t is not None and not t.is_numeric):
+                if not blocked:
+                    diags.append(error(f"input {spec.name!r} ({t}) must be connected",
+                                       nid, spec.name, f))
+                continue
+            if spec.name in node.values and t is not None:
+                try:
+                    coerce_value(t, node.values[spec.name])
+                except ValueError as exc:
+                    diags.append(error(str(exc), nid, spec.name, f))
+        d = nodes.REGISTRY[node.kind]
+        for vf in d.values:
+            if vf.name in node.values:
+                try:
+                    coerce_value(PortType(vf.type), node.values[vf.name])
+                except ValueError as exc:
+                    diags.append(error(str(exc), nid, vf.name, f))
+        if node.kind == "constant":
+            try:
+                coerce_value(outs["value"], node.settings.get("value", 0.0))
+            except ValueError as exc:
+                diags.append(error(str(exc), nid, "value", f))
+        for name in node.values:
+            if p.input(name) is None and d.values and not any(v.name == name for v in d.values):
+                diags.append(warning(f"stored value for unknown field {name!r} is ignored",
+                                     nid, name, f))
+
+    diags.extend(_document_rules(doc, ports, f))
+    diags.extend(_call_cycles(doc, resolver))
+    return Analysis(ports, in_types, out_types, order, diags)
+
+
+def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
+    diags = []
+    kinds = [n.kind for n in doc.graph.nodes.values()]
+    if doc.is_function:
+        if "function_output" not in kinds:
+            diags.append(error("a material function needs at least one Function Output node",
+                               file=f))
+        if "material_output" in kinds:
+            diags.append(error("a material function cannot contain a Material Output node",
+                               file=f))
+        names: dict[tuple[str, str], str] = {}
+        for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
+            if n.kind in ("function_input", "function_output"):
+                key = (n.kind, str(n.settings.get("name", "")))
+                if key in names:
+                    diags.append(error(f"two {n.kind.replace('_', ' ')}s named {key[1]!r} "
+                                       f"({names[key]} and {n.id})", n.id, "name", f))
+                names[key] = n.id
+                if not str(key[1]).isidentifier():
+                    diags.append(error(f"name {key[1]!r} is not an identifier", n.id, "name", f))
+    else:
+        outs = [n.id for n in doc.graph.nodes.values() if n.kind == "material_output"]
+        if len(outs) != 1:
+            diags.append(error(f"a material needs exactly one Material Output node, "
+                               f"found {len(outs)}", file=f))
+        for n in doc.graph.nodes.values():
+            if n.kind in ("function_input", "function_output"):
+                diags.append(error("function inputs and outputs belong in material functions",
+                                   n.id, None, f))
+    params: dict[str, str] = {}
+    for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
+        if n.kind.endswith("_parameter"):
+            name = str(n.settings.get("name", ""))
+            if not name.isidentifier():
+                diags.append(error(f"parameter name {name!r} is not an identifier", n.id,
+                                   "name", f))
+            elif name in params:
+                diags.append(error(f"parameter name {name!r} is used by {params[name]} too",
+                                   n.id, "name", f))
+            params[name] = n.id
+    return diags
+
+
+def function_refs(doc: MaterialDocument) -> list[tuple[str, str]]:
+    """(node id, function file) for every function a document uses directly."""
+    refs = []
+    for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
+        if n.kind == "function_call" and isinstance(n.settings.get("function"), str):
+            refs.append((n.id, n.settings["function"]))
+        elif n.kind == "layer_stack":
+            for e in layer_entries(n):
+                if isinstance(e, dict):
+                    for key in ("function", "blend"):
+                        ref = e.get(key)
+                        if isinstance(ref, str) and ref.endswith(".json"):
+                            refs.append((n.id, ref))
+    return refs
+
+
+def _doc_key(doc: MaterialDocument) -> str:
+    return str(Path(doc.path).resolve()) if doc.path else f"<unsaved {id(doc)}>"
+
+
+def _call_cycles(doc: MaterialDocument, resolver: FunctionResolver | None) -> list[Diagnostic]:
+    """Recursion through function calls, across files (a call graph of documents)."""
+    if resolver is None:
+        return []
+    calls = nx.DiGraph()
+    first_hop: dict[str, str] = {}  # callee key -> calling node id in `doc`
+    stack = [doc]
+    seen = set()
+    while stack:
+        d = stack.pop()
+        k = _doc_key(d)
+        if k in seen:
+            continue
+        seen.add(k)
+        calls.add_node(k)
+        for nid, ref in function_refs(d):
+            try:
+                callee = resolver.resolve(ref, d)
+            except (LookupError, ValueError):
+                continue  # reported where the ports are resolved
+            ck = _doc_key(callee)
+            calls.add_edge(k, ck)
+            if d is doc:
+                first_hop.setdefault(ck, nid)
+            stack.append(callee)
+    try:
+        cycle = nx.find_cycle(calls, source=_doc_key(doc))
+    except nx.NetworkXNoCycle:
+        return []
+    names = [Path(a).name for a, _ in cycle] + [Path(cycle[0][0]).name]
+    node = first_hop.get(cycle[0][1]) if cycle[0][0] == _doc_key(doc) else None
+    if node is None:
+        node = next(iter(first_hop.values()), None)
+    return [error(f"recursive function calls: {' -> '.join(names)}", node, "function",
+                  _file(doc))]
+
+
+def validate(doc: MaterialDocument, resolver: FunctionResolver | None = None) -> list[Diagnostic]:
+    return analyse(doc, resolver).diagnostics
+
+
+def check_connect(
+    doc: MaterialDocument, link: Link, resolver: FunctionResolver | None = None
+) -> str | None:
+    """None if `link` may be made now, else the reason it is refused (type or cycle)."""
+    g = doc.graph
+    for end in (link.src, link.dst):
+        if end not in g.nodes:
+            return f"no node {end!r}"
+    if link.src == link.dst:
+        return "a node cannot feed itself"
+    try:
+        src_ports = node_ports(g.nodes[link.src], resolver, doc)
+        dst_ports = node_ports(g.nodes[link.dst], resolver, doc)
+    except (PortError, LookupError, ValueError) as exc:
+        return str(exc)
+    if src_ports.output(link.src_port) is None:
+        return f"{link.src} has no output {link.src_port!r}"
+    if dst_ports.input(link.dst_port) is None:
+        return f"{link.dst} has no input {link.dst_port!r}"
+    dep = dependency_graph(doc)
+    if nx.has_path(dep, link.dst, link.src):
+        return f"connecting {link.src} to {link.dst} would close a cycle"
+    # Types: analyse the graph as it would be with the link.
+    trial = MaterialDocument(doc.kind, g.copy(), doc.name, doc.description, doc.path)
+    old = trial.graph.incoming(link.dst, link.dst_port)
+    if old is not None:
+        trial.graph.links.discard(old)
+    trial.graph.links.add(link)
+    before = {(d.node_id, d.port, d.message) for d in _type_errors(doc, resolver)}
+    for d in _type_errors(trial, resolver):
+        if (d.node_id, d.port, d.message) not in before:
+            return d.message
+    return None
+
+
+def _type_errors(doc, resolver) -> list[Diagnostic]:
+    a = analyse(doc, resolver)
+    return [d for d in a.diagnostics if d.severity == Severity.ERROR and "must be connected"
+            not in d.message]

@@ -1,0 +1,1 @@
+"""Image-based lighting bakes."""

@@ -1,0 +1,1 @@
+"""File formats: material JSON, and images through OpenImageIO."""

@@ -1,0 +1,280 @@
+"""Material and material-function files: JSON load, save, and path resolution.
+
+Loading parses JSON only: it never executes anything from the file. Structural
+problems (not JSON, wrong shapes, a newer version) raise `FormatError` naming
+the file, node and field; graph-level problems are left to validation.
+Saving writes sorted keys and two-space indent, atomically, with paths stored
+relative to the saved file.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
+from matedit.io.atomic import atomic_write_text
+from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
+
+FORMATS = {"matedit.material": DocumentKind.MATERIAL, "matedit.function": DocumentKind.FUNCTION}
+FORMAT_OF = {v: k for k, v in FORMATS.items()}
+MAX_FILE_BYTES = 64 * 1024 * 1024
+
+
+class FormatError(ValueError):
+    """A file that cannot be read as a matedit document."""
+
+    def __init__(self, file: str | None, message: str, node: str | None = None,
+                 field: str | None = None) -> None:
+        self.file, self.node, self.field, self.reason = file, node, field, message
+        where = []
+        if node:
+            where.append(f"node {node}")
+        if field:
+            where.append(f"field {field}")
+        loc = (", ".join(where) + ": ") if where else ""
+        super().__init__(f"{file or '<document>'}: {loc}{message}")
+
+
+def _no_constants(name: str) -> Any:
+    raise ValueError(f"{name} is not valid JSON")
+
+
+def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
+    """Parse a document from JSON text (`path` anchors its relative references)."""
+    try:
+        raw = json.loads(text, parse_constant=_no_constants)
+    except (ValueError, RecursionError) as exc:
+        raise FormatError(file, f"not valid JSON: {exc}") from None
+    return from_dict(raw, file, path)
+
+
+def load(path: str | os.PathLike) -> MaterialDocument:
+    p = Path(path)
+    try:
+        if p.is_dir():
+            raise FormatError(str(p), "is a directory, not a material file")
+        if p.stat().st_size > MAX_FILE_BYTES:
+            raise FormatError(str(p), f"file is larger than {MAX_FILE_BYTES >> 20} MiB")
+        data = p.read_bytes()
+    except FileNotFoundError:
+        raise FormatError(str(p), "file not found") from None
+    except OSError as exc:
+        raise FormatError(str(p), f"cannot read: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise FormatError(str(p), "not UTF-8 text") from None
+    return loads(text, str(p), p)
+
+
+def _expect(cond: bool, file, msg, node=None, field=None) -> None:
+    if not cond:
+        raise FormatError(file, msg, node, field)
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and x == x and abs(x) != float(
+        "inf")
+
+
+def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> MaterialDocument:
+    _expect(isinstance(raw, dict), file, "top level must be a JSON object")
+    fmt = raw.get("format")
+    _expect(isinstance(fmt, str) and fmt in FORMATS, file,
+            f"'format' must be one of {', '.join(sorted(FORMATS))}, got {fmt!r}", field="format")
+    version = raw.get("version")
+    _expect(isinstance(version, int) and not isinstance(version, bool) and version >= 1, file,
+            f"'version' must be a positive integer, got {version!r}", field="version")
+    if version > CURRENT_VERSION:
+        raise FormatError(file, f"written by a newer matedit (file version {version}, this "
+                          f"build reads up to {CURRENT_VERSION}); update matedit to open it",
+                          field="version")
+    try:
+        raw = migrate(raw)
+    except MigrationError as exc:
+        raise FormatError(file, f"cannot migrate from version {version}: {exc}") from None
+    except (TypeError, AttributeError) as exc:
+        raise FormatError(file, f"cannot migrate from version {version}: {exc}") from None
+
+    doc = MaterialDocument(kind=FORMATS[fmt], path=Path(path) if path else None)
+    for key in ("name", "description"):
+        val = raw.get(key, "")
+        _expect(isinstance(val, str), file, f"'{key}' must be a string", field=key)
+        setattr(doc, key, val)
+    preview = raw.get("preview", {})
+    _expect(isinstance(preview, dict), file, "'preview' must be an object", field="preview")
+    doc.preview = preview
+
+    nodes = raw.get("nodes", [])
+    _expect(isinstance(nodes, list), file, "'nodes' must be a list", field="nodes")
+    for i, n in enumerate(nodes):
+        _expect(isinstance(n, dict), file, f"nodes[{i}] must be an object", field=f"nodes[{i}]")
+        nid = n.get("id")
+        _expect(valid_id(nid), file,
+                f"nodes[{i}]: id must be an identifier (letters, digits, _; no '__'), got {nid!r}",
+                field="id")
+        _expect(nid not in doc.graph.nodes, file, "duplicate node id", node=nid, field="id")
+        kind = n.get("kind")
+        _expect(isinstance(kind, str) and kind != "", file, "kind must be a string", nid, "kind")
+        pos = n.get("position", [0, 0])
+        _expect(isinstance(pos, list) and len(pos) == 2 and all(_number(x) for x in pos), file,
+                "position must be two numbers", nid, "position")
+        settings = n.get("settings", {})
+        _expect(isinstance(settings, dict), file, "settings must be an object", nid, "settings")
+        values = n.get("values", {})
+        _expect(isinstance(values, dict), file, "values must be an object", nid, "values")
+        label = n.get("label", "")
+        _expect(isinstance(label, str), file, "label must be a string", nid, "label")
+        doc.graph.nodes[nid] = Node(nid, kind, (float(pos[0]), float(pos[1])), settings,
+                                    values, label)
+
+    links = raw.get("links", [])
+    _expect(isinstance(links, list), file, "'links' must be a list", field="links")
+    for i, l in enumerate(links):
+        ok = (isinstance(l, dict) and all(isinstance(l.get(k), list) and len(l[k]) == 2
+                                          and all(isinstance(x, str) for x in l[k])
+                                          for k in ("from", "to")))
+        _expect(ok, file, f"links[{i}] must be {{\"from\": [node, output], \"to\": [node, "
+                f"input]}}", field=f"links[{i}]")
+        link = Link(l["from"][0], l["from"][1], l["to"][0], l["to"][1])
+        _expect(link not in doc.graph.links, file, f"links[{i}] is listed twice",
+                node=link.dst, field=link.dst_port)
+        doc.graph.links.add(link)
+
+    comments = raw.get("comments", [])
+    _expect(isinstance(comments, list), file, "'comments' must be a list", field="comments")
+    for i, c in enumerate(comments):
+        _expect(isinstance(c, dict) and valid_id(c.get("id")), file,
+                f"comments[{i}] needs an identifier id", field=f"comments[{i}]")
+        rect = c.get("rect", [0, 0, 200, 120])
+        color = c.get("color", [0.3, 0.3, 0.3])
+        text = c.get("text", "")
+        _expect(isinstance(rect, list) and len(rect) == 4 and all(_number(x) for x in rect),
+                file, "rect must be four numbers", c["id"], "rect")
+        _expect(isinstance(color, list) and len(color) == 3 and all(_number(x) for x in color),
+                file, "color must be three numbers", c["id"], "color")
+        _expect(isinstance(text, str), file, "text must be a string", c["id"], "text")
+        _expect(c["id"] not in doc.graph.comments and c["id"] not in doc.graph.nodes, file,
+                "duplicate id", c["id"], "id")
+        doc.graph.comments[c["id"]] = Comment(c["id"], text, tuple(float(x) for x in rect),
+                                              tuple(float(x) for x in color))
+    return doc
+
+
+def to_dict(doc: MaterialDocument) -> dict:
+    g = doc.graph
+    out: dict[str, Any] = {
+        "format": FORMAT_OF[doc.kind],
+        "version": CURRENT_VERSION,
+        "name": doc.name,
+        "description": doc.description,
+        "nodes": [],
+        "links": [l.to_json() for l in sorted(g.links)],
+    }
+    for nid in sorted(g.nodes):
+        n = g.nodes[nid]
+        entry: dict[str, Any] = {"id": n.id, "kind": n.kind,
+                                 "position": [_num(n.position[0]), _num(n.position[1])]}
+        if n.settings:
+            entry["settings"] = n.settings
+        if n.values:
+            entry["values"] = n.values
+        if n.label:
+            entry["label"] = n.label
+        out["nodes"].append(entry)
+    if g.comments:
+        out["comments"] = [
+            {"id": c.id, "text": c.text, "rect": [_num(x) for x in c.rect],
+             "color": [_num(x) for x in c.color]}
+            for c in (g.comments[k] for k in sorted(g.comments))
+        ]
+    if doc.preview:
+        out["preview"] = doc.preview
+    return out
+
+
+def _num(x: float) -> float | int:
+    """Whole numbers are written without '.0' so files stay tidy; others as Python's repr."""
+    return int(x) if float(x).is_integer() and abs(x) < 2**53 else float(x)
+
+
+def dumps(doc: MaterialDocument) -> str:
+    return json.dumps(to_dict(doc), sort_keys=True, indent=2, ensure_ascii=False,
+                      allow_nan=False) + "\n"
+
+
+# --- relative references ---------------------------------------------------------------------
+
+def _ref_fields(doc: MaterialDocument):
+    """(node, container, key) for every stored file reference, for rebasing on save-as."""
+    for n in doc.graph.nodes.values():
+        if n.kind == "function_call" and isinstance(n.settings.get("function"), str):
+            yield n.settings, "function"
+        elif n.kind == "texture_parameter" and isinstance(n.settings.get("path"), str):
+            yield n.settings, "path"
+        elif n.kind == "layer_stack" and isinstance(n.settings.get("layers"), list):
+            for e in n.settings["layers"]:
+                if isinstance(e, dict):
+                    if isinstance(e.get("function"), str):
+                        yield e, "function"
+                    if isinstance(e.get("blend"), str) and e["blend"].endswith(".json"):
+                        yield e, "blend"
+
+
+def rebase_references(doc: MaterialDocument, new_path: Path) -> None:
+    """Rewrites relative references so they still point at the same files from `new_path`."""
+    if doc.path is None:
+        return
+    old_dir = Path(doc.path).resolve().parent
+    new_dir = Path(new_path).resolve().parent
+    if old_dir == new_dir:
+        return
+    for container, key in _ref_fields(doc):
+        ref = container[key]
+        if not ref or Path(ref).is_absolute():
+            continue
+        target = (old_dir / ref).resolve()
+        container[key] = Path(os.path.relpath(target, new_dir)).as_posix()
+
+
+def save(doc: MaterialDocument, path: str | os.PathLike | None = None) -> Path:
+    """Atomic save; with a new path, relative references are rebased first."""
+    target = Path(path) if path is not None else doc.path
+    if target is None:
+        raise ValueError("no path to save to")
+    rebase_references(doc, target)
+    atomic_write_text(target, dumps(doc))
+    doc.path = Path(target)
+    return Path(target)
+
+
+class FileResolver:
+    """Finds material functions relative to the file that uses them, caching loaded files."""
+
+    def __init__(self) -> None:
+        self._cache: dict[Path, tuple[float, MaterialDocument]] = {}
+
+    def path_of(self, ref: str, owner: MaterialDocument | None) -> Path:
+        base = Path(owner.path).parent if owner is not None and owner.path else Path.cwd()
+        return (base / ref).resolve()
+
+    def resolve(self, ref: str, owner: MaterialDocument | None) -> MaterialDocument:
+        p = self.path_of(ref, owner)
+        try:
+            mtime = p.stat().st_mtime
+        except OSError:
+            raise LookupError(f"{ref}: file not found ({p})") from None
+        hit = self._cache.get(p)
+        if hit and hit[0] == mtime:
+            return hit[1]
+        try:
+            doc = load(p)
+        except FormatError as exc:
+            raise LookupError(f"{ref}: {exc.reason}") from None
+        if not doc.is_function:
+            raise LookupError(f"{ref} is a material, not a material function")
+        self._cache[p] = (mtime, doc)
+        return doc

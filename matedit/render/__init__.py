@@ -1,0 +1,1 @@
+"""moderngl preview renderer: meshes, camera, lights, IBL, program cache (no Qt)."""

@@ -1,0 +1,66 @@
+"""Twin of ``brdf.glsl``: Lambert, GGX, Schlick-Smith visibility, Schlick Fresnel."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from matedit.shading.common import INV_PI, PI, f64, pow5
+
+
+def Fd_Lambert() -> float:
+    return INV_PI
+
+
+def D_GGX(NoH, a) -> np.ndarray:
+    NoH, a = f64(NoH), f64(a)
+    a2 = a * a
+    d = (1.0 - NoH) * (1.0 + NoH) + NoH * NoH * a2
+    return a2 / (PI * d * d)
+
+
+def k_Analytic(roughness) -> np.ndarray:
+    r = f64(roughness) + 1.0
+    return r * r * 0.125
+
+
+def k_IBL(a) -> np.ndarray:
+    return 0.5 * f64(a)
+
+
+def G1_Schlick(NoX, k) -> np.ndarray:
+    NoX, k = f64(NoX), f64(k)
+    return NoX / (NoX * (1.0 - k) + k)
+
+
+def V_SchlickSmith(NoV, NoL, k) -> np.ndarray:
+    NoV, NoL, k = f64(NoV), f64(NoL), f64(k)
+    return 0.25 / ((NoV * (1.0 - k) + k) * (NoL * (1.0 - k) + k))
+
+
+def Fc_SphericalGaussian(VoH) -> np.ndarray:
+    VoH = f64(VoH)
+    return np.exp2((-5.55473 * VoH - 6.98316) * VoH)
+
+
+def Fc_Exact(VoH) -> np.ndarray:
+    return pow5(1.0 - f64(VoH))
+
+
+def F_Schlick(F0, VoH) -> np.ndarray:
+    """F0 (..., 3), VoH (...) -> (..., 3)."""
+    F0 = f64(F0)
+    return F0 + (1.0 - F0) * Fc_SphericalGaussian(VoH)[..., None]
+
+
+def F_SchlickExact(F0, VoH) -> np.ndarray:
+    F0 = f64(F0)
+    return F0 + (1.0 - F0) * Fc_Exact(VoH)[..., None]
+
+
+def specularLobe(F0, a, k, NoV, NoL, NoH, VoH) -> np.ndarray:
+    s = D_GGX(NoH, a) * V_SchlickSmith(NoV, NoL, k)
+    return s[..., None] * F_Schlick(F0, VoH)
+
+
+def diffuseLobe(diffuseColor) -> np.ndarray:
+    return f64(diffuseColor) * INV_PI

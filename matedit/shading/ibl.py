@@ -1,0 +1,157 @@
+"""Twin of ``ibl.glsl`` (split sum, SH irradiance, reference estimator) and the
+bytes of the ``IblBlock`` uniform block of ``ibl_inputs.glsl``.
+
+Textures become callables: an environment is ``env(directions (..., 3)) -> rgb (..., 3)``,
+a prefiltered environment ``env(directions, lod) -> rgb``; the BRDF LUT is an array
+``(N, N, >=2)`` laid out as the EXR (row k: roughness (k + 0.5) / N, column i: NoV).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from matedit.shading.brdf import F_SchlickExact, G1_Schlick, k_IBL
+from matedit.shading.common import INV_PI, dot, f64, saturate
+from matedit.shading.sampling import hammersley, importanceSampleCosine, importanceSampleGGX
+
+Environment = Callable[[np.ndarray], np.ndarray]
+PrefilteredEnvironment = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+IBL_MODE_SPLIT_SUM = 0
+IBL_MODE_REFERENCE = 1
+IBL_MODE_NONE = 2
+IBL_BLOCK_SIZE = 176
+
+# Real SH basis constants, order L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22.
+_Y0 = 0.5 * np.sqrt(1.0 / np.pi)
+_Y1 = np.sqrt(3.0 / (4.0 * np.pi))
+_Y2 = 0.5 * np.sqrt(15.0 / np.pi)
+_Y20 = 0.25 * np.sqrt(5.0 / np.pi)
+_Y22 = 0.25 * np.sqrt(15.0 / np.pi)
+
+
+def prefilteredRadiance(prefilteredEnv: PrefilteredEnvironment, R, roughness, mipCount):
+    return f64(prefilteredEnv(f64(R), f64(roughness) * (f64(mipCount) - 1.0)))
+
+
+def sample_lut(lut: np.ndarray, NoV, roughness) -> np.ndarray:
+    """Bilinear, clamp-to-edge lookup of a LUT array at (s, t) = (NoV, roughness), like GL."""
+    lut = f64(lut)
+    h, w = lut.shape[:2]
+    x = np.clip(f64(NoV) * w - 0.5, 0.0, w - 1.0)
+    y = np.clip(f64(roughness) * h - 0.5, 0.0, h - 1.0)
+    x0 = np.minimum(np.floor(x).astype(int), w - 2) if w > 1 else np.zeros_like(x, int)
+    y0 = np.minimum(np.floor(y).astype(int), h - 2) if h > 1 else np.zeros_like(y, int)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    x1, y1 = np.minimum(x0 + 1, w - 1), np.minimum(y0 + 1, h - 1)
+    top = lut[y0, x0] * (1 - fx) + lut[y0, x1] * fx
+    bottom = lut[y1, x0] * (1 - fx) + lut[y1, x1] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def environmentBRDF(brdfLut, NoV, roughness) -> np.ndarray:
+    """(A, B) from a LUT array (see module doc) or a callable (NoV, roughness) -> (..., 2)."""
+    if callable(brdfLut):
+        return f64(brdfLut(f64(NoV), f64(roughness)))[..., :2]
+    return sample_lut(brdfLut, NoV, roughness)[..., :2]
+
+
+def splitSumSpecular(prefiltered, envBRDF, F0) -> np.ndarray:
+    envBRDF = f64(envBRDF)
+    return f64(prefiltered) * (f64(F0) * envBRDF[..., 0:1] + envBRDF[..., 1:2])
+
+
+def irradianceSH9(sh, N) -> np.ndarray:
+    """sh (..., 9, 3), N (..., 3) -> E (..., 3)."""
+    sh, N = f64(sh), f64(N)
+    c1, c2, c3, c4, c5 = 0.429043, 0.511664, 0.743125, 0.886227, 0.247708
+    x, y, z = (N[..., i : i + 1] for i in range(3))
+    L = [sh[..., i, :] for i in range(9)]
+    return (
+        c1 * L[8] * (x * x - y * y) + c3 * L[6] * z * z + c4 * L[0] - c5 * L[6]
+        + 2.0 * c1 * (L[4] * x * y + L[7] * x * z + L[5] * y * z)
+        + 2.0 * c2 * (L[3] * x + L[1] * y + L[2] * z)
+    )  # fmt: skip
+
+
+def diffuseIrradianceSH9(sh, N, diffuseColor) -> np.ndarray:
+    return f64(diffuseColor) * irradianceSH9(sh, N) * INV_PI
+
+
+def sh9_basis(dirs) -> np.ndarray:
+    """The 9 real SH basis functions at unit directions, (..., 9), in the order above."""
+    d = f64(dirs)
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    return np.stack(
+        [
+            np.full_like(x, _Y0), _Y1 * y, _Y1 * z, _Y1 * x, _Y2 * x * y, _Y2 * y * z,
+            _Y20 * (3.0 * z * z - 1.0), _Y2 * x * z, _Y22 * (x * x - y * y),
+        ],
+        axis=-1,
+    )  # fmt: skip
+
+
+def sh9_project(env: Environment, n: int = 128) -> np.ndarray:
+    """SH coefficients (9, 3) of an environment, by midpoint quadrature on an n x 2n grid."""
+    theta = (np.arange(n) + 0.5) * np.pi / n
+    phi = (np.arange(2 * n) + 0.5) * np.pi / n
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    dirs = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+    w = np.sin(t) * (np.pi / n) ** 2
+    return np.einsum("ijk,ijc,ij->kc", sh9_basis(dirs), f64(env(dirs)), w)
+
+
+def rotatedHammersley(i, n, offset) -> np.ndarray:
+    return np.mod(hammersley(i, n) + f64(offset), 1.0)
+
+
+def _sample_points(sampleCount: int, offset) -> np.ndarray:
+    return rotatedHammersley(np.arange(sampleCount), sampleCount, offset)
+
+
+def referenceSpecularIBL(env: Environment, F0, roughness, N, V, sampleCount: int, offset):
+    """Vectorised over pixels (leading axes of N, V) and samples."""
+    N, V, F0 = f64(N)[..., None, :], f64(V)[..., None, :], f64(F0)[..., None, :]
+    a = f64(roughness)[..., None]
+    k = k_IBL(a)
+    NoV = np.maximum(dot(N, V), 1e-4)
+    Xi = _sample_points(sampleCount, offset)
+    H = importanceSampleGGX(Xi, a, N)
+    L = 2.0 * dot(V, H)[..., None] * H - V
+    NoL = saturate(dot(N, L))
+    NoH = saturate(dot(N, H))
+    VoH = saturate(dot(V, H))
+    G = G1_Schlick(NoL, k) * G1_Schlick(NoV, k)
+    w = np.where(NoL > 0.0, G * VoH / np.maximum(NoH * NoV, 1e-8), 0.0)
+    contrib = f64(env(L)) * F_SchlickExact(F0, VoH) * w[..., None]
+    return contrib.sum(axis=-2) / sampleCount
+
+
+def referenceDiffuseIBL(env: Environment, diffuseColor, N, sampleCount: int, offset):
+    Xi = _sample_points(sampleCount, offset)
+    L = importanceSampleCosine(Xi, f64(N)[..., None, :])
+    return f64(diffuseColor) * f64(env(L)).sum(axis=-2) / sampleCount
+
+
+def referenceIBL(env, diffuseColor, F0, roughness, N, V, sampleCount: int, offset):
+    return referenceDiffuseIBL(env, diffuseColor, N, sampleCount, offset) + referenceSpecularIBL(
+        env, F0, roughness, N, V, sampleCount, offset
+    )
+
+
+def pack_ibl_block(
+    sh,
+    mip_count: float,
+    intensity: float = 1.0,
+    samples: int = 64,
+    mode: int = IBL_MODE_SPLIT_SUM,
+    sample_offset: tuple[float, float] = (0.0, 0.0),
+) -> bytes:
+    """Bytes of IblBlock (std140, 176 bytes): vec4 sh[9], vec4 params, vec4 sampleOffset."""
+    data = np.zeros((11, 4), dtype="<f4")
+    data[:9, :3] = f64(sh).reshape(9, 3)
+    data[9] = (mip_count, intensity, samples, mode)
+    data[10, :2] = sample_offset
+    return data.tobytes()

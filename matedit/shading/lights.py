@@ -1,0 +1,180 @@
+"""Twin of ``lights.glsl``: the Light description and point, directional, sphere and tube lights."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from matedit.shading.brdf import diffuseLobe, k_Analytic, specularLobe
+from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
+
+LIGHT_TYPE_POINT = 0
+LIGHT_TYPE_DIRECTIONAL = 1
+LIGHT_TYPE_SPHERE = 2
+LIGHT_TYPE_TUBE = 3
+LIGHT_TYPES = {
+    "point": LIGHT_TYPE_POINT,
+    "directional": LIGHT_TYPE_DIRECTIONAL,
+    "sphere": LIGHT_TYPE_SPHERE,
+    "tube": LIGHT_TYPE_TUBE,
+}
+LIGHT_FALLOFF_EPS = 0.01
+MIN_ANALYTIC_ROUGHNESS = 0.03
+
+LightKind = Literal["point", "directional", "sphere", "tube"]
+
+
+@dataclass
+class Light:
+    """One analytic light. Units: metres; `direction` is the travel direction of a
+    directional light and the unit axis of a tube; `position` is a sphere's or tube's centre."""
+
+    kind: LightKind = "point"
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    intensity: float = 1.0
+    influence_radius: float = 10.0
+    source_radius: float = 0.0
+    source_length: float = 0.0
+
+    @property
+    def type(self) -> int:
+        return LIGHT_TYPES[self.kind]
+
+
+@dataclass
+class ShadingContext:
+    P: np.ndarray
+    N: np.ndarray
+    V: np.ndarray
+    NoV: np.ndarray
+    diffuseColor: np.ndarray
+    F0: np.ndarray
+    roughness: np.ndarray
+    a: np.ndarray
+    k: np.ndarray
+
+
+def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
+    N, V = f64(N), f64(V)
+    r = np.clip(f64(roughness), MIN_ANALYTIC_ROUGHNESS, 1.0)
+    return ShadingContext(
+        P=f64(P), N=N, V=V, NoV=np.maximum(dot(N, V), 1e-4), diffuseColor=f64(diffuseColor),
+        F0=f64(F0), roughness=r, a=r * r, k=k_Analytic(r),
+    )  # fmt: skip
+
+
+def distanceWindow(d, influenceRadius) -> np.ndarray:
+    x = f64(d) / f64(influenceRadius)
+    x2 = x * x
+    return sq(saturate(1.0 - x2 * x2))
+
+
+def distanceFalloff(d, influenceRadius) -> np.ndarray:
+    d = f64(d)
+    return distanceWindow(d, influenceRadius) / (d * d + LIGHT_FALLOFF_EPS**2)
+
+
+def specularTowards(s: ShadingContext, L) -> np.ndarray:
+    H = normalize(f64(L) + s.V)
+    NoL = saturate(dot(s.N, L))
+    NoH = saturate(dot(s.N, H))
+    VoH = saturate(dot(s.V, H))
+    return specularLobe(s.F0, s.a, s.k, s.NoV, NoL, NoH, VoH) * NoL[..., None]
+
+
+def sphereRepresentativePoint(Lc, R, sourceRadius) -> np.ndarray:
+    Lc, R = f64(Lc), f64(R)
+    centerToRay = dot(Lc, R)[..., None] * R - Lc
+    t = saturate(f64(sourceRadius) / np.maximum(length(centerToRay), 1e-8))
+    return Lc + centerToRay * t[..., None]
+
+
+def sphereNormalization(a, sourceRadius, d) -> np.ndarray:
+    a = f64(a)
+    a_prime = saturate(a + f64(sourceRadius) / (3.0 * np.maximum(f64(d), 1e-8)))
+    return sq(a / a_prime)
+
+
+def lineNormalization(a, sourceLength, d) -> np.ndarray:
+    a = f64(a)
+    a_prime = saturate(a + 0.5 * f64(sourceLength) / (3.0 * np.maximum(f64(d), 1e-8)))
+    return a / a_prime
+
+
+def _scale(light: Light, factor) -> np.ndarray:
+    return f64(light.color) * (light.intensity * f64(factor))[..., None]
+
+
+def pointLight(s: ShadingContext, light: Light) -> np.ndarray:
+    Lc = f64(light.position) - s.P
+    d = length(Lc)
+    L = Lc / np.maximum(d, 1e-8)[..., None]
+    NoL = saturate(dot(s.N, L))
+    radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    return radiance * _scale(light, distanceFalloff(d, light.influence_radius))
+
+
+def directionalLight(s: ShadingContext, light: Light) -> np.ndarray:
+    L = np.broadcast_to(-f64(light.direction), s.N.shape)
+    NoL = saturate(dot(s.N, L))
+    radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    return radiance * _scale(light, 1.0)
+
+
+def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
+    Lc = f64(light.position) - s.P
+    d = length(Lc)
+    falloff = distanceFalloff(d, light.influence_radius)
+    NoLc = saturate(dot(s.N, Lc / np.maximum(d, 1e-8)[..., None]))
+    diffuse = diffuseLobe(s.diffuseColor) * NoLc[..., None]
+    R = reflect(-s.V, s.N)
+    L = normalize(sphereRepresentativePoint(Lc, R, light.source_radius))
+    norm = sphereNormalization(s.a, light.source_radius, d)
+    specular = specularTowards(s, L) * norm[..., None]
+    return (diffuse + specular) * _scale(light, falloff)
+
+
+def tubeIrradiance(N, L0, L1) -> np.ndarray:
+    l0, l1 = length(L0), length(L1)
+    cos_term = saturate(dot(N, L0) / (2.0 * l0) + dot(N, L1) / (2.0 * l1))
+    return 2.0 * cos_term / (l0 * l1 + dot(L0, L1) + 2.0 * LIGHT_FALLOFF_EPS**2)
+
+
+def tubeRepresentativePoint(L0, L1, R) -> np.ndarray:
+    L0, L1, R = f64(L0), f64(L1), f64(R)
+    Ld = L1 - L0
+    RoLd = dot(R, Ld)
+    t = (dot(R, L0) * RoLd - dot(L0, Ld)) / np.maximum(dot(Ld, Ld) - RoLd * RoLd, 1e-12)
+    return L0 + saturate(t)[..., None] * Ld
+
+
+def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
+    Lc = f64(light.position) - s.P
+    d = length(Lc)
+    half_axis = 0.5 * f64(light.source_length)[..., None] * f64(light.direction)
+    L0, L1 = Lc - half_axis, Lc + half_axis
+    window = distanceWindow(d, light.influence_radius)
+    diffuse = diffuseLobe(s.diffuseColor) * tubeIrradiance(s.N, L0, L1)[..., None]
+    R = reflect(-s.V, s.N)
+    Lp = tubeRepresentativePoint(L0, L1, R)
+    dp = length(Lp)
+    L = normalize(sphereRepresentativePoint(Lp, R, light.source_radius))
+    energy = lineNormalization(s.a, light.source_length, d) * sphereNormalization(
+        s.a, light.source_radius, dp
+    )
+    specular = specularTowards(s, L) * (energy / (dp * dp + LIGHT_FALLOFF_EPS**2))[..., None]
+    return (diffuse + specular) * _scale(light, window)
+
+
+def evaluateLight(s: ShadingContext, light: Light) -> np.ndarray:
+    kind = {
+        "point": pointLight,
+        "directional": directionalLight,
+        "sphere": sphereLight,
+        "tube": tubeLight,
+    }
+    return kind[light.kind](s, light)

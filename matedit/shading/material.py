@@ -1,0 +1,43 @@
+"""Twin of ``material.glsl``: MaterialAttributes, defaults, diffuse colour and F0."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from matedit.shading.common import f64, mix, normalize
+
+
+def _v(*xs: float):
+    return field(default_factory=lambda: np.array(xs, dtype=np.float64))
+
+
+@dataclass
+class MaterialAttributes:
+    """Fields in the GLSL struct's order; each may be an array broadcasting over pixels."""
+
+    baseColor: np.ndarray = _v(0.5, 0.5, 0.5)
+    metallic: np.ndarray | float = 0.0
+    roughness: np.ndarray | float = 0.5
+    cavity: np.ndarray | float = 1.0
+    normal: np.ndarray = _v(0.0, 0.0, 1.0)
+    emissive: np.ndarray = _v(0.0, 0.0, 0.0)
+    opacity: np.ndarray | float = 1.0
+
+
+def defaultMaterialAttributes() -> MaterialAttributes:
+    return MaterialAttributes()
+
+
+def computeDiffuseColor(baseColor, metallic) -> np.ndarray:
+    return f64(baseColor) * (1.0 - f64(metallic))[..., None]
+
+
+def computeF0(baseColor, metallic) -> np.ndarray:
+    return mix(np.full(3, 0.04), f64(baseColor), f64(metallic)[..., None])
+
+
+def tangentToWorldNormal(tangentNormal, T, B, N) -> np.ndarray:
+    n = f64(tangentNormal)
+    return normalize(f64(T) * n[..., 0:1] + f64(B) * n[..., 1:2] + f64(N) * n[..., 2:3])

@@ -1,0 +1,82 @@
+// BRDF terms of the UE4 shading model: Lambert diffuse, GGX distribution,
+// Schlick-Smith visibility and Schlick Fresnel, then a small dispatch so the
+// light code never names a formula. `roughness` is perceptual, `a` is alpha.
+#include "common.glsl"
+
+// Lambert diffuse lobe without the albedo: multiply by diffuseColor.
+float Fd_Lambert() {
+    // Karis 2013, "Real Shading in Unreal Engine 4", diffuse BRDF: Lambert, c_diff / pi
+    return INV_PI;
+}
+
+// GGX / Trowbridge-Reitz normal distribution, alpha = roughness^2.
+float D_GGX(float NoH, float a) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 3 (GGX, Trowbridge-Reitz)
+    // 1 - NoH^2 (1 - a^2) written as (1 - NoH)(1 + NoH) + NoH^2 a^2: no cancellation near NoH = 1.
+    float a2 = a * a;
+    float d = (1.0 - NoH) * (1.0 + NoH) + NoH * NoH * a2;
+    return a2 / (PI * d * d);
+}
+
+// Schlick's k for analytic lights: Disney's remapping of roughness.
+float k_Analytic(float roughness) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 4: k = (roughness + 1)^2 / 8
+    float r = roughness + 1.0;
+    return r * r * 0.125;
+}
+
+// Schlick's k for image-based lighting (no remapping).
+float k_IBL(float a) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 4 note: k = alpha / 2 for IBL
+    return 0.5 * a;
+}
+
+// Schlick-Smith G1 for one direction.
+float G1_Schlick(float NoX, float k) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 4: G1(x) = x / (x (1 - k) + k)
+    return NoX / (NoX * (1.0 - k) + k);
+}
+
+// Visibility Vis = G / (4 NoL NoV) with the NoL NoV folded out analytically.
+float V_SchlickSmith(float NoV, float NoL, float k) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 4, G / (4 NoL NoV) simplified
+    float gv = NoV * (1.0 - k) + k;
+    float gl = NoL * (1.0 - k) + k;
+    return 0.25 / (gv * gl);
+}
+
+// Schlick's Fresnel weight, spherical-Gaussian approximation of (1 - VoH)^5.
+float Fc_SphericalGaussian(float VoH) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 5: 2^((-5.55473 VoH - 6.98316) VoH)
+    return exp2((-5.55473 * VoH - 6.98316) * VoH);
+}
+
+// Schlick's Fresnel weight, exact fifth power.
+float Fc_Exact(float VoH) {
+    // Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering": (1 - VoH)^5
+    return pow5(1.0 - VoH);
+}
+
+// Schlick Fresnel for analytic lights (spherical-Gaussian weight).
+vec3 F_Schlick(vec3 F0, float VoH) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 5: F0 + (1 - F0) Fc
+    return F0 + (1.0 - F0) * Fc_SphericalGaussian(VoH);
+}
+
+// Schlick Fresnel with the exact fifth power (IBL integration, reference mode).
+vec3 F_SchlickExact(vec3 F0, float VoH) {
+    // Schlick 1994, as used by Karis 2013 IntegrateBRDF / SpecularIBL: exact (1 - VoH)^5
+    return F0 + (1.0 - F0) * Fc_Exact(VoH);
+}
+
+// Specular lobe D * Vis * F for an analytic light; caller multiplies by NoL.
+vec3 specularLobe(vec3 F0, float a, float k, float NoV, float NoL, float NoH, float VoH) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", specular BRDF D F G / (4 NoL NoV)
+    return D_GGX(NoH, a) * V_SchlickSmith(NoV, NoL, k) * F_Schlick(F0, VoH);
+}
+
+// Diffuse lobe for an analytic light; caller multiplies by NoL.
+vec3 diffuseLobe(vec3 diffuseColor) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", diffuse BRDF: Lambert
+    return diffuseColor * Fd_Lambert();
+}

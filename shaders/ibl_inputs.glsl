@@ -1,0 +1,48 @@
+// Inputs of image-based lighting: environment textures and one std140 uniform block.
+//
+// Bindings (Vulkan: set 0; in GL the renderer assigns units and block bindings by name):
+//   0 LightsBlock (lights_block.glsl), 1 IblBlock, 2 uPrefilteredEnv, 3 uBrdfLut, 4 uEnvironment.
+// std140 layout of block `IblBlock` (instance `uIbl`), float32 unless said otherwise:
+//   offset   0: vec4 sh[9]   xyz = order-2 SH coefficient of the environment radiance, w = 0;
+//                            order L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (real SH basis,
+//                            Ramamoorthi-Hanrahan 2001); see matedit.shading.ibl.sh9_basis
+//   offset 144: vec4 params  x = mip count M of uPrefilteredEnv, y = environment intensity,
+//                            z = reference-mode sample count, w = mode (0 split sum, 1 reference,
+//                            2 no image-based light)
+//   offset 160: vec4 sampleOffset  xy = per-frame offset of the reference sample set, zw = 0
+// Total 176 bytes. matedit.shading.ibl.pack_ibl_block writes exactly these bytes.
+
+#ifndef MATEDIT_UBO
+#ifdef VULKAN
+#define MATEDIT_UBO(n) layout(std140, binding = n)
+#else
+#define MATEDIT_UBO(n) layout(std140)
+#endif
+#endif
+
+#ifndef MATEDIT_BINDING
+#ifdef VULKAN
+#define MATEDIT_BINDING(n) layout(binding = n)
+#else
+#define MATEDIT_BINDING(n)
+#endif
+#endif
+
+#define IBL_MODE_SPLIT_SUM 0
+#define IBL_MODE_REFERENCE 1
+#define IBL_MODE_NONE 2
+
+#define MATEDIT_IBL_BINDING 1
+#define MATEDIT_PREFILTERED_ENV_BINDING 2
+#define MATEDIT_BRDF_LUT_BINDING 3
+#define MATEDIT_ENVIRONMENT_BINDING 4
+
+MATEDIT_UBO(MATEDIT_IBL_BINDING) uniform IblBlock {
+    vec4 sh[9];
+    vec4 params;
+    vec4 sampleOffset;
+} uIbl;
+
+MATEDIT_BINDING(MATEDIT_PREFILTERED_ENV_BINDING) uniform samplerCube uPrefilteredEnv;  // GGX-prefiltered, mip m: roughness m/(M-1)
+MATEDIT_BINDING(MATEDIT_BRDF_LUT_BINDING) uniform sampler2D uBrdfLut;           // (NoV, roughness) -> (A, B) in (R, G)
+MATEDIT_BINDING(MATEDIT_ENVIRONMENT_BINDING) uniform samplerCube uEnvironment;     // unfiltered, for reference mode

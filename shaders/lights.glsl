@@ -1,0 +1,184 @@
+// Analytic lights: the Light struct, the windowed inverse-square falloff, and
+// point, directional, sphere and tube lights (representative point method).
+// Each light returns outgoing radiance: diffuse + specular, times NoL, colour and intensity.
+#include "common.glsl"
+#include "brdf.glsl"
+
+#define LIGHT_TYPE_POINT 0
+#define LIGHT_TYPE_DIRECTIONAL 1
+#define LIGHT_TYPE_SPHERE 2
+#define LIGHT_TYPE_TUBE 3
+
+// 1 cm in metres: the notes' "+1" in centimetre units, keeps the falloff finite at d = 0.
+const float LIGHT_FALLOFF_EPS = 0.01;
+// Smallest perceptual roughness analytic lights see: a mirror has no finite peak.
+const float MIN_ANALYTIC_ROUGHNESS = 0.03;
+
+struct Light {
+    int type;               // LIGHT_TYPE_*
+    vec3 position;          // world, metres (centre for sphere and tube)
+    vec3 direction;         // directional: direction the light travels; tube: unit axis
+    vec3 color;             // linear RGB
+    float intensity;
+    float influenceRadius;  // R of the window; falloff is 0 at and beyond it
+    float sourceRadius;     // sphere and tube
+    float sourceLength;     // tube
+};
+
+// What a light needs to know about the point being shaded.
+struct ShadingContext {
+    vec3 P;                 // position
+    vec3 N;                 // unit shading normal
+    vec3 V;                 // unit vector to the eye
+    float NoV;              // saturated, clamped away from 0
+    vec3 diffuseColor;
+    vec3 F0;
+    float roughness;        // clamped to MIN_ANALYTIC_ROUGHNESS
+    float a;                // roughness^2
+    float k;                // Schlick-Smith k for analytic lights
+};
+
+ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
+                                  float roughness) {
+    // Karis 2013, "Real Shading in Unreal Engine 4": a = roughness^2, k = (roughness + 1)^2 / 8
+    ShadingContext s;
+    s.P = P;
+    s.N = N;
+    s.V = V;
+    s.NoV = max(dot(N, V), 1e-4);
+    s.diffuseColor = diffuseColor;
+    s.F0 = F0;
+    s.roughness = clamp(roughness, MIN_ANALYTIC_ROUGHNESS, 1.0);
+    s.a = s.roughness * s.roughness;
+    s.k = k_Analytic(s.roughness);
+    return s;
+}
+
+// The smooth window that takes the falloff to exactly 0 at the influence radius.
+float distanceWindow(float d, float influenceRadius) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 9: saturate(1 - (d / R)^4)^2
+    float x = d / influenceRadius;
+    float x2 = x * x;
+    return sq(saturate(1.0 - x2 * x2));
+}
+
+// Windowed inverse-square falloff.
+float distanceFalloff(float d, float influenceRadius) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 9, with eps = 1 cm in metres
+    return distanceWindow(d, influenceRadius) / (d * d + LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS);
+}
+
+// Specular lobe times NoL towards the unit direction L.
+vec3 specularTowards(ShadingContext s, vec3 L) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", specular D Vis F, times NoL
+    vec3 H = normalize(L + s.V);
+    float NoL = saturate(dot(s.N, L));
+    float NoH = saturate(dot(s.N, H));
+    float VoH = saturate(dot(s.V, H));
+    return specularLobe(s.F0, s.a, s.k, s.NoV, NoL, NoH, VoH) * NoL;
+}
+
+// Point on a sphere closest to the reflection ray, as an unnormalised vector from P.
+vec3 sphereRepresentativePoint(vec3 Lc, vec3 R, float sourceRadius) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 11: closest point on the sphere to R
+    vec3 centerToRay = dot(Lc, R) * R - Lc;
+    float t = saturate(sourceRadius / max(length(centerToRay), 1e-8));
+    return Lc + centerToRay * t;
+}
+
+// Energy conservation of the widened highlight: (a / a')^2.
+float sphereNormalization(float a, float sourceRadius, float d) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 14: a' = saturate(a + sourceRadius / (3 d))
+    float aPrime = saturate(a + sourceRadius / (3.0 * max(d, 1e-8)));
+    return sq(a / aPrime);
+}
+
+// Energy conservation of a line's highlight: a / a'_line.
+float lineNormalization(float a, float sourceLength, float d) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 20 (form a / a'); a' as SHADING.md
+    float aPrime = saturate(a + 0.5 * sourceLength / (3.0 * max(d, 1e-8)));
+    return a / aPrime;
+}
+
+vec3 pointLight(ShadingContext s, Light light) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 9: punctual light with windowed falloff
+    vec3 Lc = light.position - s.P;
+    float d = length(Lc);
+    vec3 L = Lc / max(d, 1e-8);
+    float NoL = saturate(dot(s.N, L));
+    vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+    return radiance * light.color * (light.intensity * distanceFalloff(d, light.influenceRadius));
+}
+
+vec3 directionalLight(ShadingContext s, Light light) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", punctual lights: directional, no falloff
+    vec3 L = -light.direction;
+    float NoL = saturate(dot(s.N, L));
+    vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+    return radiance * light.color * light.intensity;
+}
+
+vec3 sphereLight(ShadingContext s, Light light) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", sphere lights: representative point
+    vec3 Lc = light.position - s.P;
+    float d = length(Lc);
+    float falloff = distanceFalloff(d, light.influenceRadius);
+    // Diffuse: the irradiance of a point light at the centre.
+    float NoLc = saturate(dot(s.N, Lc / max(d, 1e-8)));
+    vec3 diffuse = diffuseLobe(s.diffuseColor) * NoLc;
+    // Specular: the point of the sphere closest to the reflection ray, energy renormalised.
+    vec3 R = reflect(-s.V, s.N);
+    vec3 L = normalize(sphereRepresentativePoint(Lc, R, light.sourceRadius));
+    vec3 specular = specularTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d);
+    return (diffuse + specular) * light.color * (light.intensity * falloff);
+}
+
+// Average irradiance factor of a segment from L0 to L1 (unnormalised, from P), without the window.
+float tubeIrradiance(vec3 N, vec3 L0, vec3 L1) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 16, eps^2 terms as in eq 9
+    float l0 = length(L0);
+    float l1 = length(L1);
+    float cosTerm = saturate(dot(N, L0) / (2.0 * l0) + dot(N, L1) / (2.0 * l1));
+    float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
+    return 2.0 * cosTerm / (l0 * l1 + dot(L0, L1) + 2.0 * eps2);
+}
+
+// Point of a segment closest to the reflection ray, as an unnormalised vector from P.
+vec3 tubeRepresentativePoint(vec3 L0, vec3 L1, vec3 R) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 19: shortest distance to the ray
+    vec3 Ld = L1 - L0;
+    float RoLd = dot(R, Ld);
+    float t = (dot(R, L0) * RoLd - dot(L0, Ld)) / max(dot(Ld, Ld) - RoLd * RoLd, 1e-12);
+    return L0 + saturate(t) * Ld;
+}
+
+vec3 tubeLight(ShadingContext s, Light light) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", tube lights: eq 16 diffuse, eq 19 specular
+    vec3 Lc = light.position - s.P;
+    float d = length(Lc);
+    vec3 halfAxis = 0.5 * light.sourceLength * light.direction;
+    vec3 L0 = Lc - halfAxis;
+    vec3 L1 = Lc + halfAxis;
+    float window = distanceWindow(d, light.influenceRadius);
+    vec3 diffuse = diffuseLobe(s.diffuseColor) * tubeIrradiance(s.N, L0, L1);
+    // Specular: the sphere step around the closest point on the segment; our choice of
+    // falloff is the inverse square to that point (the tube's limit is the sphere light).
+    vec3 R = reflect(-s.V, s.N);
+    vec3 Lp = tubeRepresentativePoint(L0, L1, R);
+    float dp = length(Lp);
+    vec3 L = normalize(sphereRepresentativePoint(Lp, R, light.sourceRadius));
+    float energy = lineNormalization(s.a, light.sourceLength, d)
+                 * sphereNormalization(s.a, light.sourceRadius, dp);
+    float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
+    vec3 specular = specularTowards(s, L) * (energy / (dp * dp + eps2));
+    return (diffuse + specular) * light.color * (light.intensity * window);
+}
+
+// Radiance reflected towards V from one light, by type.
+vec3 evaluateLight(ShadingContext s, Light light) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", dispatch over the light types
+    if (light.type == LIGHT_TYPE_DIRECTIONAL) return directionalLight(s, light);
+    if (light.type == LIGHT_TYPE_SPHERE) return sphereLight(s, light);
+    if (light.type == LIGHT_TYPE_TUBE) return tubeLight(s, light);
+    return pointLight(s, light);
+}

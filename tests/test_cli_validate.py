@@ -1,0 +1,46 @@
+"""`matedit validate` per the command-line contract."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from matedit.resources import graphs_dir
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "matedit", *args], capture_output=True,
+                          text=True, cwd=cwd)
+
+
+def test_all_samples_validate():
+    files = sorted(str(p) for p in graphs_dir().rglob("*.json"))
+    r = run("validate", *files)
+    assert r.returncode == 0, r.stderr
+    assert "error" not in r.stderr
+
+
+def test_malformed_files_exit_2_with_one_line_each(tmp_path):
+    (tmp_path / "a.json").write_text("{")
+    (tmp_path / "b.json").write_text('{"format": "matedit.material", "version": 99}')
+    (tmp_path / "c.json").write_text(
+        '{"format": "matedit.material", "version": 2, "nodes": [{"id": "x", "kind": "nope"}]}')
+    r = run("validate", str(tmp_path / "a.json"), str(tmp_path / "b.json"),
+            str(tmp_path / "c.json"), str(tmp_path / "missing.json"))
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert all(l.startswith("error: ") for l in lines), r.stderr
+    assert "Traceback" not in r.stderr
+    assert any("a.json" in l and "JSON" in l for l in lines)
+    assert any("b.json" in l and "newer" in l for l in lines)
+    assert any("c.json" in l and "node x" in l and "nope" in l for l in lines)
+    assert any("missing.json" in l and "not found" in l for l in lines)
+    per_file = [l.split(":")[1].strip() for l in lines]
+    assert per_file.count(str(tmp_path / "a.json")) == 1
+
+
+def test_bad_option_exits_2():
+    r = run("validate")
+    assert r.returncode == 2 and r.stderr.startswith("error: ")
+    r = run("frobnicate")
+    assert r.returncode == 2 and r.stderr.startswith("error: ")

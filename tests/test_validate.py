@@ -1,0 +1,168 @@
+"""Validation diagnostics and connect-time refusals."""
+
+from __future__ import annotations
+
+from graphs_util import function, link, material, node, simple_material
+
+from matedit.graph.model import Link
+from matedit.graph.validate import Severity, check_connect, validate
+from matedit.io.document import FileResolver, save
+
+
+def errors(doc, resolver=None):
+    return [d for d in validate(doc, resolver) if d.severity == Severity.ERROR]
+
+
+def test_simple_material_is_valid():
+    assert errors(simple_material()) == []
+
+
+def test_unknown_kind_is_reported_on_the_node():
+    d = simple_material()
+    node(d, "x", "frobnicate")
+    (e,) = errors(d)
+    assert e.node_id == "x" and e.port == "kind" and "frobnicate" in e.message
+
+
+def test_type_mismatch_vec2_into_vec3():
+    d = simple_material()
+    node(d, "uv", "texcoord")
+    d.graph.links.discard(d.graph.incoming("make", "baseColor"))
+    link(d, "uv", "uv", "make", "baseColor")
+    (e,) = errors(d)
+    assert (e.node_id, e.port) == ("make", "baseColor")
+    assert "vec2" in e.message and "vec3" in e.message
+
+
+def test_mixed_vector_sizes_in_generic_node():
+    d = simple_material()
+    node(d, "uv", "texcoord")
+    node(d, "a", "add")
+    link(d, "uv", "uv", "a", "a")
+    link(d, "col", "color", "a", "b")
+    (e,) = errors(d)
+    assert e.node_id == "a" and "mixed vector sizes" in e.message
+
+
+def test_float_splats_into_vectors():
+    d = simple_material()
+    node(d, "a", "add")
+    link(d, "r", "value", "a", "a")
+    link(d, "col", "color", "a", "b")
+    d.graph.links.discard(d.graph.incoming("make", "baseColor"))
+    link(d, "a", "result", "make", "baseColor")
+    assert errors(d) == []
+
+
+def test_missing_required_link():
+    d = simple_material()
+    d.graph.links.discard(d.graph.incoming("out", "attributes"))
+    (e,) = errors(d)
+    assert (e.node_id, e.port) == ("out", "attributes")
+
+
+def test_cycle_is_reported():
+    d = simple_material()
+    node(d, "a", "add")
+    node(d, "b", "add")
+    link(d, "a", "result", "b", "a")
+    link(d, "b", "result", "a", "a")
+    assert any("cycle" in e.message for e in errors(d))
+
+
+def test_links_to_missing_nodes_and_ports():
+    d = simple_material()
+    link(d, "ghost", "value", "m", "b")
+    link(d, "r", "nope", "make", "metallic")
+    msgs = [e.message for e in errors(d)]
+    assert any("missing node 'ghost'" in m for m in msgs)
+    assert any("no output 'nope'" in m for m in msgs)
+
+
+def test_bad_value_names_node_and_field():
+    d = simple_material()
+    d.graph.nodes["m"].values["b"] = "lots"
+    (e,) = errors(d)
+    assert (e.node_id, e.port) == ("m", "b")
+
+
+def test_material_needs_one_output():
+    d = simple_material()
+    node(d, "out2", "material_output")
+    link(d, "make", "attributes", "out2", "attributes")
+    assert any("exactly one Material Output" in e.message for e in errors(d))
+
+
+def test_call_to_missing_function(tmp_path):
+    d = simple_material(tmp_path / "m.json")
+    node(d, "call", "function_call", {"function": "nowhere.json"})
+    (e,) = errors(d, FileResolver())
+    assert e.node_id == "call" and "nowhere.json" in e.message
+
+
+def _fn_calling(tmp_path, name, callee):
+    f = function(tmp_path / f"{name}.json")
+    node(f, "x", "function_input", {"name": "x", "type": "float"})
+    node(f, "out", "function_output", {"name": "y", "type": "float"})
+    if callee:
+        node(f, "call", "function_call", {"function": f"{callee}.json"})
+        link(f, "x", "value", "call", "x")
+        link(f, "call", "y", "out", "value")
+    else:
+        link(f, "x", "value", "out", "value")
+    save(f)
+    return f
+
+
+def test_recursive_functions_through_files(tmp_path):
+    _fn_calling(tmp_path, "f", "g")
+    g = _fn_calling(tmp_path, "g", "f")
+    errs = errors(g, FileResolver())
+    assert any("recursive" in e.message for e in errs)
+
+
+def test_self_recursive_function(tmp_path):
+    f = _fn_calling(tmp_path, "f", "f")
+    assert any("recursive" in e.message for e in errors(f, FileResolver()))
+
+
+def test_function_call_ports_and_types(tmp_path):
+    _fn_calling(tmp_path, "leaf", None)
+    d = simple_material(tmp_path / "m.json")
+    node(d, "call", "function_call", {"function": "leaf.json"})
+    link(d, "r", "value", "call", "x")
+    d.graph.links.discard(d.graph.incoming("m", "a"))
+    link(d, "call", "y", "m", "a")
+    assert errors(d, FileResolver()) == []
+
+
+def test_check_connect_refuses_cycles_and_types_with_reason():
+    d = simple_material()
+    reason = check_connect(d, Link("m", "result", "m", "a"))
+    assert reason and "itself" in reason
+    node(d, "a", "add")
+    link(d, "m", "result", "a", "a")
+    reason = check_connect(d, Link("a", "result", "m", "b"))
+    assert reason and "cycle" in reason
+    node(d, "uv", "texcoord")
+    reason = check_connect(d, Link("uv", "uv", "make", "baseColor"))
+    assert reason and "vec2" in reason and "vec3" in reason
+    assert check_connect(d, Link("r", "value", "make", "metallic")) is None
+
+
+def test_function_document_rules():
+    f = function()
+    node(f, "x", "function_input", {"name": "bad name", "type": "float"})
+    msgs = [e.message for e in errors(f)]
+    assert any("Function Output" in m for m in msgs)
+    assert any("not an identifier" in m for m in msgs)
+
+
+def test_duplicate_parameter_names():
+    d = simple_material()
+    node(d, "r2", "scalar_parameter", {"name": "rough"})
+    assert any("used by" in e.message for e in errors(d))
+
+
+def test_empty_material_reports_missing_output():
+    assert any("Material Output" in e.message for e in errors(material()))
