@@ -18,6 +18,15 @@ float D_GGX(float NoH, float a) {
     return a2 / (PI * d * d);
 }
 
+// GGX with 1 - NoH^2 given, as |N x H|^2 from the vectors: accurate where H is near N and
+// the lobe is narrow (1 - NoH^2 from a rounded NoH loses everything at a ~ 1e-3).
+float D_GGX(float NoH, float a, float oneMinusNoH2) {
+    // Karis 2013, eq 3; Filament's cross-product form of 1 - NoH^2 (Lagrange's identity)
+    float a2 = a * a;
+    float d = oneMinusNoH2 + NoH * NoH * a2;
+    return a2 / (PI * d * d);
+}
+
 // Schlick's k for analytic lights: Disney's remapping of roughness.
 float k_Analytic(float roughness) {
     // Karis 2013, "Real Shading in Unreal Engine 4", eq 4: k = (roughness + 1)^2 / 8

@@ -71,11 +71,17 @@ float distanceFalloff(float d, float influenceRadius) {
 // Specular lobe times NoL towards the unit direction L.
 vec3 specularTowards(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4", specular D Vis F, times NoL
-    vec3 H = normalize(L + s.V);
     float NoL = saturate(dot(s.N, L));
+    // Below the horizon nothing is reflected; this also skips L = -V, where H is undefined
+    // (a representative point behind the surface can land exactly there).
+    if (NoL <= 0.0) return vec3(0.0);
+    vec3 h = L + s.V;
+    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
     float NoH = saturate(dot(s.N, H));
     float VoH = saturate(dot(s.V, H));
-    return specularLobe(s.F0, s.a, s.k, s.NoV, NoL, NoH, VoH) * NoL;
+    vec3 NxH = cross(s.N, H);
+    float D = D_GGX(NoH, s.a, dot(NxH, NxH));
+    return D * V_SchlickSmith(s.NoV, NoL, s.k) * F_Schlick(s.F0, VoH) * NoL;
 }
 
 // Point on a sphere closest to the reflection ray, as an unnormalised vector from P.
@@ -139,8 +145,14 @@ float tubeIrradiance(vec3 N, vec3 L0, vec3 L1) {
     float l0 = length(L0);
     float l1 = length(L1);
     float cosTerm = saturate(dot(N, L0) / (2.0 * l0) + dot(N, L1) / (2.0 * l1));
+    // |L0||L1| + L0.L1 cancels when P lies near the segment between its ends (L0, L1
+    // opposed); there use the equal |L0 x L1|^2 / (|L0||L1| - L0.L1), which does not.
+    float l0l1 = l0 * l1;
+    float d01 = dot(L0, L1);
+    vec3 c = cross(L0, L1);
+    float den = d01 >= 0.0 ? l0l1 + d01 : dot(c, c) / (l0l1 - d01);
     float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
-    return 2.0 * cosTerm / (l0 * l1 + dot(L0, L1) + 2.0 * eps2);
+    return 2.0 * cosTerm / (den + 2.0 * eps2);
 }
 
 // Point of a segment closest to the reflection ray, as an unnormalised vector from P.

@@ -174,9 +174,7 @@ def gpu_eval(
     **kwargs,
 ) -> np.ndarray:
     """Evaluate one GLSL expression of type `out_type` per element (see gpu_eval_many)."""
-    return gpu_eval_many(ctx, f"result = {expr};", inputs, {"result": out_type}, **kwargs)[
-        "result"
-    ]
+    return gpu_eval_many(ctx, f"result = {expr};", inputs, {"result": out_type}, **kwargs)["result"]
 
 
 def write_cube_level(tex, face: int, level: int, data: np.ndarray) -> None:

@@ -32,10 +32,10 @@ class SoftBox:
 
 
 _STUDIO_BOXES = (
-    SoftBox((-0.65, 0.55, 0.55), 0.45, 0.6, (14.0, 12.6, 11.0)),  # key, warm
+    SoftBox((-0.65, 0.45, 0.55), 0.45, 0.55, (14.0, 12.6, 11.0)),  # key, warm
     SoftBox((0.85, 0.25, 0.45), 0.35, 0.55, (2.6, 3.0, 3.6)),  # fill, cool
     SoftBox((0.35, 0.35, -0.87), 0.08, 0.7, (9.0, 9.0, 9.0)),  # rim strip behind
-    SoftBox((0.0, 1.0, 0.05), 0.5, 0.5, (4.0, 4.0, 4.0)),  # overhead panel
+    SoftBox((0.0, 1.0, 0.05), 0.3, 0.3, (3.0, 3.0, 3.0)),  # overhead panel
 )
 
 

@@ -11,10 +11,13 @@ def Fd_Lambert() -> float:
     return INV_PI
 
 
-def D_GGX(NoH, a) -> np.ndarray:
+def D_GGX(NoH, a, oneMinusNoH2=None) -> np.ndarray:
+    """Both GLSL overloads: D_GGX(NoH, a) and D_GGX(NoH, a, oneMinusNoH2)."""
     NoH, a = f64(NoH), f64(a)
     a2 = a * a
-    d = (1.0 - NoH) * (1.0 + NoH) + NoH * NoH * a2
+    if oneMinusNoH2 is None:
+        oneMinusNoH2 = (1.0 - NoH) * (1.0 + NoH)
+    d = f64(oneMinusNoH2) + NoH * NoH * a2
     return a2 / (PI * d * d)
 
 

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 
 from matedit.shading.brdf import F_SchlickExact, G1_Schlick, k_IBL
-from matedit.shading.common import INV_PI, dot, f64, saturate
+from matedit.shading.common import INV_PI, dot, f64, saturate, sq
 from matedit.shading.sampling import hammersley, importanceSampleCosine, importanceSampleGGX
 
 Environment = Callable[[np.ndarray], np.ndarray]
@@ -108,13 +108,14 @@ def rotatedHammersley(i, n, offset) -> np.ndarray:
 
 
 def _sample_points(sampleCount: int, offset) -> np.ndarray:
-    return rotatedHammersley(np.arange(sampleCount), sampleCount, offset)
+    """Rotated Hammersley points (..., sampleCount, 2) for per-pixel offsets (..., 2)."""
+    return rotatedHammersley(np.arange(sampleCount), sampleCount, f64(offset)[..., None, :])
 
 
 def referenceSpecularIBL(env: Environment, F0, roughness, N, V, sampleCount: int, offset):
     """Vectorised over pixels (leading axes of N, V) and samples."""
     N, V, F0 = f64(N)[..., None, :], f64(V)[..., None, :], f64(F0)[..., None, :]
-    a = f64(roughness)[..., None]
+    a = sq(f64(roughness))[..., None]
     k = k_IBL(a)
     NoV = np.maximum(dot(N, V), 1e-4)
     Xi = _sample_points(sampleCount, offset)

@@ -7,7 +7,7 @@ from typing import Literal
 
 import numpy as np
 
-from matedit.shading.brdf import diffuseLobe, k_Analytic, specularLobe
+from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
 
 LIGHT_TYPE_POINT = 0
@@ -79,11 +79,16 @@ def distanceFalloff(d, influenceRadius) -> np.ndarray:
 
 
 def specularTowards(s: ShadingContext, L) -> np.ndarray:
-    H = normalize(f64(L) + s.V)
     NoL = saturate(dot(s.N, L))
+    h = f64(L) + s.V
+    H = h / np.sqrt(np.maximum(dot(h, h), 1e-30))[..., None]
     NoH = saturate(dot(s.N, H))
     VoH = saturate(dot(s.V, H))
-    return specularLobe(s.F0, s.a, s.k, s.NoV, NoL, NoH, VoH) * NoL[..., None]
+    NxH = np.cross(s.N, H)
+    D = D_GGX(NoH, s.a, dot(NxH, NxH))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lobe = np.where(NoL > 0.0, D * V_SchlickSmith(s.NoV, NoL, s.k) * NoL, 0.0)
+    return lobe[..., None] * F_Schlick(s.F0, VoH)
 
 
 def sphereRepresentativePoint(Lc, R, sourceRadius) -> np.ndarray:
@@ -141,7 +146,12 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
 def tubeIrradiance(N, L0, L1) -> np.ndarray:
     l0, l1 = length(L0), length(L1)
     cos_term = saturate(dot(N, L0) / (2.0 * l0) + dot(N, L1) / (2.0 * l1))
-    return 2.0 * cos_term / (l0 * l1 + dot(L0, L1) + 2.0 * LIGHT_FALLOFF_EPS**2)
+    l0l1, d01 = l0 * l1, dot(L0, L1)
+    c = np.cross(f64(L0), f64(L1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        opposed = dot(c, c) / (l0l1 - d01)
+    den = np.where(d01 >= 0.0, l0l1 + d01, opposed)
+    return 2.0 * cos_term / (den + 2.0 * LIGHT_FALLOFF_EPS**2)
 
 
 def tubeRepresentativePoint(L0, L1, R) -> np.ndarray:

@@ -1,0 +1,58 @@
+"""`matedit compile FILE -o DIR [--target glsl330|glsl450|essl300|all]`."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from matedit.cli import UsageError
+from matedit.compiler import TARGETS, CompileError, compile_all
+from matedit.io.atomic import atomic_write_text
+from matedit.io.document import FileResolver, FormatError, load
+
+
+def register(sub) -> None:
+    p = sub.add_parser("compile", help="compile a material to GLSL",
+                       description="Compile a material to vertex and fragment GLSL plus a "
+                       "reflection JSON (uniforms, textures, targets).")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("-o", "--output", required=True, metavar="DIR")
+    p.add_argument("--target", default="glsl330", choices=[*TARGETS, "all"])
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    path = Path(args.file)
+    try:
+        doc = load(path)
+    except FormatError as exc:
+        raise UsageError(str(exc)) from None
+    if doc.is_function:
+        raise UsageError(f"{path}: is a material function; compile a material that calls it")
+    targets = list(TARGETS) if args.target == "all" else [args.target]
+    try:
+        compiled = compile_all(doc, FileResolver(), targets)
+    except CompileError as exc:
+        for d in exc.diagnostics[1:]:
+            print(f"error: {d.file or path}: {d.format()}", file=sys.stderr)
+        first = exc.diagnostics[0] if exc.diagnostics else None
+        raise UsageError(f"{first.file or path}: {first.format()}" if first else str(exc)) \
+            from None
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"{out}: exists and is not a folder")
+    stem = path.name[:-5] if path.name.endswith(".json") else path.stem
+    reflection = {"source": str(path), "targets": {}}
+    for name, cm in compiled.items():
+        atomic_write_text(out / f"{stem}.{name}.vert", cm.vertex_text)
+        atomic_write_text(out / f"{stem}.{name}.frag", cm.fragment_text)
+        reflection["targets"][name] = cm.reflection()
+    first = next(iter(compiled.values())).reflection()
+    for key in ("attributes", "uniforms", "textures", "uniform_block"):
+        reflection[key] = first[key]
+    atomic_write_text(out / f"{stem}.json",
+                      json.dumps(reflection, sort_keys=True, indent=2) + "\n")
+    if sys.stderr.isatty():
+        print(f"compiled {path} for {', '.join(targets)} into {out}", file=sys.stderr)
+    return 0

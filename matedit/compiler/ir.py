@@ -1,0 +1,145 @@
+"""The typed intermediate representation between a graph and GLSL.
+
+A scope (the material, or one material function) is a list of `Op`s in a
+stable topological order. Operands are `Expr`s: another op's output (`Var`), a
+literal (`Lit`), a uniform (`Uni`), a function parameter (`Param`), the mesh UV
+(`SurfaceUV`), or an implicit conversion (`Splat`). Variables are named
+`<node>_<port>`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from matedit.graph.types import PortType
+
+
+class Expr:
+    type: PortType
+
+    def key(self) -> str:
+        """A canonical string; equal keys mean equal values (used by CSE)."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Var(Expr):
+    name: str
+    type: PortType
+
+    def key(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True)
+class Param(Expr):
+    name: str
+    type: PortType
+
+    def key(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True)
+class Lit(Expr):
+    value: Any  # float or tuple of floats, or None for MaterialAttributes defaults
+    type: PortType
+
+    def key(self) -> str:
+        return f"lit:{self.type}:{self.value!r}"
+
+
+@dataclass(frozen=True)
+class Uni(Expr):
+    name: str
+    type: PortType
+
+    def key(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True)
+class SurfaceUV(Expr):
+    type: PortType = PortType.VEC2
+
+    def key(self) -> str:
+        return "g_surface.uv"
+
+
+@dataclass(frozen=True)
+class Splat(Expr):
+    expr: Expr
+    type: PortType
+
+    def key(self) -> str:
+        return f"{self.type}({self.expr.key()})"
+
+
+@dataclass
+class Op:
+    """One evaluation: a node kind's GLSL function / inline template, or a compiler op.
+
+    `kind` is a node kind from the registry, or one of the compiler's own:
+    'mask', 'append', 'set_attributes', 'call' (material function), 'blend'
+    (blendMaterialAttributes), 'weight' (saturate(mask * opacity)).
+    """
+
+    var: str  # stem of the output names
+    node: str  # node id the op came from (source map)
+    kind: str
+    args: list[Expr]
+    outs: list[tuple[str, PortType]]
+    data: dict[str, Any] = field(default_factory=dict)
+
+    def out(self, port: str) -> Var:
+        for name, t in self.outs:
+            if name == port:
+                return Var(f"{self.var}_{port}", t)
+        raise KeyError(port)
+
+    def key(self) -> str:
+        data = repr(sorted((k, repr(v)) for k, v in self.data.items()))
+        return f"{self.kind}|{data}|{','.join(a.key() for a in self.args)}"
+
+
+@dataclass
+class UniformInfo:
+    name: str
+    type: PortType
+    default: Any
+    node: str
+    port: str
+    parameter: str | None = None  # the artist-facing name for parameter nodes
+
+
+@dataclass
+class TextureInfo:
+    name: str
+    node: str
+    path: str
+    srgb: bool
+    parameter: str
+
+
+@dataclass
+class Scope:
+    """A material's graph or a function's body."""
+
+    name: str  # GLSL function name
+    ops: list[Op] = field(default_factory=list)
+    params: list[tuple[str, PortType]] = field(default_factory=list)
+    outputs: list[tuple[str, PortType, Expr]] = field(default_factory=list)
+    source: str = ""  # file the scope came from (source map)
+    # (node id, port) -> expression, for probing any socket after lowering
+    sockets: dict[tuple[str, str], Expr] = field(default_factory=dict)
+
+
+@dataclass
+class MaterialIR:
+    main: Scope
+    functions: list[Scope]  # callees before callers
+    uniforms: list[UniformInfo]
+    textures: list[TextureInfo]
+    node_kinds: set[str]  # node kinds whose GLSL files are needed
+    attributes: list[str]  # MaterialAttributes fields the graph writes

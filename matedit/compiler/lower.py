@@ -1,0 +1,413 @@
+"""Lowering: a validated document (and the functions it calls) to the typed IR.
+
+Top-level unconnected inputs become uniforms (`u_<node>_<port>`), parameter nodes
+uniforms named after the parameter (`p_<name>`); inside material functions
+unconnected inputs are literals of the function's own file. Implicit
+conversions (a float splatted to a vector) are made explicit here.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from matedit.compiler.ir import (
+    Expr,
+    Lit,
+    MaterialIR,
+    Op,
+    Param,
+    Scope,
+    Splat,
+    SurfaceUV,
+    TextureInfo,
+    Uni,
+    UniformInfo,
+    Var,
+)
+from matedit.graph import nodes
+from matedit.graph.model import MaterialDocument
+from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, MA, MESH_UV
+from matedit.graph.ports import FunctionResolver, function_interface, layer_entries
+from matedit.graph.types import PortType, coerce_value
+from matedit.graph.validate import Analysis, Diagnostic, Severity, analyse
+
+# Kinds the compiler lowers itself; every other kind calls its GLSL function or inline template.
+SPECIAL_KINDS = {
+    "constant", "scalar_parameter", "color_parameter", "texture_parameter", "function_input",
+    "function_output", "function_call", "layer_stack", "material_output", "set_attributes",
+    "component_mask", "append", "reroute",
+}
+ALL_FIELDS = frozenset(ATTRIBUTE_NAMES)
+
+
+class CompileError(Exception):
+    """The document does not compile; carries the diagnostics (node, port, message)."""
+
+    def __init__(self, diagnostics: list[Diagnostic]) -> None:
+        self.diagnostics = diagnostics
+        first = diagnostics[0] if diagnostics else None
+        msg = first.format() if first else "compile error"
+        if first and first.file:
+            msg = f"{first.file}: {msg}"
+        super().__init__(msg)
+
+
+def _doc_key(doc: MaterialDocument) -> str:
+    return str(Path(doc.path).resolve()) if doc.path else f"<unsaved {id(doc)}>"
+
+
+def _ident(s: str) -> str:
+    s = re.sub(r"[^A-Za-z0-9_]", "_", s)
+    s = re.sub(r"_+", "_", s).strip("_") or "f"
+    return s if s[0].isalpha() else "f" + s
+
+
+def literal(t: PortType, value: Any) -> Lit:
+    v = coerce_value(t, value)
+    return Lit(v if isinstance(v, float) else tuple(v), t)
+
+
+def convert(expr: Expr, to: PortType) -> Expr:
+    if expr.type == to:
+        return expr
+    if expr.type == PortType.FLOAT and to.is_numeric:
+        if isinstance(expr, Lit):
+            return Lit((expr.value,) * to.components, to)
+        return Splat(expr, to)
+    raise TypeError(f"no implicit conversion from {expr.type} to {to}")
+
+
+@dataclass
+class _Ctx:
+    resolver: FunctionResolver | None
+    functions: dict[str, Scope] = field(default_factory=dict)  # doc key -> scope
+    function_written: dict[str, dict[str, frozenset]] = field(default_factory=dict)
+    order: list[str] = field(default_factory=list)
+    names: set[str] = field(default_factory=set)
+    uniforms: dict[str, UniformInfo] = field(default_factory=dict)
+    textures: dict[str, TextureInfo] = field(default_factory=dict)
+    kinds: set[str] = field(default_factory=set)
+
+
+class _Lowerer:
+    def __init__(self, ctx: _Ctx, doc: MaterialDocument, analysis: Analysis, top: bool,
+                 scope: Scope) -> None:
+        self.ctx, self.doc, self.a, self.top, self.scope = ctx, doc, analysis, top, scope
+        self.alias: dict[tuple[str, str], Expr] = {}
+        self.written: dict[str, frozenset] = {}  # expr key -> fields written (MA values)
+        self.incoming = {nid: {} for nid in doc.graph.nodes}
+        for l in doc.graph.links:
+            self.incoming[l.dst][l.dst_port] = l
+
+    # --- operands --------------------------------------------------------------------------
+    def source(self, nid: str, port: str) -> Expr:
+        if (nid, port) in self.alias:
+            return self.alias[(nid, port)]
+        return Var(f"{nid}_{port}", self.a.out_types[nid][port])
+
+    def arg(self, nid: str, port: str, t: PortType, default: Any) -> Expr:
+        link = self.incoming[nid].get(port)
+        if link is not None:
+            return convert(self.source(link.src, link.src_port), t)
+        node = self.doc.graph.nodes[nid]
+        value = node.values.get(port, default)
+        if value == MESH_UV:
+            return SurfaceUV()
+        if t == MA:
+            return Lit(None, PortType.MATERIAL)  # defaultMaterialAttributes()
+        if not t.is_numeric:
+            raise CompileError([Diagnostic(Severity.ERROR, f"input {port!r} must be connected",
+                                           nid, port, self.file)])
+        if value is None:
+            value = 0.0
+        if self.top:
+            name = f"u_{nid}_{port}"
+            self._uniform(UniformInfo(name, t, coerce_value(t, value), nid, port))
+            return Uni(name, t)
+        return literal(t, value)
+
+    @property
+    def file(self) -> str | None:
+        return str(self.doc.path) if self.doc.path else None
+
+    def _uniform(self, info: UniformInfo) -> None:
+        old = self.ctx.uniforms.get(info.name)
+        if old is not None and (old.type != info.type or old.node != info.node):
+            raise CompileError([Diagnostic(
+                Severity.ERROR, f"uniform name {info.name!r} is used twice "
+                f"(by {old.node} and {info.node}); rename the parameter", info.node, "name",
+                self.file)])
+        if old is None:
+            self.ctx.uniforms[info.name] = info
+
+    def emit(self, op: Op) -> Op:
+        self.scope.ops.append(op)
+        for port, _ in op.outs:
+            self.scope.sockets[(op.node, port)] = op.out(port)
+        return op
+
+    # --- nodes -------------------------------------------------------------------------------
+    def lower(self) -> None:
+        for nid in self.a.order:
+            node = self.doc.graph.nodes[nid]
+            getattr(self, f"_k_{node.kind}", self._generic)(nid, node)
+        for (nid, port), e in self.alias.items():
+            self.scope.sockets.setdefault((nid, port), e)
+
+    def _inputs(self, nid: str) -> list[Expr]:
+        ins = self.a.in_types[nid]
+        return [self.arg(nid, p.name, ins[p.name], p.default) for p in self.a.ports[nid].inputs]
+
+    def _generic(self, nid, node) -> None:
+        d = nodes.REGISTRY[node.kind]
+        args = self._inputs(nid)
+        if node.kind == "make_attributes":
+            # The tangent-space normal is only written when connected (MATERIAL_HAS_NORMAL).
+            idx = [f.name for f in ATTRIBUTE_FIELDS].index("normal")
+            if "normal" not in self.incoming[nid]:
+                args[idx] = Lit((0.0, 0.0, 1.0), PortType.VEC3)
+        outs = [(p.name, self.a.out_types[nid][p.name]) for p in self.a.ports[nid].outputs]
+        data = {"glsl": d.glsl} if d.glsl else {"inline": d.inline}
+        self.ctx.kinds.add(node.kind)
+        op = self.emit(Op(nid, nid, node.kind, args, outs, data))
+        if node.kind == "make_attributes":
+            w = set(ALL_FIELDS)
+            if "normal" not in self.incoming[nid]:
+                w.discard("normal")
+            self.written[op.out("attributes").key()] = frozenset(w)
+        elif node.kind in ("layer_blend", "height_blend"):
+            self.written[op.out("result").key()] = self._w(args[0]) | self._w(args[1])
+
+    def _w(self, e: Expr) -> frozenset:
+        if isinstance(e, Param):
+            return frozenset({"@" + e.name})
+        if isinstance(e, Lit):
+            return frozenset()
+        return self.written.get(e.key(), ALL_FIELDS)
+
+    def _k_constant(self, nid, node) -> None:
+        t = self.a.out_types[nid]["value"]
+        self.alias[(nid, "value")] = literal(t, node.settings.get("value", 0.0))
+
+    def _parameter(self, nid, node, port: str, t: PortType, default: Any) -> None:
+        pname = str(node.settings.get("name", nid))
+        name = f"p_{pname}"
+        value = coerce_value(t, node.values.get("value", default))
+        self._uniform(UniformInfo(name, t, value, nid, "value", pname))
+        self.alias[(nid, port)] = Uni(name, t)
+
+    def _k_scalar_parameter(self, nid, node) -> None:
+        self._parameter(nid, node, "value", PortType.FLOAT, 0.5)
+
+    def _k_color_parameter(self, nid, node) -> None:
+        self._parameter(nid, node, "color", PortType.VEC3, [0.5, 0.5, 0.5])
+
+    def _k_vector_parameter(self, nid, node) -> None:
+        pname = str(node.settings.get("name", nid))
+        name = f"p_{pname}"
+        value = coerce_value(PortType.VEC4, node.values.get("value", [0.0, 0.0, 0.0, 1.0]))
+        self._uniform(UniformInfo(name, PortType.VEC4, value, nid, "value", pname))
+        self.ctx.kinds.add(node.kind)
+        self.emit(Op(nid, nid, node.kind, [Uni(name, PortType.VEC4)],
+                     [("value", PortType.VEC4), ("xyz", PortType.VEC3)],
+                     {"glsl": "node_vector_parameter"}))
+
+    def _k_texture_parameter(self, nid, node) -> None:
+        pname = str(node.settings.get("name", nid))
+        name = f"t_{pname}"
+        path = str(node.settings.get("path", ""))
+        if path and self.doc.path is not None and not Path(path).is_absolute():
+            path = str((Path(self.doc.path).parent / path).resolve())
+        if name not in self.ctx.textures:
+            self.ctx.textures[name] = TextureInfo(name, nid, path,
+                                                  bool(node.settings.get("srgb", True)), pname)
+        self.alias[(nid, "texture")] = Uni(name, PortType.TEXTURE)
+
+    def _k_reroute(self, nid, node) -> None:
+        t = self.a.in_types[nid]["value"]
+        self.alias[(nid, "value")] = self.arg(nid, "value", t, 0.0)
+
+    def _k_component_mask(self, nid, node) -> None:
+        from matedit.graph.ports import normalize_channels
+
+        (arg,) = self._inputs(nid)
+        channels = normalize_channels(node.settings.get("channels", "xy"))
+        t = self.a.out_types[nid]["result"]
+        self.emit(Op(nid, nid, "mask", [arg], [("result", t)], {"channels": channels}))
+
+    def _k_append(self, nid, node) -> None:
+        args = self._inputs(nid)
+        t = self.a.out_types[nid]["result"]
+        self.emit(Op(nid, nid, "append", args, [("result", t)], {}))
+
+    def _k_set_attributes(self, nid, node) -> None:
+        args = self._inputs(nid)
+        fields = [p.name for p in self.a.ports[nid].inputs[1:]]
+        op = self.emit(Op(nid, nid, "set_attributes", args, [("attributes", PortType.MATERIAL)],
+                          {"fields": tuple(fields)}))
+        self.written[op.out("attributes").key()] = self._w(args[0]) | frozenset(fields)
+
+    def _k_material_output(self, nid, node) -> None:
+        (arg,) = self._inputs(nid)
+        self.scope.outputs.append(("attributes", PortType.MATERIAL, arg))
+        self.scope_written = {"attributes": self._w(arg)}
+
+    def _k_function_input(self, nid, node) -> None:
+        t = self.a.out_types[nid]["value"]
+        self.alias[(nid, "value")] = Param(f"in_{node.settings.get('name', nid)}", t)
+
+    def _k_function_output(self, nid, node) -> None:
+        t = self.a.in_types[nid]["value"]
+        name = str(node.settings.get("name", nid))
+        self.scope.outputs.append((name, t, self.arg(nid, "value", t, None)))
+
+    def _call(self, nid: str, var: str, ref: str, args: dict[str, Expr]) -> tuple[Op, Scope]:
+        callee_doc = self.ctx.resolver.resolve(ref, self.doc)
+        callee = lower_function(self.ctx, callee_doc)
+        iface = function_interface(callee_doc)
+        ordered = []
+        for p in iface.inputs:
+            ordered.append(args[p.name])
+        outs = [(o.name, PortType(o.type)) for o in iface.outputs]
+        op = self.emit(Op(var, nid, "call", ordered, outs, {"function": callee.name}))
+        fw = self.ctx.function_written.get(callee.name, {})
+        params = {f"in_{p.name}": e for p, e in zip(iface.inputs, ordered)}
+        for name, t in outs:
+            if t == PortType.MATERIAL:
+                w = fw.get(name, ALL_FIELDS)
+                resolved = set()
+                for f in w:
+                    if f.startswith("@"):
+                        resolved |= self._w(params[f[1:]]) if f[1:] in params else ALL_FIELDS
+                    else:
+                        resolved.add(f)
+                self.written[op.out(name).key()] = frozenset(resolved)
+        return op, callee
+
+    def _k_function_call(self, nid, node) -> None:
+        ins = self.a.in_types[nid]
+        args = {p.name: self.arg(nid, p.name, ins[p.name], p.default)
+                for p in self.a.ports[nid].inputs}
+        self._call(nid, nid, node.settings["function"], args)
+
+    def _k_layer_stack(self, nid, node) -> None:
+        ins = self.a.in_types[nid]
+        specs = {p.name: p for p in self.a.ports[nid].inputs}
+
+        def port(name: str) -> Expr:
+            return self.arg(nid, name, ins[name], specs[name].default)
+
+        acc: Expr | None = None
+        for i, layer in enumerate(layer_entries(node)):
+            lid = layer["id"]
+            iface = function_interface(self.ctx.resolver.resolve(layer["function"], self.doc))
+            args = {p.name: port(f"{lid}_{p.name}") for p in iface.inputs}
+            op, _ = self._call(nid, f"{nid}_{lid}", layer["function"], args)
+            ma_out = next(o for o, t in op.outs if t == PortType.MATERIAL)
+            value = op.out(ma_out)
+            if not layer.get("visible", True) and i > 0:
+                self.scope.ops.pop()  # hidden: compiled out entirely
+                continue
+            if acc is None:
+                acc = value
+                continue
+            blend = layer.get("blend", "alpha")
+            opacity = port(f"{lid}_opacity")
+            if blend == "alpha":
+                w = self.emit(Op(f"{nid}_{lid}_w", nid, "weight", [port(f"{lid}_mask"), opacity],
+                                 [("result", PortType.FLOAT)], {}))
+                blended = self.emit(Op(f"{nid}_{lid}_blend", nid, "blend",
+                                       [acc, value, w.out("result")],
+                                       [("result", PortType.MATERIAL)], {}))
+            else:
+                if blend == "height":
+                    self.ctx.kinds.add("height_blend")
+                    shaped = self.emit(Op(
+                        f"{nid}_{lid}_h", nid, "height_blend",
+                        [acc, value, port(f"{lid}_base_height"), port(f"{lid}_mask"),
+                         port(f"{lid}_contrast")],
+                        [("result", PortType.MATERIAL)], {"glsl": "node_height_blend"}))
+                else:
+                    biface = function_interface(self.ctx.resolver.resolve(blend, self.doc))
+                    mas = [p.name for p in biface.inputs if p.type == MA][:2]
+                    bargs = {mas[0]: acc, mas[1]: value}
+                    for p in biface.inputs:
+                        if p.name not in bargs:
+                            bargs[p.name] = port(f"{lid}_{p.name}")
+                    shaped, _ = self._call(nid, f"{nid}_{lid}_b", blend, bargs)
+                out_name = next(o for o, t in shaped.outs if t == PortType.MATERIAL)
+                blended = self.emit(Op(f"{nid}_{lid}_blend", nid, "blend",
+                                       [acc, shaped.out(out_name), convert(opacity,
+                                                                           PortType.FLOAT)],
+                                       [("result", PortType.MATERIAL)], {}))
+            self.ctx.kinds.add("layer_blend")
+            self.written[blended.out("result").key()] = self._w(acc) | self._w(value)
+            acc = blended.out("result")
+        if acc is None:
+            acc = Lit(None, PortType.MATERIAL)
+        self.alias[(nid, "attributes")] = acc
+        # keep "written" for the alias
+        if isinstance(acc, Var):
+            self.written.setdefault(acc.key(), ALL_FIELDS)
+
+
+def _check(doc: MaterialDocument, resolver) -> Analysis:
+    a = analyse(doc, resolver)
+    errors = [d for d in a.diagnostics if d.severity == Severity.ERROR]
+    if errors:
+        raise CompileError(errors)
+    return a
+
+
+def lower_function(ctx: _Ctx, doc: MaterialDocument) -> Scope:
+    key = _doc_key(doc)
+    if key in ctx.functions:
+        return ctx.functions[key]
+    stem = _ident("fn_" + (Path(doc.path).stem if doc.path else doc.name or "function"))
+    name, i = stem, 2
+    while name in ctx.names:
+        name, i = f"{stem}_{i}", i + 1
+    ctx.names.add(name)
+    a = _check(doc, ctx.resolver)
+    scope = Scope(name=name, source=str(doc.path or doc.name))
+    iface = function_interface(doc)
+    scope.params = [(f"in_{p.name}", PortType(p.type)) for p in iface.inputs]
+    low = _Lowerer(ctx, doc, a, top=False, scope=scope)
+    low.lower()
+    # outputs in interface order
+    by_name = {n: (n, t, e) for n, t, e in scope.outputs}
+    scope.outputs = [by_name[o.name] for o in iface.outputs]
+    ctx.function_written[name] = {n: low._w(e) for n, t, e in scope.outputs
+                                  if t == PortType.MATERIAL}
+    ctx.functions[key] = scope
+    ctx.order.append(key)
+    return scope
+
+
+def lower_document(doc: MaterialDocument, resolver: FunctionResolver | None) -> MaterialIR:
+    """Validate and lower a material document; raises CompileError with diagnostics."""
+    if doc.is_function:
+        raise CompileError([Diagnostic(Severity.ERROR, "a material function is compiled through "
+                                       "the materials that call it", None, None,
+                                       str(doc.path) if doc.path else None)])
+    ctx = _Ctx(resolver)
+    a = _check(doc, resolver)
+    scope = Scope(name="evaluateMaterial", source=str(doc.path or doc.name))
+    low = _Lowerer(ctx, doc, a, top=True, scope=scope)
+    try:
+        low.lower()
+    except LookupError as exc:
+        raise CompileError([Diagnostic(Severity.ERROR, str(exc), None, None, low.file)]) from None
+    written = low._w(scope.outputs[0][2]) if scope.outputs else frozenset()
+    attributes = [f for f in ATTRIBUTE_NAMES if f in written]
+    return MaterialIR(
+        main=scope,
+        functions=[ctx.functions[k] for k in ctx.order],
+        uniforms=sorted(ctx.uniforms.values(), key=lambda u: u.name),
+        textures=sorted(ctx.textures.values(), key=lambda t: t.name),
+        node_kinds=ctx.kinds,
+        attributes=attributes,
+    )

@@ -1,0 +1,118 @@
+"""IR optimisation passes: constant folding, common subexpressions, dead code.
+
+Each pass keeps the op order (a stable topological order), so the output is
+deterministic whatever the order of nodes in the file.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from matedit.compiler.ir import Expr, Lit, Op, Scope, Splat, Var
+from matedit.graph.types import PortType
+
+# Kinds whose value depends on more than their inputs (geometry, time, textures, uniforms).
+IMPURE = {"texcoord", "world_position", "world_normal", "view_direction", "time",
+          "texture_sample", "vector_parameter", "call"}
+
+
+def _subst(e: Expr, table: dict[str, Expr]) -> Expr:
+    if isinstance(e, Var):
+        return table.get(e.name, e)
+    if isinstance(e, Splat):
+        inner = _subst(e.expr, table)
+        if isinstance(inner, Lit):
+            return Lit((inner.value,) * e.type.components, e.type)
+        return Splat(inner, e.type)
+    return e
+
+
+def _as_array(lit: Lit):
+    if lit.type == PortType.FLOAT:
+        return np.array([lit.value], dtype=np.float64)
+    return np.array([lit.value], dtype=np.float64).reshape(1, -1)
+
+
+def _to_lit(value, t: PortType) -> Lit | None:
+    arr = np.asarray(value, dtype=np.float64).reshape(-1)
+    if not np.all(np.isfinite(arr)):
+        return None  # leave inf/NaN to the GPU rather than writing them as literals
+    if t == PortType.FLOAT:
+        return Lit(float(arr[0]), t) if arr.size == 1 else None
+    if arr.size != t.components:
+        return None
+    return Lit(tuple(float(x) for x in arr), t)
+
+
+def fold_constants(scope: Scope) -> None:
+    """Evaluates ops whose operands are all literals with the numpy implementation."""
+    from matedit.compiler import cpu_eval
+
+    table: dict[str, Expr] = {}
+    kept: list[Op] = []
+    for op in scope.ops:
+        op.args = [_subst(a, table) for a in op.args]
+        numeric = all(t.is_numeric for _, t in op.outs)
+        if (op.kind not in IMPURE and numeric and op.args
+                and all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)):
+            try:
+                values = cpu_eval.eval_op(op, [_as_array(a) for a in op.args], None)
+            except Exception:  # no implementation, or it refused: keep the op
+                values = None
+            if values is not None:
+                lits = [_to_lit(v, t) for v, (_, t) in zip(values, op.outs)]
+                if all(l is not None for l in lits):
+                    for (port, _), lit in zip(op.outs, lits):
+                        table[op.out(port).name] = lit
+                    continue
+        kept.append(op)
+    scope.ops = kept
+    scope.outputs = [(n, t, _subst(e, table)) for n, t, e in scope.outputs]
+    scope.sockets = {k: _subst(e, table) for k, e in scope.sockets.items()}
+
+
+def merge_common(scope: Scope) -> None:
+    """Reuses the first of several ops with the same kind, data and operands."""
+    seen: dict[str, Op] = {}
+    table: dict[str, Expr] = {}
+    kept: list[Op] = []
+    for op in scope.ops:
+        op.args = [_subst(a, table) for a in op.args]
+        k = op.key()
+        first = seen.get(k)
+        if first is not None and first.outs == op.outs:
+            for port, _ in op.outs:
+                table[op.out(port).name] = first.out(port)
+            continue
+        seen[k] = op
+        kept.append(op)
+    scope.ops = kept
+    scope.outputs = [(n, t, _subst(e, table)) for n, t, e in scope.outputs]
+    scope.sockets = {k: _subst(e, table) for k, e in scope.sockets.items()}
+
+
+def _vars(e: Expr):
+    if isinstance(e, Var):
+        yield e.name
+    elif isinstance(e, Splat):
+        yield from _vars(e.expr)
+
+
+def remove_unused(scope: Scope) -> None:
+    """Drops ops whose outputs reach no scope output."""
+    live: set[str] = set()
+    for _, _, e in scope.outputs:
+        live.update(_vars(e))
+    kept = []
+    for op in reversed(scope.ops):
+        if any(op.out(p).name in live for p, _ in op.outs):
+            kept.append(op)
+            for a in op.args:
+                live.update(_vars(a))
+    scope.ops = list(reversed(kept))
+
+
+def optimise(scope: Scope) -> None:
+    fold_constants(scope)
+    merge_common(scope)
+    remove_unused(scope)

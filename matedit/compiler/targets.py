@@ -1,0 +1,49 @@
+"""The three GLSL dialects matedit emits, and the bindings they share.
+
+Bindings (Vulkan: set 0; desktop GL and WebGL2 assign block bindings and texture
+units by name at link time): 0 LightsBlock, 1 IblBlock, 2 prefiltered
+environment, 3 BRDF LUT, 4 unfiltered environment (see shaders/ibl_inputs.glsl),
+5 FrameBlock, 6 MaterialParams, 7 and up the material's textures.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+FRAME_BINDING = 5
+MATERIAL_BINDING = 6
+FIRST_TEXTURE_BINDING = 7
+
+
+@dataclass(frozen=True)
+class Target:
+    name: str
+    version: str
+    vulkan: bool = False
+    es: bool = False
+
+    def prelude(self) -> str:
+        lines = []
+        if self.es:
+            lines += ["precision highp float;", "precision highp int;",
+                      "precision highp sampler2D;", "precision highp samplerCube;"]
+        if self.vulkan:
+            lines += [
+                      "#define MATEDIT_UBO(n) layout(std140, set = 0, binding = n)",
+                      "#define MATEDIT_BINDING(n) layout(set = 0, binding = n)"]
+        else:
+            lines += ["#define MATEDIT_UBO(n) layout(std140)", "#define MATEDIT_BINDING(n)"]
+        return "\n".join(lines)
+
+    def varying(self, direction: str, location: int, decl: str) -> str:
+        """An interface variable between stages; Vulkan needs explicit locations."""
+        if self.vulkan:
+            return f"layout(location = {location}) {direction} {decl};"
+        return f"{direction} {decl};"
+
+
+TARGETS = {
+    "glsl330": Target("glsl330", "330 core"),
+    "glsl450": Target("glsl450", "450", vulkan=True),
+    "essl300": Target("essl300", "300 es", es=True),
+}

@@ -1,0 +1,227 @@
+"""Bake an environment for the split-sum shading, with a disk cache.
+
+`bake()` turns an environment into an `IBLBake`: the GGX-prefiltered cube mips, the
+environment BRDF LUT and the SH irradiance, all numpy arrays. A second bake of the same
+pixels with the same settings reads the cache and does no GPU work.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from matedit.ibl import cache, gpu
+from matedit.ibl.environment import DEFAULT_ENVIRONMENT, Environment, load_environment
+from matedit.ibl.sh import sh_irradiance
+
+Progress = Callable[[float, str], None]
+
+# Rougher mips get this many times more samples per mip, up to the second factor (see
+# gpu.Baker.prefilter): same work per mip, and wide lobes converge.
+PREFILTER_GROWTH = (4, 16)
+
+
+@dataclass(frozen=True)
+class BakeSettings:
+    """What a bake computes; every field is part of the cache key.
+
+    size: face size of mip 0 (a power of two, 8 to 4096). levels: number of prefiltered
+    mips, mip m for roughness m / (levels - 1); None means down to 4 x 4 faces
+    (log2(size) - 1). samples: GGX samples per texel of prefiltered mip 1; each rougher
+    mip takes 4 times more, up to 16 times (`PREFILTER_GROWTH`). lod_bias: extra
+    source-mip blur of each sample (filtered importance sampling). lut_size, lut_samples:
+    the environment BRDF LUT (see matedit/ibl/lut.py).
+    """
+
+    size: int = 256
+    samples: int = 256
+    levels: int | None = None
+    lod_bias: float = 0.5
+    lut_size: int = 128
+    lut_samples: int = 1024
+
+    def resolved(self) -> BakeSettings:
+        """Check the values; fill in `levels`. Raises ValueError on nonsense."""
+        if self.size < 8 or self.size > 4096 or self.size & (self.size - 1):
+            raise ValueError(f"cube size must be a power of two from 8 to 4096, not {self.size}")
+        if not 1 <= self.samples <= 65536:
+            raise ValueError(f"samples must be 1 to 65536, not {self.samples}")
+        if not 2 <= self.lut_size <= 4096:
+            raise ValueError(f"LUT size must be 2 to 4096, not {self.lut_size}")
+        if not 64 <= self.lut_samples <= 65536:
+            raise ValueError(f"LUT samples must be 64 to 65536, not {self.lut_samples}")
+        max_levels = int(math.log2(self.size)) + 1
+        levels = self.levels if self.levels is not None else max(2, max_levels - 2)
+        if not 1 <= levels <= max_levels:
+            raise ValueError(f"levels must be 1 to {max_levels} for size {self.size}, not {levels}")
+        return replace(self, levels=levels)
+
+
+@dataclass
+class IBLBake:
+    """A baked environment, ready to upload (`matedit.ibl.textures.upload`) or write out.
+
+    mips[m]: (6, size >> m, size >> m, 3) float32 cube faces in OpenGL face order
+        (+X -X +Y -Y +Z -Z, rows as `TextureCube.write` takes them), prefiltered for
+        roughness m / (len(mips) - 1); mips[0] is the environment itself.
+    lut: (N, N, 2) float32, lut[k, i] = (A, B) at roughness (k + 0.5) / N and
+        NoV (i + 0.5) / N; upload as is and sample with texture(lut, vec2(NoV, roughness)).
+    sh: (9, 3) irradiance coefficients: E(N) = sum_i sh[i] * Y_i(N) (matedit.ibl.sh).
+    """
+
+    mips: list[np.ndarray]
+    lut: np.ndarray
+    sh: np.ndarray
+    settings: BakeSettings
+    key: str = ""
+    from_cache: bool = False
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def levels(self) -> int:
+        return len(self.mips)
+
+    def roughness(self, level: int) -> float:
+        return level / (self.levels - 1) if self.levels > 1 else 0.0
+
+
+def _cache_dir(cache_dir: str | os.PathLike | None) -> Path:
+    return Path(cache_dir) if cache_dir is not None else cache.ibl_cache_dir()
+
+
+def bake_brdf_lut(
+    size: int = 128,
+    samples: int = 1024,
+    *,
+    baker: gpu.Baker | None = None,
+    use_cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+) -> np.ndarray:
+    """The environment BRDF LUT (size, size, 2), from the cache when possible."""
+    BakeSettings(lut_size=size, lut_samples=samples).resolved()  # validates
+    key = cache.make_key("brdf-lut", size=size, samples=samples, method="quadrature")
+    path = _cache_dir(cache_dir) / f"lut-{key}.npz"
+    if use_cache:
+        hit = cache.load(path)
+        if hit is not None and hit.get("lut", np.empty(0)).shape == (size, size, 2):
+            return hit["lut"].astype(np.float32)
+    own = baker is None
+    b = baker if baker is not None else gpu.Baker()
+    try:
+        lut = b.brdf_lut(size, samples)
+    finally:
+        if own:
+            b.close()
+    if use_cache:
+        try:
+            cache.save(path, {"lut": lut})
+        except OSError:
+            pass  # a read-only cache only costs time
+    return lut
+
+
+def _pack(result: IBLBake) -> dict[str, np.ndarray]:
+    arrays = {f"mip{m}": mip for m, mip in enumerate(result.mips)}
+    arrays["lut"] = result.lut
+    arrays["sh"] = result.sh
+    arrays["settings"] = np.array(json.dumps(asdict(result.settings), sort_keys=True))
+    return arrays
+
+
+def _unpack(arrays: dict[str, np.ndarray], settings: BakeSettings, key: str) -> IBLBake | None:
+    try:
+        mips = [arrays[f"mip{m}"].astype(np.float32) for m in range(settings.levels)]
+        lut, sh = arrays["lut"].astype(np.float32), arrays["sh"].astype(np.float64)
+    except KeyError:
+        return None
+    expected = [(6, settings.size >> m, settings.size >> m, 3) for m in range(settings.levels)]
+    if [m.shape for m in mips] != expected or lut.shape != (settings.lut_size,) * 2 + (2,):
+        return None
+    if sh.shape != (9, 3):
+        return None
+    return IBLBake(mips=mips, lut=lut, sh=sh, settings=settings, key=key, from_cache=True)
+
+
+def bake(
+    env: Environment | str | os.PathLike = DEFAULT_ENVIRONMENT,
+    settings: BakeSettings | None = None,
+    *,
+    ctx=None,
+    use_cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    progress: Progress | None = None,
+) -> IBLBake:
+    """Bake `env` (an Environment, a file path or a built-in name) on the GPU, or load it.
+
+    ctx: a moderngl context to bake in (default: a headless one, created and released
+    here). progress(fraction, message) is called as work proceeds. Raises
+    EnvironmentMapError for unusable files and ValueError for bad settings.
+    """
+    settings = (settings or BakeSettings()).resolved()
+    if not isinstance(env, Environment):
+        env = load_environment(env, settings.size)
+    key = cache.make_key(
+        "ibl", env=env.content_hash(), settings=asdict(settings), growth=PREFILTER_GROWTH
+    )
+    folder = _cache_dir(cache_dir)
+    path = folder / f"ibl-{key}.npz"
+    if use_cache:
+        hit = cache.load(path)
+        result = _unpack(hit, settings, key) if hit is not None else None
+        if result is not None:
+            result.warnings = list(env.warnings)
+            if progress:
+                progress(1.0, "loaded from cache")
+            return result
+
+    def report(lo: float, hi: float) -> Progress | None:
+        if progress is None:
+            return None
+        return lambda f, msg: progress(lo + (hi - lo) * f, msg)
+
+    baker = gpu.Baker(ctx)
+    try:
+        if progress:
+            progress(0.0, "environment to cube")
+        if env.equirect is not None:
+            cube = baker.equirect_to_cube(env.equirect, settings.size)
+        else:
+            cube = baker.resample_cube(env.faces, settings.size)
+        mips = baker.prefilter(
+            cube,
+            settings.levels,
+            settings.samples,
+            settings.lod_bias,
+            report(0.05, 0.95),
+            growth=PREFILTER_GROWTH[0],
+            max_growth=PREFILTER_GROWTH[1],
+        )
+        if progress:
+            progress(0.95, "BRDF LUT")
+        lut = bake_brdf_lut(
+            settings.lut_size,
+            settings.lut_samples,
+            baker=baker,
+            use_cache=use_cache,
+            cache_dir=folder,
+        )
+    finally:
+        baker.close()
+    sh = sh_irradiance(cube)
+    result = IBLBake(
+        mips=mips, lut=lut, sh=sh, settings=settings, key=key, warnings=list(env.warnings)
+    )
+    if use_cache:
+        try:
+            cache.save(path, _pack(result))
+        except OSError as exc:
+            result.warnings.append(f"{folder}: cannot write the IBL cache: {exc.strerror or exc}")
+    if progress:
+        progress(1.0, "done")
+    return result

@@ -1,0 +1,84 @@
+"""On-disk cache of bakes: one .npz per (environment content, settings, bake shaders) key.
+
+Location: ``$MATEDIT_CACHE_DIR/ibl`` when that variable is set, else
+``${XDG_CACHE_HOME:-~/.cache}/matedit/ibl``. Files are written to a temporary name in the
+same folder and renamed into place, so a reader never sees half a file; an unreadable
+entry counts as a miss and is baked again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+import zipfile
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from matedit.resources import shaders_dir
+
+# Bump when the meaning of cached arrays changes without any shader text changing.
+CACHE_FORMAT = 1
+
+
+def cache_root() -> Path:
+    """The matedit cache folder (not created)."""
+    override = os.environ.get("MATEDIT_CACHE_DIR")
+    if override:
+        return Path(override).expanduser()
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    base = Path(xdg).expanduser() if xdg else Path.home() / ".cache"
+    return base / "matedit"
+
+
+def ibl_cache_dir() -> Path:
+    return cache_root() / "ibl"
+
+
+@cache
+def shader_fingerprint() -> str:
+    """Hash of every shader a bake runs, so editing one invalidates old entries."""
+    root = shaders_dir()
+    h = hashlib.sha256()
+    for rel in ("common.glsl", "sampling.glsl"):
+        h.update((root / rel).read_bytes())
+    for p in sorted((root / "bake").rglob("*")):
+        if p.is_file():
+            h.update(p.relative_to(root).as_posix().encode())
+            h.update(p.read_bytes())
+    return h.hexdigest()
+
+
+def make_key(kind: str, **parts) -> str:
+    """A stable hex key of JSON-able parts, the cache format and the shader fingerprint."""
+    payload = {"kind": kind, "format": CACHE_FORMAT, "shaders": shader_fingerprint(), **parts}
+    text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:40]
+
+
+def load(path: Path) -> dict[str, np.ndarray] | None:
+    """The arrays of a cache file, or None when missing or unreadable."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return {name: data[name] for name in data.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError):
+        return None
+
+
+def save(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Write arrays to `path` atomically (temporary file in the same folder, then rename)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            np.savez(f, **arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise

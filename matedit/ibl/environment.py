@@ -1,0 +1,106 @@
+"""Environments: HDR images (equirect or cube cross) and the built-ins, as linear float RGB.
+
+`load_environment` accepts a file path or a built-in name. LDR files (8/16-bit PNG,
+JPEG, ...) are taken as sRGB, linearised, and flagged in `Environment.warnings`; every
+unreadable input raises `EnvironmentMapError` (a ValueError) whose message starts with
+the file name.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from matedit.ibl.builtin import BUILTIN_NAMES, builtin_environment
+from matedit.ibl.cubemap import cross_to_faces
+from matedit.io.images import ImageError, read_image
+
+DEFAULT_ENVIRONMENT = "studio"
+
+
+class EnvironmentMapError(ValueError):
+    """An environment that cannot be used; the message names the file and what is wrong."""
+
+
+@dataclass
+class Environment:
+    """Linear RGB radiance, as an equirect image (h, w, 3) or cube faces (6, n, n, 3)."""
+
+    name: str
+    equirect: np.ndarray | None = None
+    faces: np.ndarray | None = None
+    warnings: list[str] = field(default_factory=list)
+
+    def content_hash(self) -> str:
+        """SHA-256 of the pixels (not of the file): same radiance, same key."""
+        h = hashlib.sha256()
+        arr = self.equirect if self.equirect is not None else self.faces
+        kind = "equirect" if self.equirect is not None else "cube"
+        h.update(f"{kind}:{arr.shape}".encode())
+        h.update(np.ascontiguousarray(arr, dtype=np.float32).tobytes())
+        return h.hexdigest()
+
+
+def srgb_to_linear(x: np.ndarray) -> np.ndarray:
+    """The sRGB transfer function, inverted (IEC 61966-2-1)."""
+    x = np.clip(x, 0.0, 1.0)
+    return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def _to_rgb(pixels: np.ndarray) -> np.ndarray:
+    c = pixels.shape[2]
+    if c >= 3:
+        return pixels[..., :3]
+    return np.repeat(pixels[..., :1], 3, axis=2)  # grey, or grey + alpha
+
+
+def builtin(name: str, size: int = 256) -> Environment:
+    """A built-in environment drawn at a resolution that suits cube faces of `size`."""
+    width = max(256, 4 * int(size))
+    return Environment(name=name, equirect=builtin_environment(name, width))
+
+
+def load_environment(spec: str | os.PathLike, size: int = 256) -> Environment:
+    """Load an environment from a file, or draw a built-in ('studio', 'sky').
+
+    A path that exists is always read as a file; otherwise a built-in name is accepted.
+    Layout comes from the aspect ratio: 2:1 is equirectangular, 4:3 or 3:4 a cube cross.
+    `size` only sets the resolution the built-ins are drawn at.
+    """
+    text = os.fspath(spec)
+    path = Path(text)
+    if not path.exists() and text in BUILTIN_NAMES:
+        return builtin(text, size)
+    if not path.exists():
+        raise EnvironmentMapError(
+            f"{text}: no such file (built-in environments: {', '.join(BUILTIN_NAMES)})"
+        )
+    try:
+        image = read_image(path)
+    except ImageError as exc:
+        raise EnvironmentMapError(str(exc)) from exc
+    warnings: list[str] = []
+    rgb = _to_rgb(image.pixels)
+    if image.is_ldr:
+        rgb = srgb_to_linear(rgb)
+        warnings.append(
+            f"{text}: LDR image ({image.format_name}) read as sRGB and linearised; "
+            "it has no light brighter than 1, so lighting will look flat (prefer .hdr or .exr)"
+        )
+    bad = ~np.isfinite(rgb) | (rgb < 0)
+    if bad.any():
+        warnings.append(f"{text}: {int(bad.any(axis=-1).sum())} pixels negative or not finite, set to 0")
+        rgb = np.where(bad, 0.0, rgb).astype(np.float32)
+    h, w = rgb.shape[:2]
+    if abs(w - 2 * h) <= max(1, w // 100):
+        return Environment(name=text, equirect=np.ascontiguousarray(rgb), warnings=warnings)
+    if (w * 3 == h * 4 and w % 4 == 0) or (w * 4 == h * 3 and w % 3 == 0):
+        faces = cross_to_faces(rgb)
+        return Environment(name=text, faces=np.ascontiguousarray(faces), warnings=warnings)
+    raise EnvironmentMapError(
+        f"{text}: a {w}x{h} image is neither equirectangular (2:1) nor a cube cross (4:3 or 3:4)"
+    )

@@ -1,0 +1,244 @@
+"""The GPU half of the bake: resampling to a cube, GGX prefiltering, the BRDF LUT.
+
+Everything renders with one full-screen triangle into a float32 target and reads the
+texels back as numpy arrays, so the results can be cached and tested without a window.
+Shaders live in shaders/bake/ and are assembled with `matedit.glsl.include`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import moderngl
+import numpy as np
+
+from matedit.glsl.include import assemble
+from matedit.resources import shaders_dir
+
+GL_TEXTURE_CUBE_MAP_SEAMLESS = 0x884F
+
+# Gauss-Legendre orders of the LUT quadrature (see matedit/ibl/lut.py); the shader's arrays.
+LUT_S_NODES = 4
+LUT_PHI_NODES = 8
+
+Progress = Callable[[float, str], None]
+
+
+class BakeShaderError(RuntimeError):
+    """A bake shader failed to compile: an internal error, never bad user input."""
+
+
+def create_context() -> moderngl.Context:
+    """A headless OpenGL 3.3+ context (EGL first, then the platform default)."""
+    try:
+        return moderngl.create_standalone_context(require=330, backend="egl")
+    except Exception:
+        return moderngl.create_standalone_context(require=330)
+
+
+def _gauss_legendre01(n: int) -> tuple[np.ndarray, np.ndarray]:
+    x, w = np.polynomial.legendre.leggauss(n)
+    return ((x + 1.0) * 0.5).astype(np.float32), (w * 0.5).astype(np.float32)
+
+
+def samples_for_mip(samples: int, mip: int, growth: int = 4, max_growth: int = 16) -> int:
+    """GGX samples a texel at prefiltered mip `mip` >= 1 (see `Baker.prefilter`)."""
+    return int(samples * min(growth ** max(mip - 1, 0), max_growth))
+
+
+class Baker:
+    """Owns the bake programs for one moderngl context (given, or created and owned)."""
+
+    def __init__(self, ctx: moderngl.Context | None = None) -> None:
+        self._owns = ctx is None
+        self.ctx = ctx if ctx is not None else create_context()
+        self._programs: dict[tuple[str, str], moderngl.Program] = {}
+        self._vaos: dict[tuple[str, str], moderngl.VertexArray] = {}
+
+    def close(self) -> None:
+        for vao in self._vaos.values():
+            vao.release()
+        for prog in self._programs.values():
+            prog.release()
+        self._vaos.clear()
+        self._programs.clear()
+        if self._owns:
+            self.ctx.release()
+
+    def __enter__(self) -> Baker:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- plumbing -------------------------------------------------------------------------
+
+    def _vao(self, frag: str, defines: str = "") -> tuple[moderngl.Program, moderngl.VertexArray]:
+        key = (frag, defines)
+        if key not in self._programs:
+            root = shaders_dir()
+            vert = assemble((root / "bake" / "fullscreen.vert").read_text(), name="bake/fullscreen.vert")
+            frag_asm = assemble(
+                (root / "bake" / frag).read_text(), name=f"bake/{frag}", prelude=defines
+            )
+            try:
+                prog = self.ctx.program(vertex_shader=vert.text, fragment_shader=frag_asm.text)
+            except moderngl.Error as exc:
+                raise BakeShaderError(f"bake/{frag}: {frag_asm.map_log(str(exc))}") from exc
+            self._programs[key] = prog
+            self._vaos[key] = self.ctx.vertex_array(prog, [])
+        return self._programs[key], self._vaos[key]
+
+    def _draw(self, vao: moderngl.VertexArray, width: int, height: int) -> np.ndarray:
+        """Run `vao` over a width x height float target; (height, width, 4), row 0 = y 0."""
+        tex = self.ctx.texture((width, height), 4, dtype="f4")
+        fbo = self.ctx.framebuffer(color_attachments=[tex])
+        try:
+            fbo.use()
+            self.ctx.viewport = (0, 0, width, height)
+            self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+            vao.render(moderngl.TRIANGLES, vertices=3)
+            data = fbo.read(components=4, dtype="f4")
+        finally:
+            fbo.release()
+            tex.release()
+        return np.frombuffer(data, dtype=np.float32).reshape(height, width, 4).copy()
+
+    @staticmethod
+    def _set(prog: moderngl.Program, name: str, value) -> None:
+        if name in prog:  # the driver may drop uniforms a variant does not use
+            prog[name].value = value
+
+    # -- environment -> cube ------------------------------------------------------------------
+
+    def equirect_to_cube(self, image: np.ndarray, size: int) -> np.ndarray:
+        """Resample an equirect image (h, w, 3) to cube faces (6, size, size, 3), box-filtered."""
+        h, w = image.shape[:2]
+        rgb = np.ascontiguousarray(image[..., :3], dtype=np.float32)
+        tex = self.ctx.texture((w, h), 3, data=rgb.tobytes(), dtype="f4")
+        tex.repeat_x, tex.repeat_y = True, False
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        # Source texels per output texel (equator vs. face centre), rounded up.
+        ratio = w / (math.pi * size)
+        try:
+            return self._to_cube(tex, "", size, max(1, min(8, math.ceil(ratio))))
+        finally:
+            tex.release()
+
+    def resample_cube(self, faces: np.ndarray, size: int) -> np.ndarray:
+        """Resample cube faces (6, n, n, 3) to another face size."""
+        n = faces.shape[1]
+        if n == size:
+            return np.ascontiguousarray(faces[..., :3], dtype=np.float32)
+        tex = self.cube_texture(faces, mipmaps=False)
+        try:
+            return self._to_cube(tex, "#define SOURCE_CUBE\n", size, max(1, min(8, math.ceil(n / size))))
+        finally:
+            tex.release()
+
+    def _to_cube(self, tex, defines: str, size: int, supersample: int) -> np.ndarray:
+        prog, vao = self._vao("to_cube.frag", defines)
+        self.ctx.enable_direct(GL_TEXTURE_CUBE_MAP_SEAMLESS)
+        tex.use(location=0)
+        self._set(prog, "uSource", 0)
+        self._set(prog, "uSize", size)
+        self._set(prog, "uSuper", supersample)
+        out = np.empty((6, size, size, 3), dtype=np.float32)
+        for face in range(6):
+            self._set(prog, "uFace", face)
+            out[face] = self._draw(vao, size, size)[..., :3]
+        return out
+
+    def cube_texture(self, faces: np.ndarray, mipmaps: bool = True) -> moderngl.TextureCube:
+        """Upload faces (6, n, n, 3) as an RGB32F cube map, optionally with a full mip chain."""
+        n = faces.shape[1]
+        tex = self.ctx.texture_cube((n, n), 3, dtype="f4")
+        for face in range(6):
+            tex.write(face, np.ascontiguousarray(faces[face, ..., :3], dtype=np.float32).tobytes())
+        if mipmaps:
+            tex.build_mipmaps()
+            tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        else:
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        return tex
+
+    # -- GGX prefiltering ---------------------------------------------------------------------
+
+    def prefilter(
+        self,
+        faces: np.ndarray,
+        levels: int,
+        samples: int,
+        lod_bias: float = 1.0,
+        progress: Progress | None = None,
+        growth: int = 4,
+        max_growth: int = 16,
+    ) -> list[np.ndarray]:
+        """Mips 0..levels-1 of the prefiltered environment; mip m is for roughness m/(levels-1).
+
+        Mip 0 (roughness 0, a mirror) is the source itself, copied exactly. Mip 1 takes
+        `samples` GGX samples a texel; each rougher mip, with a quarter of the texels and
+        a wider lobe, takes `growth` times more, up to `max_growth` times `samples`.
+        """
+        n = faces.shape[1]
+        mips = [np.ascontiguousarray(faces[..., :3], dtype=np.float32)]
+        if levels <= 1:
+            return mips
+        src = self.cube_texture(faces)
+        prog, vao = self._vao("prefilter_ggx.frag")
+        self.ctx.enable_direct(GL_TEXTURE_CUBE_MAP_SEAMLESS)
+        # Work per mip is proportional to its texel count: report progress by it.
+        total = sum(6 * max(1, n >> m) ** 2 for m in range(1, levels))
+        done = 0
+        try:
+            src.use(location=0)
+            self._set(prog, "uSource", 0)
+            self._set(prog, "uSourceSize", float(n))
+            self._set(prog, "uMaxSourceLod", float(int(math.log2(n))))
+            self._set(prog, "uLodBias", float(lod_bias))
+            for m in range(1, levels):
+                size = max(1, n >> m)
+                roughness = m / (levels - 1)
+                self._set(prog, "uSamples", samples_for_mip(samples, m, growth, max_growth))
+                self._set(prog, "uSize", size)
+                self._set(prog, "uRoughness", roughness)
+                mip = np.empty((6, size, size, 3), dtype=np.float32)
+                for face in range(6):
+                    self._set(prog, "uFace", face)
+                    mip[face] = self._draw(vao, size, size)[..., :3]
+                    done += size * size
+                    if progress:
+                        progress(done / total, f"prefilter mip {m}/{levels - 1}")
+                mips.append(mip)
+        finally:
+            src.release()
+        return mips
+
+    # -- environment BRDF LUT -------------------------------------------------------------------
+
+    def brdf_lut(self, size: int, samples: int, method: str = "quadrature") -> np.ndarray:
+        """The (size, size, 2) LUT: [k, i] = (A, B) at roughness (k+.5)/size, NoV (i+.5)/size.
+
+        `samples` is the number of integrand evaluations per texel: with the default
+        "quadrature" method it sets the number of panels (samples / 32); "hammersley" is
+        the notes' Monte Carlo estimator with that many points, kept for comparison.
+        """
+        if method == "hammersley":
+            prog, vao = self._vao("brdf_lut.frag", "#define LUT_HAMMERSLEY\n")
+            self._set(prog, "uSamples", int(samples))
+        elif method == "quadrature":
+            defines = f"#define S_NODES {LUT_S_NODES}\n#define PHI_NODES {LUT_PHI_NODES}\n"
+            prog, vao = self._vao("brdf_lut.frag", defines)
+            panels = max(2, round(samples / (LUT_S_NODES * LUT_PHI_NODES)))
+            xs, ws = _gauss_legendre01(LUT_S_NODES)
+            xp, wp = _gauss_legendre01(LUT_PHI_NODES)
+            prog["uNodeS"].write(xs.tobytes())
+            prog["uWeightS"].write(ws.tobytes())
+            prog["uNodePhi"].write(xp.tobytes())
+            prog["uWeightPhi"].write(wp.tobytes())
+            self._set(prog, "uPanels", panels)
+        else:
+            raise ValueError(f"unknown LUT method {method!r}")
+        self._set(prog, "uSize", int(size))
+        return self._draw(vao, size, size)[..., :2].copy()
