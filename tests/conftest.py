@@ -23,6 +23,6 @@ def gl_ctx():
 @pytest.fixture
 def ctx(gl_ctx):
     """The session context; fails the test if it leaves a GL error behind."""
-    gl_ctx.error  # clear any stale error
+    _ = gl_ctx.error  # reading it clears any stale error
     yield gl_ctx
     assert gl_ctx.error == "GL_NO_ERROR"

@@ -5,7 +5,7 @@ Each module exposes `register(subparsers)`, which adds its parser and sets
 Bad input raises `matedit.cli.UsageError` (one line, exit 2).
 """
 
+from matedit.commands import bake_ibl, brdf_lut, validate
 from matedit.commands import compile as compile_cmd
-from matedit.commands import validate
 
-REGISTRY = [validate.register, compile_cmd.register]
+REGISTRY = [validate.register, compile_cmd.register, bake_ibl.register, brdf_lut.register]

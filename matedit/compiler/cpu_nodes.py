@@ -214,9 +214,10 @@ def pcg_hash(v: np.ndarray) -> np.ndarray:
     return (word >> np.uint32(22)) ^ word
 
 
-def _lattice(cx: np.ndarray, cy: np.ndarray, seed: int) -> np.ndarray:
-    """nodeNoiseLattice: pcg(x + pcg(y + seed)), top 24 bits as a float in [0, 1)."""
-    h = pcg_hash(cx + pcg_hash(cy + np.uint32(seed)))
+def noise_lattice(cx: np.ndarray, cy: np.ndarray, seed) -> np.ndarray:
+    """nodeNoiseLattice: pcg(x + pcg(y + seed)) of uint32 cell coordinates, its top 24 bits
+    as a float in [0, 1) (exact in float32)."""
+    h = pcg_hash(cx + pcg_hash(cy + np.asarray(seed, dtype=np.uint32)))
     return (h >> np.uint32(8)).astype(np.float32) * np.float32(1.0 / 16777216.0)
 
 
@@ -227,10 +228,10 @@ def _noise_octave(p: np.ndarray, seed: int) -> np.ndarray:
     c = i.astype(np.int64).astype(np.uint32)
     cx, cy = c[:, 0], c[:, 1]
     one = np.uint32(1)
-    v00 = _lattice(cx, cy, seed)
-    v10 = _lattice(cx + one, cy, seed)
-    v01 = _lattice(cx, cy + one, seed)
-    v11 = _lattice(cx + one, cy + one, seed)
+    v00 = noise_lattice(cx, cy, seed)
+    v10 = noise_lattice(cx + one, cy, seed)
+    v01 = noise_lattice(cx, cy + one, seed)
+    v11 = noise_lattice(cx + one, cy + one, seed)
     u = f * f * (3.0 - 2.0 * f)
     return _mix(_mix(v00, v10, u[:, 0]), _mix(v01, v11, u[:, 0]), u[:, 1])
 

@@ -372,7 +372,7 @@ register(NodeDef(
 ))
 register(NodeDef(
     "layer_blend", "Layer Blend (mask)", "Layers",
-    "Blends layer over base by mask, field by field; normals by reoriented blending.",
+    "Blends layer over base by mask, field by field; normals by normalized lerp (nlerp).",
     inputs=(_i("base", MA, None, required=True), _i("layer", MA, None, required=True),
             _i("mask", "float", 1.0, "layer coverage", UNIT)),
     outputs=(_o("result", MA),),

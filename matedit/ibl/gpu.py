@@ -55,6 +55,7 @@ class Baker:
         self.ctx = ctx if ctx is not None else create_context()
         self._programs: dict[tuple[str, str], moderngl.Program] = {}
         self._vaos: dict[tuple[str, str], moderngl.VertexArray] = {}
+        self._default_fbo: moderngl.Framebuffer | None = None
 
     def close(self) -> None:
         for vao in self._vaos.values():
@@ -92,6 +93,14 @@ class Baker:
 
     def _draw(self, vao: moderngl.VertexArray, width: int, height: int) -> np.ndarray:
         """Run `vao` over a width x height float target; (height, width, 4), row 0 = y 0."""
+        # Rebind what was bound before releasing our target: moderngl would otherwise
+        # restore the deleted framebuffer when it next creates one (GL_INVALID_OPERATION).
+        previous = self.ctx.fbo
+        if previous is None:
+            if self._default_fbo is None:
+                self._default_fbo = self.ctx.detect_framebuffer(0)
+            previous = self._default_fbo
+        viewport = self.ctx.viewport
         tex = self.ctx.texture((width, height), 4, dtype="f4")
         fbo = self.ctx.framebuffer(color_attachments=[tex])
         try:
@@ -101,6 +110,9 @@ class Baker:
             vao.render(moderngl.TRIANGLES, vertices=3)
             data = fbo.read(components=4, dtype="f4")
         finally:
+            previous.use()
+            if viewport is not None:
+                self.ctx.viewport = viewport
             fbo.release()
             tex.release()
         return np.frombuffer(data, dtype=np.float32).reshape(height, width, 4).copy()

@@ -85,8 +85,9 @@ def specularTowards(s: ShadingContext, L) -> np.ndarray:
     NoH = saturate(dot(s.N, H))
     VoH = saturate(dot(s.V, H))
     NxH = np.cross(s.N, H)
-    D = D_GGX(NoH, s.a, dot(NxH, NxH))
+    # Masked where NoL = 0 (there H may be undefined and D infinite), as the GLSL returns 0.
     with np.errstate(divide="ignore", invalid="ignore"):
+        D = D_GGX(NoH, s.a, dot(NxH, NxH))
         lobe = np.where(NoL > 0.0, D * V_SchlickSmith(s.NoV, NoL, s.k) * NoL, 0.0)
     return lobe[..., None] * F_Schlick(s.F0, VoH)
 

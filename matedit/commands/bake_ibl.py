@@ -1,0 +1,76 @@
+"""`matedit bake-ibl ENV -o DIR [--size N] [--samples N]`: bake an environment to files.
+
+ENV is an HDR image (equirect 2:1 or cube cross 4:3 / 3:4; .hdr, .exr, ...) or a built-in
+name (studio, sky). The files written are described in matedit/ibl/output.py.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from matedit.cli import UsageError
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "bake-ibl",
+        help="bake an environment: prefiltered cube mips, BRDF LUT, SH irradiance",
+        description=__doc__.splitlines()[0].split(": ", 1)[1],
+    )
+    p.add_argument("env", metavar="ENV", help="environment image, or a built-in: studio, sky")
+    p.add_argument("-o", "--output", metavar="DIR", required=True, help="output folder")
+    p.add_argument("--size", type=int, default=256, help="face size of mip 0 (default 256)")
+    p.add_argument(
+        "--samples", type=int, default=256, help="GGX samples per texel of mip 1 (default 256)"
+    )
+    p.add_argument("--no-cache", action="store_true", help="bake even if a cached bake exists")
+    p.set_defaults(run=run)
+
+
+def terminal_progress(label: str):
+    """A progress callback drawing one line on stderr, or None when stderr is no terminal."""
+    if not sys.stderr.isatty():
+        return None
+
+    def show(fraction: float, message: str) -> None:
+        sys.stderr.write(f"\r{label}: {100 * fraction:3.0f}% {message:<40}")
+        if fraction >= 1.0:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+    return show
+
+
+def run(args: argparse.Namespace) -> int:
+    from matedit.ibl import BakeSettings, EnvironmentMapError, bake, load_environment, write_bake
+    from matedit.io.images import ImageError
+
+    settings = BakeSettings(size=args.size, samples=args.samples)
+    try:
+        settings = settings.resolved()
+    except ValueError as exc:
+        raise UsageError(f"{args.env}: {exc}") from exc
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"{out}: exists and is not a folder")
+    try:
+        env = load_environment(args.env, settings.size)
+    except EnvironmentMapError as exc:
+        raise UsageError(str(exc)) from exc
+    for warning in env.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+    env.warnings = []  # printed already
+    result = bake(env, settings, use_cache=not args.no_cache, progress=terminal_progress("bake-ibl"))
+    for warning in result.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+    try:
+        written = write_bake(result, out)
+    except ImageError as exc:
+        raise UsageError(str(exc)) from exc
+    except OSError as exc:
+        raise UsageError(f"{exc.filename or out}: {exc.strerror or exc}") from exc
+    for path in written:
+        print(path)
+    return 0

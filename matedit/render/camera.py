@@ -1,0 +1,74 @@
+"""An orbit camera: yaw and pitch around a target, distance, vertical field of view."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def perspective(fovy_deg: float, aspect: float, near: float, far: float) -> np.ndarray:
+    f = 1.0 / math.tan(math.radians(fovy_deg) / 2)
+    m = np.zeros((4, 4))
+    m[0, 0] = f / aspect
+    m[1, 1] = f
+    m[2, 2] = (far + near) / (near - far)
+    m[2, 3] = 2 * far * near / (near - far)
+    m[3, 2] = -1.0
+    return m
+
+
+def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
+    eye, target, up = (np.asarray(x, dtype=np.float64) for x in (eye, target, up))
+    f = target - eye
+    f /= np.linalg.norm(f)
+    s = np.cross(f, up)
+    if np.linalg.norm(s) < 1e-9:
+        s = np.cross(f, (0.0, 0.0, 1.0))
+    s /= np.linalg.norm(s)
+    u = np.cross(s, f)
+    m = np.eye(4)
+    m[0, :3], m[1, :3], m[2, :3] = s, u, -f
+    m[:3, 3] = -m[:3, :3] @ eye
+    return m
+
+
+@dataclass
+class OrbitCamera:
+    yaw: float = 30.0  # degrees about +Y, 0 looks down -Z
+    pitch: float = 15.0  # degrees above the horizon
+    distance: float = 3.2
+    target: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    fov: float = 40.0
+    near: float = 0.05
+    far: float = 100.0
+
+    def reset(self) -> None:
+        self.yaw, self.pitch, self.distance, self.target = 30.0, 15.0, 3.2, (0.0, 0.0, 0.0)
+
+    @property
+    def eye(self) -> np.ndarray:
+        y, p = math.radians(self.yaw), math.radians(self.pitch)
+        d = np.array([math.sin(y) * math.cos(p), math.sin(p), math.cos(y) * math.cos(p)])
+        return np.asarray(self.target) + self.distance * d
+
+    def orbit(self, dyaw: float, dpitch: float) -> None:
+        self.yaw = (self.yaw + dyaw) % 360.0
+        self.pitch = max(-89.0, min(89.0, self.pitch + dpitch))
+
+    def dolly(self, factor: float) -> None:
+        self.distance = max(0.3, min(50.0, self.distance * factor))
+
+    def pan(self, dx: float, dy: float) -> None:
+        """Moves the target in the view plane by fractions of the distance."""
+        view = self.view_matrix()
+        right, up = view[0, :3], view[1, :3]
+        t = np.asarray(self.target) + (right * dx + up * dy) * self.distance
+        self.target = tuple(float(x) for x in t)
+
+    def view_matrix(self) -> np.ndarray:
+        return look_at(self.eye, self.target)
+
+    def projection(self, aspect: float) -> np.ndarray:
+        return perspective(self.fov, aspect, self.near, self.far)
