@@ -9,6 +9,14 @@ import pytest
 os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "false")
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _private_cache(tmp_path_factory):
+    """Bakes go to a per-run cache, never the user's."""
+    if "MATEDIT_CACHE_DIR" not in os.environ:
+        os.environ["MATEDIT_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
+    yield
+
+
 @pytest.fixture(scope="session")
 def gl_ctx():
     moderngl = pytest.importorskip("moderngl")

@@ -61,7 +61,9 @@ def default_lut(gl_ctx) -> np.ndarray:
 def test_default_lut_is_within_1e3_of_brute_force_at_cell_centres(ctx, default_lut, reference):
     err = np.abs(default_lut - reference)
     # SHADING.md: 1e-3 max absolute; we measure ~5e-5, the reference's own accuracy.
-    assert err.max() < 1e-3, f"max error {err.max():.2e} at {np.unravel_index(err.argmax(), err.shape)}"
+    assert err.max() < 1e-3, (
+        f"max error {err.max():.2e} at {np.unravel_index(err.argmax(), err.shape)}"
+    )
 
 
 def test_lut_terms_are_bounded(ctx, default_lut):

@@ -166,3 +166,30 @@ def test_duplicate_parameter_names():
 
 def test_empty_material_reports_missing_output():
     assert any("Material Output" in e.message for e in errors(material()))
+
+
+def test_function_input_default_must_suit_its_type():
+    f = function()
+    node(f, "x", "function_input", {"name": "x", "type": "float", "default": "banana"})
+    node(f, "uv", "function_input", {"name": "uv", "type": "vec2", "default": "mesh_uv"})
+    node(f, "bad", "function_input", {"name": "c", "type": "vec3", "default": "mesh_uv"})
+    node(f, "out", "function_output", {"name": "y", "type": "float"})
+    link(f, "x", "value", "out", "value")
+    errs = {(e.node_id, e.port) for e in errors(f)}
+    assert ("x", "default") in errs and ("bad", "default") in errs
+    assert ("uv", "default") not in errs
+
+
+def test_layer_stack_port_name_collisions_are_errors(tmp_path):
+    a = function(tmp_path / "a.json")
+    node(a, "m", "function_input", {"name": "mask", "type": "float", "default": 0.5})
+    node(a, "make", "make_attributes")
+    node(a, "out", "function_output", {"name": "attributes", "type": "MaterialAttributes"})
+    link(a, "m", "value", "make", "metallic")
+    link(a, "make", "attributes", "out", "value")
+    save(a)
+    d = simple_material(tmp_path / "m.json")
+    node(d, "stack", "layer_stack", {"layers": [{"id": "a", "function": "a.json"},
+                                                {"id": "b", "function": "a.json"}]})
+    errs = errors(d, FileResolver())
+    assert any(e.node_id == "stack" and "b_mask" in e.message for e in errs)

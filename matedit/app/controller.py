@@ -8,30 +8,75 @@ as Qt signals; views subscribe and never hold graph state of their own.
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 from PySide6.QtCore import QObject, QTimer, Signal
 from PySide6.QtGui import QUndoCommand, QUndoStack
 
-from matedit.graph.commands import Command, CommandError, Macro
+from matedit.graph.commands import Command, CommandError, Macro, SetSetting, SetValue
 from matedit.graph.model import ChangeEvent, ChangeKind, MaterialDocument
 from matedit.graph.validate import Analysis, analyse
 from matedit.io.document import FileResolver
 
 
 class ModelUndoCommand(QUndoCommand):
-    """A model command on the QUndoStack. `redo` applies it, `undo` reverts it."""
+    """A model command on the QUndoStack. `redo` applies it, `undo` reverts it.
 
-    def __init__(self, controller: DocumentController, command: Command) -> None:
+    `applied=True` means the controller already applied it (to learn whether the
+    model accepts it before it goes on the stack), so the first `redo` is skipped.
+    """
+
+    def __init__(self, controller: DocumentController, command: Command,
+                 applied: bool = False) -> None:
         super().__init__(command.text)
         self.controller = controller
         self.command = command
+        self._skip_redo = applied
 
     def redo(self) -> None:
+        if self._skip_redo:
+            self._skip_redo = False
+            return
         self.command.apply(self.controller.document.graph)
 
     def undo(self) -> None:
         self.command.revert(self.controller.document.graph)
+
+
+_merge_ids = itertools.count(1000)
+
+
+def new_merge_id() -> int:
+    """An id for one continuous edit (a slider drag); QUndoCommand ids are ints."""
+    return next(_merge_ids)
+
+
+class MergingUndoCommand(ModelUndoCommand):
+    """A value or setting edit that absorbs later edits of the same field with the same id:
+    every step of a drag is applied (the viewport follows live) yet undoes as one."""
+
+    def __init__(self, controller: DocumentController, command: Command, merge_id: int,
+                 applied: bool = False) -> None:
+        super().__init__(controller, command, applied)
+        self._merge_id = merge_id
+
+    def id(self) -> int:
+        return self._merge_id
+
+    def mergeWith(self, other: QUndoCommand) -> bool:  # noqa: N802 - Qt's name
+        if not isinstance(other, MergingUndoCommand) or other.id() != self.id():
+            return False
+        mine, theirs = self.command, other.command
+        if isinstance(mine, SetValue) and isinstance(theirs, SetValue) and \
+                (mine.node_id, mine.port) == (theirs.node_id, theirs.port):
+            mine.value = theirs.value  # the model holds it already; our _old stays
+            return True
+        if isinstance(mine, SetSetting) and isinstance(theirs, SetSetting) and \
+                (mine.node_id, mine.name) == (theirs.node_id, theirs.name):
+            mine.value = theirs.value
+            return True
+        return False
 
 
 class DocumentController(QObject):
@@ -82,12 +127,20 @@ class DocumentController(QObject):
         return not self.undo_stack.isClean()
 
     # --- edits -----------------------------------------------------------------------------
-    def push(self, command: Command) -> bool:
-        """Apply `command` as one undoable edit; False (and nothing changes) if it is refused."""
+    def push(self, command: Command, merge_id: int | None = None) -> bool:
+        """Apply `command` as one undoable edit; False (and nothing changes) if it is refused.
+
+        With `merge_id` (see `new_merge_id`), consecutive value edits of one field carrying
+        the same id merge into one undo step.
+        """
         try:
-            self.undo_stack.push(ModelUndoCommand(self, command))
+            command.apply(self.document.graph)  # refused edits never reach the stack
         except CommandError:
             return False
+        if merge_id is None:
+            self.undo_stack.push(ModelUndoCommand(self, command, applied=True))
+        else:
+            self.undo_stack.push(MergingUndoCommand(self, command, merge_id, applied=True))
         return True
 
     def push_all(self, commands: list[Command], text: str) -> bool:
@@ -106,6 +159,12 @@ class DocumentController(QObject):
         if self._debounce.isActive():
             self._debounce.stop()
             self._settle()
+
+    def reanalyse(self) -> None:
+        """Validate and announce a structural change now, with no edit: a function or layer
+        file the document uses changed on disk (saved from another tab)."""
+        self._debounce.stop()
+        self._settle()
 
     def _settle(self) -> None:
         self.analysis = analyse(self.document, self.resolver)

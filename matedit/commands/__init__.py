@@ -5,7 +5,13 @@ Each module exposes `register(subparsers)`, which adds its parser and sets
 Bad input raises `matedit.cli.UsageError` (one line, exit 2).
 """
 
-from matedit.commands import bake_ibl, brdf_lut, validate
+from matedit.commands import bake_ibl, brdf_lut, render, validate
 from matedit.commands import compile as compile_cmd
 
-REGISTRY = [validate.register, compile_cmd.register, bake_ibl.register, brdf_lut.register]
+REGISTRY = [
+    validate.register,
+    compile_cmd.register,
+    render.register,
+    bake_ibl.register,
+    brdf_lut.register,
+]

@@ -62,7 +62,9 @@ def run(args: argparse.Namespace) -> int:
     for warning in env.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     env.warnings = []  # printed already
-    result = bake(env, settings, use_cache=not args.no_cache, progress=terminal_progress("bake-ibl"))
+    result = bake(
+        env, settings, use_cache=not args.no_cache, progress=terminal_progress("bake-ibl")
+    )
     for warning in result.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     try:

@@ -214,6 +214,12 @@ def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
         else:
             raise PortError(node.id, f"layers[{index}].blend",
                             f"unknown blend {blend!r} (alpha, height, or a blend function file)")
+    names: set[str] = set()
+    for p in ports:
+        if p.name in names:
+            raise PortError(node.id, "layers", f"two layer inputs would both be named {p.name!r}; "
+                            "rename a layer or the function input")
+        names.add(p.name)
     return ports
 
 

@@ -228,6 +228,8 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                 names[key] = n.id
                 if not str(key[1]).isidentifier():
                     diags.append(error(f"name {key[1]!r} is not an identifier", n.id, "name", f))
+                if n.kind == "function_input":
+                    diags.extend(_check_input_default(n, f))
     else:
         outs = [n.id for n in doc.graph.nodes.values() if n.kind == "material_output"]
         if len(outs) != 1:
@@ -249,6 +251,27 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                                    n.id, "name", f))
             params[name] = n.id
     return diags
+
+
+def _check_input_default(n, f) -> list[Diagnostic]:
+    """A function input's default must suit its type (the mesh UVs may default a vec2)."""
+    t_name = str(n.settings.get("type", "float"))
+    default = n.settings.get("default")
+    try:
+        t = PortType(t_name)
+    except ValueError:
+        return []  # reported with the ports
+    if default is None or not t.is_numeric:
+        return []
+    if default == nodes.MESH_UV:
+        if t == PortType.VEC2:
+            return []
+        return [error(f"only a vec2 input can default to {nodes.MESH_UV!r}", n.id, "default", f)]
+    try:
+        coerce_value(t, default)
+    except ValueError as exc:
+        return [error(f"default does not suit type {t}: {exc}", n.id, "default", f)]
+    return []
 
 
 def function_refs(doc: MaterialDocument) -> list[tuple[str, str]]:

@@ -43,4 +43,3 @@ __all__ = [
     "write_bake",
     "write_lut",
 ]
-

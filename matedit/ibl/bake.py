@@ -160,8 +160,10 @@ def bake(
     """Bake `env` (an Environment, a file path or a built-in name) on the GPU, or load it.
 
     ctx: a moderngl context to bake in (default: a headless one, created and released
-    here). progress(fraction, message) is called as work proceeds. Raises
-    EnvironmentMapError for unusable files and ValueError for bad settings.
+    here); a given context gets its framebuffer binding and viewport back, but is left
+    with BLEND, DEPTH_TEST and CULL_FACE disabled and seamless cube filtering enabled.
+    progress(fraction, message) is called as work proceeds. Raises EnvironmentMapError
+    for unusable files and ValueError for bad settings.
     """
     settings = (settings or BakeSettings()).resolved()
     if not isinstance(env, Environment):

@@ -93,7 +93,9 @@ def load_environment(spec: str | os.PathLike, size: int = 256) -> Environment:
         )
     bad = ~np.isfinite(rgb) | (rgb < 0)
     if bad.any():
-        warnings.append(f"{text}: {int(bad.any(axis=-1).sum())} pixels negative or not finite, set to 0")
+        warnings.append(
+            f"{text}: {int(bad.any(axis=-1).sum())} pixels negative or not finite, set to 0"
+        )
         rgb = np.where(bad, 0.0, rgb).astype(np.float32)
     h, w = rgb.shape[:2]
     if abs(w - 2 * h) <= max(1, w // 100):

@@ -79,7 +79,9 @@ class Baker:
         key = (frag, defines)
         if key not in self._programs:
             root = shaders_dir()
-            vert = assemble((root / "bake" / "fullscreen.vert").read_text(), name="bake/fullscreen.vert")
+            vert = assemble(
+                (root / "bake" / "fullscreen.vert").read_text(), name="bake/fullscreen.vert"
+            )
             frag_asm = assemble(
                 (root / "bake" / frag).read_text(), name=f"bake/{frag}", prelude=defines
             )
@@ -145,7 +147,9 @@ class Baker:
             return np.ascontiguousarray(faces[..., :3], dtype=np.float32)
         tex = self.cube_texture(faces, mipmaps=False)
         try:
-            return self._to_cube(tex, "#define SOURCE_CUBE\n", size, max(1, min(8, math.ceil(n / size))))
+            return self._to_cube(
+                tex, "#define SOURCE_CUBE\n", size, max(1, min(8, math.ceil(n / size)))
+            )
         finally:
             tex.release()
 

@@ -28,8 +28,17 @@ from matedit.ibl.bake import IBLBake
 from matedit.ibl.cubemap import faces_to_cross
 from matedit.io.images import write_image
 
-SH_BASIS_NAMES = ("Y00", "Y1-1 y", "Y10 z", "Y11 x", "Y2-2 xy", "Y2-1 yz", "Y20 3z^2-1",
-                  "Y21 xz", "Y22 x^2-y^2")
+SH_BASIS_NAMES = (
+    "Y00",
+    "Y1-1 y",
+    "Y10 z",
+    "Y11 x",
+    "Y2-2 xy",
+    "Y2-1 yz",
+    "Y20 3z^2-1",
+    "Y21 xz",
+    "Y22 x^2-y^2",
+)
 
 
 def write_lut(path: str | os.PathLike, lut: np.ndarray) -> Path:

@@ -79,8 +79,17 @@ def _gl():
         except (OSError, AttributeError):
             continue
         sub.restype = None
-        sub.argtypes = [ctypes.c_uint, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_int,
-                        ctypes.c_int, ctypes.c_uint, ctypes.c_uint, ctypes.c_void_p]
+        sub.argtypes = [
+            ctypes.c_uint,
+            ctypes.c_int,
+            ctypes.c_int,
+            ctypes.c_int,
+            ctypes.c_int,
+            ctypes.c_int,
+            ctypes.c_uint,
+            ctypes.c_uint,
+            ctypes.c_void_p,
+        ]
         store.restype = None
         store.argtypes = [ctypes.c_uint, ctypes.c_int]
         return sub, store
@@ -106,8 +115,17 @@ def upload_cube(ctx: moderngl.Context, mips: list[np.ndarray], unit: int | None 
             s = mip.shape[1]
             for face in range(6):
                 data = np.ascontiguousarray(mip[face], dtype=np.float32)
-                sub(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face, m, 0, 0, s, s, GL_RGB, GL_FLOAT,
-                    data.ctypes.data)
+                sub(
+                    GL_TEXTURE_CUBE_MAP_POSITIVE_X + face,
+                    m,
+                    0,
+                    0,
+                    s,
+                    s,
+                    GL_RGB,
+                    GL_FLOAT,
+                    data.ctypes.data,
+                )
     tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
     ctx.enable_direct(GL_TEXTURE_CUBE_MAP_SEAMLESS)
     return tex
@@ -116,8 +134,9 @@ def upload_cube(ctx: moderngl.Context, mips: list[np.ndarray], unit: int | None 
 def upload_lut(ctx: moderngl.Context, lut: np.ndarray) -> moderngl.Texture:
     """The (N, N, 2) LUT as an RG32F texture; texture coordinates (NoV, roughness)."""
     h, w = lut.shape[:2]
-    tex = ctx.texture((w, h), 2, data=np.ascontiguousarray(lut, dtype=np.float32).tobytes(),
-                      dtype="f4")
+    tex = ctx.texture(
+        (w, h), 2, data=np.ascontiguousarray(lut, dtype=np.float32).tobytes(), dtype="f4"
+    )
     tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
     tex.repeat_x = tex.repeat_y = False
     return tex

@@ -17,7 +17,9 @@ import numpy as np
 try:  # OpenImageIO is a hard dependency, but keep the import error readable.
     import OpenImageIO as oiio
 except ImportError as exc:  # pragma: no cover - broken install
-    raise ImportError("matedit needs the OpenImageIO Python module (pip install OpenImageIO)") from exc
+    raise ImportError(
+        "matedit needs the OpenImageIO Python module (pip install OpenImageIO)"
+    ) from exc
 
 # Integer storage means a display-referred (LDR) image; float/half means scene-linear HDR.
 _LDR_BASETYPES = {
@@ -89,7 +91,9 @@ def read_image(path: str | os.PathLike) -> ImageData:
         pixels = inp.read_image(0, 0, 0, c, "float")
         err = inp.geterror() if inp.has_error else ""
         if pixels is None or err:
-            raise ImageError(f"{name}: corrupt or truncated image: {_oiio_error(inp) if not err else err}")
+            raise ImageError(
+                f"{name}: corrupt or truncated image: {_oiio_error(inp) if not err else err}"
+            )
         pixels = np.asarray(pixels, dtype=np.float32)
         if pixels.ndim == 2:
             pixels = pixels[:, :, None]

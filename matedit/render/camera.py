@@ -38,14 +38,14 @@ def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
 class OrbitCamera:
     yaw: float = 30.0  # degrees about +Y, 0 looks down -Z
     pitch: float = 15.0  # degrees above the horizon
-    distance: float = 3.2
+    distance: float = 4.0
     target: tuple[float, float, float] = (0.0, 0.0, 0.0)
     fov: float = 40.0
     near: float = 0.05
     far: float = 100.0
 
     def reset(self) -> None:
-        self.yaw, self.pitch, self.distance, self.target = 30.0, 15.0, 3.2, (0.0, 0.0, 0.0)
+        self.yaw, self.pitch, self.distance, self.target = 30.0, 15.0, 4.0, (0.0, 0.0, 0.0)
 
     @property
     def eye(self) -> np.ndarray:

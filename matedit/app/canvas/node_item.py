@@ -1,0 +1,363 @@
+"""A node on the canvas: a category-coloured header, typed ports in rows, a badge, a preview.
+
+The item is dumb on purpose: the scene tells it what to show (`set_content`,
+`set_types`, `set_connected`, `set_diagnostics`, `set_preview`) from the model's
+events and the analysis, and it never reads or edits the model. It paints into
+a device-coordinate cache, so a frame of a big graph is mostly pixmap blits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from html import escape
+
+from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtGui import (
+    QBrush,
+    QColor,
+    QImage,
+    QLinearGradient,
+    QPainter,
+    QPainterPath,
+    QPen,
+    QPixmap,
+)
+from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem
+
+from matedit.app.canvas import constants as C
+from matedit.app.canvas.port_item import PortItem, port_shape
+
+
+@dataclass(frozen=True)
+class PortRow:
+    """What a node shows for one port: its name, display type and one-line doc."""
+
+    name: str
+    type: str
+    doc: str = ""
+    generic: bool = False  # declared `T`: takes any float or vector until wired
+
+
+@dataclass
+class NodeLayout:
+    width: float
+    height: float
+    top: float  # y of the first port row's top
+    inputs: dict[str, QPointF] = field(default_factory=dict)
+    outputs: dict[str, QPointF] = field(default_factory=dict)
+    preview: QRectF | None = None
+
+
+def measure(title: str, subtitle: str, inputs: list[PortRow], outputs: list[PortRow],
+            preview: bool = False) -> NodeLayout:
+    """The size of a node and where its ports sit (pure geometry, usable before an item exists).
+
+    Inputs and outputs share rows, left and right, as in Unreal's material editor:
+    a node is as tall as its longer side, not the sum of both.
+    """
+    fm_t, fm_p = C.metrics("title"), C.metrics("port")
+    head = 2 * 8.0 + fm_t.horizontalAdvance(title) + 2 * C.BADGE_RADIUS + 4
+    if subtitle:
+        head = max(head, 16.0 + C.metrics("subtitle").horizontalAdvance(subtitle))
+    left = max((fm_p.horizontalAdvance(p.name) for p in inputs), default=0.0)
+    right = max((fm_p.horizontalAdvance(p.name) for p in outputs), default=0.0)
+    rows_w = left + right + 2 * C.LABEL_GAP + (18.0 if left and right else 6.0)
+    width = max(C.NODE_MIN_WIDTH, head, rows_w, (C.PREVIEW_SIZE + 16) if preview else 0.0)
+    width = min(C.NODE_MAX_WIDTH, float(round(width / 4.0 + 0.49) * 4))
+    top = C.HEADER_HEIGHT + (C.SUBTITLE_HEIGHT if subtitle else 0.0) + 3.0
+    lay = NodeLayout(width, 0.0, top)
+    for i, p in enumerate(inputs):
+        lay.inputs[p.name] = QPointF(0.0, top + (i + 0.5) * C.ROW_HEIGHT)
+    for i, p in enumerate(outputs):
+        lay.outputs[p.name] = QPointF(width, top + (i + 0.5) * C.ROW_HEIGHT)
+    y = top + max(len(inputs), len(outputs)) * C.ROW_HEIGHT
+    if preview:
+        y += 4.0
+        lay.preview = QRectF((width - C.PREVIEW_SIZE) / 2, y, C.PREVIEW_SIZE, C.PREVIEW_SIZE)
+        y += C.PREVIEW_SIZE
+    lay.height = y + C.BODY_PAD
+    return lay
+
+
+class BadgeItem(QGraphicsItem):
+    """The diagnostic badge in a node's header; its tooltip lists the messages."""
+
+    def __init__(self, parent: QGraphicsItem) -> None:
+        super().__init__(parent)
+        self.color = C.ERROR
+        self.setAcceptHoverEvents(True)
+
+    def set(self, color: QColor, messages: list[str]) -> None:
+        self.color = color
+        self.setToolTip("<br>".join(escape(m) for m in messages))
+        self.update()
+
+    def boundingRect(self) -> QRectF:
+        r = C.BADGE_RADIUS + 1
+        return QRectF(-r, -r, 2 * r, 2 * r)
+
+    def paint(self, painter: QPainter, option, widget=None) -> None:
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing)
+        painter.setPen(QPen(C.NODE_BODY_EDGE, 1.0))
+        painter.setBrush(self.color)
+        painter.drawEllipse(QPointF(0, 0), C.BADGE_RADIUS, C.BADGE_RADIUS)
+        painter.setPen(QPen(QColor("#ffffff"), 2.0, cap=Qt.PenCapStyle.RoundCap))
+        painter.drawLine(QPointF(0, -3.6), QPointF(0, 1.0))
+        painter.drawPoint(QPointF(0, 3.8))
+
+
+class NodeItem(QGraphicsItem):
+    """One graph node, positioned at the model's (top-left) position."""
+
+    def __init__(self, node_id: str, kind: str) -> None:
+        super().__init__()
+        self.node_id = node_id
+        self.kind = kind
+        self.title = kind
+        self.subtitle = ""
+        self.category = ""
+        self.inputs: list[PortRow] = []
+        self.outputs: list[PortRow] = []
+        self.connected_inputs: set[str] = set()
+        self.connected_outputs: set[str] = set()
+        self.diagnostics: list[tuple[str, str]] = []  # (severity, message)
+        self._preview: QPixmap | None = None
+        self._ports: dict[tuple[str, bool], PortItem] = {}
+        self._badge: BadgeItem | None = None
+        self.layout = NodeLayout(C.NODE_MIN_WIDTH, C.HEADER_HEIGHT + C.BODY_PAD, C.HEADER_HEIGHT)
+        F = QGraphicsItem.GraphicsItemFlag
+        self.setFlags(F.ItemIsMovable | F.ItemIsSelectable | F.ItemSendsGeometryChanges)
+        self.setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
+        self.setZValue(C.Z_NODE)
+
+    # --- content, from the scene -------------------------------------------------------------
+    def set_content(self, title: str, subtitle: str, category: str, inputs: list[PortRow],
+                    outputs: list[PortRow], tooltip: str = "") -> None:
+        if (title, subtitle, category, inputs, outputs) == (
+                self.title, self.subtitle, self.category, self.inputs, self.outputs):
+            return
+        self.title, self.subtitle, self.category = title, subtitle, category
+        self.inputs, self.outputs = list(inputs), list(outputs)
+        self.setToolTip(tooltip)
+        self._relayout()
+
+    def set_types(self, in_types: dict[str, str], out_types: dict[str, str]) -> bool:
+        """Concrete types from the analysis (generic `T` ports resolve); True if any changed."""
+        changed = False
+        for rows, types, out in ((self.inputs, in_types, False), (self.outputs, out_types, True)):
+            for i, row in enumerate(rows):
+                t = types.get(row.name)
+                if t and t != row.type:
+                    rows[i] = PortRow(row.name, t, row.doc, row.generic)
+                    port = self._ports.get((row.name, out))
+                    if port is not None:
+                        port.set_type(t)
+                    changed = True
+        if changed:
+            self.update()
+        return changed
+
+    def set_connected(self, inputs: set[str], outputs: set[str]) -> None:
+        if inputs != self.connected_inputs or outputs != self.connected_outputs:
+            self.connected_inputs, self.connected_outputs = set(inputs), set(outputs)
+            self.update()
+
+    def set_diagnostics(self, diagnostics: list[tuple[str, str]]) -> None:
+        if diagnostics == self.diagnostics:
+            return
+        self.diagnostics = list(diagnostics)
+        if not diagnostics:
+            if self._badge is not None:
+                self._badge.setParentItem(None)
+                if self.scene() is not None:
+                    self.scene().removeItem(self._badge)
+                self._badge = None
+        else:
+            if self._badge is None:
+                self._badge = BadgeItem(self)
+            error = any(s == "error" for s, _ in diagnostics)
+            self._badge.set(C.ERROR if error else C.WARNING,
+                            [f"{s}: {m}" for s, m in diagnostics])
+            self._place_badge()
+        self.update()
+
+    def has_error(self) -> bool:
+        return any(s == "error" for s, _ in self.diagnostics)
+
+    def set_preview(self, image: QImage | None) -> None:
+        had = self._preview is not None
+        if image is None or image.isNull():
+            self._preview = None
+        else:
+            size = int(C.PREVIEW_SIZE * 2)  # twice the slot: sharp at zoom 2
+            self._preview = QPixmap.fromImage(image.scaled(
+                size, size, Qt.AspectRatioMode.KeepAspectRatio,
+                Qt.TransformationMode.SmoothTransformation))
+        if had != (self._preview is not None):
+            self._relayout()
+        else:
+            self.update()
+
+    def has_preview(self) -> bool:
+        return self._preview is not None
+
+    # --- ports ---------------------------------------------------------------------------------
+    def port(self, name: str, is_output: bool) -> PortItem | None:
+        return self._ports.get((name, is_output))
+
+    def ports(self) -> list[PortItem]:
+        return list(self._ports.values())
+
+    def port_scene_pos(self, name: str, is_output: bool) -> QPointF:
+        """Where a wire attaches; a port the node no longer has attaches at the node's edge."""
+        table = self.layout.outputs if is_output else self.layout.inputs
+        local = table.get(name)
+        if local is None:
+            local = QPointF(self.layout.width if is_output else 0.0, C.HEADER_HEIGHT / 2)
+        return self.pos() + local
+
+    def port_type(self, name: str, is_output: bool) -> str:
+        rows = self.outputs if is_output else self.inputs
+        return next((r.type for r in rows if r.name == name), "T")
+
+    # --- geometry ------------------------------------------------------------------------------
+    def _relayout(self) -> None:
+        self.prepareGeometryChange()
+        self.layout = measure(self.title, self.subtitle, self.inputs, self.outputs,
+                              self._preview is not None)
+        wanted: dict[tuple[str, bool], tuple[PortRow, QPointF]] = {}
+        for row in self.inputs:
+            wanted[(row.name, False)] = (row, self.layout.inputs[row.name])
+        for row in self.outputs:
+            wanted[(row.name, True)] = (row, self.layout.outputs[row.name])
+        for key in list(self._ports):
+            if key not in wanted:
+                port = self._ports.pop(key)
+                port.setParentItem(None)
+                if self.scene() is not None:
+                    self.scene().removeItem(port)
+        for key, (row, pos) in wanted.items():
+            port = self._ports.get(key)
+            if port is None:
+                port = PortItem(self, self.node_id, row.name, key[1], row.type, row.doc)
+                port.generic = row.generic
+                self._ports[key] = port
+            else:
+                port.set_type(row.type)
+                port.doc = row.doc
+                port.update_tooltip()
+            port.setPos(pos)
+        self._place_badge()
+        self.update()
+        scene = self.scene()
+        if scene is not None and hasattr(scene, "node_geometry_changed"):
+            scene.node_geometry_changed(self.node_id)
+
+    def _place_badge(self) -> None:
+        if self._badge is not None:
+            self._badge.setPos(self.layout.width - C.BADGE_RADIUS - 4, C.HEADER_HEIGHT / 2)
+
+    def boundingRect(self) -> QRectF:
+        m = 2.0
+        return QRectF(-m, -m, self.layout.width + 2 * m, self.layout.height + 2 * m)
+
+    def shape(self) -> QPainterPath:
+        path = QPainterPath()
+        path.addRoundedRect(QRectF(0, 0, self.layout.width, self.layout.height), C.CORNER,
+                            C.CORNER)
+        return path
+
+    def itemChange(self, change, value):
+        GC = QGraphicsItem.GraphicsItemChange
+        if change == GC.ItemPositionHasChanged:
+            scene = self.scene()
+            if scene is not None and hasattr(scene, "node_item_moved"):
+                scene.node_item_moved(self.node_id)
+        elif change == GC.ItemSelectedHasChanged:
+            self.setZValue(C.Z_NODE_SELECTED if value else C.Z_NODE)
+        return super().itemChange(change, value)
+
+    # --- painting ------------------------------------------------------------------------------
+    def paint(self, painter: QPainter, option: QStyleOptionGraphicsItem, widget=None) -> None:
+        lod = QStyleOptionGraphicsItem.levelOfDetailFromTransform(painter.worldTransform())
+        lay = self.layout
+        rect = QRectF(0, 0, lay.width, lay.height)
+        header = C.category_color(self.category)
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing, lod > 0.2)
+        body = QPainterPath()
+        body.addRoundedRect(rect, C.CORNER, C.CORNER)
+        painter.setPen(Qt.PenStyle.NoPen)
+        painter.setBrush(C.NODE_BODY)
+        painter.drawPath(body)
+        painter.save()
+        painter.setClipRect(QRectF(0, 0, lay.width, C.HEADER_HEIGHT))
+        grad = QLinearGradient(0, 0, 0, C.HEADER_HEIGHT)
+        grad.setColorAt(0.0, header.lighter(118))
+        grad.setColorAt(1.0, header)
+        painter.setBrush(QBrush(grad))
+        painter.drawPath(body)
+        painter.restore()
+        if self.isSelected():
+            edge = QPen(C.NODE_SELECTED, 2.0)
+        elif self.has_error():
+            edge = QPen(C.ERROR, 1.6)
+        else:
+            edge = QPen(C.NODE_BODY_EDGE, 1.2)
+        painter.setPen(edge)
+        painter.setBrush(Qt.BrushStyle.NoBrush)
+        painter.drawPath(body)
+        if lod < C.LOD_TEXT:
+            self._paint_ports(painter, labels=False)
+            return
+        # Title, elided to leave room for the badge.
+        painter.setFont(C.title_font())
+        painter.setPen(C.NODE_TEXT)
+        room = lay.width - 16 - (2 * C.BADGE_RADIUS + 4 if self.diagnostics else 0)
+        title = C.metrics("title").elidedText(self.title, Qt.TextElideMode.ElideRight, room)
+        painter.drawText(QRectF(8, 0, room, C.HEADER_HEIGHT),
+                         Qt.AlignmentFlag.AlignVCenter | Qt.AlignmentFlag.AlignLeft, title)
+        if self.subtitle:
+            painter.setFont(C.subtitle_font())
+            painter.setPen(C.NODE_SUBTEXT)
+            sub = C.metrics("subtitle").elidedText(self.subtitle, Qt.TextElideMode.ElideMiddle,
+                                                   lay.width - 16)
+            painter.drawText(QRectF(8, C.HEADER_HEIGHT, lay.width - 16, C.SUBTITLE_HEIGHT + 2),
+                             Qt.AlignmentFlag.AlignVCenter | Qt.AlignmentFlag.AlignLeft, sub)
+        self._paint_ports(painter, labels=True)
+        if self._preview is not None and lay.preview is not None:
+            painter.drawPixmap(lay.preview, self._preview, QRectF(self._preview.rect()))
+            painter.setPen(QPen(C.NODE_BODY_EDGE, 1.0))
+            painter.setBrush(Qt.BrushStyle.NoBrush)
+            painter.drawRect(lay.preview)
+
+    def _paint_ports(self, painter: QPainter, labels: bool) -> None:
+        lay = self.layout
+        fm = C.metrics("port")
+        half = lay.width / 2 - C.LABEL_GAP - 3
+        if labels:
+            painter.setFont(C.port_font())
+        for rows, table, out, connected in (
+                (self.inputs, lay.inputs, False, self.connected_inputs),
+                (self.outputs, lay.outputs, True, self.connected_outputs)):
+            for row in rows:
+                pos = table[row.name]
+                port_shape(painter, pos, row.type, C.PORT_RADIUS, row.name in connected)
+                if not labels:
+                    continue
+                # One side may use the whole width when the other side has no port on this row.
+                other = lay.inputs if out else lay.outputs
+                shared = any(abs(p.y() - pos.y()) < 1 for p in other.values())
+                room = half if shared else lay.width - 2 * C.LABEL_GAP - 4
+                text = fm.elidedText(row.name, Qt.TextElideMode.ElideRight, room)
+                painter.setPen(C.PORT_LABEL_DIM if (connected and row.name in connected
+                                                    and not out) else C.PORT_LABEL)
+                r = QRectF(0, pos.y() - C.ROW_HEIGHT / 2, 0, C.ROW_HEIGHT)
+                if out:
+                    r.setLeft(lay.width - C.LABEL_GAP - room)
+                    r.setRight(lay.width - C.LABEL_GAP)
+                    align = Qt.AlignmentFlag.AlignRight
+                else:
+                    r.setLeft(C.LABEL_GAP)
+                    r.setRight(C.LABEL_GAP + room)
+                    align = Qt.AlignmentFlag.AlignLeft
+                painter.drawText(r, align | Qt.AlignmentFlag.AlignVCenter, text)

@@ -1,0 +1,388 @@
+"""NodeScene: the graphics items that mirror the controller's document graph.
+
+The scene holds no graph state of its own: only items, keyed by node id, link
+and comment id, plus indexes to find them fast. It builds them from the model,
+follows the model's change events one by one (adding, removing or updating just
+the items an event touches), takes types and diagnostics from each analysis,
+and rebuilds when the document is replaced. Edits the items ask for (a finished
+drag, a comment resize) go back to the model as commands through the controller.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import QLineF, QRectF, Qt, Signal
+from PySide6.QtGui import QImage, QPainter
+from PySide6.QtWidgets import QGraphicsScene
+
+from matedit.app.canvas import constants as C
+from matedit.app.canvas.comment_item import CommentItem
+from matedit.app.canvas.node_item import NodeItem, PortRow
+from matedit.app.canvas.reroute_item import RerouteItem
+from matedit.app.canvas.wire_item import WireItem
+from matedit.app.controller import DocumentController
+from matedit.graph import nodes
+from matedit.graph.commands import MoveNodes, PutComment
+from matedit.graph.model import ChangeEvent, Comment, Link, Node
+from matedit.graph.ports import node_ports
+from matedit.graph.validate import Analysis
+
+
+def _fmt(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.3g}"
+    if isinstance(value, (list, tuple)):
+        return "(" + ", ".join(_fmt(v) for v in value) + ")"
+    return str(value)
+
+
+def describe(node: Node) -> tuple[str, str, str, str]:
+    """(title, subtitle, category, tooltip) a node shows, from its kind, label and settings."""
+    d = nodes.REGISTRY.get(node.kind)
+    kind_title = d.title if d else node.kind
+    title = node.label or kind_title
+    s = node.settings
+    sub = ""
+    if node.kind.endswith("_parameter"):
+        sub = str(s.get("name", "param"))
+        if node.kind == "scalar_parameter" and "value" in node.values:
+            sub += f" = {_fmt(node.values['value'])}"
+    elif node.kind == "constant":
+        sub = _fmt(s.get("value", 0.0))
+    elif node.kind == "function_call":
+        sub = Path(str(s.get("function", ""))).stem or "no function"
+    elif node.kind in ("function_input", "function_output"):
+        sub = f"{s.get('name', '')} : {s.get('type', 'float')}"
+    elif node.kind == "component_mask":
+        sub = "." + str(s.get("channels", "xy"))
+    elif node.kind == "layer_stack":
+        layers = s.get("layers", [])
+        if isinstance(layers, list):
+            sub = " · ".join(str(e.get("name", e.get("id", "?"))) for e in layers
+                             if isinstance(e, dict))
+    if node.label and not sub:
+        sub = kind_title
+    tip = f"<b>{title}</b> &nbsp;<i>{node.kind}</i> &nbsp;id {node.id}"
+    if d is not None:
+        tip += f"<br>{d.description}"
+    return title, sub, d.category if d else "", tip
+
+
+class NodeScene(QGraphicsScene):
+    """Items for the nodes, wires and comments of `controller.document.graph`."""
+
+    commentTextRequested = Signal(str)  # a comment's title was double-clicked
+    rebuilt = Signal()
+
+    def __init__(self, controller: DocumentController, parent=None) -> None:
+        super().__init__(parent)
+        self.controller = controller
+        self.node_items: dict[str, NodeItem] = {}
+        self.wire_items: dict[Link, WireItem] = {}
+        self.comment_items: dict[str, CommentItem] = {}
+        self._wires_of: dict[str, set[Link]] = {}
+        self._node_errors: dict[str, str] = {}  # GLSL errors mapped to nodes, from the window
+        self._previews: dict[str, QImage] = {}
+        self.rubber_banding = False  # set by the view: wires ignore rubber-band selection
+        self._last_diags: dict[str, list[tuple[str, str]]] = {}
+        self.setItemIndexMethod(QGraphicsScene.ItemIndexMethod.BspTreeIndex)
+        self.setBackgroundBrush(C.BACKGROUND)
+        controller.changed.connect(self._on_changed)
+        controller.analysed.connect(self._on_analysed)
+        controller.documentReplaced.connect(self.rebuild)
+        self.rebuild()
+
+    # --- queries ---------------------------------------------------------------------------------
+    @property
+    def graph(self):
+        return self.controller.document.graph
+
+    def node_item(self, node_id: str) -> NodeItem | None:
+        return self.node_items.get(node_id)
+
+    def wire_item(self, link: Link) -> WireItem | None:
+        return self.wire_items.get(link)
+
+    def wires_of(self, node_id: str) -> list[WireItem]:
+        return [self.wire_items[l] for l in self._wires_of.get(node_id, ())]
+
+    def selected_node_ids(self) -> list[str]:
+        return sorted(it.node_id for it in self.selectedItems() if isinstance(it, NodeItem))
+
+    def node_items_in(self, rect: QRectF) -> list[NodeItem]:
+        return [it for it in self.items(rect, Qt.ItemSelectionMode.ContainsItemBoundingRect)
+                if isinstance(it, NodeItem)]
+
+    def nodes_bounding_rect(self, items=None) -> QRectF:
+        rect = QRectF()
+        for it in (items if items is not None else
+                   list(self.node_items.values()) + list(self.comment_items.values())):
+            rect = rect.united(it.sceneBoundingRect())
+        return rect
+
+    # --- building --------------------------------------------------------------------------------
+    def rebuild(self) -> None:
+        """Drop every item and build them again from the model (a new document)."""
+        self.clear()
+        self.node_items.clear()
+        self.wire_items.clear()
+        self.comment_items.clear()
+        self._wires_of.clear()
+        self._node_errors.clear()
+        self._previews.clear()
+        g = self.graph
+        for cid in sorted(g.comments):
+            self._sync_comment(cid)
+        for nid in sorted(g.nodes):
+            self._add_node(nid)
+        for link in sorted(g.links):
+            self._add_wire(link)
+        if self.controller.analysis is not None:
+            self._on_analysed(self.controller.analysis)
+        self.rebuilt.emit()
+
+    def _add_node(self, node_id: str) -> None:
+        node = self.graph.nodes[node_id]
+        item = (RerouteItem if node.kind == "reroute" else NodeItem)(node_id, node.kind)
+        self.node_items[node_id] = item
+        self._wires_of.setdefault(node_id, set())
+        item.setPos(node.position[0], node.position[1])
+        self._refresh_node(node_id, item)
+        self.addItem(item)
+        if node_id in self._previews:
+            item.set_preview(self._previews[node_id])
+
+    def _refresh_node(self, node_id: str, item: NodeItem | None = None) -> None:
+        """Title, ports and subtitle from the model (a setting may add or remove ports)."""
+        item = item or self.node_items.get(node_id)
+        node = self.graph.nodes.get(node_id)
+        if item is None or node is None:
+            return
+        try:
+            ports = node_ports(node, self.controller.resolver, self.controller.document)
+            ins = [PortRow(p.name, p.type, p.doc, p.type == "T") for p in ports.inputs]
+            outs = [PortRow(p.name, p.type, p.doc, p.type == "T") for p in ports.outputs]
+        except (LookupError, ValueError):
+            ins, outs = [], []  # the analysis reports why, as a badge
+        # Keep types the last analysis resolved for generic ports that are still there.
+        a = self.controller.analysis
+        if a is not None:
+            it, ot = a.in_types.get(node_id, {}), a.out_types.get(node_id, {})
+            ins = [PortRow(r.name, str(it[r.name]), r.doc, r.generic) if r.name in it else r
+                   for r in ins]
+            outs = [PortRow(r.name, str(ot[r.name]), r.doc, r.generic) if r.name in ot else r
+                    for r in outs]
+        title, sub, category, tip = describe(node)
+        item.set_content(title, sub, category, ins, outs, tip)
+        self._update_connected(node_id)
+
+    def _add_wire(self, link: Link) -> None:
+        if link in self.wire_items:
+            return
+        src, dst = self.node_items.get(link.src), self.node_items.get(link.dst)
+        if src is None or dst is None:
+            return
+        wire = WireItem(link, src, dst)
+        wire.set_style(src.port_type(link.src_port, True), False)
+        self.wire_items[link] = wire
+        self._wires_of[link.src].add(link)
+        self._wires_of[link.dst].add(link)
+        self.addItem(wire)
+        self._update_connected(link.src)
+        self._update_connected(link.dst)
+
+    def _remove_wire(self, link: Link) -> None:
+        wire = self.wire_items.pop(link, None)
+        if wire is None:
+            return
+        for end in (link.src, link.dst):
+            self._wires_of.get(end, set()).discard(link)
+        self.removeItem(wire)
+        self._update_connected(link.src)
+        self._update_connected(link.dst)
+
+    def _update_connected(self, node_id: str) -> None:
+        item = self.node_items.get(node_id)
+        if item is None:
+            return
+        ins, outs = set(), set()
+        for l in self._wires_of.get(node_id, ()):
+            if l.dst == node_id:
+                ins.add(l.dst_port)
+            if l.src == node_id:
+                outs.add(l.src_port)
+        item.set_connected(ins, outs)
+
+    def _sync_comment(self, comment_id: str) -> None:
+        comment = self.graph.comments.get(comment_id)
+        item = self.comment_items.get(comment_id)
+        if comment is None:
+            if item is not None:
+                self.removeItem(self.comment_items.pop(comment_id))
+            return
+        if item is None:
+            item = CommentItem(comment_id)
+            self.comment_items[comment_id] = item
+            self.addItem(item)
+        item.set_content(comment)
+
+    # --- model events ----------------------------------------------------------------------------
+    def _on_changed(self, ev: ChangeEvent) -> None:
+        what = ev.what
+        if what == "node_added":
+            self._add_node(ev.node_ids[0])
+        elif what == "node_removed":
+            nid = ev.node_ids[0]
+            for link in list(self._wires_of.pop(nid, ())):
+                self._remove_wire(link)
+            item = self.node_items.pop(nid, None)
+            if item is not None:
+                self.removeItem(item)
+            self._node_errors.pop(nid, None)
+        elif what == "link_added":
+            link = self._find_added_link(ev)
+            if link is not None:
+                self._add_wire(link)
+        elif what == "link_removed":
+            src, dst = ev.node_ids
+            for link in list(self._wires_of.get(dst, ())):
+                if (link.src, link.dst, link.dst_port) == (src, dst, ev.port) \
+                        and link not in self.graph.links:
+                    self._remove_wire(link)
+        elif what in ("value", "setting", "label"):
+            self._refresh_node(ev.node_ids[0])
+        elif what == "moved":
+            nid = ev.node_ids[0]
+            item, node = self.node_items.get(nid), self.graph.nodes.get(nid)
+            if item is not None and node is not None:
+                item.setPos(node.position[0], node.position[1])
+        elif what == "comment":
+            self._sync_comment(ev.node_ids[0])
+
+    def _find_added_link(self, ev: ChangeEvent) -> Link | None:
+        """The link an event names, found by trying the source's outputs (no scan of all links)."""
+        src, dst = ev.node_ids
+        links = self.graph.links
+        item = self.node_items.get(src)
+        if item is not None:
+            for row in item.outputs:
+                link = Link(src, row.name, dst, ev.port)
+                if link in links:
+                    return link
+        return next((l for l in links if (l.src, l.dst, l.dst_port) == (src, dst, ev.port)),
+                    None)
+
+    def _on_analysed(self, analysis: Analysis) -> None:
+        """Resolved port types, diagnostics as badges, and wire colours from one analysis."""
+        diags: dict[str, list[tuple[str, str]]] = {}
+        bad_inputs: set[tuple[str, str]] = set()
+        for d in analysis.diagnostics:
+            if d.node_id is None:
+                continue
+            msg = f"{d.port}: {d.message}" if d.port else d.message
+            diags.setdefault(d.node_id, []).append((d.severity.value, msg))
+            if d.port and d.severity.value == "error":
+                bad_inputs.add((d.node_id, d.port))
+        for nid, item in self.node_items.items():
+            item.set_types({k: str(v) for k, v in analysis.in_types.get(nid, {}).items()},
+                           {k: str(v) for k, v in analysis.out_types.get(nid, {}).items()})
+            self._apply_diagnostics(item, diags.get(nid, []))
+        for link, wire in self.wire_items.items():
+            wire.set_style(wire.src_item.port_type(link.src_port, True),
+                           (link.dst, link.dst_port) in bad_inputs)
+        self._last_diags = diags
+
+    def _apply_diagnostics(self, item: NodeItem, diags: list[tuple[str, str]]) -> None:
+        extra = self._node_errors.get(item.node_id)
+        item.set_diagnostics(([("error", f"GLSL: {extra}")] if extra else []) + diags)
+
+    # --- annotations from the window ----------------------------------------------------------
+    def set_node_errors(self, errors: dict[str, str]) -> None:
+        """GLSL errors mapped to nodes; replaces the previous set."""
+        touched = set(self._node_errors) | set(errors)
+        self._node_errors = {k: v for k, v in errors.items() if v}
+        last = self._last_diags
+        for nid in touched:
+            item = self.node_items.get(nid)
+            if item is not None:
+                self._apply_diagnostics(item, last.get(nid, []))
+
+    def set_node_preview(self, node_id: str, image: QImage | None) -> None:
+        if image is None or image.isNull():
+            self._previews.pop(node_id, None)
+        else:
+            self._previews[node_id] = image
+        item = self.node_items.get(node_id)
+        if item is not None:
+            item.set_preview(image)
+
+    # --- item callbacks --------------------------------------------------------------------------
+    def node_item_moved(self, node_id: str) -> None:
+        for link in self._wires_of.get(node_id, ()):
+            self.wire_items[link].update_path()
+
+    node_geometry_changed = node_item_moved
+
+    def request_comment_edit(self, comment_id: str, rect, positions: dict) -> None:
+        old = self.graph.comments.get(comment_id)
+        if old is None:
+            return
+        new = Comment(comment_id, old.text, tuple(float(x) for x in rect), old.color)
+        commands = [PutComment(comment_id, new, text="move comment")]
+        moved = {nid: p for nid, p in positions.items()
+                 if nid in self.graph.nodes and tuple(p) != self.graph.nodes[nid].position}
+        if moved:
+            commands.append(MoveNodes(moved))
+        if not self.controller.push_all(commands, "move comment"):
+            self._resync_positions()
+
+    def request_comment_text(self, comment_id: str) -> None:
+        self.commentTextRequested.emit(comment_id)
+
+    def commit_moves(self) -> None:
+        """After a drag: one MoveNodes for every node whose item left its model position."""
+        graph = self.graph
+        moved = {}
+        for it in self.selectedItems():
+            if isinstance(it, NodeItem) and it.node_id in graph.nodes:
+                p = (it.pos().x(), it.pos().y())
+                if p != graph.nodes[it.node_id].position:
+                    moved[it.node_id] = p
+        if moved and not self.controller.push(MoveNodes(moved)):
+            self._resync_positions()
+
+    def _resync_positions(self) -> None:
+        for nid, item in self.node_items.items():
+            node = self.graph.nodes.get(nid)
+            if node is not None:
+                item.setPos(*node.position)
+        for cid in list(self.comment_items):
+            self._sync_comment(cid)
+
+    def mouseReleaseEvent(self, event) -> None:
+        super().mouseReleaseEvent(event)
+        if event.button() == Qt.MouseButton.LeftButton:
+            self.commit_moves()
+
+    # --- background ------------------------------------------------------------------------------
+    def drawBackground(self, painter: QPainter, rect: QRectF) -> None:
+        painter.fillRect(rect, C.BACKGROUND)
+        zoom = painter.worldTransform().m11()
+        for step, color in ((C.GRID_MINOR, C.GRID_MINOR_COLOR), (C.GRID_MAJOR, C.GRID_MAJOR_COLOR)):
+            if step * zoom < 8:
+                continue
+            painter.setPen(color)
+            left = int(rect.left() // step) * step
+            top = int(rect.top() // step) * step
+            x = left
+            lines = []
+            while x < rect.right():
+                lines.append(QLineF(x, rect.top(), x, rect.bottom()))
+                x += step
+            y = top
+            while y < rect.bottom():
+                lines.append(QLineF(rect.left(), y, rect.right(), y))
+                y += step
+            painter.drawLines(lines)
+

@@ -1,0 +1,77 @@
+"""Read-only view of the generated GLSL for one target, refreshed on every recompile."""
+
+from __future__ import annotations
+
+from PySide6.QtGui import QFont, QFontDatabase, QTextOption
+from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPlainTextEdit, QVBoxLayout, QWidget
+
+from matedit.app.compile_service import MaterialCompiler
+from matedit.compiler import TARGETS, CompileError
+
+STAGES = ("fragment", "vertex")
+
+
+class CodeView(QWidget):
+    def __init__(self, compiler: MaterialCompiler, parent=None) -> None:
+        super().__init__(parent)
+        self.compiler = compiler
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        lay.setSpacing(4)
+        bar = QHBoxLayout()
+        self.target = QComboBox()
+        self.target.addItems(list(TARGETS))
+        self.target.setToolTip("GLSL dialect")
+        self.stage = QComboBox()
+        self.stage.addItems(list(STAGES))
+        self.info = QLabel("")
+        self.info.setObjectName("fieldLabel")
+        bar.addWidget(self.target)
+        bar.addWidget(self.stage)
+        bar.addWidget(self.info, 1)
+        lay.addLayout(bar)
+        self.text = QPlainTextEdit()
+        self.text.setObjectName("codeView")
+        self.text.setReadOnly(True)
+        self.text.setWordWrapMode(QTextOption.WrapMode.NoWrap)
+        font = QFontDatabase.systemFont(QFontDatabase.SystemFont.FixedFont)
+        font.setStyleHint(QFont.StyleHint.Monospace)
+        self.text.setFont(font)
+        lay.addWidget(self.text, 1)
+        self.target.currentTextChanged.connect(self.refresh)
+        self.stage.currentTextChanged.connect(self.refresh)
+        compiler.compiled.connect(lambda _cm: self.refresh())
+        compiler.failed.connect(lambda _d: self.refresh())
+        self.refresh()
+
+    def refresh(self) -> None:
+        if self.compiler.controller.document.is_function:
+            self._show("// a material function compiles as part of the materials that call it",
+                       "")
+            return
+        if self.compiler.current is None:
+            last = self.compiler.last_good
+            note = "does not compile; showing the last good code" if last else "does not compile"
+            if last is not None and self.target.currentText() == last.target:
+                self._show(self._stage_text(last), note)
+            else:
+                self._show("// the material does not compile: see Diagnostics", note)
+            return
+        try:
+            cm = self.compiler.for_target(self.target.currentText())
+        except CompileError as exc:
+            self._show("// " + "\n// ".join(d.format() for d in exc.diagnostics), "error")
+            return
+        self._show(self._stage_text(cm), f"{len(cm.fragment_text.splitlines())} fragment lines"
+                   f"  ·  hash {cm.structure_hash}")
+
+    def _stage_text(self, cm) -> str:
+        return cm.fragment_text if self.stage.currentText() == "fragment" else cm.vertex_text
+
+    def _show(self, text: str, info: str) -> None:
+        if self.text.toPlainText() != text:
+            bar = self.text.verticalScrollBar()
+            pos = bar.value()
+            self.text.setPlainText(text)
+            bar.setValue(pos)
+        self.info.setText(info)

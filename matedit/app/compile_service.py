@@ -1,0 +1,104 @@
+"""Compiles the open material after each structural edit, and reads uniform values.
+
+One place turns `structureChanged` into a `CompiledMaterial` (glsl330 for the
+viewport; other targets on demand for the code view and export) or into
+diagnostics. Value edits never come here: `uniform_values` reads the current
+numbers for a compiled material's uniforms straight from the document, under
+the compiler's names (`p_<parameter>`, `u_<node>_<port>`).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QObject, Signal
+
+from matedit.app.controller import DocumentController
+from matedit.app.paths import absolute_of
+from matedit.compiler import CompiledMaterial, CompileError, compile_document
+from matedit.graph.model import MaterialDocument
+from matedit.graph.types import PortType, coerce_value
+from matedit.graph.validate import Diagnostic, Severity
+
+VIEWPORT_TARGET = "glsl330"
+
+
+def uniform_values(compiled: CompiledMaterial, doc: MaterialDocument) -> dict[str, Any]:
+    """Current values of the compiled material's uniforms, from the document."""
+    out: dict[str, Any] = {}
+    for u in compiled.ir.uniforms:
+        node = doc.graph.nodes.get(u.node)
+        value = node.values.get(u.port, u.default) if node is not None else u.default
+        try:
+            out[u.name] = coerce_value(PortType(u.type.value), value)
+        except (ValueError, TypeError):
+            out[u.name] = u.default
+    return out
+
+
+def texture_paths(compiled: CompiledMaterial, doc: MaterialDocument) -> dict[str, Path | None]:
+    """Each texture uniform's file, from the texture parameter's current `path` setting."""
+    out: dict[str, Path | None] = {}
+    for t in compiled.ir.textures:
+        node = doc.graph.nodes.get(t.node)
+        ref = node.settings.get("path", t.path) if node is not None else t.path
+        out[t.name] = absolute_of(doc, ref) if isinstance(ref, str) and ref else None
+    return out
+
+
+class MaterialCompiler(QObject):
+    """Recompiles on `structureChanged`; emits `compiled` or `failed(diagnostics)`."""
+
+    compiled = Signal(object)  # CompiledMaterial
+    failed = Signal(list)  # list[Diagnostic]
+
+    def __init__(self, controller: DocumentController, parent=None) -> None:
+        super().__init__(parent)
+        self.controller = controller
+        self.current: CompiledMaterial | None = None
+        self.last_good: CompiledMaterial | None = None
+        self.diagnostics: list[Diagnostic] = []
+        self.last_compile_ms = 0.0
+        self._cache: dict[str, CompiledMaterial] = {}
+        controller.structureChanged.connect(self.recompile)
+
+    def recompile(self) -> CompiledMaterial | None:
+        doc = self.controller.document
+        self._cache.clear()
+        self.current = None
+        if doc.is_function:
+            self.diagnostics = []
+            return None
+        t0 = time.perf_counter()
+        try:
+            cm = compile_document(doc, self.controller.resolver, VIEWPORT_TARGET)
+        except CompileError as exc:
+            self.diagnostics = list(exc.diagnostics)
+            self.last_compile_ms = (time.perf_counter() - t0) * 1e3
+            self.failed.emit(self.diagnostics)
+            return None
+        except Exception as exc:  # a compiler bug must not take the editor down
+            self.diagnostics = [Diagnostic(Severity.ERROR, f"internal compiler error: "
+                                           f"{type(exc).__name__}: {exc}")]
+            self.failed.emit(self.diagnostics)
+            return None
+        self.last_compile_ms = (time.perf_counter() - t0) * 1e3
+        self.diagnostics = []
+        self.current = self.last_good = cm
+        self._cache[VIEWPORT_TARGET] = cm
+        self.compiled.emit(cm)
+        return cm
+
+    def for_target(self, target: str) -> CompiledMaterial:
+        """The current document compiled for `target` (raises CompileError)."""
+        hit = self._cache.get(target)
+        if hit is None:
+            hit = compile_document(self.controller.document, self.controller.resolver, target)
+            self._cache[target] = hit
+        return hit
+
+    def uniforms(self) -> dict[str, Any]:
+        cm = self.current or self.last_good
+        return uniform_values(cm, self.controller.document) if cm else {}

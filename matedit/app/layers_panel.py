@@ -1,0 +1,440 @@
+"""The layer stack as a painting program shows it: top layer first.
+
+A view over the document's `layer_stack` node (`LayerStack.find`); every edit
+is a LayerStack command through the controller, and the list is rebuilt from
+the graph on each change, so it can never disagree with the canvas. Rows can
+be reordered by drag, and layer files dropped from the library (or a file
+manager) are added on top.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import QMimeData, Qt, QTimer, Signal
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QComboBox,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QListWidgetItem,
+    QMenu,
+    QPushButton,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from matedit.app.controller import DocumentController
+from matedit.app.fields import FloatField
+from matedit.app.paths import reference_for
+from matedit.app.theme import icon
+from matedit.graph.commands import AddNode, CommandError, Connect, Macro, SetValue
+from matedit.graph.layers import Layer, LayerStack
+from matedit.graph.model import ChangeEvent, ChangeKind, Link, Node
+from matedit.graph.ports import LAYER_BLENDS
+from matedit.io.document import FormatError, load
+from matedit.resources import graphs_dir
+
+LAYER_MIME = "application/x-matedit-layer"  # absolute path of a layer file (from the library)
+ROW_MIME = "application/x-matedit-layer-row"  # id of a layer being reordered
+
+
+def layer_files() -> list[Path]:
+    return sorted((graphs_dir() / "layers").glob("*.json"))
+
+
+def layer_title(path: Path) -> str:
+    try:
+        doc = load(path)
+        return doc.name or path.stem.replace("_", " ").title()
+    except FormatError:
+        return path.stem
+
+
+class _LayerRow(QWidget):
+    """Eye, name, blend and opacity of one layer."""
+
+    def __init__(self, panel: LayersPanel, layer: Layer, is_base: bool, opacity: float):
+        super().__init__()
+        self.setObjectName("layerRow")
+        self.layer_id = layer.id
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 3, 4, 3)
+        lay.setSpacing(2)
+        top = QHBoxLayout()
+        top.setSpacing(4)
+        self.eye = QToolButton()
+        self.eye.setCheckable(True)
+        self.eye.setChecked(layer.visible)
+        self.eye.setIcon(icon("eye" if layer.visible else "eye-off"))
+        self.eye.setToolTip("Show or hide this layer")
+        self.eye.toggled.connect(lambda on: panel.set_visible(layer.id, on))
+        self.name = QLineEdit(layer.name or layer.id)
+        self.name.setFrame(False)
+        self.name.setStyleSheet("background: transparent; font-weight: bold;")
+        self.name.setToolTip(f"{layer.function}\nEdit to rename")
+        self.name.editingFinished.connect(lambda: panel.rename(layer.id, self.name.text()))
+        top.addWidget(self.eye)
+        top.addWidget(self.name, 1)
+        self.blend = QComboBox()
+        if is_base:
+            self.blend.addItem("base")
+            self.blend.setEnabled(False)
+            self.blend.setToolTip("The bottom layer is the base: nothing to blend over")
+        else:
+            self.blend.addItems(list(LAYER_BLENDS))
+            if layer.blend not in LAYER_BLENDS:
+                self.blend.addItem(layer.blend)
+            self.blend.setCurrentText(layer.blend)
+            self.blend.setToolTip("How this layer blends over the ones below")
+            self.blend.currentTextChanged.connect(lambda b: panel.set_blend(layer.id, b))
+        top.addWidget(self.blend)
+        lay.addLayout(top)
+        self.opacity: FloatField | None = None
+        if not is_base:
+            row = QHBoxLayout()
+            lab = QLabel("opacity")
+            lab.setObjectName("fieldLabel")
+            self.opacity = FloatField(opacity, (0.0, 1.0))
+            self.opacity.setToolTip("Overall strength of the layer (its opacity port)")
+            self.opacity.edited.connect(lambda v, m: panel.set_opacity(layer.id, v, m))
+            row.addSpacing(26)
+            row.addWidget(lab)
+            row.addWidget(self.opacity, 1)
+            lay.addLayout(row)
+
+
+class LayerList(QListWidget):
+    """The rows; drags reorder (by command), drops of layer files add layers."""
+
+    def __init__(self, panel: LayersPanel) -> None:
+        super().__init__()
+        self.panel = panel
+        self.setDragDropMode(QAbstractItemView.DragDropMode.DragDrop)
+        self.setDefaultDropAction(Qt.DropAction.MoveAction)
+        self.setDragEnabled(True)
+        self.setAcceptDrops(True)
+        self.setDropIndicatorShown(True)
+        self.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        self.setSpacing(1)
+
+    def mimeTypes(self) -> list[str]:  # noqa: N802 - Qt's name
+        return [ROW_MIME, LAYER_MIME, "text/uri-list"]
+
+    def mimeData(self, items) -> QMimeData:  # noqa: N802 - Qt's name
+        data = QMimeData()
+        if items:
+            data.setData(ROW_MIME, items[0].data(Qt.ItemDataRole.UserRole).encode())
+        return data
+
+    def _accepts(self, mime: QMimeData) -> bool:
+        if mime.hasFormat(ROW_MIME) or mime.hasFormat(LAYER_MIME):
+            return True
+        return mime.hasUrls() and any(u.toLocalFile().endswith(".json") for u in mime.urls())
+
+    def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._accepts(event.mimeData()):
+            event.acceptProposedAction()
+        else:
+            event.ignore()
+
+    def dragMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._accepts(event.mimeData()):
+            super().dragMoveEvent(event)
+            event.acceptProposedAction()
+        else:
+            event.ignore()
+
+    def drop_row(self, pos) -> int:
+        """The list row a drop at `pos` lands before (0 = top)."""
+        item = self.itemAt(pos)
+        if item is None:
+            return self.count()
+        rect = self.visualItemRect(item)
+        row = self.row(item)
+        return row + 1 if pos.y() > rect.center().y() else row
+
+    def dropEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        mime = event.mimeData()
+        row = self.drop_row(event.position().toPoint())
+        if mime.hasFormat(ROW_MIME):
+            self.panel.move_to_row(bytes(mime.data(ROW_MIME)).decode(), row)
+        elif mime.hasFormat(LAYER_MIME):
+            self.panel.add_layer_file(Path(bytes(mime.data(LAYER_MIME)).decode()), row)
+        elif mime.hasUrls():
+            for url in mime.urls():
+                if url.toLocalFile().endswith(".json"):
+                    self.panel.add_layer_file(Path(url.toLocalFile()), row)
+        else:
+            event.ignore()
+            return
+        # The model changed by command; the list rebuilds itself, so Qt must not move items.
+        event.setDropAction(Qt.DropAction.IgnoreAction)
+        event.accept()
+
+
+class LayersPanel(QWidget):
+    """Layers of the document's layer stack, top first, with add/remove/reorder/hide/blend."""
+
+    message = Signal(str)
+    layerSelected = Signal(str)  # the layer stack node id, to show it in the inspector
+
+    def __init__(self, controller: DocumentController, parent=None) -> None:
+        super().__init__(parent)
+        self.controller = controller
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        lay.setSpacing(4)
+        bar = QHBoxLayout()
+        self.add_button = QToolButton()
+        self.add_button.setIcon(icon("add"))
+        self.add_button.setText("Add layer")
+        self.add_button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        self.add_button.setPopupMode(QToolButton.ToolButtonPopupMode.InstantPopup)
+        self.add_menu = QMenu(self)
+        self.add_menu.aboutToShow.connect(self._fill_add_menu)
+        self.add_button.setMenu(self.add_menu)
+        self.remove_button = QToolButton()
+        self.remove_button.setIcon(icon("delete"))
+        self.remove_button.setToolTip("Remove the selected layer")
+        self.remove_button.clicked.connect(self.remove_selected)
+        self.up_button = QToolButton()
+        self.up_button.setText("▲")
+        self.up_button.setToolTip("Move the selected layer up")
+        self.up_button.clicked.connect(lambda: self._nudge(-1))
+        self.down_button = QToolButton()
+        self.down_button.setText("▼")
+        self.down_button.setToolTip("Move the selected layer down")
+        self.down_button.clicked.connect(lambda: self._nudge(1))
+        bar.addWidget(self.add_button)
+        bar.addStretch(1)
+        for b in (self.up_button, self.down_button, self.remove_button):
+            bar.addWidget(b)
+        lay.addLayout(bar)
+        self.list = LayerList(self)
+        lay.addWidget(self.list, 1)
+        self.empty = QWidget()
+        el = QVBoxLayout(self.empty)
+        hint = QLabel("This material has no layer stack.\nAdd a layer to create one, or drop "
+                      "a layer from the Library here.")
+        hint.setObjectName("emptyHint")
+        hint.setWordWrap(True)
+        el.addWidget(hint)
+        self.create_button = QPushButton("Create layer stack")
+        self.create_button.clicked.connect(self.create_stack)
+        el.addWidget(self.create_button)
+        el.addStretch(1)
+        lay.addWidget(self.empty)
+        self.list.itemSelectionChanged.connect(self._selected)
+        self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
+        self._timer.setInterval(0)
+        self._timer.timeout.connect(self.rebuild)
+        controller.changed.connect(self._on_change)
+        controller.documentReplaced.connect(self.rebuild)
+        self.rebuild()
+
+    # --- model -----------------------------------------------------------------------------
+    @property
+    def stack(self) -> LayerStack | None:
+        return LayerStack.find(self.controller.document.graph)
+
+    def layer_ids_top_first(self) -> list[str]:
+        s = self.stack
+        return [layer.id for layer in reversed(s.layers)] if s else []
+
+    def _on_change(self, event: ChangeEvent) -> None:
+        s = self.stack
+        if event.kind == ChangeKind.STRUCTURAL and (
+                s is None or s.node_id in event.node_ids or event.what in ("node_added",
+                                                                            "node_removed")):
+            self._timer.start()
+        elif event.kind == ChangeKind.VALUE and s is not None and s.node_id in event.node_ids:
+            self.refresh_values()
+
+    def rebuild(self) -> None:
+        s = self.stack
+        selected = self.selected_layer()
+        self.list.clear()
+        self.empty.setVisible(s is None)
+        self.list.setVisible(s is not None)
+        for b in (self.remove_button, self.up_button, self.down_button):
+            b.setEnabled(s is not None and bool(s.layers))
+        if s is None:
+            return
+        layers = s.layers
+        values = self.controller.document.graph.nodes[s.node_id].values
+        for index in range(len(layers) - 1, -1, -1):
+            layer = layers[index]
+            opacity = values.get(f"{layer.id}_opacity", 1.0)
+            row = _LayerRow(self, layer, index == 0,
+                            float(opacity) if isinstance(opacity, (int, float)) else 1.0)
+            item = QListWidgetItem()
+            item.setData(Qt.ItemDataRole.UserRole, layer.id)
+            item.setSizeHint(row.sizeHint())
+            item.setToolTip(f"{layer.name}: {layer.function}")
+            self.list.addItem(item)
+            self.list.setItemWidget(item, row)
+            if layer.id == selected:
+                item.setSelected(True)
+
+    def refresh_values(self) -> None:
+        s = self.stack
+        if s is None:
+            return
+        values = self.controller.document.graph.nodes[s.node_id].values
+        for i in range(self.list.count()):
+            row = self.list.itemWidget(self.list.item(i))
+            if isinstance(row, _LayerRow) and row.opacity is not None:
+                v = values.get(f"{row.layer_id}_opacity", 1.0)
+                if isinstance(v, (int, float)):
+                    row.opacity.set_value(float(v))
+
+    def selected_layer(self) -> str | None:
+        items = self.list.selectedItems()
+        return items[0].data(Qt.ItemDataRole.UserRole) if items else None
+
+    def select_layer(self, layer_id: str) -> None:
+        for i in range(self.list.count()):
+            item = self.list.item(i)
+            item.setSelected(item.data(Qt.ItemDataRole.UserRole) == layer_id)
+
+    def _selected(self) -> None:
+        s = self.stack
+        if s is not None and self.selected_layer():
+            self.layerSelected.emit(s.node_id)
+
+    def _push(self, make) -> bool:
+        s = self.stack
+        if s is None:
+            return False
+        try:
+            cmd = make(s)
+        except CommandError as exc:
+            self.message.emit(str(exc))
+            return False
+        return self.controller.push(cmd)
+
+    # --- edits -----------------------------------------------------------------------------
+    def set_visible(self, layer_id: str, on: bool) -> None:
+        self._push(lambda s: s.set(layer_id, visible=bool(on)))
+
+    def set_blend(self, layer_id: str, blend: str) -> None:
+        self._push(lambda s: s.set(layer_id, blend=blend))
+
+    def rename(self, layer_id: str, name: str) -> None:
+        name = name.strip()
+        s = self.stack
+        if s is None or not name:
+            return
+        cur = next((layer for layer in s.layers if layer.id == layer_id), None)
+        if cur is not None and cur.name != name:
+            self._push(lambda s: s.set(layer_id, name=name))
+
+    def set_opacity(self, layer_id: str, value: float, merge_id: int | None = None) -> None:
+        s = self.stack
+        if s is None:
+            return
+        port = f"{layer_id}_opacity"
+        if self.controller.document.graph.nodes[s.node_id].values.get(port) == value:
+            return
+        self.controller.push(SetValue(s.node_id, port, float(value),
+                                      text=f"set {layer_id} opacity"), merge_id=merge_id)
+
+    def remove_layer(self, layer_id: str) -> bool:
+        return self._push(lambda s: s.remove(layer_id))
+
+    def remove_selected(self) -> None:
+        lid = self.selected_layer()
+        if lid:
+            self.remove_layer(lid)
+
+    def move_to_row(self, layer_id: str, row: int) -> bool:
+        """Moves a layer so it lands before list row `row` (0 = top; rows count the layer)."""
+        ids = self.layer_ids_top_first()
+        if layer_id not in ids:
+            return False
+        old = ids.index(layer_id)
+        new_row = row - 1 if row > old else row
+        new_row = max(0, min(len(ids) - 1, new_row))
+        if new_row == old:
+            return False
+        ok = self._push(lambda s: s.move(layer_id, len(ids) - 1 - new_row))
+        if ok:
+            self.rebuild()
+            self.select_layer(layer_id)
+        return ok
+
+    def _nudge(self, delta: int) -> None:
+        lid = self.selected_layer()
+        if not lid:
+            return
+        row = self.layer_ids_top_first().index(lid)
+        self.move_to_row(lid, row + (delta if delta < 0 else delta + 1))
+
+    def add_layer_file(self, path: Path, row: int | None = None) -> str | None:
+        """Adds the layer function at `path` above list row `row` (None: on top)."""
+        path = Path(path).resolve()
+        try:
+            fn = load(path)
+        except FormatError as exc:
+            self.message.emit(str(exc))
+            return None
+        if not fn.is_function:
+            self.message.emit(f"{path.name} is a material, not a material layer")
+            return None
+        ref = reference_for(self.controller.document, path)
+        s = self.stack
+        if s is None:
+            return self.create_stack(path)
+        lid = s.new_layer_id(path.stem.split("_")[0] or "layer")
+        layer = Layer(lid, ref, fn.name or path.stem, "alpha", True)
+        n = len(s.layers)
+        index = None if row is None else max(0, min(n, n - row))
+        if self._push(lambda s: s.add(layer, index)):
+            return lid
+        return None
+
+    def create_stack(self, first_layer: Path | None = None) -> str | None:
+        """Adds a layer stack node (with a first layer) wired into the material output."""
+        graph = self.controller.document.graph
+        entries = []
+        lid = None
+        if first_layer is not None:
+            fn = load(first_layer)
+            lid = "".join(c for c in first_layer.stem.split("_")[0] if c.isalnum()) or "layer"
+            lid = (lid if lid[0].isalpha() else "l" + lid) + "1"
+            entries.append(Layer(lid, reference_for(self.controller.document, first_layer),
+                                 fn.name or first_layer.stem).to_json())
+        out = next((n for n in sorted(graph.nodes.values(), key=lambda n: n.id)
+                    if n.kind == "material_output"), None)
+        pos = (out.position[0] - 260, out.position[1]) if out else (0.0, 0.0)
+        sid = graph.new_id("stack")
+        cmds = [AddNode(Node(sid, "layer_stack", pos, {"layers": entries}))]
+        if out is not None and graph.incoming(out.id, "attributes") is None:
+            cmds.append(Connect(Link(sid, "attributes", out.id, "attributes")))
+        if not self.controller.push(Macro(cmds, text="add layer stack")):
+            return None
+        return lid
+
+    def _fill_add_menu(self) -> None:
+        self.add_menu.clear()
+        for path in layer_files():
+            act = self.add_menu.addAction(icon("layer"), layer_title(path))
+            act.setToolTip(str(path))
+            act.triggered.connect(lambda _=False, p=path: self.add_layer_file(p))
+        self.add_menu.addSeparator()
+        other = self.add_menu.addAction("Other layer file…")
+        other.triggered.connect(self._add_other)
+
+    def _add_other(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getOpenFileName(self, "Add a material layer",
+                                              str(graphs_dir() / "layers"),
+                                              "Material layers (*.json)")
+        if path:
+            self.add_layer_file(Path(path))

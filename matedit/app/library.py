@@ -1,0 +1,184 @@
+"""The library: materials, layers and functions from graphs/ and the artist's folders.
+
+A searchable tree. Double-clicking a material opens it, a function opens it in a
+tab, and layers can be dragged onto the Layers panel (or double-clicked to add
+on top). User folders are remembered in QSettings.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import QMimeData, QSettings, Qt, Signal
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QFileDialog,
+    QHBoxLayout,
+    QLineEdit,
+    QToolButton,
+    QTreeWidget,
+    QTreeWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from matedit.app.layers_panel import LAYER_MIME
+from matedit.app.theme import icon
+from matedit.io.document import FormatError, load
+from matedit.resources import graphs_dir
+
+PATH_ROLE = Qt.ItemDataRole.UserRole
+KIND_ROLE = Qt.ItemDataRole.UserRole + 1
+SECTIONS = (("Materials", "materials", "material"), ("Layers", "layers", "layer"),
+            ("Functions", "functions", "function"))
+USER_FOLDERS_KEY = "library/folders"
+
+
+def classify(path: Path) -> tuple[str, str, str] | None:
+    """(kind, title, description) of a graph file; kind is material, layer or function."""
+    try:
+        doc = load(path)
+    except FormatError:
+        return None
+    title = doc.name or path.stem.replace("_", " ").title()
+    if not doc.is_function:
+        return "material", title, doc.description
+    from matedit.graph.ports import PortError, function_interface
+
+    try:
+        iface = function_interface(doc)
+    except PortError:
+        return "function", title, doc.description
+    is_layer = any(o.type == "MaterialAttributes" for o in iface.outputs) and \
+        sum(1 for i in iface.inputs if i.type == "MaterialAttributes") == 0
+    return ("layer" if is_layer else "function"), title, doc.description
+
+
+class LibraryTree(QTreeWidget):
+    def __init__(self) -> None:
+        super().__init__()
+        self.setHeaderHidden(True)
+        self.setDragEnabled(True)
+        self.setDragDropMode(QAbstractItemView.DragDropMode.DragOnly)
+
+    def mimeData(self, items) -> QMimeData:  # noqa: N802 - Qt's name
+        data = QMimeData()
+        for it in items:
+            path = it.data(0, PATH_ROLE)
+            if path and it.data(0, KIND_ROLE) == "layer":
+                data.setData(LAYER_MIME, str(path).encode())
+                break
+        return data
+
+
+class LibraryPanel(QWidget):
+    materialOpenRequested = Signal(str)
+    functionOpenRequested = Signal(str)
+    layerAddRequested = Signal(str)
+
+    def __init__(self, parent=None) -> None:
+        super().__init__(parent)
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 4)
+        lay.setSpacing(4)
+        bar = QHBoxLayout()
+        self.search = QLineEdit()
+        self.search.setPlaceholderText("Search materials, layers, functions…")
+        self.search.setClearButtonEnabled(True)
+        self.search.textChanged.connect(self.filter)
+        add = QToolButton()
+        add.setIcon(icon("folder-add"))
+        add.setToolTip("Add a folder of your own graphs to the library")
+        add.clicked.connect(self._add_folder_dialog)
+        bar.addWidget(self.search, 1)
+        bar.addWidget(add)
+        lay.addLayout(bar)
+        self.tree = LibraryTree()
+        self.tree.itemDoubleClicked.connect(self._activated)
+        lay.addWidget(self.tree, 1)
+        self.folder_dialog = QFileDialog.getExistingDirectory  # tests replace it
+        self.refresh()
+
+    # --- folders ---------------------------------------------------------------------------
+    def user_folders(self) -> list[Path]:
+        raw = QSettings().value(USER_FOLDERS_KEY, [])
+        if isinstance(raw, str):
+            raw = [raw]
+        return [Path(p) for p in (raw or []) if p]
+
+    def add_folder(self, folder: str | Path) -> None:
+        folders = [str(p) for p in self.user_folders()]
+        if str(folder) not in folders:
+            folders.append(str(folder))
+            QSettings().setValue(USER_FOLDERS_KEY, folders)
+        self.refresh()
+
+    def _add_folder_dialog(self) -> None:
+        folder = self.folder_dialog(self, "Add a library folder")
+        if folder:
+            self.add_folder(folder)
+
+    # --- tree ------------------------------------------------------------------------------
+    def refresh(self) -> None:
+        self.tree.clear()
+        sections = {}
+        for title, _sub, kind in SECTIONS:
+            top = QTreeWidgetItem(self.tree, [title])
+            top.setIcon(0, icon(kind))
+            top.setFlags(top.flags() & ~Qt.ItemFlag.ItemIsDragEnabled)
+            sections[kind] = top
+        roots = [("", graphs_dir())] + [(p.name, p) for p in self.user_folders()]
+        for origin, root in roots:
+            if not root.is_dir():
+                continue
+            for path in sorted(root.rglob("*.json")):
+                info = classify(path)
+                if info is None:
+                    continue
+                kind, title, desc = info
+                it = QTreeWidgetItem(sections[kind], [title + (f"  ({origin})" if origin else "")])
+                it.setIcon(0, icon(kind))
+                it.setData(0, PATH_ROLE, str(path.resolve()))
+                it.setData(0, KIND_ROLE, kind)
+                tip = f"{desc}\n{path}" if desc else str(path)
+                if kind == "layer":
+                    tip += "\nDrag onto the Layers panel, or double-click, to add it"
+                it.setToolTip(0, tip)
+        for top in sections.values():
+            top.setExpanded(True)
+        self.filter(self.search.text())
+
+    def filter(self, text: str) -> None:
+        words = text.lower().split()
+        for i in range(self.tree.topLevelItemCount()):
+            top = self.tree.topLevelItem(i)
+            shown = 0
+            for j in range(top.childCount()):
+                it = top.child(j)
+                hay = (it.text(0) + " " + it.toolTip(0)).lower()
+                ok = all(w in hay for w in words)
+                it.setHidden(not ok)
+                shown += ok
+            top.setHidden(bool(words) and shown == 0)
+
+    def items(self, kind: str | None = None) -> list[QTreeWidgetItem]:
+        out = []
+        for i in range(self.tree.topLevelItemCount()):
+            top = self.tree.topLevelItem(i)
+            for j in range(top.childCount()):
+                it = top.child(j)
+                if kind is None or it.data(0, KIND_ROLE) == kind:
+                    out.append(it)
+        return out
+
+    def _activated(self, item: QTreeWidgetItem, _col: int = 0) -> None:
+        path = item.data(0, PATH_ROLE)
+        kind = item.data(0, KIND_ROLE)
+        if not path:
+            return
+        if kind == "material":
+            self.materialOpenRequested.emit(path)
+        elif kind == "function":
+            self.functionOpenRequested.emit(path)
+        elif kind == "layer":
+            self.layerAddRequested.emit(path)

@@ -1,0 +1,45 @@
+"""File references as documents store them: relative to the document's own file."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from matedit.graph.model import MaterialDocument
+
+
+def reference_for(doc: MaterialDocument, target: str | os.PathLike) -> str:
+    """How `doc` should store a reference to `target`: relative to the document's folder
+    once it has one; absolute (made relative on the first save) while it is unsaved."""
+    target = Path(target).resolve()
+    if doc.path is None:
+        return target.as_posix()
+    try:
+        return Path(os.path.relpath(target, Path(doc.path).resolve().parent)).as_posix()
+    except ValueError:  # another drive on Windows
+        return target.as_posix()
+
+
+def absolute_of(doc: MaterialDocument, ref: str) -> Path | None:
+    if not ref:
+        return None
+    p = Path(ref)
+    if p.is_absolute():
+        return p
+    base = Path(doc.path).resolve().parent if doc.path else Path.cwd()
+    return (base / p).resolve()
+
+
+def relativise_references(doc: MaterialDocument, new_path: Path) -> None:
+    """Absolute references (made while the document was unsaved) become relative to the
+    file it is about to be saved as. Called just before the first save."""
+    from matedit.io.document import _ref_fields
+
+    base = Path(new_path).resolve().parent
+    for container, key in _ref_fields(doc):
+        ref = container[key]
+        if isinstance(ref, str) and ref and Path(ref).is_absolute():
+            try:
+                container[key] = Path(os.path.relpath(ref, base)).as_posix()
+            except ValueError:
+                pass

@@ -1,0 +1,131 @@
+"""`matedit render FILE -o OUT.png [--size WxH] [--mesh ...] [--env PATH|studio] [--ibl ...]
+[--exposure EV]`: a headless, deterministic preview render."""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+
+from matedit.cli import UsageError
+
+
+def register(sub) -> None:
+    p = sub.add_parser("render", help="render a material to a PNG, headless",
+                       description="Render a material on a preview mesh under the default "
+                       "light rig and an environment, headless (EGL), to a PNG.")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.png")
+    p.add_argument("--size", default="512x512", metavar="WxH")
+    p.add_argument("--mesh", default=None,
+                   help="sphere, cube, plane, cylinder or an OBJ file (default: the file's "
+                   "preview mesh, else sphere)")
+    p.add_argument("--env", default=None, metavar="PATH|studio|sky",
+                   help="built-in environment or an HDR/EXR file (default: studio)")
+    p.add_argument("--ibl", default="splitsum", choices=["splitsum", "reference", "difference"],
+                   help="split-sum approximation, converged importance-sampled reference, "
+                   "or a heat map of their difference")
+    p.add_argument("--exposure", type=float, default=None, metavar="EV")
+    p.set_defaults(run=run)
+
+
+def _size(text: str) -> tuple[int, int]:
+    m = re.fullmatch(r"(\d+)x(\d+)", text.strip())
+    if not m or not (1 <= int(m.group(1)) <= 8192 and 1 <= int(m.group(2)) <= 8192):
+        raise UsageError(f"--size must be WxH with 1..8192, e.g. 512x512, got {text!r}")
+    return int(m.group(1)), int(m.group(2))
+
+
+def write_png(path: Path, rgb) -> None:
+    import numpy as np
+    import OpenImageIO as oiio
+
+    from matedit.io.atomic import atomic_write_bytes
+
+    h, w, _ = rgb.shape
+    pixels = np.clip(np.rint(rgb * 255.0), 0, 255).astype(np.uint8)
+    tmp = path.with_name(f".{path.stem}.render-tmp.png")
+    out = oiio.ImageOutput.create(str(tmp))
+    if out is None or not out.open(str(tmp), oiio.ImageSpec(w, h, 3, "uint8")):
+        raise UsageError(f"{path}: cannot write PNG: {oiio.geterror()}")
+    out.write_image(pixels)
+    out.close()
+    atomic_write_bytes(path, tmp.read_bytes())
+    tmp.unlink()
+
+
+def run(args) -> int:
+    from matedit.compiler import CompileError, compile_document
+    from matedit.io.document import FileResolver, FormatError, load
+
+    size = _size(args.size)
+    path = Path(args.file)
+    out = Path(args.output)
+    if out.suffix.lower() != ".png":
+        raise UsageError(f"{out}: the output must be a .png file")
+    if not out.parent.exists():
+        raise UsageError(f"{out}: folder {out.parent} does not exist")
+    try:
+        doc = load(path)
+    except FormatError as exc:
+        raise UsageError(str(exc)) from None
+    if doc.is_function:
+        raise UsageError(f"{path}: is a material function; render a material that uses it")
+    try:
+        compiled = compile_document(doc, FileResolver(), "glsl330")
+    except CompileError as exc:
+        d = exc.diagnostics[0]
+        raise UsageError(f"{d.file or path}: {d.format()}") from None
+
+    import moderngl
+
+    from matedit.ibl import EnvironmentMapError
+    from matedit.render import MeshError, Renderer
+
+    try:
+        ctx = moderngl.create_standalone_context(require=330, backend="egl")
+    except Exception:
+        ctx = moderngl.create_standalone_context(require=330)
+    env = args.env or doc.preview.get("environment") or "studio"
+    mesh = args.mesh or doc.preview.get("mesh") or "sphere"
+    tty = sys.stderr.isatty()
+    try:
+        renderer = Renderer(ctx, size, environment=None)
+        try:
+            renderer.set_mesh(mesh)
+        except MeshError as exc:
+            raise UsageError(str(exc)) from None
+        try:
+            renderer.set_environment(env, progress=(lambda f: print(
+                f"\rbaking environment {f * 100:5.1f}%", end="", file=sys.stderr))
+                if tty else None)
+        except (EnvironmentMapError, ValueError) as exc:
+            raise UsageError(f"{env}: {exc}" if str(env) not in str(exc) else str(exc)) \
+                from None
+        if tty:
+            print(file=sys.stderr)
+        status = renderer.set_material(compiled)
+        if not status.ok:
+            node, msg = status.errors[0]
+            raise UsageError(f"{path}: node {node}: GLSL: {msg}" if node else f"{path}: {msg}")
+        if args.exposure is not None:
+            renderer.exposure = args.exposure
+        renderer.mode = args.ibl
+        frames = 0
+        while True:
+            renderer.render()
+            frames += 1
+            if tty and renderer.mode != "splitsum":
+                print(f"\raccumulating reference {frames}/{renderer.reference_frames}", end="",
+                      file=sys.stderr)
+            if not renderer.needs_redraw:
+                break
+        if tty and renderer.mode != "splitsum":
+            print(file=sys.stderr)
+        write_png(out, renderer.read_image())
+        if renderer.mode == "difference":
+            print(f"mean |split-sum - reference| (linear HDR): {renderer.difference_mean:.5f}")
+        renderer.release()
+    finally:
+        ctx.release()
+    return 0

@@ -1,0 +1,505 @@
+"""The preview renderer: moderngl only, no Qt; any context (headless EGL or Qt's).
+
+Frame: environment background, the material on the preview mesh (one program per
+structure hash; parameter edits only rewrite the MaterialParams buffer), light
+gizmos, all in a multisampled linear-HDR target; then resolve, and in reference
+mode accumulate frames with rotated sample sets; finally the display pass
+(exposure, ACES, sRGB) or the difference heat map into the caller's framebuffer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import moderngl
+import numpy as np
+
+from matedit.compiler.api import CompiledMaterial
+from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING
+from matedit.glsl.include import assemble
+from matedit.render.camera import OrbitCamera
+from matedit.render.lights import default_rig
+from matedit.render.mesh import GpuMesh, mesh_from_spec, uv_sphere
+from matedit.shading.ibl import (
+    IBL_MODE_NONE,
+    IBL_MODE_REFERENCE,
+    IBL_MODE_SPLIT_SUM,
+    pack_ibl_block,
+)
+from matedit.shading.lights import Light
+from matedit.shading.lights_block import pack_lights
+
+MODES = ("splitsum", "reference", "difference")
+LIGHTS_BINDING, IBL_BINDING = 0, 1
+PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = 2, 3, 4
+# SH irradiance coefficients -> radiance coefficients: divide by the cosine lobe's A_l
+# (Ramamoorthi and Hanrahan 2001): pi, 2pi/3, pi/4 for bands 0, 1, 2.
+_SH_BAND_SCALE = np.array([math.pi] + [2 * math.pi / 3] * 3 + [math.pi / 4] * 5)
+
+
+@dataclass
+class MaterialStatus:
+    ok: bool
+    errors: list[tuple[str, str]] = field(default_factory=list)  # (node id, message)
+    log: str = ""
+
+
+def _program(ctx, vert: str, frag: str, defines: str = "") -> moderngl.Program:
+    v = assemble(vert, "330 core", [], "<vertex>", prelude=defines)
+    f = assemble(frag, "330 core", [], "<fragment>", prelude=defines)
+    return ctx.program(vertex_shader=v.text, fragment_shader=f.text)
+
+
+def _read_shader(name: str) -> str:
+    from matedit.resources import shaders_dir
+
+    return (shaders_dir() / "render" / name).read_text()
+
+
+def _set(prog, name: str, value) -> None:
+    if name in prog:
+        prog[name].value = value
+
+
+def _mat_bytes(m: np.ndarray) -> bytes:
+    return np.ascontiguousarray(m.T, dtype="f4").tobytes()  # GLSL is column-major
+
+
+def r2_offset(frame: int) -> tuple[float, float]:
+    """Per-frame rotation of the reference sample set: the R2 sequence (Roberts 2018)."""
+    g = 1.32471795724474602596
+    return ((0.5 + frame / g) % 1.0, (0.5 + frame / (g * g)) % 1.0)
+
+
+class Renderer:
+    """Draws one material on a preview mesh. See the module docstring for the passes."""
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int] = (512, 512),
+                 samples: int = 4, environment: str | None = "studio",
+                 bake_settings=None) -> None:
+        self.ctx = ctx
+        self.samples = samples
+        self.camera = OrbitCamera()
+        self.lights: list[Light] = default_rig()
+        self.mode = "splitsum"
+        self.exposure = -0.5
+        self.time = 0.0
+        self.show_background = True
+        self.background_blur = 0.0
+        self.show_gizmos = True
+        self.environment_intensity = 1.0
+        self.reference_samples = 32  # per pixel per frame
+        self.reference_frames = 64  # frames to converge (32 x 64 = 2048 samples a pixel)
+        self.link_count = 0
+        self.difference_mean: float | None = None
+        self.bake_settings = bake_settings
+        self._programs: dict[str, moderngl.Program] = {}
+        self._compiled: CompiledMaterial | None = None
+        self._program: moderngl.Program | None = None
+        self._values: dict[str, Any] = {}
+        self._textures: dict[str, moderngl.Texture] = {}
+        self._accum_frames = 0
+        self._frame_index = 0
+        self._size = (0, 0)
+        self._ibl = None
+        self._env_cube = None
+        self._env_levels = 1
+        self._sh = np.zeros((9, 3))
+        self._mesh: GpuMesh | None = None
+        self.mesh_name = "sphere"
+
+        self._quad = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
+        fs = _read_shader("fullscreen.vert")
+        self._bg = _program(ctx, fs, _read_shader("background.frag"))
+        self._display = _program(ctx, fs, _read_shader("display.frag"))
+        self._accumulate = _program(ctx, fs, _read_shader("accumulate.frag"))
+        self._gizmo = _program(ctx, _read_shader("gizmo.vert"), _read_shader("gizmo.frag"))
+        self._fs_vaos = {p.glo: ctx.vertex_array(p, [(self._quad, "2f", "a_pos")])
+                         for p in (self._bg, self._display, self._accumulate)}
+        ball = uv_sphere(1.0, 16, 8)
+        self._gizmo_vbo = ctx.buffer(ball.positions.astype("f4").tobytes())
+        self._gizmo_ibo = ctx.buffer(ball.indices.astype("u4").tobytes())
+        self._gizmo_vao = ctx.vertex_array(self._gizmo, [(self._gizmo_vbo, "3f", "a_position")],
+                                           self._gizmo_ibo)
+        self._line_vbo = ctx.buffer(reserve=24)
+        self._line_vao = ctx.vertex_array(self._gizmo, [(self._line_vbo, "3f", "a_position")])
+        self._frame_buf = ctx.buffer(reserve=224)
+        self._lights_buf = ctx.buffer(pack_lights(self.lights))
+        self._ibl_buf = ctx.buffer(reserve=176)
+        self._params_buf: moderngl.Buffer | None = None
+        self.set_mesh("sphere")
+        self.resize(*size)
+        if environment is not None:
+            self.set_environment(environment)
+
+    # --- configuration --------------------------------------------------------------------
+    @property
+    def size(self) -> tuple[int, int]:
+        return self._size
+
+    def resize(self, width: int, height: int) -> None:
+        width, height = max(1, int(width)), max(1, int(height))
+        if (width, height) == self._size:
+            return
+        self._size = (width, height)
+        for name in ("_msaa_fbo", "_resolve_fbo", "_accum_fbo", "_split_fbo"):
+            fbo = getattr(self, name, None)
+            if fbo is not None:
+                for a in fbo.color_attachments:
+                    a.release()
+                if fbo.depth_attachment is not None:
+                    fbo.depth_attachment.release()
+                fbo.release()
+        ctx = self.ctx
+        s = self.samples
+        self._msaa_fbo = ctx.framebuffer(
+            [ctx.renderbuffer((width, height), 4, samples=s, dtype="f4")],
+            ctx.depth_renderbuffer((width, height), samples=s))
+        self._resolve_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
+        self._accum_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
+        self._split_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
+        self._out_fbo = None
+        self.reset_accumulation()
+
+    def reset_accumulation(self) -> None:
+        self._accum_frames = 0
+        self._frame_index = 0
+
+    def set_mesh(self, spec: str | Path) -> None:
+        """A built-in mesh name or an OBJ path; raises MeshError (a ValueError) on bad files."""
+        data = mesh_from_spec(spec)
+        if self._mesh is not None:
+            self._mesh.release()
+        self._mesh = GpuMesh(self.ctx, data)
+        self.mesh_name = str(spec)
+        self.reset_accumulation()
+
+    def set_lights(self, lights: list[Light]) -> None:
+        self.lights = list(lights)[:16]
+        self._lights_buf.write(pack_lights(self.lights))
+        self.reset_accumulation()
+
+    def set_environment(self, spec: str | Path, progress=None) -> None:
+        """A built-in name (studio, sky) or an HDR/EXR file, baked (cached) and uploaded."""
+        from matedit.ibl import bake, upload
+
+        result = bake(spec, self.bake_settings, ctx=self.ctx,
+                      progress=(lambda f, m: progress(f)) if progress else None)
+        if self._ibl is not None:
+            self._ibl.release()
+            self._env_cube.release()
+        self._ibl = upload(self.ctx, result)
+        base = result.mips[0]
+        n = base.shape[1]
+        cube = self.ctx.texture_cube((n, n), 3, dtype="f4")
+        for face in range(6):
+            cube.write(face, np.ascontiguousarray(base[face, ..., :3], dtype="f4").tobytes())
+        cube.build_mipmaps()
+        cube.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        self._env_cube = cube
+        self._env_levels = result.levels
+        self._sh = np.asarray(result.sh, dtype=np.float64) / _SH_BAND_SCALE[:, None]
+        self.environment_name = str(spec)
+        self.environment_warnings = list(result.warnings)
+        self.reset_accumulation()
+
+    # --- material -------------------------------------------------------------------------
+    def set_material(self, compiled: CompiledMaterial) -> MaterialStatus:
+        """Structural edit: link (or reuse) the program; keep the last good one on failure."""
+        prog = self._programs.get(compiled.structure_hash)
+        if prog is None:
+            try:
+                prog = self.ctx.program(vertex_shader=compiled.vertex_text,
+                                        fragment_shader=compiled.fragment_text)
+            except moderngl.Error as exc:
+                log = str(exc)
+                located = compiled.locate_error(log)
+                errors = [(node, msg) for node, _, _, msg in located
+                          if node and "error" in msg.lower()]
+                if not errors:
+                    errors = [("", next((m for _, _, _, m in located if "error" in m.lower()),
+                                        log.strip().splitlines()[-1] if log.strip() else log))]
+                return MaterialStatus(False, errors, log)
+            self.link_count += 1
+            self._bind_program(prog)
+            self._programs[compiled.structure_hash] = prog
+        self._program = prog
+        self._compiled = compiled
+        self._values = {u.name: u.default for u in compiled.ir.uniforms}
+        size = max(16, len(compiled.pack_uniforms()))
+        if self._params_buf is None or self._params_buf.size != size:
+            if self._params_buf is not None:
+                self._params_buf.release()
+            self._params_buf = self.ctx.buffer(reserve=size)
+        self._params_buf.write(compiled.pack_uniforms(self._values))
+        self._load_textures(compiled)
+        self.reset_accumulation()
+        return MaterialStatus(True)
+
+    def _bind_program(self, prog: moderngl.Program) -> None:
+        for block, binding in (("LightsBlock", LIGHTS_BINDING), ("IblBlock", IBL_BINDING),
+                               ("FrameBlock", FRAME_BINDING),
+                               ("MaterialParams", MATERIAL_BINDING)):
+            if block in prog:
+                prog[block].binding = binding
+        _set(prog, "uPrefilteredEnv", PREFILTERED_UNIT)
+        _set(prog, "uBrdfLut", LUT_UNIT)
+        _set(prog, "uEnvironment", ENVIRONMENT_UNIT)
+
+    def set_uniforms(self, values: dict[str, Any]) -> None:
+        """Parameter edit: rewrite the MaterialParams buffer; never links a program."""
+        if self._compiled is None:
+            return
+        known = {u.name for u in self._compiled.ir.uniforms}
+        self._values.update({k: v for k, v in values.items() if k in known})
+        self._params_buf.write(self._compiled.pack_uniforms(self._values))
+        self.reset_accumulation()
+
+    def set_texture(self, name: str, path: str | None) -> None:
+        """Loads a material texture (a value edit); a missing file shows a checker."""
+        old = self._textures.pop(name, None)
+        if old is not None:
+            old.release()
+        self._textures[name] = self._texture_from(path)
+        self.reset_accumulation()
+
+    def _texture_from(self, path: str | None) -> moderngl.Texture:
+        from matedit.compiler.cpu_eval import checker_texture
+
+        img = None
+        if path:
+            try:
+                from matedit.io.images import read_image
+
+                data = read_image(path).pixels
+                if data.shape[2] == 1:
+                    data = np.repeat(data, 3, axis=2)
+                if data.shape[2] == 3:
+                    data = np.concatenate([data, np.ones(data.shape[:2] + (1,), "f4")], 2)
+                img = np.ascontiguousarray(data[::-1, :, :4], dtype="f4")  # row 0 = v = 0
+            except (ValueError, OSError):
+                img = None
+        if img is None:
+            img = checker_texture(8)
+        tex = self.ctx.texture((img.shape[1], img.shape[0]), 4, img.tobytes(), dtype="f4")
+        tex.build_mipmaps()
+        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        tex.repeat_x = tex.repeat_y = True
+        return tex
+
+    def _load_textures(self, compiled: CompiledMaterial) -> None:
+        wanted = {t.name: t for t in compiled.ir.textures}
+        for name in list(self._textures):
+            if name not in wanted:
+                self._textures.pop(name).release()
+        for name, info in wanted.items():
+            if name not in self._textures:
+                self._textures[name] = self._texture_from(info.path)
+
+    # --- drawing --------------------------------------------------------------------------
+    @property
+    def needs_redraw(self) -> bool:
+        """True while reference or difference mode is still converging."""
+        return self.mode != "splitsum" and self._accum_frames < self.reference_frames
+
+    @property
+    def converged(self) -> bool:
+        return self.mode == "splitsum" or self._accum_frames >= self.reference_frames
+
+    def _write_frame_block(self) -> np.ndarray:
+        w, h = self._size
+        view = self.camera.view_matrix()
+        proj = self.camera.projection(w / h)
+        vp = proj @ view
+        data = b"".join([_mat_bytes(vp), _mat_bytes(np.eye(4)), _mat_bytes(np.eye(4)),
+                         np.array([*self.camera.eye, 1.0], "f4").tobytes(),
+                         np.array([self.time, self.exposure, w, h], "f4").tobytes()])
+        self._frame_buf.write(data)
+        return vp
+
+    def _scene(self, ibl_mode: int, offset=(0.0, 0.0)) -> None:
+        """Background, mesh and gizmos into the multisampled HDR target, then resolve."""
+        ctx = self.ctx
+        vp = self._write_frame_block()
+        self._msaa_fbo.use()
+        self._msaa_fbo.viewport = (0, 0, *self._size)
+        ctx.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
+        if self.show_background and self._ibl is not None:
+            self._ibl.prefiltered.use(location=PREFILTERED_UNIT)
+            self._env_cube.use(location=ENVIRONMENT_UNIT)
+            blur = self.background_blur > 0
+            self._bg["uEnvironmentCube"].value = PREFILTERED_UNIT if blur else ENVIRONMENT_UNIT
+            self._bg["uInvViewProjection"].write(_mat_bytes(np.linalg.inv(vp)))
+            self._bg["uLod"].value = float(self.background_blur * (self._env_levels - 1))
+            self._bg["uIntensity"].value = float(self.environment_intensity)
+            self._fs_vaos[self._bg.glo].render(vertices=3)
+        ctx.enable(moderngl.DEPTH_TEST)
+        if self._program is not None and self._mesh is not None:
+            self._lights_buf.bind_to_uniform_block(LIGHTS_BINDING)
+            mode = ibl_mode if self._ibl is not None else IBL_MODE_NONE
+            self._ibl_buf.write(pack_ibl_block(self._sh, float(self._env_levels),
+                                               self.environment_intensity,
+                                               self.reference_samples, mode, offset))
+            self._ibl_buf.bind_to_uniform_block(IBL_BINDING)
+            self._frame_buf.bind_to_uniform_block(FRAME_BINDING)
+            self._params_buf.bind_to_uniform_block(MATERIAL_BINDING)
+            if self._ibl is not None:
+                self._ibl.prefiltered.use(location=PREFILTERED_UNIT)
+                self._ibl.brdf_lut.use(location=LUT_UNIT)
+                self._env_cube.use(location=ENVIRONMENT_UNIT)
+            for i, t in enumerate(self._compiled.ir.textures):
+                unit = FIRST_TEXTURE_BINDING + i
+                self._textures[t.name].use(location=unit)
+                _set(self._program, t.name, unit)
+            ctx.enable(moderngl.BLEND)
+            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+            self._mesh.render(self._program)
+            ctx.disable(moderngl.BLEND)
+        if self.show_gizmos:
+            self._draw_gizmos(vp)
+        ctx.disable(moderngl.DEPTH_TEST)
+        ctx.copy_framebuffer(self._resolve_fbo, self._msaa_fbo)
+
+    def _draw_gizmos(self, vp: np.ndarray) -> None:
+        self._gizmo["uViewProjection"].write(_mat_bytes(vp))
+        for light in self.lights:
+            if light.kind == "directional":
+                continue
+            color = np.asarray(light.color) * min(light.intensity, 50.0) / 10.0 + 0.2
+            self._gizmo["uColor"].value = tuple(float(c) for c in color)
+            r = max(light.source_radius, 0.04)
+            if light.kind == "tube":
+                d = np.asarray(light.direction, dtype=np.float64)
+                d = d / (np.linalg.norm(d) or 1.0)
+                half = d * light.source_length / 2
+                ends = [np.asarray(light.position) - half, np.asarray(light.position) + half]
+                self._line_vbo.write(np.array(ends, "f4").tobytes())
+                self._gizmo["uModel"].write(_mat_bytes(np.eye(4)))
+                self._line_vao.render(mode=moderngl.LINES)
+                for e in ends:
+                    self._draw_ball(e, r)
+            else:
+                self._draw_ball(np.asarray(light.position), r)
+
+    def _draw_ball(self, centre, radius: float) -> None:
+        m = np.eye(4) * radius
+        m[3, 3] = 1.0
+        m[:3, 3] = centre
+        self._gizmo["uModel"].write(_mat_bytes(m))
+        self._gizmo_vao.render()
+
+    def _accumulate_into(self, fbo: moderngl.Framebuffer) -> None:
+        fbo.use()
+        if self._accum_frames == 0:
+            self.ctx.clear(0.0, 0.0, 0.0, 0.0)
+        self.ctx.enable(moderngl.BLEND)
+        self.ctx.blend_func = moderngl.ONE, moderngl.ONE
+        self._resolve_fbo.color_attachments[0].use(location=0)
+        self._accumulate["uFrame"].value = 0
+        self._fs_vaos[self._accumulate.glo].render(vertices=3)
+        self.ctx.disable(moderngl.BLEND)
+
+    def render(self, target: moderngl.Framebuffer | None = None) -> None:
+        """Draws one frame into `target` (default: an internal sRGB8 image, see read_image)."""
+        if target is None:
+            target = self._output_fbo()
+        if self.mode == "splitsum":
+            self._scene(IBL_MODE_SPLIT_SUM)
+            source, scale = self._resolve_fbo, 1.0
+        else:
+            if self._accum_frames < self.reference_frames:
+                self._scene(IBL_MODE_REFERENCE, r2_offset(self._frame_index))
+                self._accumulate_into(self._accum_fbo)
+                self._accum_frames += 1
+                self._frame_index += 1
+            source, scale = self._accum_fbo, 1.0 / max(self._accum_frames, 1)
+            if self.mode == "difference":
+                self._scene(IBL_MODE_SPLIT_SUM)
+                self._split_fbo.use()
+                self.ctx.copy_framebuffer(self._split_fbo, self._resolve_fbo)
+        self._display_pass(target, source, scale)
+
+    def _display_pass(self, target, source, scale: float) -> None:
+        target.use()
+        w, h = self._size
+        target.viewport = (0, 0, w, h)
+        self.ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+        d = self._display
+        if self.mode == "difference":
+            self._split_fbo.color_attachments[0].use(location=0)
+            source.color_attachments[0].use(location=1)
+            d["uImage"].value = 0
+            d["uReference"].value = 1
+            d["uScale"].value = 1.0
+            d["uReferenceScale"].value = scale
+            d["uMode"].value = 1
+            d["uHeatRange"].value = 0.1
+            self.difference_mean = float(np.mean(np.abs(self.read_hdr("splitsum")
+                                                        - self.read_hdr("reference"))))
+        else:
+            source.color_attachments[0].use(location=0)
+            d["uImage"].value = 0
+            _set(d, "uReference", 0)
+            d["uScale"].value = scale
+            _set(d, "uReferenceScale", 1.0)
+            d["uMode"].value = 0
+        d["uExposure"].value = float(self.exposure)
+        target.use()
+        self._fs_vaos[d.glo].render(vertices=3)
+
+    def _output_fbo(self) -> moderngl.Framebuffer:
+        w, h = self._size
+        if self._out_fbo is None or self._out_fbo.size != (w, h):
+            if self._out_fbo is not None:
+                self._out_fbo.color_attachments[0].release()
+                self._out_fbo.release()
+            self._out_fbo = self.ctx.framebuffer([self.ctx.texture((w, h), 4)])
+        return self._out_fbo
+
+    # --- reading back ---------------------------------------------------------------------
+    def read_image(self) -> np.ndarray:
+        """The last frame drawn into the internal target: (H, W, 3) float sRGB, top row first."""
+        w, h = self._size
+        raw = self._output_fbo().read(components=3, alignment=1)
+        return np.frombuffer(raw, np.uint8).reshape(h, w, 3)[::-1].astype(np.float32) / 255.0
+
+    def read_hdr(self, which: str | None = None) -> np.ndarray:
+        """Linear HDR (H, W, 3), top row first: the split-sum frame or the reference average."""
+        which = which or ("splitsum" if self.mode == "splitsum" else "reference")
+        w, h = self._size
+        if which == "reference":
+            fbo, scale = self._accum_fbo, 1.0 / max(self._accum_frames, 1)
+        elif self.mode == "difference":
+            fbo, scale = self._split_fbo, 1.0
+        else:
+            fbo, scale = self._resolve_fbo, 1.0
+        raw = fbo.read(components=4, dtype="f4")
+        return np.frombuffer(raw, np.float32).reshape(h, w, 4)[::-1, :, :3] * scale
+
+    def render_converged(self, target=None, max_frames: int | None = None) -> int:
+        """Renders until reference/difference mode has converged; returns frames drawn."""
+        frames = 0
+        limit = max_frames if max_frames is not None else self.reference_frames + 1
+        while True:
+            self.render(target)
+            frames += 1
+            if not self.needs_redraw or frames >= limit:
+                return frames
+
+    def release(self) -> None:
+        for p in self._programs.values():
+            if self._mesh is not None:
+                self._mesh.forget(p)
+            p.release()
+        self._programs.clear()
+        if self._mesh is not None:
+            self._mesh.release()
+        for t in self._textures.values():
+            t.release()
+        if self._ibl is not None:
+            self._ibl.release()
+            self._env_cube.release()
