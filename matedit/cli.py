@@ -25,10 +25,40 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def subcommand_names(parser: argparse.ArgumentParser) -> set[str]:
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return set(action.choices)
+    return set()
+
+
+def open_editor(argv: list[str]) -> int:
+    """`matedit [FILE]`: the editor, on FILE or on the built-in sample material."""
+    if len(argv) > 1:
+        raise UsageError(f"unexpected arguments after {argv[0]}: {' '.join(argv[1:])} "
+                         "(usage: matedit [FILE] | matedit COMMAND ...)")
+    path = argv[0] if argv else None
+    if path is not None:  # bad input is reported here, as for every command
+        from matedit.io.document import FormatError, load
+
+        try:
+            doc = load(path)
+        except FormatError as exc:
+            raise UsageError(str(exc)) from None
+        if doc.is_function:
+            raise UsageError(f"{path}: is a material function; open a material that uses it")
+    from matedit.app.app import run
+
+    return run(path)
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
         parser = build_parser()
+        if not argv or (not argv[0].startswith("-") and argv[0] not in
+                        subcommand_names(parser)):
+            return open_editor(argv)
         args = parser.parse_args(argv)
         if not getattr(args, "run", None):
             parser.print_help()

@@ -76,7 +76,8 @@ class ViewportWidget(QOpenGLWidget):
         self._button = Qt.MouseButton.NoButton
         self.frames = 0
         self.last_frame_time = 0.0
-        self.progress_factory = None  # (label) -> progress callback, set by the panel
+        self._fbo = None
+        self._fbo_glo = -1
 
     # --- GL lifecycle ----------------------------------------------------------------------
     def initializeGL(self) -> None:  # noqa: N802 - Qt's name
@@ -92,10 +93,16 @@ class ViewportWidget(QOpenGLWidget):
             self.problem = why
             return
         dpr = self.devicePixelRatioF()
+        size = (max(1, int(self.width() * dpr)), max(1, int(self.height() * dpr)))
         try:
-            self.renderer = cls(self.ctx, size=(max(1, int(self.width() * dpr)),
-                                                max(1, int(self.height() * dpr))), samples=4)
-            self._apply_view_state()
+            try:  # bake the wanted environment once, not the default and then ours
+                self.renderer = cls(self.ctx, size=size, samples=4,
+                                    environment=self._environment)
+                env_done = True
+            except TypeError:
+                self.renderer = cls(self.ctx, size=size, samples=4)
+                env_done = False
+            self._apply_view_state(set_environment=not env_done)
         except Exception as exc:
             self.renderer = None
             self.problem = f"renderer failed to start: {type(exc).__name__}: {exc}"
@@ -105,7 +112,7 @@ class ViewportWidget(QOpenGLWidget):
             self._apply_material(cm)
         self._flush_values()
 
-    def _apply_view_state(self) -> None:
+    def _apply_view_state(self, set_environment: bool = True) -> None:
         r = self.renderer
         r.set_mesh(self._mesh)
         r.mode = self._mode
@@ -114,9 +121,11 @@ class ViewportWidget(QOpenGLWidget):
             r.set_lights(list(self._lights))
         else:
             self._lights = list(getattr(r, "lights", []) or [])
-        self._set_environment_now(self._environment, None)
+        if set_environment:
+            self._set_environment_now(self._environment, None)
 
     def resizeGL(self, w: int, h: int) -> None:  # noqa: N802 - Qt's name
+        self._fbo = None
         if self.renderer is not None:
             dpr = self.devicePixelRatioF()
             self.renderer.resize(max(1, int(w * dpr)), max(1, int(h * dpr)))
@@ -127,8 +136,10 @@ class ViewportWidget(QOpenGLWidget):
             self._paint_message(self.problem or "starting the renderer…")
             return
         try:
-            fbo = self.ctx.detect_framebuffer(self.defaultFramebufferObject())
-            self.renderer.render(fbo)
+            glo = self.defaultFramebufferObject()
+            if self._fbo is None or self._fbo_glo != glo:  # Qt recreates it on resize
+                self._fbo, self._fbo_glo = self.ctx.detect_framebuffer(glo), glo
+            self.renderer.render(self._fbo)
         except Exception as exc:  # keep the editor alive; show what went wrong
             self.problem = f"render failed: {type(exc).__name__}: {exc}"
             self.renderer = None

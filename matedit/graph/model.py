@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 _ID = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")
 
@@ -51,8 +51,9 @@ class Node:
         return copy.deepcopy(self)
 
 
-@dataclass(frozen=True, order=True)
-class Link:
+class Link(NamedTuple):
+    """An output feeding an input. A tuple, so sorting and hashing run at C speed."""
+
     src: str
     src_port: str
     dst: str

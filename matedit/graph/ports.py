@@ -102,6 +102,20 @@ def layer_entries(node: Node) -> list[dict]:
     return layers if isinstance(layers, list) else []
 
 
+_STATIC_RULES = ("component_mask", "split", "append", "reroute")
+_STATIC: dict[str, NodePorts] = {}
+
+
+def _static_ports(kind: str) -> NodePorts:
+    """Ports that depend on nothing but the kind, built once per kind (NodePorts is frozen)."""
+    hit = _STATIC.get(kind)
+    if hit is None:
+        d = nodes.REGISTRY[kind]
+        hit = _STATIC[kind] = NodePorts(tuple(_spec(i) for i in d.inputs),
+                                        tuple(_spec(o) for o in d.outputs))
+    return hit
+
+
 def node_ports(
     node: Node, resolver: FunctionResolver | None = None, owner: MaterialDocument | None = None
 ) -> NodePorts:
@@ -109,12 +123,12 @@ def node_ports(
     d = nodes.REGISTRY.get(node.kind)
     if d is None:
         raise PortError(node.id, "kind", f"unknown node kind {node.kind!r}")
+    rule = d.ports_rule
+    if rule is None or rule in _STATIC_RULES:
+        return _static_ports(node.kind)
     ins = tuple(_spec(i) for i in d.inputs)
     outs = tuple(_spec(o) for o in d.outputs)
-    rule = d.ports_rule
     s = {**d.setting_defaults(), **node.settings}
-    if rule is None or rule in ("component_mask", "split", "append", "reroute"):
-        return NodePorts(ins, outs)
     if rule == "constant":
         try:
             t = parse_type(str(s["type"]))

@@ -86,8 +86,9 @@ def dependency_graph(doc: MaterialDocument) -> nx.DiGraph:
 
 
 def stable_order(g: nx.DiGraph) -> list[str]:
-    """Topological order, ties broken by id, so emission is the same whatever the file order."""
-    return list(nx.lexicographical_topological_sort(g))
+    """Topological order independent of the file's order: generation by generation (nodes
+    whose inputs are all in earlier generations), ids sorted within each generation."""
+    return [n for gen in nx.topological_generations(g) for n in sorted(gen)]
 
 
 def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None) -> Analysis:

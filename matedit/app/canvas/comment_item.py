@@ -46,7 +46,7 @@ class CommentItem(QGraphicsItem):
         return QRectF(self.pos(), QPointF(self.pos().x() + self.size[0],
                                           self.pos().y() + self.size[1]))
 
-    # --- geometry ------------------------------------------------------------------------------
+    # --- geometry ----------------------------------------------------------------------------
     def boundingRect(self) -> QRectF:
         return QRectF(-1, -1, self.size[0] + 2, self.size[1] + 2)
 
@@ -66,7 +66,7 @@ class CommentItem(QGraphicsItem):
         path.addRect(self._grip())
         return path
 
-    # --- dragging ------------------------------------------------------------------------------
+    # --- dragging ----------------------------------------------------------------------------
     def mousePressEvent(self, event) -> None:
         if event.button() != Qt.MouseButton.LeftButton:
             event.ignore()
@@ -116,7 +116,7 @@ class CommentItem(QGraphicsItem):
             self.scene().request_comment_text(self.comment_id)
         event.accept()
 
-    # --- painting ------------------------------------------------------------------------------
+    # --- painting ----------------------------------------------------------------------------
     def paint(self, painter: QPainter, option: QStyleOptionGraphicsItem, widget=None) -> None:
         lod = QStyleOptionGraphicsItem.levelOfDetailFromTransform(painter.worldTransform())
         w, h = self.size

@@ -17,7 +17,7 @@ Z_NODE = 0.0
 Z_NODE_SELECTED = 1.0
 Z_LIVE_WIRE = 10.0
 
-# --- sizes (scene units; 1 unit = 1 pixel at zoom 1) ---------------------------------------
+# --- sizes (scene units; 1 unit = 1 pixel at zoom 1) -----------------------------------------
 NODE_MIN_WIDTH = 112.0
 NODE_MAX_WIDTH = 260.0
 HEADER_HEIGHT = 22.0
@@ -48,7 +48,7 @@ SCENE_EXTENT = 100_000.0  # the scene rect: room to pan anywhere
 
 TOAST_MS = 3000
 
-# --- colours ----------------------------------------------------------------------------------
+# --- colours ---------------------------------------------------------------------------------
 BACKGROUND = QColor("#1b1e24")
 GRID_MINOR_COLOR = QColor("#22262e")
 GRID_MAJOR_COLOR = QColor("#2b303a")
@@ -115,7 +115,7 @@ def wire_width(type_name: str) -> float:
     return WIRE_WIDTH_STRUCT if type_name == "MaterialAttributes" else WIRE_WIDTH
 
 
-# --- fonts (created lazily: they need a QGuiApplication) --------------------------------------
+# --- fonts (created lazily: they need a QGuiApplication) ------------------------------------
 @cache
 def title_font() -> QFont:
     f = QFont("DejaVu Sans")

@@ -56,7 +56,7 @@ def measure(title: str, subtitle: str, inputs: list[PortRow], outputs: list[Port
     a node is as tall as its longer side, not the sum of both.
     """
     fm_t, fm_p = C.metrics("title"), C.metrics("port")
-    head = 2 * 8.0 + fm_t.horizontalAdvance(title) + 2 * C.BADGE_RADIUS + 4
+    head = 2 * 8.0 + fm_t.horizontalAdvance(title)
     if subtitle:
         head = max(head, 16.0 + C.metrics("subtitle").horizontalAdvance(subtitle))
     left = max((fm_p.horizontalAdvance(p.name) for p in inputs), default=0.0)
@@ -101,7 +101,7 @@ class BadgeItem(QGraphicsItem):
         painter.setPen(QPen(C.NODE_BODY_EDGE, 1.0))
         painter.setBrush(self.color)
         painter.drawEllipse(QPointF(0, 0), C.BADGE_RADIUS, C.BADGE_RADIUS)
-        painter.setPen(QPen(QColor("#ffffff"), 2.0, cap=Qt.PenCapStyle.RoundCap))
+        painter.setPen(QPen(QColor("#ffffff"), 2.0, Qt.PenStyle.SolidLine, Qt.PenCapStyle.RoundCap))
         painter.drawLine(QPointF(0, -3.6), QPointF(0, 1.0))
         painter.drawPoint(QPointF(0, 3.8))
 
@@ -201,7 +201,7 @@ class NodeItem(QGraphicsItem):
     def has_preview(self) -> bool:
         return self._preview is not None
 
-    # --- ports ---------------------------------------------------------------------------------
+    # --- ports -------------------------------------------------------------------------------
     def port(self, name: str, is_output: bool) -> PortItem | None:
         return self._ports.get((name, is_output))
 
@@ -220,7 +220,7 @@ class NodeItem(QGraphicsItem):
         rows = self.outputs if is_output else self.inputs
         return next((r.type for r in rows if r.name == name), "T")
 
-    # --- geometry ------------------------------------------------------------------------------
+    # --- geometry ----------------------------------------------------------------------------
     def _relayout(self) -> None:
         self.prepareGeometryChange()
         self.layout = measure(self.title, self.subtitle, self.inputs, self.outputs,
@@ -255,10 +255,11 @@ class NodeItem(QGraphicsItem):
 
     def _place_badge(self) -> None:
         if self._badge is not None:
-            self._badge.setPos(self.layout.width - C.BADGE_RADIUS - 4, C.HEADER_HEIGHT / 2)
+            # Astride the top-right corner, so it never hides the title.
+            self._badge.setPos(self.layout.width - 2.0, 0.0)
 
     def boundingRect(self) -> QRectF:
-        m = 2.0
+        m = C.PORT_RADIUS + 2.5  # ports sit astride the edges
         return QRectF(-m, -m, self.layout.width + 2 * m, self.layout.height + 2 * m)
 
     def shape(self) -> QPainterPath:
@@ -277,7 +278,7 @@ class NodeItem(QGraphicsItem):
             self.setZValue(C.Z_NODE_SELECTED if value else C.Z_NODE)
         return super().itemChange(change, value)
 
-    # --- painting ------------------------------------------------------------------------------
+    # --- painting ----------------------------------------------------------------------------
     def paint(self, painter: QPainter, option: QStyleOptionGraphicsItem, widget=None) -> None:
         lod = QStyleOptionGraphicsItem.levelOfDetailFromTransform(painter.worldTransform())
         lay = self.layout
@@ -309,10 +310,10 @@ class NodeItem(QGraphicsItem):
         if lod < C.LOD_TEXT:
             self._paint_ports(painter, labels=False)
             return
-        # Title, elided to leave room for the badge.
+        # Title, elided when the node is at its widest.
         painter.setFont(C.title_font())
         painter.setPen(C.NODE_TEXT)
-        room = lay.width - 16 - (2 * C.BADGE_RADIUS + 4 if self.diagnostics else 0)
+        room = lay.width - 14
         title = C.metrics("title").elidedText(self.title, Qt.TextElideMode.ElideRight, room)
         painter.drawText(QRectF(8, 0, room, C.HEADER_HEIGHT),
                          Qt.AlignmentFlag.AlignVCenter | Qt.AlignmentFlag.AlignLeft, title)

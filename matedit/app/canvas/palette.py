@@ -132,7 +132,7 @@ class NodePalette(QFrame):
         self.list.currentItemChanged.connect(self._describe)
         self.hide()
 
-    # --- opening and closing -------------------------------------------------------------------
+    # --- opening and closing -----------------------------------------------------------------
     def popup(self, at: QPoint, accept: Callable[[str], bool] | None = None,
               hint: str = "Add node") -> None:
         """Show at `at` (parent coordinates, kept inside the parent) with an optional filter."""
@@ -154,7 +154,7 @@ class NodePalette(QFrame):
             if cancelled:
                 self.cancelled.emit()
 
-    # --- list ------------------------------------------------------------------------------------
+    # --- list --------------------------------------------------------------------------------
     def visible_kinds(self) -> list[str]:
         return [self.list.item(i).data(KIND_ROLE) for i in range(self.list.count())
                 if self.list.item(i).data(KIND_ROLE)]
@@ -219,7 +219,7 @@ class NodePalette(QFrame):
             self.hide()
             self.chosen.emit(kind)
 
-    # --- keys --------------------------------------------------------------------------------------
+    # --- keys --------------------------------------------------------------------------------
     def eventFilter(self, obj: QObject, event: QEvent) -> bool:
         if obj is self.search and event.type() == QEvent.Type.KeyPress:
             key = event.key()

@@ -93,7 +93,7 @@ class NodeScene(QGraphicsScene):
         controller.documentReplaced.connect(self.rebuild)
         self.rebuild()
 
-    # --- queries ---------------------------------------------------------------------------------
+    # --- queries -----------------------------------------------------------------------------
     @property
     def graph(self):
         return self.controller.document.graph
@@ -121,7 +121,7 @@ class NodeScene(QGraphicsScene):
             rect = rect.united(it.sceneBoundingRect())
         return rect
 
-    # --- building --------------------------------------------------------------------------------
+    # --- building ----------------------------------------------------------------------------
     def rebuild(self) -> None:
         """Drop every item and build them again from the model (a new document)."""
         self.clear()
@@ -227,7 +227,7 @@ class NodeScene(QGraphicsScene):
             self.addItem(item)
         item.set_content(comment)
 
-    # --- model events ----------------------------------------------------------------------------
+    # --- model events ------------------------------------------------------------------------
     def _on_changed(self, ev: ChangeEvent) -> None:
         what = ev.what
         if what == "node_added":
@@ -297,7 +297,7 @@ class NodeScene(QGraphicsScene):
         extra = self._node_errors.get(item.node_id)
         item.set_diagnostics(([("error", f"GLSL: {extra}")] if extra else []) + diags)
 
-    # --- annotations from the window ----------------------------------------------------------
+    # --- annotations from the window ---------------------------------------------------------
     def set_node_errors(self, errors: dict[str, str]) -> None:
         """GLSL errors mapped to nodes; replaces the previous set."""
         touched = set(self._node_errors) | set(errors)
@@ -317,7 +317,7 @@ class NodeScene(QGraphicsScene):
         if item is not None:
             item.set_preview(image)
 
-    # --- item callbacks --------------------------------------------------------------------------
+    # --- item callbacks ----------------------------------------------------------------------
     def node_item_moved(self, node_id: str) -> None:
         for link in self._wires_of.get(node_id, ()):
             self.wire_items[link].update_path()
@@ -365,7 +365,7 @@ class NodeScene(QGraphicsScene):
         if event.button() == Qt.MouseButton.LeftButton:
             self.commit_moves()
 
-    # --- background ------------------------------------------------------------------------------
+    # --- background --------------------------------------------------------------------------
     def drawBackground(self, painter: QPainter, rect: QRectF) -> None:
         painter.fillRect(rect, C.BACKGROUND)
         zoom = painter.worldTransform().m11()

@@ -1,0 +1,588 @@
+"""NodeCanvasView: the node editor widget (navigation, selection, wiring, clipboard, palette).
+
+Navigation: wheel zooms about the cursor; middle drag, Alt+left drag or Space+left
+drag pans; F frames the selection, Home or A frames everything; M toggles the
+minimap. Editing: drag between ports to connect (a wire dragged off a connected
+input is lifted and moves or, dropped on nothing, is removed; a new wire dropped
+on nothing opens the palette with only the kinds that can take it); Tab opens the
+palette; Delete removes; Ctrl+C / Ctrl+X / Ctrl+V / Ctrl+D copy, cut, paste and
+duplicate; C frames the selection in a comment. Every edit is a command pushed
+through the controller; what the canvas shows comes back from the model's events.
+"""
+
+from __future__ import annotations
+
+import re
+
+from PySide6.QtCore import QEvent, QPoint, QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QImage, QKeySequence, QPainter, QPixmapCache, QTransform
+from PySide6.QtWidgets import (
+    QApplication,
+    QGraphicsItem,
+    QGraphicsView,
+    QInputDialog,
+    QMenu,
+    QWidget,
+)
+
+from matedit.app.canvas import clipboard
+from matedit.app.canvas import constants as C
+from matedit.app.canvas.comment_item import CommentItem
+from matedit.app.canvas.interaction import WireDrag, compatible_port, kind_ports, port_at
+from matedit.app.canvas.minimap import MiniMap
+from matedit.app.canvas.node_item import NodeItem, PortRow, measure
+from matedit.app.canvas.palette import NodePalette
+from matedit.app.canvas.scene import NodeScene, describe
+from matedit.app.canvas.toast import Toast
+from matedit.app.canvas.wire_item import WireItem
+from matedit.app.controller import DocumentController
+from matedit.graph import nodes
+from matedit.graph.commands import AddNode, Command, Connect, Disconnect, PutComment, RemoveNode
+from matedit.graph.model import Comment, Link, MaterialDocument, Node
+from matedit.graph.validate import check_connect
+
+_DRAG_START = 4  # pixels the mouse must travel before a press on a port becomes a drag
+
+
+def _id_stem(kind: str) -> str:
+    """`value_noise` -> `valueNoise`: readable ids for new nodes."""
+    parts = [p for p in re.split(r"[^A-Za-z0-9]+", kind) if p]
+    return (parts[0] + "".join(p[:1].upper() + p[1:] for p in parts[1:])) if parts else "n"
+
+
+class NodeCanvasView(QGraphicsView):
+    """The node canvas over one DocumentController (see `matedit.app.canvas` for the API)."""
+
+    selectionChangedIds = Signal(list)
+    functionOpenRequested = Signal(str)
+    message = Signal(str)
+
+    def __init__(self, controller: DocumentController, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.controller = controller
+        self._scene = NodeScene(controller, self)
+        self.setScene(self._scene)
+        # Node caches are pixmaps; the default 10 MB cache thrashes on a big graph.
+        QPixmapCache.setCacheLimit(max(QPixmapCache.cacheLimit(), 256 * 1024))
+        self.setRenderHints(QPainter.RenderHint.Antialiasing
+                            | QPainter.RenderHint.TextAntialiasing
+                            | QPainter.RenderHint.SmoothPixmapTransform)
+        self.setViewportUpdateMode(QGraphicsView.ViewportUpdateMode.SmartViewportUpdate)
+        self.setCacheMode(QGraphicsView.CacheModeFlag.CacheBackground)
+        self.setOptimizationFlag(QGraphicsView.OptimizationFlag.DontSavePainterState, True)
+        self.setTransformationAnchor(QGraphicsView.ViewportAnchor.NoAnchor)
+        self.setResizeAnchor(QGraphicsView.ViewportAnchor.AnchorViewCenter)
+        self.setDragMode(QGraphicsView.DragMode.RubberBandDrag)
+        self.setRubberBandSelectionMode(Qt.ItemSelectionMode.IntersectsItemShape)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        e = C.SCENE_EXTENT
+        self.setSceneRect(-e, -e, 2 * e, 2 * e)  # the view's room to pan, not the scene's index
+        self.setFrameShape(QGraphicsView.Shape.NoFrame)
+        self.setMouseTracking(True)
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self.setStyleSheet("QGraphicsView { background: #1b1e24; border: none; }")
+
+        self.node_palette = NodePalette(self)
+        self.node_palette.chosen.connect(self._palette_chosen)
+        self.node_palette.cancelled.connect(self._palette_cancelled)
+        self.toast = Toast(self.viewport())
+        self.minimap = MiniMap(self)
+
+        self._wire: WireDrag | None = None
+        self._wire_press: QPoint | None = None
+        self._pan_last: QPoint | None = None
+        self._space = False
+        self._last_pos: QPoint | None = None  # last mouse position in the viewport
+        self._palette_pos = QPointF()
+        self._palette_anchor: tuple[str, str, bool, str] | None = None
+        self._selecting = False
+        self._last_ids: list[str] = []
+
+        self._scene.selectionChanged.connect(self._selection_changed)
+        self._scene.commentTextRequested.connect(self._edit_comment_text)
+        self._scene.rebuilt.connect(self.minimap.invalidate)
+        controller.changed.connect(lambda _ev: self.minimap.invalidate())
+        controller.documentReplaced.connect(self._document_replaced)
+        self.horizontalScrollBar().valueChanged.connect(self.minimap.update)
+        self.verticalScrollBar().valueChanged.connect(self.minimap.update)
+        self.minimap.invalidate()
+
+    # --- public API --------------------------------------------------------------------------
+    def scene(self) -> NodeScene:  # type: ignore[override]
+        return self._scene
+
+    def zoom(self) -> float:
+        return self.transform().m11()
+
+    def frame_all(self) -> None:
+        """Zoom and scroll so every node and comment is in view."""
+        self._fit(self._scene.nodes_bounding_rect())
+
+    def frame_selection(self) -> None:
+        items = [it for it in self._scene.selectedItems()
+                 if isinstance(it, (NodeItem, CommentItem))]
+        if not items:
+            self.frame_all()
+            return
+        self._fit(self._scene.nodes_bounding_rect(items))
+
+    def select_nodes(self, ids) -> None:
+        """Select exactly these nodes (unknown ids are ignored); emits selectionChangedIds once."""
+        self._selecting = True
+        try:
+            self._scene.clearSelection()
+            for nid in ids:
+                item = self._scene.node_items.get(nid)
+                if item is not None:
+                    item.setSelected(True)
+        finally:
+            self._selecting = False
+        self._selection_changed()
+
+    def selected_ids(self) -> list[str]:
+        return self._scene.selected_node_ids()
+
+    def add_node_at(self, kind: str, scene_pos: QPointF, settings: dict | None = None) -> str:
+        """Add a `kind` node, top-left corner at `scene_pos`; its new id ('' if refused)."""
+        node = self._new_node(kind, scene_pos, settings)
+        if node is None:
+            return ""
+        return node.id if self.controller.push(AddNode(node)) else ""
+
+    def set_node_errors(self, errors: dict[str, str]) -> None:
+        """Errors mapped to nodes (GLSL compile errors), shown as red badges; replaces the last."""
+        self._scene.set_node_errors(errors)
+
+    def set_node_preview(self, node_id: str, image: QImage | None) -> None:
+        self._scene.set_node_preview(node_id, image)
+
+    def open_palette(self, scene_pos: QPointF | None = None) -> None:
+        """The node palette at `scene_pos` (default: the cursor, else the middle of the view)."""
+        self._palette_anchor = None
+        self._show_palette(self._resolve_pos(scene_pos), None, "Add node")
+
+    def set_minimap_visible(self, visible: bool) -> None:
+        self.minimap.setVisible(visible)
+
+    # --- edits -------------------------------------------------------------------------------
+    def delete_selection(self) -> bool:
+        sel = self._scene.selectedItems()
+        node_ids = sorted(it.node_id for it in sel if isinstance(it, NodeItem))
+        gone = set(node_ids)
+        commands: list[Command] = [
+            Disconnect(it.link) for it in sel
+            if isinstance(it, WireItem) and it.link.src not in gone and it.link.dst not in gone]
+        commands += [RemoveNode(nid) for nid in node_ids]
+        commands += [PutComment(it.comment_id, None, text="delete comment")
+                     for it in sel if isinstance(it, CommentItem)]
+        if not commands:
+            return False
+        n = len(node_ids)
+        text = f"delete {n} node{'s' if n != 1 else ''}" if n else "delete"
+        return self.controller.push_all(commands, text)
+
+    def copy_selection(self) -> bool:
+        sel = self._scene.selectedItems()
+        node_ids = [it.node_id for it in sel if isinstance(it, NodeItem)]
+        comment_ids = [it.comment_id for it in sel if isinstance(it, CommentItem)]
+        if not node_ids and not comment_ids:
+            self.message.emit("Nothing selected to copy")
+            return False
+        payload = clipboard.copy_payload(self.controller.document, node_ids, comment_ids)
+        QApplication.clipboard().setMimeData(clipboard.to_mime(payload))
+        self.message.emit(f"Copied {len(node_ids)} node{'s' if len(node_ids) != 1 else ''}")
+        return True
+
+    def cut_selection(self) -> bool:
+        return self.copy_selection() and self.delete_selection()
+
+    def paste(self, scene_pos: QPointF | None = None) -> list[str]:
+        """Paste the clipboard's nodes (top-left at `scene_pos`, else the cursor, else offset)."""
+        clip = clipboard.from_mime(QApplication.clipboard().mimeData())
+        if clip is None or not (clip.graph.nodes or clip.graph.comments):
+            self.message.emit("The clipboard holds no nodes")
+            return []
+        corner = clipboard.payload_bounds(clip)
+        if scene_pos is None and self._cursor_inside():
+            scene_pos = self.mapToScene(self._last_pos)
+        if scene_pos is not None:
+            offset = (scene_pos.x() - corner[0], scene_pos.y() - corner[1])
+        else:
+            offset = (40.0, 40.0)
+        return self._paste_doc(clip, offset, "paste")
+
+    def duplicate_selection(self) -> list[str]:
+        sel = self._scene.selectedItems()
+        node_ids = [it.node_id for it in sel if isinstance(it, NodeItem)]
+        if not node_ids:
+            return []
+        payload = clipboard.copy_payload(self.controller.document, node_ids)
+        clip = clipboard.from_mime(clipboard.to_mime(payload))
+        return self._paste_doc(clip, (40.0, 40.0), "duplicate") if clip else []
+
+    def comment_selection(self) -> str:
+        """A comment frame around the selected nodes; its id ('' if nothing is selected)."""
+        items = [it for it in self._scene.selectedItems() if isinstance(it, NodeItem)]
+        if not items:
+            return ""
+        r = self._scene.nodes_bounding_rect(items).adjusted(-20, -20 - C.COMMENT_HEADER, 20, 20)
+        cid = self.controller.document.graph.new_id("comment")
+        comment = Comment(cid, "Comment", (r.x(), r.y(), r.width(), r.height()),
+                          (0.32, 0.36, 0.45))
+        return cid if self.controller.push(PutComment(cid, comment, text="add comment")) else ""
+
+    def _paste_doc(self, clip: MaterialDocument, offset, text: str) -> list[str]:
+        commands, ids = clipboard.paste_commands(self.controller.document.graph, clip, offset)
+        if not commands or not self.controller.push_all(commands, text):
+            return []
+        self.select_nodes(ids)
+        self.message.emit(f"{text.capitalize()}d {len(ids)} node{'s' if len(ids) != 1 else ''}"
+                          if text == "paste" else f"Duplicated {len(ids)} nodes")
+        return ids
+
+    def _new_node(self, kind: str, scene_pos: QPointF, settings: dict | None) -> Node | None:
+        if kind not in nodes.REGISTRY:
+            self.message.emit(f"Unknown node kind {kind!r}")
+            return None
+        graph = self.controller.document.graph
+        nid = graph.new_id(_id_stem(kind))
+        s = dict(settings or {})
+        if kind.endswith("_parameter") and "name" not in s:
+            taken = {str(n.settings.get("name")) for n in graph.nodes.values()
+                     if n.kind.endswith("_parameter")}
+            name, i = nid, 1
+            while name in taken:
+                i += 1
+                name = f"{nid}_{i}"
+            s["name"] = name
+        return Node(nid, kind, (round(scene_pos.x(), 1), round(scene_pos.y(), 1)), s)
+
+    def refuse(self, reason: str, at: QPoint | None = None) -> None:
+        """Show why an edit was refused: near the cursor for a few seconds, and as `message`."""
+        if at is None:
+            at = self._last_pos if self._cursor_inside() else self.viewport().rect().center()
+        self.toast.show_at(reason, at)
+        self.message.emit(reason)
+
+    # --- palette -----------------------------------------------------------------------------
+    def _resolve_pos(self, scene_pos: QPointF | None) -> QPointF:
+        if scene_pos is not None:
+            return QPointF(scene_pos)
+        if self._cursor_inside():
+            return self.mapToScene(self._last_pos)
+        return self.mapToScene(self.viewport().rect().center())
+
+    def _cursor_inside(self) -> bool:
+        return self._last_pos is not None and self.viewport().rect().contains(self._last_pos)
+
+    def _show_palette(self, scene_pos: QPointF, accept, hint: str) -> None:
+        self._palette_pos = QPointF(scene_pos)
+        at = self.viewport().mapTo(self, self.mapFromScene(scene_pos))
+        self.node_palette.popup(at, accept, hint)
+
+    def _palette_chosen(self, kind: str) -> None:
+        anchor, self._palette_anchor = self._palette_anchor, None
+        if anchor is None:
+            self.add_node_at(kind, self._palette_pos)
+        else:
+            self._add_connected(kind, self._palette_pos, anchor)
+        self.setFocus()
+
+    def _palette_cancelled(self) -> None:
+        self._palette_anchor = None
+        self.setFocus()
+
+    def _add_connected(self, kind: str, at: QPointF, anchor: tuple[str, str, bool, str]) -> str:
+        """Add a `kind` node whose compatible port sits at `at`, wired to the anchor port."""
+        a_node, a_port, a_out, a_type = anchor
+        port = compatible_port(kind, a_type, a_out)
+        ports = kind_ports(kind)
+        node = self._new_node(kind, at, None)
+        if node is None or port is None or ports is None:
+            return self.add_node_at(kind, at)
+        title, sub, _, _ = describe(node)
+        lay = measure(title, sub, [PortRow(p.name, p.type) for p in ports.inputs],
+                      [PortRow(p.name, p.type) for p in ports.outputs])
+        local = lay.inputs[port] if a_out else lay.outputs[port]
+        node.position = (round(at.x() - local.x(), 1), round(at.y() - local.y(), 1))
+        link = (Link(a_node, a_port, node.id, port) if a_out else
+                Link(node.id, port, a_node, a_port))
+        doc = self.controller.document
+        trial = MaterialDocument(doc.kind, doc.graph.copy(), doc.name, doc.description, doc.path)
+        AddNode(node).apply(trial.graph)
+        reason = check_connect(trial, link, self.controller.resolver)
+        if reason is not None:
+            self.controller.push(AddNode(node))
+            self.refuse(reason)
+            return node.id
+        ok = self.controller.push_all([AddNode(node), Connect(link)], "add connected node")
+        return node.id if ok else ""
+
+    # --- selection ---------------------------------------------------------------------------
+    def _selection_changed(self) -> None:
+        if self._selecting:
+            return
+        ids = self._scene.selected_node_ids()
+        if ids != self._last_ids:
+            self._last_ids = ids
+            self.selectionChangedIds.emit(list(ids))
+
+    def _document_replaced(self) -> None:
+        self._wire = None
+        self.node_palette.close_palette()
+        self._last_ids = []
+        self.selectionChangedIds.emit([])
+        self.frame_all()
+
+    # --- view transform ----------------------------------------------------------------------
+    def _fit(self, rect: QRectF) -> None:
+        vp = self.viewport().rect()
+        if rect.isEmpty():
+            self.setTransform(QTransform())
+            self.centerOn(0, 0)
+            self.minimap.update()
+            return
+        m = 40.0
+        s = min((vp.width() - 2 * m) / max(rect.width(), 1.0),
+                (vp.height() - 2 * m) / max(rect.height(), 1.0))
+        s = max(C.ZOOM_MIN, min(s, 1.0))
+        self.setTransform(QTransform.fromScale(s, s))
+        self.centerOn(rect.center())
+        self.minimap.update()
+
+    def _zoom_by(self, factor: float, vp_pos: QPointF) -> None:
+        cur = self.zoom()
+        new = max(C.ZOOM_MIN, min(C.ZOOM_MAX, cur * factor))
+        if abs(new - cur) < 1e-9:
+            return
+        before = self.mapToScene(vp_pos.toPoint())
+        self.scale(new / cur, new / cur)
+        after = self.mapFromScene(before)
+        d = after - vp_pos.toPoint()
+        self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() + d.x())
+        self.verticalScrollBar().setValue(self.verticalScrollBar().value() + d.y())
+        self.minimap.update()
+
+    def wheelEvent(self, event) -> None:
+        steps = event.angleDelta().y() / 120.0
+        if steps:
+            self._zoom_by(C.ZOOM_STEP ** steps, event.position())
+        event.accept()
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        m = 10
+        self.minimap.move(self.width() - self.minimap.width() - m,
+                          self.height() - self.minimap.height() - m)
+
+    # --- mouse -------------------------------------------------------------------------------
+    def _hit_radius(self) -> float:
+        return C.PORT_HIT_RADIUS / max(self.zoom(), 1e-3)
+
+    def mousePressEvent(self, event) -> None:
+        pos = event.position().toPoint()
+        self._last_pos = pos
+        if self.node_palette.isVisible():
+            self.node_palette.close_palette()
+        button, mods = event.button(), event.modifiers()
+        if button == Qt.MouseButton.MiddleButton or (button == Qt.MouseButton.LeftButton and (
+                mods & Qt.KeyboardModifier.AltModifier or self._space)):
+            self._pan_last = pos
+            self.viewport().setCursor(Qt.CursorShape.ClosedHandCursor)
+            event.accept()
+            return
+        if button == Qt.MouseButton.LeftButton:
+            sp = self.mapToScene(pos)
+            port = port_at(self._scene, sp, self._hit_radius(), for_press=True)
+            if port is not None:
+                self._wire = WireDrag(self._scene, port)
+                self._wire_press = pos
+                event.accept()
+                return
+            if self.itemAt(pos) is None:
+                self._scene.rubber_banding = True
+        super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event) -> None:
+        pos = event.position().toPoint()
+        self._last_pos = pos
+        if self._pan_last is not None:
+            d = pos - self._pan_last
+            self._pan_last = pos
+            self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() - d.x())
+            self.verticalScrollBar().setValue(self.verticalScrollBar().value() - d.y())
+            event.accept()
+            return
+        if self._wire is not None:
+            self._wire.move(self.mapToScene(pos), self._hit_radius())
+            event.accept()
+            return
+        super().mouseMoveEvent(event)
+
+    def mouseReleaseEvent(self, event) -> None:
+        pos = event.position().toPoint()
+        self._last_pos = pos
+        if self._pan_last is not None and event.button() in (Qt.MouseButton.MiddleButton,
+                                                             Qt.MouseButton.LeftButton):
+            self._pan_last = None
+            self.viewport().unsetCursor()
+            event.accept()
+            return
+        if self._wire is not None and event.button() == Qt.MouseButton.LeftButton:
+            self._finish_wire(pos)
+            event.accept()
+            return
+        super().mouseReleaseEvent(event)
+        self._scene.rubber_banding = False
+
+    def _finish_wire(self, pos: QPoint) -> None:
+        wire, self._wire = self._wire, None
+        moved = (pos - self._wire_press).manhattanLength() >= _DRAG_START
+        result = wire.finish(self.mapToScene(pos), self._hit_radius())
+        anchor = wire.anchor
+        wire.cleanup()
+        if not moved:
+            return
+        if result.link is not None:
+            if result.lifted is None:
+                self.controller.push(Connect(result.link))
+            elif result.lifted != result.link:
+                self.controller.push_all([Disconnect(result.lifted), Connect(result.link)],
+                                         "reconnect")
+        elif result.reason is not None:
+            self.refuse(result.reason, pos)
+        elif result.lifted is not None:
+            self.controller.push(Disconnect(result.lifted))
+        else:
+            side = "output" if anchor.is_output else "input"
+            self._palette_anchor = (anchor.node_id, anchor.name, anchor.is_output,
+                                    wire.anchor_type)
+            a_type = wire.anchor_type
+            self._show_palette(
+                self.mapToScene(pos),
+                lambda kind: compatible_port(kind, a_type, anchor.is_output) is not None,
+                f"Connect to {anchor.node_id}.{anchor.name} ({a_type} {side})")
+
+    def mouseDoubleClickEvent(self, event) -> None:
+        item = self.itemAt(event.position().toPoint())
+        while item is not None and not isinstance(item, (NodeItem, CommentItem)):
+            item = item.parentItem()
+        if isinstance(item, NodeItem) and item.kind == "function_call":
+            node = self.controller.document.graph.nodes.get(item.node_id)
+            ref = node.settings.get("function") if node else None
+            if isinstance(ref, str) and ref:
+                path = self.controller.resolver.path_of(ref, self.controller.document)
+                self.functionOpenRequested.emit(str(path))
+            event.accept()
+            return
+        super().mouseDoubleClickEvent(event)
+
+    def contextMenuEvent(self, event) -> None:
+        pos = event.pos()
+        self._last_pos = pos
+        sp = self.mapToScene(pos)
+        item = self.itemAt(pos)
+        while item is not None and not isinstance(item, QGraphicsItem):
+            item = item.parentItem()
+        if item is not None and not item.isSelected() and isinstance(
+                item, (NodeItem, CommentItem, WireItem)):
+            self._scene.clearSelection()
+            item.setSelected(True)
+        menu = QMenu(self)
+        menu.addAction("Add node…\tTab", lambda: self.open_palette(sp))
+        has_sel = bool(self._scene.selectedItems())
+        for text, slot, key, enabled in (
+                ("Copy", self.copy_selection, "Ctrl+C", has_sel),
+                ("Cut", self.cut_selection, "Ctrl+X", has_sel),
+                ("Paste", lambda: self.paste(sp), "Ctrl+V", True),
+                ("Duplicate", self.duplicate_selection, "Ctrl+D", has_sel),
+                ("Delete", self.delete_selection, "Del", has_sel),
+                ("Comment around selection", self.comment_selection, "C", has_sel),
+                ("Frame all", self.frame_all, "Home", True)):
+            action = menu.addAction(f"{text}\t{key}", slot)
+            action.setEnabled(enabled)
+        menu.exec(event.globalPos())
+
+    # --- keys --------------------------------------------------------------------------------
+    _OWN_KEYS = (QKeySequence.StandardKey.Copy, QKeySequence.StandardKey.Paste,
+                 QKeySequence.StandardKey.Cut, QKeySequence.StandardKey.Delete)
+
+    def _is_own_key(self, event) -> bool:
+        if any(event.matches(k) for k in self._OWN_KEYS):
+            return True
+        key, mods = event.key(), event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        if mods == Qt.KeyboardModifier.ControlModifier and key == Qt.Key.Key_D:
+            return True
+        return mods == Qt.KeyboardModifier.NoModifier and key in (
+            Qt.Key.Key_Tab, Qt.Key.Key_Delete, Qt.Key.Key_Backspace, Qt.Key.Key_F,
+            Qt.Key.Key_A, Qt.Key.Key_Home, Qt.Key.Key_C, Qt.Key.Key_M, Qt.Key.Key_Space,
+            Qt.Key.Key_Escape)
+
+    def event(self, event) -> bool:
+        t = event.type()
+        if t == QEvent.Type.ShortcutOverride and self._is_own_key(event):
+            event.accept()  # the canvas's keys win over window shortcuts while it has focus
+            return True
+        if t == QEvent.Type.KeyPress and event.key() == Qt.Key.Key_Tab and not (
+                event.modifiers() & (Qt.KeyboardModifier.ControlModifier
+                                     | Qt.KeyboardModifier.AltModifier
+                                     | Qt.KeyboardModifier.ShiftModifier)):
+            self.open_palette()
+            return True
+        return super().event(event)
+
+    def keyPressEvent(self, event) -> None:
+        key, mods = event.key(), event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        ctrl = mods == Qt.KeyboardModifier.ControlModifier
+        plain = mods == Qt.KeyboardModifier.NoModifier
+        if event.matches(QKeySequence.StandardKey.Copy):
+            self.copy_selection()
+        elif event.matches(QKeySequence.StandardKey.Cut):
+            self.cut_selection()
+        elif event.matches(QKeySequence.StandardKey.Paste):
+            self.paste()
+        elif ctrl and key == Qt.Key.Key_D:
+            self.duplicate_selection()
+        elif plain and key in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):
+            self.delete_selection()
+        elif plain and key == Qt.Key.Key_F:
+            self.frame_selection()
+        elif plain and key in (Qt.Key.Key_A, Qt.Key.Key_Home):
+            self.frame_all()
+        elif plain and key == Qt.Key.Key_C:
+            self.comment_selection()
+        elif plain and key == Qt.Key.Key_M:
+            self.minimap.setVisible(not self.minimap.isVisible())
+        elif plain and key == Qt.Key.Key_Space:
+            if not event.isAutoRepeat():
+                self._space = True
+                self.viewport().setCursor(Qt.CursorShape.OpenHandCursor)
+        elif key == Qt.Key.Key_Escape:
+            if self._wire is not None:
+                self._wire.cleanup()
+                self._wire = None
+            else:
+                self._scene.clearSelection()
+        else:
+            super().keyPressEvent(event)
+            return
+        event.accept()
+
+    def keyReleaseEvent(self, event) -> None:
+        if event.key() == Qt.Key.Key_Space and not event.isAutoRepeat():
+            self._space = False
+            self.viewport().unsetCursor()
+            event.accept()
+            return
+        super().keyReleaseEvent(event)
+
+    # --- comments ----------------------------------------------------------------------------
+    def _edit_comment_text(self, comment_id: str) -> None:
+        old = self.controller.document.graph.comments.get(comment_id)
+        if old is None:
+            return
+        text, ok = QInputDialog.getText(self, "Comment", "Text:", text=old.text)
+        if ok and text != old.text:
+            self.controller.push(PutComment(comment_id, Comment(comment_id, text, old.rect,
+                                                                old.color), text="edit comment"))

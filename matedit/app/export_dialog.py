@@ -1,0 +1,113 @@
+"""Export compiled shaders: targets and a folder; the same files as `matedit compile`
+(STEM.TARGET.vert, STEM.TARGET.frag and STEM.json with the reflection)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from PySide6.QtCore import QSettings
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QDialog,
+    QDialogButtonBox,
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QMessageBox,
+    QPushButton,
+    QVBoxLayout,
+)
+
+from matedit.compiler import TARGETS, CompileError, compile_all
+from matedit.graph.model import MaterialDocument
+from matedit.io.atomic import atomic_write_text
+from matedit.io.document import FileResolver
+
+FOLDER_KEY = "export/folder"
+
+
+def export_shaders(doc: MaterialDocument, resolver: FileResolver | None, targets: list[str],
+                   folder: Path) -> list[Path]:
+    """Writes the compiled shaders and reflection; raises CompileError or OSError."""
+    compiled = compile_all(doc, resolver, targets)
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise OSError(f"{folder} exists and is not a folder")
+    name = Path(doc.path).name if doc.path else (doc.name or "material").replace(" ", "_")
+    stem = name[:-5] if name.endswith(".json") else name
+    written = []
+    reflection = {"source": str(doc.path) if doc.path else stem, "targets": {}}
+    for target, cm in compiled.items():
+        for ext, text in (("vert", cm.vertex_text), ("frag", cm.fragment_text)):
+            out = folder / f"{stem}.{target}.{ext}"
+            atomic_write_text(out, text)
+            written.append(out)
+        reflection["targets"][target] = cm.reflection()
+    first = next(iter(compiled.values())).reflection()
+    for key in ("attributes", "uniforms", "textures", "uniform_block"):
+        reflection[key] = first[key]
+    out = folder / f"{stem}.json"
+    atomic_write_text(out, json.dumps(reflection, sort_keys=True, indent=2) + "\n")
+    written.append(out)
+    return written
+
+
+class ExportDialog(QDialog):
+    def __init__(self, doc: MaterialDocument, resolver: FileResolver | None, parent=None):
+        super().__init__(parent)
+        self.setWindowTitle("Export shaders")
+        self.doc, self.resolver = doc, resolver
+        self.written: list[Path] = []
+        lay = QVBoxLayout(self)
+        lay.addWidget(QLabel("Targets"))
+        self.boxes = {}
+        for t in TARGETS:
+            box = QCheckBox(t)
+            box.setChecked(t == "glsl330")
+            lay.addWidget(box)
+            self.boxes[t] = box
+        lay.addWidget(QLabel("Folder"))
+        row = QHBoxLayout()
+        default = QSettings().value(FOLDER_KEY, "") or (
+            str(Path(doc.path).parent / "shaders") if doc.path else "")
+        self.folder = QLineEdit(str(default))
+        browse = QPushButton("Browse…")
+        browse.clicked.connect(self._browse)
+        row.addWidget(self.folder, 1)
+        row.addWidget(browse)
+        lay.addLayout(row)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Cancel)
+        self.export_button = buttons.addButton("Export", QDialogButtonBox.ButtonRole.AcceptRole)
+        buttons.accepted.connect(self.run_export)
+        buttons.rejected.connect(self.reject)
+        lay.addWidget(buttons)
+        self.resize(420, self.sizeHint().height())
+
+    def targets(self) -> list[str]:
+        return [t for t, b in self.boxes.items() if b.isChecked()]
+
+    def _browse(self) -> None:
+        folder = QFileDialog.getExistingDirectory(self, "Export into", self.folder.text())
+        if folder:
+            self.folder.setText(folder)
+
+    def run_export(self) -> bool:
+        targets = self.targets()
+        folder = self.folder.text().strip()
+        if not targets or not folder:
+            QMessageBox.warning(self, "Export shaders", "Choose at least one target and a folder.")
+            return False
+        try:
+            self.written = export_shaders(self.doc, self.resolver, targets, Path(folder))
+        except CompileError as exc:
+            QMessageBox.critical(self, "Export shaders", "The material does not compile:\n"
+                                 + "\n".join(d.format() for d in exc.diagnostics[:10]))
+            return False
+        except OSError as exc:
+            QMessageBox.critical(self, "Export shaders", f"Cannot write to {folder}:\n{exc}")
+            return False
+        QSettings().setValue(FOLDER_KEY, folder)
+        self.accept()
+        return True

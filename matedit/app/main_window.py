@@ -1,0 +1,400 @@
+"""The main window: canvas tabs in the centre, dockable panels around it, menus, status bar.
+
+Panels are wired to the active tab's controller (inspector, history, diagnostics)
+or to the material's (viewport, layers, code). Dock layout and window geometry
+are kept in QSettings and restored at the next start.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QKeySequence, QUndoGroup
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMenu, QUndoView
+
+from matedit.app.canvas_tabs import CanvasTab, CanvasTabs
+from matedit.app.code_view import CodeView
+from matedit.app.compile_service import MaterialCompiler
+from matedit.app.controller import DocumentController
+from matedit.app.diagnostics import DiagnosticsPanel, Problem
+from matedit.app.document_actions import DocumentActions, document_title
+from matedit.app.export_dialog import ExportDialog
+from matedit.app.inspector import InspectorPanel
+from matedit.app.layers_panel import LayersPanel
+from matedit.app.library import LibraryPanel
+from matedit.app.lights_panel import LightsPanel
+from matedit.app.theme import icon
+from matedit.app.viewport import ViewportPanel
+from matedit.graph.model import MaterialDocument
+from matedit.resources import graphs_dir
+
+SAMPLE = "materials/rusty_painted_metal.json"
+GEOMETRY_KEY, STATE_KEY = "window/geometry", "window/state"
+STATE_VERSION = 1
+
+
+def sample_path() -> Path:
+    return graphs_dir() / SAMPLE
+
+
+class MainWindow(QMainWindow):
+    def __init__(self, path: str | Path | None = None, *, sample: bool = True,
+                 restore_layout: bool = True, start: bool = True) -> None:
+        super().__init__()
+        self.setObjectName("MainWindow")
+        self.resize(1480, 900)
+        self.setDockNestingEnabled(True)
+        self.controller = DocumentController(MaterialDocument(name="Untitled"), self)
+        self.actions = DocumentActions(self, self.controller)
+        self.compiler = MaterialCompiler(self.controller, self)
+        self.undo_group = QUndoGroup(self)
+        self._problems = {"compile": [], "gl": []}
+
+        self.tabs = CanvasTabs(self.controller, self.actions, self.undo_group, self)
+        self.setCentralWidget(self.tabs)
+        self._build_docks()
+        self._build_actions()
+        self._build_menus()
+        self._build_status()
+        self._connect()
+        self._default_state = self.saveState(STATE_VERSION)
+        if restore_layout:
+            self.restore_layout()
+        self.undo_group.setActiveStack(self.controller.undo_stack)
+        self._on_active(self.tabs.active)
+        self._retitle()
+        if start:
+            self.actions.start(path, sample_path() if sample else None)
+            self.compiler.recompile()
+
+    # --- construction ----------------------------------------------------------------------
+    def _dock(self, title: str, name: str, widget, area, icon_name: str = "") -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(name)
+        dock.setWidget(widget)
+        dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable
+                         | QDockWidget.DockWidgetFeature.DockWidgetFloatable
+                         | QDockWidget.DockWidgetFeature.DockWidgetClosable)
+        self.addDockWidget(area, dock)
+        if icon_name:
+            dock.toggleViewAction().setIcon(icon(icon_name))
+        return dock
+
+    def _build_docks(self) -> None:
+        L, R, B = (Qt.DockWidgetArea.LeftDockWidgetArea, Qt.DockWidgetArea.RightDockWidgetArea,
+                   Qt.DockWidgetArea.BottomDockWidgetArea)
+        self.viewport = ViewportPanel(self.compiler)
+        self.inspector = InspectorPanel(self.controller)
+        self.layers = LayersPanel(self.controller)
+        self.library = LibraryPanel()
+        self.lights = LightsPanel()
+        self.code = CodeView(self.compiler)
+        self.diagnostics = DiagnosticsPanel()
+        self.history = QUndoView(self.undo_group)
+        self.history.setEmptyLabel("<opened>")
+
+        self.library_dock = self._dock("Library", "libraryDock", self.library, L, "folder-add")
+        self.layers_dock = self._dock("Layers", "layersDock", self.layers, L, "layer")
+        self.viewport_dock = self._dock("Viewport", "viewportDock", self.viewport, R,
+                                        "material")
+        self.inspector_dock = self._dock("Inspector", "inspectorDock", self.inspector, R)
+        self.lights_dock = self._dock("Lights && Environment", "lightsDock", self.lights, R,
+                                      "light")
+        self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
+                                           B, "warning")
+        self.code_dock = self._dock("GLSL", "codeDock", self.code, B)
+        self.history_dock = self._dock("History", "historyDock", self.history, B, "undo")
+        self.splitDockWidget(self.library_dock, self.layers_dock, Qt.Orientation.Vertical)
+        self.splitDockWidget(self.viewport_dock, self.inspector_dock, Qt.Orientation.Vertical)
+        self.tabifyDockWidget(self.inspector_dock, self.lights_dock)
+        self.inspector_dock.raise_()
+        self.tabifyDockWidget(self.diagnostics_dock, self.code_dock)
+        self.tabifyDockWidget(self.code_dock, self.history_dock)
+        self.diagnostics_dock.raise_()
+        self.resizeDocks([self.library_dock, self.viewport_dock], [270, 430],
+                         Qt.Orientation.Horizontal)
+        self.resizeDocks([self.viewport_dock, self.inspector_dock], [400, 420],
+                         Qt.Orientation.Vertical)
+        self.resizeDocks([self.library_dock, self.layers_dock], [330, 420],
+                         Qt.Orientation.Vertical)
+        self.resizeDocks([self.diagnostics_dock], [170], Qt.Orientation.Vertical)
+
+    def _action(self, text: str, slot, shortcut=None, icon_name: str = "",
+                tip: str = "") -> QAction:
+        a = QAction(icon(icon_name) if icon_name else icon("none"), text, self)
+        if shortcut is not None:
+            a.setShortcut(shortcut)
+        if tip:
+            a.setStatusTip(tip)
+            a.setToolTip(tip)
+        a.triggered.connect(slot)
+        return a
+
+    def _build_actions(self) -> None:
+        K = QKeySequence.StandardKey
+        self.act_new = self._action("&New", self.actions.new, K.New, "new", "New material")
+        self.act_open = self._action("&Open…", self.actions.open_dialog, K.Open, "open",
+                                     "Open a material")
+        self.act_save = self._action("&Save", self.save_active, K.Save, "save",
+                                     "Save the document in the active tab")
+        self.act_save_as = self._action("Save &As…", self.save_active_as, K.SaveAs, "save-as")
+        self.act_export = self._action("&Export Shaders…", self.export_shaders, "Ctrl+E",
+                                       "export", "Write GLSL for chosen targets to a folder")
+        self.act_quit = self._action("&Quit", self.close, K.Quit)
+        self.act_undo = self.undo_group.createUndoAction(self, "&Undo")
+        self.act_undo.setShortcut(K.Undo)
+        self.act_undo.setIcon(icon("undo"))
+        self.act_redo = self.undo_group.createRedoAction(self, "&Redo")
+        self.act_redo.setShortcut(K.Redo)
+        self.act_redo.setIcon(icon("redo"))
+        self.act_add_node = self._action("Add &Node…", self.open_palette, "Tab", "add",
+                                         "Add a node (palette)")
+        self.act_add_node.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        self.tabs.addAction(self.act_add_node)
+        self.act_frame_all = self._action("Frame &All", lambda: self.tabs.active.canvas
+                                          .frame_all(), "Home", "frame")
+        self.act_frame_sel = self._action("Frame &Selection", lambda: self.tabs.active.canvas
+                                          .frame_selection(), "F")
+        self.act_frame_sel.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        self.tabs.addAction(self.act_frame_sel)
+        self.act_reset_layout = self._action("Reset &Layout", self.reset_layout)
+
+    def _build_menus(self) -> None:
+        mb = self.menuBar()
+        f = mb.addMenu("&File")
+        for a in (self.act_new, self.act_open):
+            f.addAction(a)
+        self.recent_menu = QMenu("Open &Recent", self)
+        self.recent_menu.aboutToShow.connect(self._fill_recent)
+        f.addMenu(self.recent_menu)
+        f.addSeparator()
+        for a in (self.act_save, self.act_save_as):
+            f.addAction(a)
+        f.addSeparator()
+        f.addAction(self.act_export)
+        f.addSeparator()
+        f.addAction(self.act_quit)
+        e = mb.addMenu("&Edit")
+        e.addAction(self.act_undo)
+        e.addAction(self.act_redo)
+        e.addSeparator()
+        e.addAction(self.act_add_node)
+        v = mb.addMenu("&View")
+        v.addAction(self.act_frame_all)
+        v.addAction(self.act_frame_sel)
+        v.addSeparator()
+        for dock in (self.viewport_dock, self.inspector_dock, self.layers_dock,
+                     self.library_dock, self.lights_dock, self.code_dock,
+                     self.diagnostics_dock, self.history_dock):
+            v.addAction(dock.toggleViewAction())
+        v.addSeparator()
+        v.addAction(self.act_reset_layout)
+        tb = self.addToolBar("Main")
+        tb.setObjectName("mainToolBar")
+        tb.setMovable(False)
+        tb.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
+        for a in (self.act_new, self.act_open, self.act_save, None, self.act_undo,
+                  self.act_redo, None, self.act_add_node, self.act_frame_all, None,
+                  self.act_export):
+            if a is None:
+                tb.addSeparator()
+            else:
+                tb.addAction(a)
+
+    def _build_status(self) -> None:
+        sb = self.statusBar()
+        self.compile_label = QLabel("")
+        self.count_label = QLabel("")
+        sb.addPermanentWidget(self.count_label)
+        sb.addPermanentWidget(self.compile_label)
+
+    def _connect(self) -> None:
+        c = self.controller
+        c.undo_stack.cleanChanged.connect(lambda _clean: self._retitle())
+        c.documentReplaced.connect(self._document_replaced)
+        c.analysed.connect(lambda _a: self._refresh_problems())
+        self.actions.opened.connect(lambda _p: self._retitle())
+        self.actions.saved.connect(lambda p: self.status(f"saved {p}"))
+        self.actions.message.connect(self.status)
+        self.compiler.compiled.connect(self._compiled)
+        self.compiler.failed.connect(self._compile_failed)
+        self.viewport.view.glErrors.connect(self._gl_errors)
+        self.viewport.view.materialApplied.connect(self._material_applied)
+        self.viewport.statusMessage.connect(self.status)
+        self.viewport.environmentChanged.connect(lambda s: self.status(f"environment: {s}"))
+        self.tabs.activeChanged.connect(self._on_active)
+        self.tabs.selectionChanged.connect(self.inspector.set_selection)
+        self.tabs.message.connect(self.status)
+        self.tabs.functionSaved.connect(lambda _p: self.controller.reanalyse())
+        self.inspector.message.connect(self.status)
+        self.inspector.functionOpenRequested.connect(
+            lambda p: self.tabs.open_function(p, self.tabs.active))
+        self.layers.message.connect(self.status)
+        self.layers.layerSelected.connect(self._layer_selected)
+        self.library.materialOpenRequested.connect(self.open_material)
+        self.library.functionOpenRequested.connect(
+            lambda p: self.tabs.open_function(p, self.tabs.material))
+        self.library.layerAddRequested.connect(
+            lambda p: self.layers.add_layer_file(Path(p)))
+        self.diagnostics.nodeActivated.connect(self.select_node)
+        self.lights.lightsChanged.connect(self.viewport.view.set_lights)
+        QTimer.singleShot(0, self._sync_lights)
+
+    def _sync_lights(self) -> None:
+        """The lights panel starts with the renderer's default lights once GL is up."""
+        if self.viewport.view.renderer is not None and not self.lights.lights:
+            self.lights.set_lights(self.viewport.view.lights)
+        elif self.viewport.view.renderer is None and self.isVisible():
+            QTimer.singleShot(200, self._sync_lights)
+
+    # --- documents -------------------------------------------------------------------------
+    def open_material(self, path: str | Path) -> bool:
+        if not self.tabs.close_functions():
+            return False
+        return self.actions.open(path)
+
+    def save_active(self) -> bool:
+        return self.tabs.active.actions.save()
+
+    def save_active_as(self) -> bool:
+        return self.tabs.active.actions.save_as()
+
+    def export_shaders(self) -> None:
+        if self.compiler.current is None:
+            self.status("the material does not compile: see Diagnostics")
+        dlg = ExportDialog(self.controller.document, self.controller.resolver, self)
+        if dlg.exec() and dlg.written:
+            self.status(f"exported {len(dlg.written)} files to {dlg.written[0].parent}")
+
+    def _document_replaced(self) -> None:
+        self._retitle()
+        self.viewport.set_preview(self.controller.document.preview)
+        self.inspector.show_node(None)
+
+    def _retitle(self) -> None:
+        doc = self.controller.document
+        name = document_title(doc)
+        self.setWindowTitle(f"{name}[*] — matedit")
+        self.setWindowModified(self.controller.dirty)
+        g = doc.graph
+        self.count_label.setText(f"{len(g.nodes)} nodes · {len(g.links)} links")
+
+    def _fill_recent(self) -> None:
+        self.recent_menu.clear()
+        files = self.actions.recent_files()
+        for f in files:
+            a = self.recent_menu.addAction(Path(f).name)
+            a.setToolTip(f)
+            a.setStatusTip(f)
+            a.triggered.connect(lambda _=False, p=f: self.open_material(p))
+        if not files:
+            self.recent_menu.addAction("(none)").setEnabled(False)
+        else:
+            self.recent_menu.addSeparator()
+            self.recent_menu.addAction("Clear", self.actions.clear_recent)
+
+    # --- active tab ------------------------------------------------------------------------
+    def _on_active(self, tab: CanvasTab) -> None:
+        self.inspector.set_controller(tab.controller)
+        self._refresh_problems()
+
+    def select_node(self, node_id: str) -> None:
+        canvas = self.tabs.active.canvas
+        canvas.select_nodes([node_id])
+        if hasattr(canvas, "frame_selection"):
+            canvas.frame_selection()
+        self.inspector.show_node(node_id)
+        self.inspector_dock.show()
+        self.inspector_dock.raise_()
+
+    def _layer_selected(self, stack_id: str) -> None:
+        if self.tabs.active is not self.tabs.material:
+            return
+        self.tabs.material.canvas.select_nodes([stack_id])
+        self.inspector.show_node(stack_id)
+
+    def open_palette(self) -> None:
+        self.tabs.active.canvas.open_palette()
+
+    # --- compile results and problems ------------------------------------------------------
+    def _compiled(self, cm) -> None:
+        self._problems["compile"] = []
+        self.compile_label.setText(f"compiled in {self.compiler.last_compile_ms:.0f} ms")
+        self._refresh_problems()
+
+    def _compile_failed(self, diagnostics) -> None:
+        self._problems["compile"] = [
+            Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "compiler")
+            for d in diagnostics]
+        self.compile_label.setText("does not compile: the viewport shows the last good "
+                                   "material")
+        self._refresh_problems()
+
+    def _gl_errors(self, errors) -> None:
+        self._problems["gl"] = [Problem("error", str(msg), nid or "", "", "GL")
+                                for nid, msg in errors]
+        self.compile_label.setText("GLSL failed to build: the viewport keeps the last good "
+                                   "program")
+        self._refresh_problems()
+
+    def _material_applied(self, ok: bool) -> None:
+        if ok:
+            self._problems["gl"] = []
+            self._refresh_problems()
+
+    def _refresh_problems(self) -> None:
+        tab = self.tabs.active
+        problems: list[Problem] = []
+        a = tab.controller.analysis
+        if a is not None:
+            problems += [Problem(d.severity.value, d.message, d.node_id or "", d.port or "",
+                                 "graph") for d in a.diagnostics]
+        if tab is self.tabs.material:
+            problems += self._problems["compile"] + self._problems["gl"]
+        self.diagnostics.set_problems(problems)
+        errors = self.diagnostics.errors_by_node()
+        tab.canvas.set_node_errors(errors)
+        if tab is not self.tabs.material:
+            m = self.tabs.material
+            merr: dict[str, str] = {}
+            for p in self._problems["compile"] + self._problems["gl"]:
+                if p.node_id and p.severity == "error":
+                    merr[p.node_id] = p.message
+            m.canvas.set_node_errors(merr)
+        n = sum(1 for p in problems if p.severity == "error")
+        title = "Diagnostics" + (f" ({n})" if n else "")
+        self.diagnostics_dock.setWindowTitle(title)
+        self._retitle()
+
+    def status(self, text: str) -> None:
+        self.statusBar().showMessage(text, 6000)
+
+    # --- layout ----------------------------------------------------------------------------
+    def restore_layout(self) -> None:
+        s = QSettings()
+        geo = s.value(GEOMETRY_KEY)
+        state = s.value(STATE_KEY)
+        if isinstance(geo, QByteArray) and not geo.isEmpty():
+            self.restoreGeometry(geo)
+        if isinstance(state, QByteArray) and not state.isEmpty():
+            self.restoreState(state, STATE_VERSION)
+
+    def save_layout(self) -> None:
+        s = QSettings()
+        s.setValue(GEOMETRY_KEY, self.saveGeometry())
+        s.setValue(STATE_KEY, self.saveState(STATE_VERSION))
+
+    def reset_layout(self) -> None:
+        self.restoreState(self._default_state, STATE_VERSION)
+        for dock in self.findChildren(QDockWidget):
+            if not dock.isFloating():
+                dock.show()
+
+    # --- closing ---------------------------------------------------------------------------
+    def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802 - Qt's name
+        if not self.tabs.close_functions() or not self.actions.close():
+            event.ignore()
+            return
+        self.save_layout()
+        event.accept()
