@@ -68,14 +68,19 @@ def synthetic_material(n: int, seed: int = 1) -> MaterialDocument:
     return doc
 
 
-def machine() -> str:
+def machine(ctx=None) -> str:
+    """Cores, Python and GL renderer. Pass the benchmark's context if it has one: creating
+    and releasing a second context would leave the first one not current."""
     renderer = "?"
     try:
-        import moderngl
+        if ctx is None:
+            import moderngl
 
-        ctx = moderngl.create_standalone_context(backend="egl")
-        renderer = ctx.info["GL_RENDERER"]
-        ctx.release()
+            tmp = moderngl.create_standalone_context(backend="egl")
+            renderer = tmp.info["GL_RENDERER"]
+            tmp.release()
+        else:
+            renderer = ctx.info["GL_RENDERER"]
     except Exception:
         pass
     return f"{platform.node()}: {os.cpu_count()} cores, {platform.python_version()}, GL {renderer}"

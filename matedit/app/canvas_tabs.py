@@ -218,3 +218,4 @@ class CanvasTabs(QWidget):
             b.clicked.connect(lambda _=False, t=tab: t in self._tabs and self.activate(t))
             self.crumb_layout.addWidget(b)
         self.crumb_layout.addStretch(1)
+        self.crumbs.setVisible(len(chain) > 1)  # one level: the tab says it all

@@ -43,7 +43,7 @@ def _spin(decimals: int = 3) -> QDoubleSpinBox:
     s.setDecimals(decimals)
     s.setSingleStep(0.01)
     s.setKeyboardTracking(False)
-    s.setButtonSymbols(QDoubleSpinBox.ButtonSymbols.NoButtons)
+    s.setObjectName("field")  # the stylesheet hides its arrows (NoButtons hides its text)
     s.setAlignment(Qt.AlignmentFlag.AlignRight)
     s.setMinimumWidth(58)
     return s

@@ -148,16 +148,22 @@ class MainWindow(QMainWindow):
         self.act_redo = self.undo_group.createRedoAction(self, "&Redo")
         self.act_redo.setShortcut(K.Redo)
         self.act_redo.setIcon(icon("redo"))
-        self.act_add_node = self._action("Add &Node…", self.open_palette, "Tab", "add",
+        # The canvas owns its keys (Tab, F, Home, Delete, Ctrl+C/X/V/D): menus only show them.
+        self.act_add_node = self._action("Add &Node…\tTab", self.open_palette, None, "add",
                                          "Add a node (palette)")
-        self.act_add_node.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
-        self.tabs.addAction(self.act_add_node)
-        self.act_frame_all = self._action("Frame &All", lambda: self.tabs.active.canvas
-                                          .frame_all(), "Home", "frame")
-        self.act_frame_sel = self._action("Frame &Selection", lambda: self.tabs.active.canvas
-                                          .frame_selection(), "F")
-        self.act_frame_sel.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
-        self.tabs.addAction(self.act_frame_sel)
+        self.act_frame_all = self._action("Frame &All\tHome", lambda: self._canvas_call(
+            "frame_all"), None, "frame", "Frame the whole graph")
+        self.act_frame_sel = self._action("Frame &Selection\tF", lambda: self._canvas_call(
+            "frame_selection"))
+        self.canvas_actions = []
+        for text, method in (("&Delete\tDel", "delete_selection"),
+                             ("Cu&t\tCtrl+X", "cut_selection"),
+                             ("&Copy\tCtrl+C", "copy_selection"),
+                             ("&Paste\tCtrl+V", "paste"),
+                             ("D&uplicate\tCtrl+D", "duplicate_selection"),
+                             ("Co&mment Selection\tC", "comment_selection")):
+            self.canvas_actions.append(self._action(text, lambda _=False, m=method:
+                                                    self._canvas_call(m)))
         self.act_reset_layout = self._action("Reset &Layout", self.reset_layout)
 
     def _build_menus(self) -> None:
@@ -178,6 +184,9 @@ class MainWindow(QMainWindow):
         e = mb.addMenu("&Edit")
         e.addAction(self.act_undo)
         e.addAction(self.act_redo)
+        e.addSeparator()
+        for a in self.canvas_actions:
+            e.addAction(a)
         e.addSeparator()
         e.addAction(self.act_add_node)
         v = mb.addMenu("&View")
@@ -315,7 +324,12 @@ class MainWindow(QMainWindow):
         self.inspector.show_node(stack_id)
 
     def open_palette(self) -> None:
-        self.tabs.active.canvas.open_palette()
+        self._canvas_call("open_palette")
+
+    def _canvas_call(self, method: str):
+        """Calls a canvas method on the active tab (the placeholder canvas lacks some)."""
+        fn = getattr(self.tabs.active.canvas, method, None)
+        return fn() if fn is not None else None
 
     # --- compile results and problems ------------------------------------------------------
     def _compiled(self, cm) -> None:

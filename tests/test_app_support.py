@@ -1,0 +1,81 @@
+"""Shared set-up for the editor's GUI tests (pytest-qt under Xvfb; imported, holds no tests).
+
+Importing this module before the QApplication exists asks for OpenGL 3.3 core
+contexts (what the viewport's renderer needs) and isolates QSettings and the
+autosave folder in Qt's test locations, emptied for each test.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
+
+pytest.importorskip("PySide6")
+pytest.importorskip("pytestqt")
+
+from PySide6.QtCore import QCoreApplication, QSettings, QStandardPaths, Qt  # noqa: E402
+
+from matedit.app.app import configure_application_names, configure_gl  # noqa: E402
+
+configure_gl()
+QCoreApplication.setAttribute(Qt.ApplicationAttribute.AA_ShareOpenGLContexts)
+configure_application_names()
+QStandardPaths.setTestModeEnabled(True)
+
+
+@pytest.fixture
+def app_env(qapp):
+    """A clean QSettings and AppData (autosave) for one test; the dark theme applied."""
+    from matedit.app.document_actions import recovery_dir
+    from matedit.app.theme import apply_theme
+
+    configure_application_names()
+    QStandardPaths.setTestModeEnabled(True)
+    QSettings().clear()
+    shutil.rmtree(recovery_dir(), ignore_errors=True)
+    apply_theme(qapp)
+    yield qapp
+    QSettings().clear()
+    shutil.rmtree(recovery_dir(), ignore_errors=True)
+
+
+def make_window(qtbot, path=None, *, sample: bool = False, show: bool = False,
+                answers: dict | None = None):
+    """A main window on `path` (or an empty material); questions answered from `answers`
+    (`save_changes`: save/discard/cancel, `recover`: bool), never by a modal dialog."""
+    from matedit.app.main_window import MainWindow
+
+    answers = {"save_changes": "discard", "recover": True, **(answers or {})}
+    errors: list[tuple[str, str]] = []
+    w = MainWindow(restore_layout=False, start=False)
+    qtbot.addWidget(w)
+    w.actions.ask_save_changes = lambda name: answers["save_changes"]
+    w.actions.ask_recover = lambda p, rec: answers["recover"]
+    w.actions.show_error = lambda title, text: errors.append((title, text))
+    w.shown_errors = errors
+    w.actions.start(path, None if not sample else Path(sample))
+    w.compiler.recompile()
+    if show:
+        w.resize(1400, 880)
+        w.show()
+        qtbot.waitExposed(w)
+    return w
+
+
+def wait_for_renderer(qtbot, window, timeout: int = 30000):
+    view = window.viewport.view
+    qtbot.waitUntil(lambda: view.renderer is not None or bool(view.problem), timeout=timeout)
+    assert view.renderer is not None, view.problem
+    return view.renderer
+
+
+def settle(qtbot, window, ms: int = 0) -> None:
+    """Run the debounced recompile now and let queued UI work happen."""
+    for tab in window.tabs.all_tabs():
+        tab.controller.flush()
+    qtbot.wait(ms)
