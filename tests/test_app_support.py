@@ -74,7 +74,7 @@ def wait_for_renderer(qtbot, window, timeout: int = 30000):
     return view.renderer
 
 
-def settle(qtbot, window, ms: int = 0) -> None:
+def settle(qtbot, window, ms: int = 5) -> None:
     """Run the debounced recompile now and let queued UI work happen."""
     for tab in window.tabs.all_tabs():
         tab.controller.flush()
