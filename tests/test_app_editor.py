@@ -9,10 +9,10 @@ from test_app_support import app_env, make_window, settle  # noqa: F401 - fixtur
 
 from matedit.graph.layers import LayerStack
 from matedit.graph.model import MaterialDocument
-from matedit.io.document import load
+from matedit.io.document import dumps, load
 from matedit.resources import graphs_dir
 
-pytestmark = pytest.mark.gui
+pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 
 LAYERS = graphs_dir() / "layers"
 
@@ -23,8 +23,7 @@ def _stack(window) -> LayerStack:
     return s
 
 
-def test_two_layer_material_built_from_empty_saves_reopens_and_undoes_to_empty(
-        app_env, qtbot, tmp_path):
+def test_two_layer_material_built_from_empty_saves_reopens_and_undoes_to_empty(qtbot, tmp_path):
     from PySide6.QtCore import QPointF
     from PySide6.QtGui import QColor
 
@@ -101,14 +100,13 @@ def test_two_layer_material_built_from_empty_saves_reopens_and_undoes_to_empty(
     w.actions.ask_save_path = lambda suggestion: str(target)
     assert w.actions.save()
     assert not w.controller.dirty and not w.isWindowModified()
-    saved = w.controller.document.graph.snapshot()
+    saved = dumps(w.controller.document)  # canonical: sorted keys all the way down
     reopened = load(target)
-    for part_a, part_b in zip(reopened.graph.snapshot(), saved):
-        assert part_a == part_b
+    assert dumps(reopened) == saved
     for e in reopened.graph.nodes[stack.node_id].settings["layers"]:
         assert not Path(e["function"]).is_absolute()  # references relative to the file
     w2 = make_window(qtbot, target)
-    assert w2.controller.document.graph.snapshot() == saved
+    assert dumps(w2.controller.document) == saved
     assert w2.compiler.current is not None
     assert w2.layers.layer_ids_top_first() == [base, top]
 
@@ -121,7 +119,7 @@ def test_two_layer_material_built_from_empty_saves_reopens_and_undoes_to_empty(
     assert w.layers.stack is None and w.layers.empty.isVisibleTo(w.layers)
 
 
-def test_inspector_slider_drag_is_one_undo_step_and_never_recompiles(app_env, qtbot):
+def test_inspector_slider_drag_is_one_undo_step_and_never_recompiles(qtbot):
     from matedit.app.fields import FloatField
 
     w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json")
@@ -148,7 +146,7 @@ def test_inspector_slider_drag_is_one_undo_step_and_never_recompiles(app_env, qt
     assert f.value() == pytest.approx(0.45)  # the widget follows the undo
 
 
-def test_settings_editors_and_texture_picker_push_commands(app_env, qtbot, tmp_path):
+def test_settings_editors_and_texture_picker_push_commands(qtbot, tmp_path):
     from PySide6.QtCore import QPointF
     from PySide6.QtGui import QColor, QImage
     from PySide6.QtWidgets import QComboBox, QLineEdit
@@ -172,6 +170,7 @@ def test_settings_editors_and_texture_picker_push_commands(app_env, qtbot, tmp_p
     q = QImage(8, 8, QImage.Format.Format_RGB32)
     q.fill(QColor(200, 40, 40))
     assert q.save(str(img))
+    settle(qtbot, w)
     field = w.inspector._fields[("setting", "path")]
     assert isinstance(field, TextureField)
     field.file_dialog = lambda *a: (str(img), "")
@@ -190,7 +189,7 @@ def test_settings_editors_and_texture_picker_push_commands(app_env, qtbot, tmp_p
     assert w.controller.document.graph.nodes[c].label == "Tint"
 
 
-def test_layer_dropped_from_library_and_rows_reordered_by_drop(app_env, qtbot):
+def test_layer_dropped_from_library_and_rows_reordered_by_drop(qtbot):
     from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt
     from PySide6.QtGui import QDropEvent
 
@@ -221,7 +220,7 @@ def test_layer_dropped_from_library_and_rows_reordered_by_drop(app_env, qtbot):
     assert w.compiler.current is not None, w.compiler.diagnostics
 
 
-def test_library_function_opens_in_a_tab_with_breadcrumbs_back(app_env, qtbot):
+def test_library_function_opens_in_a_tab_with_breadcrumbs_back(qtbot):
     from PySide6.QtWidgets import QPushButton
 
     w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json")
@@ -236,7 +235,7 @@ def test_library_function_opens_in_a_tab_with_breadcrumbs_back(app_env, qtbot):
     assert w.tabs.close_tab(1) and w.tabs.tabs.count() == 1
 
 
-def test_diagnostics_click_selects_the_node(app_env, qtbot):
+def test_diagnostics_click_selects_the_node(qtbot):
     from matedit.graph.commands import Disconnect
 
     w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json")

@@ -45,17 +45,20 @@ def app_env(qapp):
 
 
 def make_window(qtbot, path=None, *, sample: bool = False, show: bool = False,
-                answers: dict | None = None):
-    """A main window on `path` (or an empty material); questions answered from `answers`
-    (`save_changes`: save/discard/cancel, `recover`: bool), never by a modal dialog."""
+                answers: dict | None = None, track: bool = True):
+    """A main window on `path` (or an empty material). Questions are answered from
+    `answers` (`save_changes`: save/discard/cancel; `recover`: bool or a callable), never
+    by a modal dialog."""
     from matedit.app.main_window import MainWindow
 
     answers = {"save_changes": "discard", "recover": True, **(answers or {})}
     errors: list[tuple[str, str]] = []
     w = MainWindow(restore_layout=False, start=False)
-    qtbot.addWidget(w)
+    if track:
+        qtbot.addWidget(w)
     w.actions.ask_save_changes = lambda name: answers["save_changes"]
-    w.actions.ask_recover = lambda p, rec: answers["recover"]
+    recover = answers["recover"]
+    w.actions.ask_recover = recover if callable(recover) else (lambda p, rec: recover)
     w.actions.show_error = lambda title, text: errors.append((title, text))
     w.shown_errors = errors
     w.actions.start(path, None if not sample else Path(sample))

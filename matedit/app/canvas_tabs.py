@@ -86,12 +86,12 @@ class CanvasTabs(QWidget):
         canvas.selectionChangedIds.connect(self._selection)
         canvas.functionOpenRequested.connect(lambda p, t=tab: self.open_function(p, t))
         canvas.message.connect(self.message)
-        controller.undo_stack.cleanChanged.connect(lambda _c, t=tab: self._retitle(t))
+        controller.undo_stack.cleanChanged.connect(self._clean_changed)
         actions.saved.connect(lambda p, t=tab: self._saved(t, p))
         self.tabs.addTab(canvas, icon("function" if controller.document.is_function
                                       else "material"), "")
         self._retitle(tab)
-        QTimer.singleShot(0, canvas.frame_all)
+        QTimer.singleShot(0, canvas, canvas.frame_all)
         return tab
 
     def all_tabs(self) -> list[CanvasTab]:
@@ -158,12 +158,18 @@ class CanvasTabs(QWidget):
 
     def _material_replaced(self) -> None:
         self._retitle(self.material)
-        QTimer.singleShot(0, self.material.canvas.frame_all)
+        QTimer.singleShot(0, self.material.canvas, self.material.canvas.frame_all)
 
     def _saved(self, tab: CanvasTab, _path) -> None:
         self._retitle(tab)
         if tab.is_function:  # materials that call it must see the new file
             self.functionSaved.emit(tab.controller.document.path)
+
+    def _clean_changed(self, _clean: bool) -> None:
+        stack = self.sender()
+        for tab in self._tabs:
+            if tab.controller.undo_stack is stack:
+                self._retitle(tab)
 
     def _retitle(self, tab: CanvasTab) -> None:
         if tab not in self._tabs:

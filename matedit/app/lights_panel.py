@@ -185,5 +185,5 @@ class LightsPanel(QWidget):
         if item is not None:
             item.setText(describe(self._lights[row]))
         if rebuild:  # not inside the combo's own signal: the form is rebuilt later
-            QTimer.singleShot(0, lambda: self._show(row))
+            QTimer.singleShot(0, self, lambda: self._show(row))
         self.lightsChanged.emit(self.lights)

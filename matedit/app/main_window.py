@@ -220,7 +220,7 @@ class MainWindow(QMainWindow):
 
     def _connect(self) -> None:
         c = self.controller
-        c.undo_stack.cleanChanged.connect(lambda _clean: self._retitle())
+        c.undo_stack.cleanChanged.connect(self._clean_changed)
         c.documentReplaced.connect(self._document_replaced)
         c.analysed.connect(lambda _a: self._refresh_problems())
         self.actions.opened.connect(lambda _p: self._retitle())
@@ -248,14 +248,14 @@ class MainWindow(QMainWindow):
             lambda p: self.layers.add_layer_file(Path(p)))
         self.diagnostics.nodeActivated.connect(self.select_node)
         self.lights.lightsChanged.connect(self.viewport.view.set_lights)
-        QTimer.singleShot(0, self._sync_lights)
+        QTimer.singleShot(0, self, self._sync_lights)
 
     def _sync_lights(self) -> None:
         """The lights panel starts with the renderer's default lights once GL is up."""
         if self.viewport.view.renderer is not None and not self.lights.lights:
             self.lights.set_lights(self.viewport.view.lights)
         elif self.viewport.view.renderer is None and self.isVisible():
-            QTimer.singleShot(200, self._sync_lights)
+            QTimer.singleShot(200, self, self._sync_lights)
 
     # --- documents -------------------------------------------------------------------------
     def open_material(self, path: str | Path) -> bool:
@@ -280,6 +280,9 @@ class MainWindow(QMainWindow):
         self._retitle()
         self.viewport.set_preview(self.controller.document.preview)
         self.inspector.show_node(None)
+
+    def _clean_changed(self, _clean: bool) -> None:
+        self._retitle()
 
     def _retitle(self) -> None:
         doc = self.controller.document

@@ -149,7 +149,7 @@ class ViewportWidget(QOpenGLWidget):
         self.last_frame_time = time.perf_counter() - t0
         self.frameDrawn.emit()
         if getattr(self.renderer, "needs_redraw", False):
-            QTimer.singleShot(0, self.update)  # reference mode accumulates until converged
+            QTimer.singleShot(0, self, self.update)  # reference mode accumulates until converged
 
     def _paint_message(self, text: str) -> None:
         p = QPainter(self)

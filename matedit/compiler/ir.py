@@ -99,7 +99,10 @@ class Op:
         raise KeyError(port)
 
     def key(self) -> str:
-        data = repr(sorted((k, repr(v)) for k, v in self.data.items()))
+        if set(self.data) <= {"glsl", "inline"}:
+            data = ""  # a registry kind's implementation follows from its kind
+        else:
+            data = repr(sorted((k, repr(v)) for k, v in self.data.items()))
         return f"{self.kind}|{data}|{','.join(a.key() for a in self.args)}"
 
 

@@ -31,11 +31,16 @@ class NodePorts:
     inputs: tuple[PortSpec, ...]
     outputs: tuple[PortSpec, ...]
 
+    def __post_init__(self) -> None:
+        # first match wins, as a linear scan would (duplicates are reported elsewhere)
+        object.__setattr__(self, "_by_input", {p.name: p for p in reversed(self.inputs)})
+        object.__setattr__(self, "_by_output", {p.name: p for p in reversed(self.outputs)})
+
     def input(self, name: str) -> PortSpec | None:
-        return next((p for p in self.inputs if p.name == name), None)
+        return self._by_input.get(name)
 
     def output(self, name: str) -> PortSpec | None:
-        return next((p for p in self.outputs if p.name == name), None)
+        return self._by_output.get(name)
 
 
 class PortError(ValueError):

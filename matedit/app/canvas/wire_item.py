@@ -1,10 +1,16 @@
-"""A wire: a cubic curve from an output port to an input port, coloured by what it carries."""
+"""A wire: a cubic curve from an output port to an input port, coloured by what it carries.
+
+Wires are the most numerous items, so they draw in C++: a QGraphicsPathItem whose pen
+the scene sets (type colour, error dashes, selection, a hairline when zoomed far out),
+with no Python `paint` or `boundingRect` called per frame. Only `shape`, for clicks,
+is ours: a wider band than the stroke, so a wire is easy to pick.
+"""
 
 from __future__ import annotations
 
-from PySide6.QtCore import QPointF, QRectF, Qt
-from PySide6.QtGui import QColor, QPainter, QPainterPath, QPainterPathStroker, QPen
-from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem
+from PySide6.QtCore import QPointF, Qt
+from PySide6.QtGui import QColor, QPainterPath, QPainterPathStroker, QPen
+from PySide6.QtWidgets import QGraphicsPathItem
 
 from matedit.app.canvas import constants as C
 from matedit.graph.model import Link
@@ -24,71 +30,68 @@ def wire_path(p1: QPointF, p2: QPointF) -> QPainterPath:
     return path
 
 
-class WireItem(QGraphicsItem):
+def wire_pen(type_name: str, error: bool, selected: bool, hairline: bool) -> QPen:
+    """Flat caps and hairlines matter: on the raster engine a round-capped antialiased
+    stroke costs half as much again, and a wide stroke several times a hairline."""
+    width = C.wire_width(type_name)
+    if selected:
+        pen = QPen(C.WIRE_SELECTED, width + 1.5, Qt.PenStyle.SolidLine, Qt.PenCapStyle.FlatCap)
+    else:
+        color = QColor(C.ERROR if error else C.port_color(type_name))
+        style = Qt.PenStyle.DashLine if error else Qt.PenStyle.SolidLine
+        pen = QPen(color, width, style, Qt.PenCapStyle.FlatCap)
+    if hairline:
+        pen.setWidthF(1.5 if selected else 1.0)
+        pen.setCosmetic(True)
+    return pen
+
+
+class WireItem(QGraphicsPathItem):
     """The view of one model `Link`; its path follows the two node items it joins."""
 
-    def __init__(self, link: Link, src_item, dst_item) -> None:
+    def __init__(self, link: Link, src_item, dst_item, hairline: bool = False) -> None:
         super().__init__()
         self.link = link
         self.src_item = src_item
         self.dst_item = dst_item
         self.type_name = "T"
         self.error = False
-        self._path = QPainterPath()
+        self.selected = False  # the scene's wire selection (wires skip Qt's rubber band)
+        self.hairline = hairline
         self._shape: QPainterPath | None = None
-        self._bounds = QRectF()
-        self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIsSelectable)
         self.setZValue(C.Z_WIRE)
         self.setAcceptedMouseButtons(Qt.MouseButton.LeftButton)
+        self._restyle()
         self.update_path()
 
     def update_path(self) -> None:
         p1 = self.src_item.port_scene_pos(self.link.src_port, True)
         p2 = self.dst_item.port_scene_pos(self.link.dst_port, False)
-        self.prepareGeometryChange()
-        self._path = wire_path(p1, p2)
         self._shape = None
-        m = C.WIRE_WIDTH_STRUCT + 3
-        self._bounds = self._path.controlPointRect().adjusted(-m, -m, m, m)
+        self.setPath(wire_path(p1, p2))
+
+    def _restyle(self) -> None:
+        self.setPen(wire_pen(self.type_name, self.error, self.selected, self.hairline))
 
     def set_style(self, type_name: str, error: bool) -> None:
         if (type_name, error) != (self.type_name, self.error):
             self.type_name, self.error = type_name, error
-            self.update()
+            self._restyle()
 
-    def path(self) -> QPainterPath:
-        return self._path
+    def set_selected(self, selected: bool) -> None:
+        if selected != self.selected:
+            self.selected = selected
+            self.setZValue(C.Z_WIRE + (0.5 if selected else 0.0))
+            self._restyle()
 
-    def boundingRect(self) -> QRectF:
-        return self._bounds
+    def set_hairline(self, hairline: bool) -> None:
+        if hairline != self.hairline:
+            self.hairline = hairline
+            self._restyle()
 
     def shape(self) -> QPainterPath:
         if self._shape is None:
             stroker = QPainterPathStroker()
             stroker.setWidth(C.WIRE_HIT_WIDTH)
-            self._shape = stroker.createStroke(self._path)
+            self._shape = stroker.createStroke(self.path())
         return self._shape
-
-    def itemChange(self, change, value):
-        # A rubber band selects nodes, not the wires that happen to cross it.
-        if (change == QGraphicsItem.GraphicsItemChange.ItemSelectedChange and value
-                and getattr(self.scene(), "rubber_banding", False)):
-            return False
-        return super().itemChange(change, value)
-
-    def paint(self, painter: QPainter, option: QStyleOptionGraphicsItem, widget=None) -> None:
-        lod = QStyleOptionGraphicsItem.levelOfDetailFromTransform(painter.worldTransform())
-        painter.setRenderHint(QPainter.RenderHint.Antialiasing, lod > 0.25)
-        width = C.wire_width(self.type_name)
-        color = QColor(C.port_color(self.type_name))
-        if self.isSelected():
-            painter.setPen(QPen(C.WIRE_SELECTED, width + 3.0, Qt.PenStyle.SolidLine,
-                                Qt.PenCapStyle.RoundCap))
-            painter.drawPath(self._path)
-        if self.error:
-            pen = QPen(C.ERROR, width, Qt.PenStyle.DashLine, Qt.PenCapStyle.RoundCap)
-        else:
-            pen = QPen(color, width, Qt.PenStyle.SolidLine, Qt.PenCapStyle.RoundCap)
-        painter.setPen(pen)
-        painter.setBrush(Qt.BrushStyle.NoBrush)
-        painter.drawPath(self._path)

@@ -1,0 +1,126 @@
+"""The viewport inside the editor: it draws, follows value edits without relinking, and keeps
+the last good image when an edit breaks the material (real GL under Xvfb)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
+
+from matedit.graph.commands import Disconnect, SetValue
+from matedit.resources import graphs_dir
+
+pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
+
+SAMPLE = graphs_dir() / "materials" / "rusty_painted_metal.json"
+
+
+def frame(qtbot, view) -> np.ndarray:
+    """The viewport's own framebuffer after one more frame, as (H, W, 3) floats in [0, 1]."""
+    from PySide6.QtGui import QImage
+
+    n = view.frames
+    view.update()
+    qtbot.waitUntil(lambda: view.frames > n, timeout=10000)
+    img = view.grabFramebuffer().convertToFormat(QImage.Format.Format_RGB888)
+    h, w, bpl = img.height(), img.width(), img.bytesPerLine()
+    arr = np.frombuffer(img.constBits(), np.uint8, count=h * bpl).reshape(h, bpl)
+    return arr[:, : w * 3].reshape(h, w, 3).astype(np.float32) / 255.0
+
+
+@pytest.fixture
+def window(qtbot, request):
+    request.getfixturevalue("app_env")
+    w = make_window(qtbot, SAMPLE, show=True)
+    wait_for_renderer(qtbot, w)
+    settle(qtbot, w)
+    return w
+
+
+def test_viewport_draws_and_a_parameter_edit_changes_it_without_relinking(window, qtbot):
+    view = window.viewport.view
+    before = frame(qtbot, view)
+    assert before.std() > 0.05, "the viewport is blank"
+    h, w, _ = before.shape
+    centre = before[h // 2 - 5: h // 2 + 5, w // 2 - 5: w // 2 + 5].mean(axis=(0, 1))
+    assert centre.max() > 0.1  # the sphere is lit
+    links = view.renderer.link_count
+    recompiles = []
+    window.controller.structureChanged.connect(lambda: recompiles.append(1))
+    assert window.controller.push(SetValue("stack", "paint_color", [0.9, 0.02, 0.02]))
+    after = frame(qtbot, view)
+    settle(qtbot, window)
+    assert np.abs(after - before).mean() > 0.01, "a colour edit did not show"
+    redness = after[..., 0].mean() - after[..., 2].mean()
+    assert redness > before[..., 0].mean() - before[..., 2].mean()
+    assert view.renderer.link_count == links and recompiles == []
+
+
+def test_a_broken_edit_keeps_the_last_good_image(window, qtbot):
+    view = window.viewport.view
+    good = frame(qtbot, view)
+    link = window.controller.document.graph.incoming("out", "attributes")
+    assert window.controller.push(Disconnect(link))  # the graph no longer compiles
+    settle(qtbot, window)
+    assert window.compiler.current is None
+    assert any(p.severity == "error" for p in window.diagnostics.problems)
+    still = frame(qtbot, view)
+    assert np.abs(still - good).max() < 2.5 / 255
+
+    # A program that fails in the GL compiler: errors reported, the old program stays.
+    window.controller.undo_stack.undo()
+    settle(qtbot, window)
+    good = frame(qtbot, view)
+    cm = copy.copy(window.compiler.current)
+    broken = "#version 330 core\nvoid main() { this is not glsl; }\n"
+
+    class Broken(type(cm)):
+        fragment_text = property(lambda self: broken)
+
+    cm.__class__ = Broken
+    cm.structure_hash = "broken"
+    errors = []
+    view.glErrors.connect(errors.append)
+    window.viewport.on_compiled(cm)
+    assert errors and errors[0]
+    assert any(p.source == "GL" for p in window.diagnostics.problems)
+    still = frame(qtbot, view)
+    assert np.abs(still - good).max() < 2.5 / 255
+
+
+def test_reference_mode_keeps_drawing_until_converged(window, qtbot):
+    view = window.viewport.view
+    view.renderer.reference_frames = 4
+    window.viewport.mode_combo.setCurrentText("Difference")
+    n = view.frames
+    qtbot.waitUntil(lambda: view.frames >= n + 4, timeout=30000)
+    qtbot.waitUntil(lambda: not view.renderer.needs_redraw, timeout=30000)
+    assert "mean" in window.viewport.diff_label.text()
+    window.viewport.mode_combo.setCurrentText("Split-sum")
+
+
+def test_lights_panel_drives_the_renderer(window, qtbot):
+    view = window.viewport.view
+    qtbot.waitUntil(lambda: bool(window.lights.lights), timeout=5000)
+    n = len(view.renderer.lights)
+    window.lights.add_light("tube")
+    assert len(view.renderer.lights) == n + 1
+    assert view.renderer.lights[-1].kind == "tube"
+    window.lights.list.setCurrentRow(n)
+    window.lights.remove_selected()
+    assert len(view.renderer.lights) == n
+
+
+def test_a_bad_environment_file_is_reported_and_the_old_one_kept(window, qtbot, tmp_path,
+                                                                  monkeypatch):
+    from PySide6.QtWidgets import QMessageBox
+
+    bad = tmp_path / "broken.hdr"
+    bad.write_bytes(b"not an image")
+    shown = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda *a, **k: shown.append(a[2]))
+    assert not window.viewport.choose_environment(str(bad))
+    assert shown and "broken.hdr" in shown[0]
+    assert window.viewport.env_combo.currentText() == "Studio"
