@@ -45,9 +45,10 @@ class DiagnosticsPanel(QTreeWidget):
     def set_problems(self, problems: list[Problem]) -> None:
         seen = set()
         unique = []
-        for p in problems:
-            if p not in seen:
-                seen.add(p)
+        for p in problems:  # validation and the compiler often report the same thing
+            key = (p.severity, p.message, p.node_id, p.field)
+            if key not in seen:
+                seen.add(key)
                 unique.append(p)
         self.problems = unique
         self.clear()

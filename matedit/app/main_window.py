@@ -11,7 +11,15 @@ from pathlib import Path
 
 from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence, QUndoGroup
-from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMenu, QUndoView
+from PySide6.QtWidgets import (
+    QDockWidget,
+    QLabel,
+    QMainWindow,
+    QMenu,
+    QUndoView,
+    QVBoxLayout,
+    QWidget,
+)
 
 from matedit.app.canvas_tabs import CanvasTab, CanvasTabs
 from matedit.app.code_view import CodeView
@@ -25,7 +33,7 @@ from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
 from matedit.app.theme import icon
-from matedit.app.viewport import ViewportPanel
+from matedit.app.viewport import EnvironmentPanel, ViewportPanel
 from matedit.graph.model import MaterialDocument
 from matedit.resources import graphs_dir
 
@@ -99,7 +107,14 @@ class MainWindow(QMainWindow):
         self.viewport_dock = self._dock("Viewport", "viewportDock", self.viewport, R,
                                         "material")
         self.inspector_dock = self._dock("Inspector", "inspectorDock", self.inspector, R)
-        self.lights_dock = self._dock("Lights && Environment", "lightsDock", self.lights, R,
+        self.environment = EnvironmentPanel(self.viewport)
+        lights_host = QWidget()
+        lh = QVBoxLayout(lights_host)
+        lh.setContentsMargins(0, 0, 0, 0)
+        lh.setSpacing(0)
+        lh.addWidget(self.environment)
+        lh.addWidget(self.lights, 1)
+        self.lights_dock = self._dock("Lights && Environment", "lightsDock", lights_host, R,
                                       "light")
         self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
                                            B, "warning")

@@ -18,8 +18,12 @@ def icon(name: str) -> QIcon:
 
 
 def stylesheet() -> str:
+    """The stylesheet, with @ICONS@ standing for the icon folder (QSS urls are relative to
+    the working directory otherwise)."""
     path = ui_dir() / "style.qss"
-    return path.read_text(encoding="utf-8") if path.is_file() else ""
+    if not path.is_file():
+        return ""
+    return path.read_text(encoding="utf-8").replace("@ICONS@", (ui_dir() / "icons").as_posix())
 
 
 def apply_theme(app: QApplication) -> None:

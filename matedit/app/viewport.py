@@ -78,6 +78,7 @@ class ViewportWidget(QOpenGLWidget):
         self.last_frame_time = 0.0
         self._fbo = None
         self._fbo_glo = -1
+        self._options: dict[str, Any] = {}
 
     # --- GL lifecycle ----------------------------------------------------------------------
     def initializeGL(self) -> None:  # noqa: N802 - Qt's name
@@ -117,6 +118,9 @@ class ViewportWidget(QOpenGLWidget):
         r.set_mesh(self._mesh)
         r.mode = self._mode
         r.exposure = self._exposure
+        for name, value in self._options.items():
+            if hasattr(r, name):
+                setattr(r, name, value)
         if self._lights is not None:
             r.set_lights(list(self._lights))
         else:
@@ -228,6 +232,15 @@ class ViewportWidget(QOpenGLWidget):
         self._exposure = float(ev)
         if self.renderer is not None:
             self.renderer.exposure = float(ev)
+            self.update()
+
+    def set_render_option(self, name: str, value) -> None:
+        """A renderer attribute that needs no GL work (background, blur, IBL intensity)."""
+        self._options[name] = value
+        if self.renderer is not None and hasattr(self.renderer, name):
+            setattr(self.renderer, name, value)
+            if hasattr(self.renderer, "reset_accumulation"):
+                self.renderer.reset_accumulation()
             self.update()
 
     @property
@@ -454,3 +467,50 @@ class ViewportPanel(QWidget):
         self._env_index = idx
         self.environmentChanged.emit(spec)
         return True
+
+
+class EnvironmentPanel(QWidget):
+    """The environment half of the Lights & Environment dock: the same choice as the viewport
+    bar (one shared list), the background, its blur, and the IBL intensity."""
+
+    def __init__(self, viewport: ViewportPanel, parent=None) -> None:
+        super().__init__(parent)
+        from PySide6.QtWidgets import QCheckBox, QFormLayout
+
+        from matedit.app.fields import FloatField
+
+        self.viewport = viewport
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(4, 4, 4, 0)
+        title = QLabel("Environment")
+        title.setObjectName("sectionHeader")
+        lay.addWidget(title)
+        form = QFormLayout()
+        form.setLabelAlignment(Qt.AlignmentFlag.AlignRight)
+        self.combo = QComboBox()
+        self.combo.setModel(viewport.env_combo.model())
+        self.combo.setCurrentIndex(viewport.env_combo.currentIndex())
+        self.combo.activated.connect(self._chosen)
+        viewport.env_combo.currentIndexChanged.connect(self.combo.setCurrentIndex)
+        form.addRow("image", self.combo)
+        self.intensity = FloatField(1.0, (0.0, 4.0))
+        self.intensity.setToolTip("Multiplies the environment's light")
+        self.intensity.edited.connect(
+            lambda v, _m: viewport.view.set_render_option("environment_intensity", float(v)))
+        form.addRow("intensity", self.intensity)
+        self.background = QCheckBox("show behind the mesh")
+        self.background.setChecked(True)
+        self.background.toggled.connect(
+            lambda on: viewport.view.set_render_option("show_background", bool(on)))
+        form.addRow("background", self.background)
+        self.blur = FloatField(0.0, (0.0, 1.0))
+        self.blur.setToolTip("Blurs the background only (lighting is unchanged)")
+        self.blur.edited.connect(
+            lambda v, _m: viewport.view.set_render_option("background_blur", float(v)))
+        form.addRow("blur", self.blur)
+        lay.addLayout(form)
+
+    def _chosen(self, index: int) -> None:
+        self.viewport.env_combo.setCurrentIndex(index)
+        self.viewport._env_activated(index)
+        self.combo.setCurrentIndex(self.viewport.env_combo.currentIndex())

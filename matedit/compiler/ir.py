@@ -93,10 +93,11 @@ class Op:
     data: dict[str, Any] = field(default_factory=dict)
 
     def out(self, port: str) -> Var:
-        for name, t in self.outs:
-            if name == port:
-                return Var(f"{self.var}_{port}", t)
-        raise KeyError(port)
+        cache = self.__dict__.get("_out_vars")
+        if cache is None:
+            cache = {name: Var(f"{self.var}_{name}", t) for name, t in self.outs}
+            self.__dict__["_out_vars"] = cache
+        return cache[port]
 
     def key(self) -> str:
         if set(self.data) <= {"glsl", "inline"}:

@@ -250,6 +250,20 @@ def _default_type(value: Any) -> PortType:
     return PortType.FLOAT
 
 
+_CONCRETE: dict[str, tuple | None] = {}
+
+
+def _concrete_types(kind: str):
+    """Types of a kind with no generic ports, computed once (callers only read them)."""
+    if kind not in _CONCRETE:
+        p = _static_ports(kind)
+        specs = p.inputs + p.outputs
+        _CONCRETE[kind] = None if any(s.type == GENERIC for s in specs) else (
+            {s.name: PortType(s.type) for s in p.inputs},
+            {s.name: PortType(s.type) for s in p.outputs})
+    return _CONCRETE[kind]
+
+
 def resolve_types(
     node: Node, ports: NodePorts, connected: dict[str, PortType]
 ) -> tuple[dict[str, PortType], dict[str, PortType]]:
@@ -259,6 +273,10 @@ def resolve_types(
     """
     d = nodes.REGISTRY[node.kind]
     rule = d.ports_rule
+    if rule is None:
+        fixed = _concrete_types(node.kind)
+        if fixed is not None:
+            return fixed
 
     def concrete(spec: PortSpec) -> PortType | None:
         return None if spec.type == GENERIC else PortType(spec.type)

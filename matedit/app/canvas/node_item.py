@@ -245,7 +245,6 @@ class NodeItem(QGraphicsItem):
             else:
                 port.set_type(row.type)
                 port.doc = row.doc
-                port.update_tooltip()
             port.setPos(pos)
         self._place_badge()
         self.update()

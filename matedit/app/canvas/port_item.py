@@ -50,19 +50,17 @@ class PortItem(QGraphicsItem):
         self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemHasNoContents, True)
         self.setAcceptHoverEvents(True)
         self.setCursor(Qt.CursorShape.CrossCursor)
-        self.update_tooltip()
 
-    def update_tooltip(self) -> None:
+    def tooltip_text(self) -> str:
+        """Made when asked (the scene's help event): thousands of ports, few tooltips."""
         side = "output" if self.is_output else "input"
         tip = f"<b>{self.name}</b> &nbsp;<i>{self.type_name}</i> {side}"
         if self.doc:
             tip += f"<br>{self.doc}"
-        self.setToolTip(tip)
+        return tip
 
     def set_type(self, type_name: str) -> None:
-        if type_name != self.type_name:
-            self.type_name = type_name
-            self.update_tooltip()
+        self.type_name = type_name
 
     @property
     def key(self) -> tuple[str, str, bool]:

@@ -14,11 +14,12 @@ from pathlib import Path
 
 from PySide6.QtCore import QLineF, QRectF, Qt, Signal
 from PySide6.QtGui import QImage, QPainter
-from PySide6.QtWidgets import QGraphicsScene
+from PySide6.QtWidgets import QGraphicsScene, QToolTip
 
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.comment_item import CommentItem
 from matedit.app.canvas.node_item import NodeItem, PortRow
+from matedit.app.canvas.port_item import PortItem
 from matedit.app.canvas.reroute_item import RerouteItem
 from matedit.app.canvas.wire_item import WireItem
 from matedit.app.controller import DocumentController
@@ -84,7 +85,8 @@ class NodeScene(QGraphicsScene):
         self._wires_of: dict[str, set[Link]] = {}
         self._node_errors: dict[str, str] = {}  # GLSL errors mapped to nodes, from the window
         self._previews: dict[str, QImage] = {}
-        self.rubber_banding = False  # set by the view: wires ignore rubber-band selection
+        self.selected_wires: set[Link] = set()  # wires keep their own selection (see WireItem)
+        self.hairline = False  # wires draw as hairlines when zoomed far out
         self._last_diags: dict[str, list[tuple[str, str]]] = {}
         self.setItemIndexMethod(QGraphicsScene.ItemIndexMethod.BspTreeIndex)
         self.setBackgroundBrush(C.BACKGROUND)
@@ -127,6 +129,7 @@ class NodeScene(QGraphicsScene):
         self.clear()
         self.node_items.clear()
         self.wire_items.clear()
+        self.selected_wires.clear()
         self.comment_items.clear()
         self._wires_of.clear()
         self._node_errors.clear()
@@ -183,7 +186,7 @@ class NodeScene(QGraphicsScene):
         src, dst = self.node_items.get(link.src), self.node_items.get(link.dst)
         if src is None or dst is None:
             return
-        wire = WireItem(link, src, dst)
+        wire = WireItem(link, src, dst, self.hairline)
         wire.set_style(src.port_type(link.src_port, True), False)
         self.wire_items[link] = wire
         self._wires_of[link.src].add(link)
@@ -196,6 +199,7 @@ class NodeScene(QGraphicsScene):
         wire = self.wire_items.pop(link, None)
         if wire is None:
             return
+        self.selected_wires.discard(link)
         for end in (link.src, link.dst):
             self._wires_of.get(end, set()).discard(link)
         self.removeItem(wire)
@@ -317,6 +321,30 @@ class NodeScene(QGraphicsScene):
         if item is not None:
             item.set_preview(image)
 
+    # --- wire selection and zoom ---------------------------------------------------------------
+    def select_wire(self, link: Link, additive: bool = False) -> None:
+        if not additive:
+            self.clear_wire_selection()
+        wire = self.wire_items.get(link)
+        if wire is not None:
+            wire.set_selected(True)
+            self.selected_wires.add(link)
+
+    def clear_wire_selection(self) -> None:
+        for link in self.selected_wires:
+            wire = self.wire_items.get(link)
+            if wire is not None:
+                wire.set_selected(False)
+        self.selected_wires.clear()
+
+    def set_zoom(self, zoom: float) -> None:
+        """Wires become cosmetic hairlines once thinner than 1.3 device pixels (fast to draw)."""
+        hairline = zoom * C.WIRE_WIDTH < 1.3
+        if hairline != self.hairline:
+            self.hairline = hairline
+            for wire in self.wire_items.values():
+                wire.set_hairline(hairline)
+
     # --- item callbacks ----------------------------------------------------------------------
     def node_item_moved(self, node_id: str) -> None:
         for link in self._wires_of.get(node_id, ()):
@@ -364,6 +392,15 @@ class NodeScene(QGraphicsScene):
         super().mouseReleaseEvent(event)
         if event.button() == Qt.MouseButton.LeftButton:
             self.commit_moves()
+
+    def helpEvent(self, event) -> None:
+        """Port tooltips are made on demand; other items use their stored tooltip."""
+        for item in self.items(event.scenePos()):
+            if isinstance(item, PortItem):
+                QToolTip.showText(event.screenPos(), item.tooltip_text(), event.widget())
+                event.accept()
+                return
+        super().helpEvent(event)
 
     # --- background --------------------------------------------------------------------------
     def drawBackground(self, painter: QPainter, rect: QRectF) -> None:

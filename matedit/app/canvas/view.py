@@ -18,7 +18,6 @@ from PySide6.QtCore import QEvent, QPoint, QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QImage, QKeySequence, QPainter, QPixmapCache, QTransform
 from PySide6.QtWidgets import (
     QApplication,
-    QGraphicsItem,
     QGraphicsView,
     QInputDialog,
     QMenu,
@@ -171,8 +170,8 @@ class NodeCanvasView(QGraphicsView):
         node_ids = sorted(it.node_id for it in sel if isinstance(it, NodeItem))
         gone = set(node_ids)
         commands: list[Command] = [
-            Disconnect(it.link) for it in sel
-            if isinstance(it, WireItem) and it.link.src not in gone and it.link.dst not in gone]
+            Disconnect(link) for link in sorted(self._scene.selected_wires)
+            if link.src not in gone and link.dst not in gone]
         commands += [RemoveNode(nid) for nid in node_ids]
         commands += [PutComment(it.comment_id, None, text="delete comment")
                      for it in sel if isinstance(it, CommentItem)]
@@ -364,6 +363,10 @@ class NodeCanvasView(QGraphicsView):
         self.verticalScrollBar().setValue(self.verticalScrollBar().value() + d.y())
         self.minimap.update()
 
+    def paintEvent(self, event) -> None:
+        self._scene.set_zoom(self.zoom())  # any transform change, from here or a caller
+        super().paintEvent(event)
+
     def wheelEvent(self, event) -> None:
         steps = event.angleDelta().y() / 120.0
         if steps:
@@ -400,8 +403,16 @@ class NodeCanvasView(QGraphicsView):
                 self._wire_press = pos
                 event.accept()
                 return
-            if self.itemAt(pos) is None:
-                self._scene.rubber_banding = True
+            item = self.itemAt(pos)
+            additive = bool(mods & Qt.KeyboardModifier.ControlModifier)
+            if isinstance(item, WireItem):
+                if not additive:
+                    self._scene.clearSelection()
+                self._scene.select_wire(item.link, additive)
+                event.accept()
+                return
+            if not additive:
+                self._scene.clear_wire_selection()
         super().mousePressEvent(event)
 
     def mouseMoveEvent(self, event) -> None:
@@ -434,7 +445,6 @@ class NodeCanvasView(QGraphicsView):
             event.accept()
             return
         super().mouseReleaseEvent(event)
-        self._scene.rubber_banding = False
 
     def _finish_wire(self, pos: QPoint) -> None:
         wire, self._wire = self._wire, None
@@ -483,15 +493,19 @@ class NodeCanvasView(QGraphicsView):
         self._last_pos = pos
         sp = self.mapToScene(pos)
         item = self.itemAt(pos)
-        while item is not None and not isinstance(item, QGraphicsItem):
+        while item is not None and not isinstance(item, (NodeItem, CommentItem, WireItem)):
             item = item.parentItem()
-        if item is not None and not item.isSelected() and isinstance(
-                item, (NodeItem, CommentItem, WireItem)):
+        if isinstance(item, WireItem):
             self._scene.clearSelection()
+            self._scene.select_wire(item.link)
+        elif item is not None and not item.isSelected() and isinstance(
+                item, (NodeItem, CommentItem)):
+            self._scene.clearSelection()
+            self._scene.clear_wire_selection()
             item.setSelected(True)
         menu = QMenu(self)
         menu.addAction("Add node…\tTab", lambda: self.open_palette(sp))
-        has_sel = bool(self._scene.selectedItems())
+        has_sel = bool(self._scene.selectedItems() or self._scene.selected_wires)
         for text, slot, key, enabled in (
                 ("Copy", self.copy_selection, "Ctrl+C", has_sel),
                 ("Cut", self.cut_selection, "Ctrl+X", has_sel),
