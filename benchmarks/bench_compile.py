@@ -38,9 +38,9 @@ def link_times() -> list[tuple[str, float, float]]:
     for path in sorted((graphs_dir() / "materials").glob("*.json")):
         doc = load(path)
         cm = compile_document(doc, FileResolver())
-        t_compile = median_time(lambda: compile_document(doc, FileResolver()), repeat=5)
+        t_compile = median_time(lambda d=doc: compile_document(d, FileResolver()), repeat=5)
 
-        def link():
+        def link(cm=cm):
             ctx.program(vertex_shader=cm.vertex_text, fragment_shader=cm.fragment_text).release()
 
         rows.append((path.stem, t_compile, median_time(link, repeat=3)))
@@ -54,7 +54,7 @@ def main() -> None:
     print("\n| nodes | graph -> GLSL (ms, median) | growth per decade |")
     print("|---:|---:|---:|")
     rows = compile_scaling()
-    for i, (n, real, t) in enumerate(rows):
+    for i, (_n, real, t) in enumerate(rows):
         growth = f"{t / rows[i - 1][2]:.1f}x" if i else ""
         print(f"| {real} | {t * 1000:.1f} | {growth} |")
     print("\n| sample | graph -> GLSL (ms) | GL compile + link on llvmpipe (ms) |")

@@ -226,12 +226,11 @@ def lut_error(lut: np.ndarray, model: str) -> tuple[float, str]:
     return best
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=int, default=256)
-    parser.add_argument("--samples", type=int, default=256)
-    parser.add_argument("--lut", type=int, default=128)
-    args = parser.parse_args(argv)
+def compare(size: int = 256, samples: int = 256, lut: int = 128, repeat: int = 1) -> dict:
+    """Both tools on the same input; times are medians over `repeat` runs (errors from the
+    last run). Returns {"matedit": {...}, "cmgen": {...} or absent, "errors": {...}}."""
+    import statistics
+
     with tempfile.TemporaryDirectory() as tmpname:
         tmp = Path(tmpname)
         image = studio(2048)
@@ -240,38 +239,58 @@ def main(argv=None) -> int:
         source = EquirectSource(image)
         ours_out = tmp / "matedit"
         ours_out.mkdir()
-        print(f"input: studio, 2048x1024 EXR; cube {args.size}^2 with mips; LUT {args.lut}^2")
-        ours = run_matedit(path, ours_out, args.size, args.samples, args.lut)
-        results = {"matedit": ours}
+        runs = [run_matedit(path, ours_out, size, samples, lut) for _ in range(repeat)]
+        results = {"matedit": runs[-1]}
         cmgen = shutil.which("cmgen")
         if cmgen:
-            results["cmgen"] = run_cmgen(cmgen, path, tmp, args.size, args.lut)
+            cruns = [run_cmgen(cmgen, path, tmp, size, lut) for _ in range(repeat)]
+            results["cmgen"] = cruns[-1]
+            runs_by = {"matedit": runs, "cmgen": cruns}
         else:
-            print("cmgen not found (apt-get install libfilament-tools): skipping Filament's side")
-        print()
-        print(f"{'tool':8} {'prefilter s':>12} {'LUT s':>8}  levels (roughness)")
-        for name, r in results.items():
-            rough = ", ".join(f"{lv[0]:.3f}" for lv in r["levels"])
-            print(f"{name:8} {r['prefilter_s']:12.2f} {r['lut_s']:8.2f}  {rough}")
-        if "cmgen" in results:
-            c = results["cmgen"]
-            ratio_prefilter = c["prefilter_s"] / ours["prefilter_s"]
-            ratio_lut = c["lut_s"] / ours["lut_s"]
-            print(
-                f"time ratio cmgen / matedit: prefilter {ratio_prefilter:.2f}, LUT {ratio_lut:.2f}"
-            )
-        print("\nprefiltered texels vs brute force (relative error: mean / max over 48 texels)")
-        for name, r in results.items():
-            for rough, mean, worst in prefilter_errors(r["levels"], source):
-                print(f"  {name:8} roughness {rough:.3f}: {mean:.4f} / {worst:.4f}")
-        print("\nLUT vs brute force of each tool's own G (max |error| at 32x32 texel centres)")
-        err, layout = lut_error(ours["lut"], "schlick")
-        print(f"  matedit (Schlick-Smith k=a/2): {err:.2e}  [{layout}]")
-        if "cmgen" in results:
-            err, layout = lut_error(results["cmgen"]["lut"], "correlated")
-            print(f"  cmgen (height-correlated Smith): {err:.2e}  [{layout}]")
-    return 0
+            runs_by = {"matedit": runs}
+        for name, rs in runs_by.items():
+            for key in ("prefilter_s", "lut_s"):
+                results[name][key] = statistics.median(r[key] for r in rs)
+                results[name][key + "_all"] = [r[key] for r in rs]
+        for name, r in list(results.items()):
+            r["prefilter_errors"] = prefilter_errors(r["levels"], source)
+            r["lut_error"] = lut_error(r["lut"], "schlick" if name == "matedit" else "correlated")
+    return results
 
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=int, default=256)
+    parser.add_argument("--samples", type=int, default=256)
+    parser.add_argument("--lut", type=int, default=128)
+    parser.add_argument("--repeat", type=int, default=1, help="runs per tool (median time)")
+    args = parser.parse_args(argv)
+    print(f"input: studio, 2048x1024 EXR; cube {args.size}^2 with mips; LUT {args.lut}^2")
+    results = compare(args.size, args.samples, args.lut, args.repeat)
+    ours = results["matedit"]
+    if "cmgen" not in results:
+        print("cmgen not found (apt-get install libfilament-tools): skipping Filament's side")
+    print()
+    print(f"{'tool':8} {'prefilter s':>12} {'LUT s':>8}  levels (roughness)")
+    for name, r in results.items():
+        rough = ", ".join(f"{lv[0]:.3f}" for lv in r["levels"])
+        print(f"{name:8} {r['prefilter_s']:12.2f} {r['lut_s']:8.2f}  {rough}")
+    if "cmgen" in results:
+        c = results["cmgen"]
+        ratio_prefilter = c["prefilter_s"] / ours["prefilter_s"]
+        ratio_lut = c["lut_s"] / ours["lut_s"]
+        print(f"time ratio cmgen / matedit: prefilter {ratio_prefilter:.2f}, LUT {ratio_lut:.2f}")
+    print("\nprefiltered texels vs brute force (relative error: mean / max over 48 texels)")
+    for name, r in results.items():
+        for rough, mean, worst in r["prefilter_errors"]:
+            print(f"  {name:8} roughness {rough:.3f}: {mean:.4f} / {worst:.4f}")
+    print("\nLUT vs brute force of each tool's own G (max |error| at 32x32 texel centres)")
+    err, layout = ours["lut_error"]
+    print(f"  matedit (Schlick-Smith k=a/2): {err:.2e}  [{layout}]")
+    if "cmgen" in results:
+        err, layout = results["cmgen"]["lut_error"]
+        print(f"  cmgen (height-correlated Smith): {err:.2e}  [{layout}]")
+    return 0
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -17,7 +17,7 @@ from common import machine, median_time  # noqa: E402
 
 from matedit.compiler import compile_document  # noqa: E402
 from matedit.compiler.api import CompiledMaterial  # noqa: E402
-from matedit.compiler.emit import SHADE_MAIN, FRAME_BLOCK, SourceMap, vertex_source  # noqa: E402
+from matedit.compiler.emit import FRAME_BLOCK, SHADE_MAIN, SourceMap, vertex_source  # noqa: E402
 from matedit.compiler.ir import MaterialIR, Scope  # noqa: E402
 from matedit.compiler.targets import FRAME_BINDING, TARGETS  # noqa: E402
 from matedit.glsl.include import assemble  # noqa: E402
@@ -63,6 +63,61 @@ def frame_time(renderer, ctx, frames: int = 5) -> float:
     return median_time(one, repeat=frames, warmup=1)
 
 
+def frame_vs_floor(renderer, ctx, material: CompiledMaterial, sizes=(512, 1024),
+                   frames: int = 5) -> list[tuple[int, float, float]]:
+    """[(size, material frame s, floor frame s)], measured back to back at each size."""
+    rows = []
+    for size in sizes:
+        renderer.resize(size, size)
+        renderer.set_material(material)
+        t_mat = frame_time(renderer, ctx, frames)
+        renderer.set_material(floor_material())
+        t_floor = frame_time(renderer, ctx, frames)
+        rows.append((size, t_mat, t_floor))
+    return rows
+
+
+def structural_edit(renderer, ctx, doc, repeat: int = 3) -> tuple[float, float, float, float]:
+    """Median (compile, GL link, first frame, total) seconds of a structural edit to `doc`:
+    compile, link a new program (the program cache is cleared first), draw, finish."""
+    rows = []
+    for _ in range(repeat):
+        renderer._programs.clear()  # force a new link, as a structural edit does
+        t0 = time.perf_counter()
+        cm = compile_document(doc, FileResolver())
+        t1 = time.perf_counter()
+        renderer.set_material(cm)
+        ctx.finish()
+        t2 = time.perf_counter()
+        renderer.render()
+        ctx.finish()
+        t3 = time.perf_counter()
+        rows.append((t1 - t0, t2 - t1, t3 - t2, t3 - t0))
+    rows.sort(key=lambda x: x[3])
+    return rows[len(rows) // 2]
+
+
+def parameter_edit(renderer, ctx, material: CompiledMaterial, repeat: int = 5,
+                   values: list[dict] | None = None) -> tuple[float, int]:
+    """Median seconds from a parameter edit (set_uniforms) to the next finished frame, and the
+    number of program links the edits caused."""
+    renderer.set_material(material)
+    renderer.render()
+    ctx.finish()
+    links = renderer.link_count
+    if values is None:
+        values = [{u.name: u.default for u in material.ir.uniforms}]
+    times = []
+    for i in range(repeat):
+        t0 = time.perf_counter()
+        renderer.set_uniforms(values[i % len(values)])
+        renderer.render()
+        ctx.finish()
+        times.append(time.perf_counter() - t0)
+    times.sort()
+    return times[len(times) // 2], renderer.link_count - links
+
+
 def main() -> None:
     import moderngl
 
@@ -76,48 +131,22 @@ def main() -> None:
     material = compile_document(sample, FileResolver())
     print("| size | worn_painted_steel (ms) | hand-written floor (ms) | ratio |")
     print("|---|---:|---:|---:|")
-    for size in (512, 1024):
-        r.resize(size, size)
-        r.set_material(material)
-        t_mat = frame_time(r, ctx)
-        r.set_material(floor_material())
-        t_floor = frame_time(r, ctx)
+    for size, t_mat, t_floor in frame_vs_floor(r, ctx, material):
         print(f"| {size}² | {t_mat * 1000:.0f} | {t_floor * 1000:.0f} | {t_mat / t_floor:.2f} |")
 
     r.resize(512, 512)
-    print("\n| sample | compile (ms) | GL link (ms) | first frame (ms) | structural edit total (ms) |")
+    print("\n| sample | compile (ms) | GL link (ms) | first frame (ms) "
+          "| structural edit total (ms) |")
     print("|---|---:|---:|---:|---:|")
     for path in sorted((graphs_dir() / "materials").glob("*.json")):
-        doc = load(path)
-        rows = []
-        for _ in range(3):
-            r._programs.clear()  # force a new link, as a structural edit does
-            t0 = time.perf_counter()
-            cm = compile_document(doc, FileResolver())
-            t1 = time.perf_counter()
-            r.set_material(cm)
-            ctx.finish()
-            t2 = time.perf_counter()
-            r.render()
-            ctx.finish()
-            t3 = time.perf_counter()
-            rows.append((t1 - t0, t2 - t1, t3 - t2, t3 - t0))
-        rows.sort(key=lambda x: x[3])
-        c, l, f, tot = rows[len(rows) // 2]
-        print(f"| {path.stem} | {c * 1000:.1f} | {l * 1000:.0f} | {f * 1000:.0f} | "
+        c, li, f, tot = structural_edit(r, ctx, load(path))
+        print(f"| {path.stem} | {c * 1000:.1f} | {li * 1000:.0f} | {f * 1000:.0f} | "
               f"{tot * 1000:.0f} |")
 
-    links = r.link_count
-    r.set_material(material)
-    t0 = time.perf_counter()
-    r.set_uniforms({u.name: u.default for u in material.ir.uniforms})
-    r.render()
-    ctx.finish()
-    t1 = time.perf_counter()
-    print(f"\nparameter edit -> next frame at 512²: {(t1 - t0) * 1000:.0f} ms, "
-          f"program links caused: {r.link_count - links}")
+    t, links = parameter_edit(r, ctx, material, repeat=1)
+    print(f"\nparameter edit -> next frame at 512²: {t * 1000:.0f} ms, "
+          f"program links caused: {links}")
     r.release()
-
 
 if __name__ == "__main__":
     main()

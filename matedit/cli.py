@@ -16,7 +16,9 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="matedit", description="Node-based material editor (Karis 2013).")
+    parser = _Parser(prog="matedit", description="Node-based material editor (Karis 2013). "
+                     "`matedit [FILE]` opens the editor (no FILE: the built-in sample "
+                     "layered material); the commands below run headless.")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
     from matedit import commands
 

@@ -12,21 +12,8 @@
 //   offset 160: vec4 sampleOffset  xy = per-frame offset of the reference sample set, zw = 0
 // Total 176 bytes. matedit.shading.ibl.pack_ibl_block writes exactly these bytes.
 
-#ifndef MATEDIT_UBO
-#ifdef VULKAN
-#define MATEDIT_UBO(n) layout(std140, binding = n)
-#else
-#define MATEDIT_UBO(n) layout(std140)
-#endif
-#endif
+#include "bindings.glsl"
 
-#ifndef MATEDIT_BINDING
-#ifdef VULKAN
-#define MATEDIT_BINDING(n) layout(binding = n)
-#else
-#define MATEDIT_BINDING(n)
-#endif
-#endif
 
 #define IBL_MODE_SPLIT_SUM 0
 #define IBL_MODE_REFERENCE 1

@@ -12,15 +12,7 @@
 // matedit.shading.lights_block.pack_lights writes exactly these bytes.
 #include "lights.glsl"
 
-// The compiler defines MATEDIT_UBO per target; this fallback picks std140, plus a
-// binding where the dialect allows one (Vulkan GLSL requires it, GLSL 330 and ESSL 300 lack it).
-#ifndef MATEDIT_UBO
-#ifdef VULKAN
-#define MATEDIT_UBO(n) layout(std140, binding = n)
-#else
-#define MATEDIT_UBO(n) layout(std140)
-#endif
-#endif
+#include "bindings.glsl"
 
 #ifndef MATEDIT_MAX_LIGHTS
 #define MATEDIT_MAX_LIGHTS 16

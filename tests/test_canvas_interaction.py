@@ -243,3 +243,49 @@ def test_palette_search_ranks_titles_and_fuzzy_matches():
     assert search("smooth", entries)[0].kind == "smoothstep"
     assert search("attributes make", entries)[0].kind == "make_attributes"
     assert search("zzzz", entries) == []
+
+
+def test_dragging_a_comment_moves_the_nodes_inside_as_one_step(view):
+    from matedit.graph.commands import PutComment
+    from matedit.graph.model import Comment
+    c = view.controller
+    c.push(PutComment("box", Comment("box", "Inputs", (-30, -50, 260, 300))))  # p and col
+    steps = c.undo_stack.count()
+    item = view.scene().comment_items["box"]
+    a = view.mapFromScene(item.pos() + QPointF(100, 10))  # its title bar
+    drag(view, a, a + QPoint(0, 100))
+    g = c.document.graph
+    dy = 100 / view.zoom()
+    assert c.undo_stack.count() == steps + 1
+    assert g.comments["box"].rect[1] == pytest.approx(-50 + dy, abs=2)
+    assert g.nodes["p"].position[1] == pytest.approx(dy, abs=2)
+    assert g.nodes["col"].position[1] == pytest.approx(150 + dy, abs=2)
+    assert g.nodes["mul"].position == (250.0, 0.0)  # outside the frame
+    c.undo_stack.undo()
+    assert g.nodes["p"].position == (0.0, 0.0) and g.comments["box"].rect[1] == -50
+
+
+def test_clicking_a_wire_and_pressing_delete_disconnects_it(view):
+    c = view.controller
+    wire = view.scene().wire_items[Link("mul", "result", "make", "roughness")]
+    mid = view.mapFromScene(wire.path().pointAtPercent(0.5))
+    QTest.mouseClick(view.viewport(), LEFT, pos=mid)
+    assert view.scene().selected_wires == {wire.link}
+    view.setFocus()
+    QTest.keyClick(view, Qt.Key.Key_Delete)
+    assert wire.link not in c.document.graph.links
+    assert "mul" in c.document.graph.nodes
+
+
+def test_f_frames_the_selection_and_the_minimap_navigates(view):
+    view.select_nodes(["out"])
+    view.setFocus()
+    QTest.keyClick(view, Qt.Key.Key_F)
+    centre = view.mapToScene(view.viewport().rect().center())
+    out = view.scene().node_items["out"].sceneBoundingRect().center()
+    assert abs(centre.x() - out.x()) < 5 and abs(centre.y() - out.y()) < 5
+    mm = view.minimap
+    mm._render()
+    QTest.mouseClick(mm, LEFT, pos=QPoint(8, 8))
+    moved = view.mapToScene(view.viewport().rect().center())
+    assert moved.x() < centre.x() - 50

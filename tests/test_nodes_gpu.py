@@ -9,15 +9,12 @@ Tolerance: |gpu - numpy| <= rtol |numpy| + atol, 1e-5 each unless a kind states 
 from __future__ import annotations
 
 import re
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
 
 from matedit.compiler import cpu_nodes
 from matedit.compiler.cpu_nodes import IMPLS, SurfaceArrays
-from matedit.glsl.include import assemble
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, GENERIC, REGISTRY
 from matedit.resources import shaders_dir
 from tests.gpu_eval import gpu_eval, gpu_eval_many
@@ -140,45 +137,8 @@ def test_every_kind_but_the_compilers_own_has_a_numpy_impl():
     assert set(IMPLS) == set(REGISTRY) - COMPILER_HANDLED
 
 
-_VERTEX = "#version 330 core\nvoid main() { gl_Position = vec4(0.0); }\n"
-TARGETS = {
-    # name: (#version, prelude, output declaration, glslangValidator arguments)
-    "glsl330": ("330 core", "", "out vec4 color;", []),
-    "glsl450": ("450", "", "layout(location = 0) out vec4 color;", ["-V"]),
-    "essl300": ("300 es", "precision highp float;\n", "out vec4 color;", []),
-}
-
-
-def _wrapped(name: str, target: str):
-    version, prelude, out_decl, _ = TARGETS[target]
-    body = f"{out_decl}\nvoid main() {{\n    color = vec4(0.0);\n}}\n"
-    return assemble(body, version=version, includes=[f"nodes/{name}"], prelude=prelude)
-
-
-@pytest.mark.gl
-@pytest.mark.parametrize("name", NODE_FILES)
-def test_node_file_compiles_alone_on_llvmpipe(ctx, name):
-    asm = _wrapped(name, "glsl330")
-    try:
-        ctx.program(vertex_shader=_VERTEX, fragment_shader=asm.text).release()
-    except Exception as exc:
-        pytest.fail(asm.map_log(str(exc)))
-
-
-@pytest.mark.parametrize("target", sorted(TARGETS))
-@pytest.mark.parametrize("name", NODE_FILES)
-def test_node_file_compiles_alone_in_glslang(tmp_path, name, target):
-    exe = shutil.which("glslangValidator")
-    if exe is None:
-        pytest.skip("glslangValidator is not installed: cannot check 450 / ES 300 targets")
-    asm = _wrapped(name, target)
-    src = tmp_path / f"{name}.{target}.frag"
-    src.write_text(asm.text)
-    args = [exe, *TARGETS[target][3], str(src)]
-    if "-V" in args:
-        args += ["-o", str(tmp_path / "out.spv")]
-    run = subprocess.run(args, capture_output=True, text=True)
-    assert run.returncode == 0, asm.map_log(run.stdout + run.stderr)
+# Each node file compiling on its own (llvmpipe, glslang) is checked with the rest of the
+# library in test_shading_compile.py.
 
 
 # --- generic maths: inline templates and the normalize / remap overloads ------------------

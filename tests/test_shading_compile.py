@@ -1,5 +1,5 @@
-"""Every top-level file of shaders/ compiles on its own: llvmpipe (GLSL 330 core) and
-glslangValidator for GLSL 330, Vulkan GLSL 450 (to SPIR-V) and ESSL 300."""
+"""Every library file of shaders/ (top level and nodes/) compiles on its own: llvmpipe
+(GLSL 330 core) and glslangValidator for GLSL 330, Vulkan GLSL 450 (to SPIR-V) and ESSL 300."""
 
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ import pytest
 from matedit.glsl.include import assemble
 from matedit.resources import shaders_dir
 
-FILES = sorted(p.name for p in shaders_dir().glob("*.glsl"))
+FILES = sorted(p.name for p in shaders_dir().glob("*.glsl")) + sorted(
+    f"nodes/{p.name}" for p in (shaders_dir() / "nodes").glob("*.glsl"))
 _VERTEX = "#version 330 core\nvoid main() { gl_Position = vec4(0.0); }\n"
 _ES_PRELUDE = "precision highp float;\nprecision highp int;\n"
 TARGETS = {
@@ -51,7 +52,7 @@ def test_compiles_alone_in_glslang(tmp_path, name, target):
     if exe is None:
         pytest.skip("glslangValidator is not installed: cannot check 450 / ES 300 targets")
     asm = _wrapped(name, target)
-    src = tmp_path / f"{name}.{target}.frag"
+    src = tmp_path / f"{name.replace('/', '_')}.{target}.frag"
     src.write_text(asm.text)
     args = [exe, *TARGETS[target][3], str(src)]
     if "-V" in args:

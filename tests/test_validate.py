@@ -193,3 +193,12 @@ def test_layer_stack_port_name_collisions_are_errors(tmp_path):
                                                 {"id": "b", "function": "a.json"}]})
     errs = errors(d, FileResolver())
     assert any(e.node_id == "stack" and "b_mask" in e.message for e in errs)
+
+
+def test_missing_texture_is_a_warning_not_an_error(tmp_path):
+    d = simple_material(tmp_path / "m.json")
+    node(d, "tex", "texture_parameter", {"name": "albedo", "path": "gone.png"})
+    diags = validate(d)
+    assert not [x for x in diags if x.severity == Severity.ERROR]
+    (w,) = [x for x in diags if x.severity == Severity.WARNING]
+    assert (w.node_id, w.port) == ("tex", "path") and "checker" in w.message

@@ -79,6 +79,7 @@ class LightsPanel(QWidget):
         bar.addWidget(self.remove_button)
         lay.addLayout(bar)
         self.list = QListWidget()
+        self.list.setMinimumHeight(84)
         self.list.setMaximumHeight(110)
         self.list.currentRowChanged.connect(self._show)
         lay.addWidget(self.list)

@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QMainWindow,
     QMenu,
+    QScrollArea,
     QUndoView,
     QVBoxLayout,
     QWidget,
@@ -114,7 +115,11 @@ class MainWindow(QMainWindow):
         lh.setSpacing(0)
         lh.addWidget(self.environment)
         lh.addWidget(self.lights, 1)
-        self.lights_dock = self._dock("Lights && Environment", "lightsDock", lights_host, R,
+        lights_scroll = QScrollArea()  # its height must not squeeze the viewport above
+        lights_scroll.setWidgetResizable(True)
+        lights_scroll.setFrameShape(QScrollArea.Shape.NoFrame)
+        lights_scroll.setWidget(lights_host)
+        self.lights_dock = self._dock("Lights && Environment", "lightsDock", lights_scroll, R,
                                       "light")
         self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
                                            B, "warning")

@@ -418,7 +418,8 @@ class ViewportPanel(QWidget):
         if isinstance(mesh, str) and mesh in MESHES:
             self.mesh_combo.setCurrentText(mesh)
         env = preview.get("environment")
-        if isinstance(env, str) and env in ENVIRONMENTS.values():
+        if isinstance(env, str) and env in ENVIRONMENTS.values() and \
+                env != self.view._environment:
             self.choose_environment(env)
 
     def _env_activated(self, index: int) -> None:

@@ -242,6 +242,13 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                                    n.id, None, f))
     params: dict[str, str] = {}
     for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
+        if n.kind == "texture_parameter":
+            tex = n.settings.get("path", "")
+            if isinstance(tex, str) and tex:
+                base = Path(doc.path).parent if doc.path else Path.cwd()
+                if not (base / tex).is_file():
+                    diags.append(warning(f"texture file {tex!r} not found; it shows as a checker",
+                                         n.id, "path", f))
         if n.kind.endswith("_parameter"):
             name = str(n.settings.get("name", ""))
             if not name.isidentifier():

@@ -43,6 +43,7 @@ ZOOM_MIN = 0.05
 ZOOM_MAX = 3.0
 ZOOM_STEP = 1.15
 LOD_TEXT = 0.42  # below this zoom nodes draw as coloured blocks without text
+LOD_PORTS = 0.3  # below this zoom ports take no clicks (their items hide)
 
 SCENE_EXTENT = 100_000.0  # the scene rect: room to pan anywhere
 

@@ -22,7 +22,7 @@ from PySide6.QtGui import (
     QPen,
     QPixmap,
 )
-from PySide6.QtWidgets import QGraphicsItem, QStyleOptionGraphicsItem
+from PySide6.QtWidgets import QGraphicsItem, QGraphicsRectItem, QStyleOptionGraphicsItem
 
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.port_item import PortItem, port_shape
@@ -59,9 +59,13 @@ def measure(title: str, subtitle: str, inputs: list[PortRow], outputs: list[Port
     head = 2 * 8.0 + fm_t.horizontalAdvance(title)
     if subtitle:
         head = max(head, 16.0 + C.metrics("subtitle").horizontalAdvance(subtitle))
-    left = max((fm_p.horizontalAdvance(p.name) for p in inputs), default=0.0)
-    right = max((fm_p.horizontalAdvance(p.name) for p in outputs), default=0.0)
-    rows_w = left + right + 2 * C.LABEL_GAP + (18.0 if left and right else 6.0)
+    ins = [fm_p.horizontalAdvance(p.name) for p in inputs]
+    outs = [fm_p.horizontalAdvance(p.name) for p in outputs]
+    rows_w = 0.0
+    for i in range(max(len(ins), len(outs))):
+        a = ins[i] if i < len(ins) else 0.0
+        b = outs[i] if i < len(outs) else 0.0
+        rows_w = max(rows_w, a + b + 2 * C.LABEL_GAP + (16.0 if a and b else 6.0))
     width = max(C.NODE_MIN_WIDTH, head, rows_w, (C.PREVIEW_SIZE + 16) if preview else 0.0)
     width = min(C.NODE_MAX_WIDTH, float(round(width / 4.0 + 0.49) * 4))
     top = C.HEADER_HEIGHT + (C.SUBTITLE_HEIGHT if subtitle else 0.0) + 3.0
@@ -106,8 +110,13 @@ class BadgeItem(QGraphicsItem):
         painter.drawPoint(QPointF(0, 3.8))
 
 
-class NodeItem(QGraphicsItem):
-    """One graph node, positioned at the model's (top-left) position."""
+class NodeItem(QGraphicsRectItem):
+    """One graph node, positioned at the model's (top-left) position.
+
+    A QGraphicsRectItem only so that Qt answers `boundingRect` in C++ (from the rect,
+    the node plus a margin for the ports astride its edges): it is asked for thousands
+    of times a frame on a big graph. The pen is NoPen and `paint` is ours.
+    """
 
     def __init__(self, node_id: str, kind: str) -> None:
         super().__init__()
@@ -124,11 +133,14 @@ class NodeItem(QGraphicsItem):
         self._preview: QPixmap | None = None
         self._ports: dict[tuple[str, bool], PortItem] = {}
         self._badge: BadgeItem | None = None
+        self._ports_visible = True
         self.layout = NodeLayout(C.NODE_MIN_WIDTH, C.HEADER_HEIGHT + C.BODY_PAD, C.HEADER_HEIGHT)
         F = QGraphicsItem.GraphicsItemFlag
         self.setFlags(F.ItemIsMovable | F.ItemIsSelectable | F.ItemSendsGeometryChanges)
         self.setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
         self.setZValue(C.Z_NODE)
+        self.setPen(Qt.PenStyle.NoPen)
+        self._set_bounds()
 
     # --- content, from the scene -------------------------------------------------------------
     def set_content(self, title: str, subtitle: str, category: str, inputs: list[PortRow],
@@ -221,10 +233,19 @@ class NodeItem(QGraphicsItem):
         return next((r.type for r in rows if r.name == name), "T")
 
     # --- geometry ----------------------------------------------------------------------------
+    def _set_bounds(self) -> None:
+        m = C.PORT_RADIUS + 2.5  # ports sit astride the edges
+        self.setRect(QRectF(-m, -m, self.layout.width + 2 * m, self.layout.height + 2 * m))
+
+    def set_ports_visible(self, visible: bool) -> None:
+        self._ports_visible = visible
+        for port in self._ports.values():
+            port.setVisible(visible)
+
     def _relayout(self) -> None:
-        self.prepareGeometryChange()
         self.layout = measure(self.title, self.subtitle, self.inputs, self.outputs,
                               self._preview is not None)
+        self._set_bounds()
         wanted: dict[tuple[str, bool], tuple[PortRow, QPointF]] = {}
         for row in self.inputs:
             wanted[(row.name, False)] = (row, self.layout.inputs[row.name])
@@ -241,6 +262,7 @@ class NodeItem(QGraphicsItem):
             if port is None:
                 port = PortItem(self, self.node_id, row.name, key[1], row.type, row.doc)
                 port.generic = row.generic
+                port.setVisible(self._ports_visible)
                 self._ports[key] = port
             else:
                 port.set_type(row.type)
@@ -256,10 +278,6 @@ class NodeItem(QGraphicsItem):
         if self._badge is not None:
             # Astride the top-right corner, so it never hides the title.
             self._badge.setPos(self.layout.width - 2.0, 0.0)
-
-    def boundingRect(self) -> QRectF:
-        m = C.PORT_RADIUS + 2.5  # ports sit astride the edges
-        return QRectF(-m, -m, self.layout.width + 2 * m, self.layout.height + 2 * m)
 
     def shape(self) -> QPainterPath:
         path = QPainterPath()
@@ -333,24 +351,28 @@ class NodeItem(QGraphicsItem):
     def _paint_ports(self, painter: QPainter, labels: bool) -> None:
         lay = self.layout
         fm = C.metrics("port")
-        half = lay.width / 2 - C.LABEL_GAP - 3
         if labels:
             painter.setFont(C.port_font())
+        # Labels sharing a row split the width: each side leaves the other what it needs.
+        across = lay.width - 2 * C.LABEL_GAP - 10
+        in_w = [fm.horizontalAdvance(r.name) for r in self.inputs]
+        out_w = [fm.horizontalAdvance(r.name) for r in self.outputs]
         for rows, table, out, connected in (
                 (self.inputs, lay.inputs, False, self.connected_inputs),
                 (self.outputs, lay.outputs, True, self.connected_outputs)):
-            for row in rows:
+            other_w = in_w if out else out_w
+            for i, row in enumerate(rows):
                 pos = table[row.name]
                 port_shape(painter, pos, row.type, C.PORT_RADIUS, row.name in connected)
                 if not labels:
                     continue
-                # One side may use the whole width when the other side has no port on this row.
-                other = lay.inputs if out else lay.outputs
-                shared = any(abs(p.y() - pos.y()) < 1 for p in other.values())
-                room = half if shared else lay.width - 2 * C.LABEL_GAP - 4
-                text = fm.elidedText(row.name, Qt.TextElideMode.ElideRight, room)
-                painter.setPen(C.PORT_LABEL_DIM if (connected and row.name in connected
-                                                    and not out) else C.PORT_LABEL)
+                own = out_w[i] if out else in_w[i]
+                other = other_w[i] if i < len(other_w) else 0.0
+                room = max(across - other, across / 2) if other else across
+                text = row.name if own <= room else fm.elidedText(
+                    row.name, Qt.TextElideMode.ElideRight, room)
+                painter.setPen(C.PORT_LABEL_DIM if (not out and row.name in connected)
+                               else C.PORT_LABEL)
                 r = QRectF(0, pos.y() - C.ROW_HEIGHT / 2, 0, C.ROW_HEIGHT)
                 if out:
                     r.setLeft(lay.width - C.LABEL_GAP - room)

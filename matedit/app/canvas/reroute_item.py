@@ -16,8 +16,8 @@ class RerouteItem(NodeItem):
     def _relayout(self) -> None:
         r = C.REROUTE_RADIUS
         super()._relayout()
-        self.prepareGeometryChange()
         self.layout = NodeLayout(2 * r, 2 * r, 0.0)
+        self.setRect(QRectF(-4, -4, 2 * r + 8, 2 * r + 8))
         self.layout.inputs = {p.name: QPointF(0.0, r) for p in self.inputs}
         self.layout.outputs = {p.name: QPointF(2 * r, r) for p in self.outputs}
         for port in self.ports():
@@ -42,10 +42,6 @@ class RerouteItem(NodeItem):
         r = C.REROUTE_RADIUS
         path.addEllipse(QPointF(r, r), r + 3, r + 3)
         return path
-
-    def boundingRect(self) -> QRectF:
-        r = C.REROUTE_RADIUS
-        return QRectF(-4, -4, 2 * r + 8, 2 * r + 8)
 
     def paint(self, painter: QPainter, option: QStyleOptionGraphicsItem, widget=None) -> None:
         r = C.REROUTE_RADIUS

@@ -52,7 +52,10 @@ def describe(node: Node) -> tuple[str, str, str, str]:
     elif node.kind == "constant":
         sub = _fmt(s.get("value", 0.0))
     elif node.kind == "function_call":
-        sub = Path(str(s.get("function", ""))).stem or "no function"
+        stem = Path(str(s.get("function", ""))).stem
+        if stem and not node.label:
+            title = stem.replace("_", " ").capitalize()  # name the function, as Unreal does
+        sub = f"{stem}.json" if stem else "no function chosen"
     elif node.kind in ("function_input", "function_output"):
         sub = f"{s.get('name', '')} : {s.get('type', 'float')}"
     elif node.kind == "component_mask":
@@ -87,6 +90,7 @@ class NodeScene(QGraphicsScene):
         self._previews: dict[str, QImage] = {}
         self.selected_wires: set[Link] = set()  # wires keep their own selection (see WireItem)
         self.hairline = False  # wires draw as hairlines when zoomed far out
+        self.ports_visible = True  # ports hide when zoomed too far out to aim at them
         self._last_diags: dict[str, list[tuple[str, str]]] = {}
         self.setItemIndexMethod(QGraphicsScene.ItemIndexMethod.BspTreeIndex)
         self.setBackgroundBrush(C.BACKGROUND)
@@ -151,6 +155,7 @@ class NodeScene(QGraphicsScene):
         self.node_items[node_id] = item
         self._wires_of.setdefault(node_id, set())
         item.setPos(node.position[0], node.position[1])
+        item.set_ports_visible(self.ports_visible)
         self._refresh_node(node_id, item)
         self.addItem(item)
         if node_id in self._previews:
@@ -338,12 +343,18 @@ class NodeScene(QGraphicsScene):
         self.selected_wires.clear()
 
     def set_zoom(self, zoom: float) -> None:
-        """Wires become cosmetic hairlines once thinner than 1.3 device pixels (fast to draw)."""
+        """Level of detail: hairline wires below 1.3 device pixels, no port items below
+        LOD_PORTS (the node still draws its ports; they just take no clicks there)."""
         hairline = zoom * C.WIRE_WIDTH < 1.3
         if hairline != self.hairline:
             self.hairline = hairline
             for wire in self.wire_items.values():
                 wire.set_hairline(hairline)
+        ports = zoom >= C.LOD_PORTS
+        if ports != self.ports_visible:
+            self.ports_visible = ports
+            for item in self.node_items.values():
+                item.set_ports_visible(ports)
 
     # --- item callbacks ----------------------------------------------------------------------
     def node_item_moved(self, node_id: str) -> None:
