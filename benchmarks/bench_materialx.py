@@ -8,8 +8,10 @@ The equivalent of a sample is built from what the sample layers: one `standard_s
 per layer (a layer stack's entries, and `function_call`s of files under graphs/layers/),
 folded by `mix` nodes of surfaceshaders, each mask a `noise2d` on the texture coordinates
 (the samples' masks are value noise, gradients and small functions of similar cost). A
-sample with no layer is one `standard_surface`. Specular IBL uses MaterialX's prefiltered
-environment method, the analogue of matedit's split sum; no analytic lights are bound.
+sample with no layer is one `standard_surface`. A second variant ("inputs") mixes the layers'
+base colour, metalness and roughness by the same masks into one `standard_surface`.
+Specular IBL uses MaterialX's prefiltered environment method, the analogue of matedit's
+split sum; no analytic lights are bound.
 """
 
 from __future__ import annotations
@@ -32,9 +34,11 @@ class Equivalent:
     layers: int
     blends: int
 
-    def describe(self) -> str:
+    def describe(self, mode: str = "shaders") -> str:
         if self.layers == 1:
             return "1 standard_surface"
+        if mode == "inputs":
+            return f"1 standard_surface, inputs mixed over {self.layers} layers by noise2d"
         return (f"{self.layers} standard_surface, {self.blends} mix(surfaceshader) "
                 f"by noise2d")
 
@@ -58,8 +62,8 @@ class MaterialXSide:
     drawing onto the caller's moderngl context at `size` with 4x MSAA, like matedit's view."""
 
     def __init__(self, ctx, size=(512, 512), camera=None) -> None:
-        import moderngl
         import MaterialX as mx
+        import moderngl
         from MaterialX import PyMaterialXGenGlsl as mx_glsl
         from MaterialX import PyMaterialXGenShader as mx_gen
 
@@ -101,30 +105,57 @@ class MaterialXSide:
         self.eye = tuple(float(x) for x in cam.eye)
 
     # -- the document ----------------------------------------------------------------------
-    def build(self, eq: Equivalent, seed: int = 0):
-        """A document holding the equivalent material; returns (document, material node)."""
+    def build(self, eq: Equivalent, seed: int = 0, mode: str = "shaders"):
+        """A document holding the equivalent material; returns (document, material node).
+        mode "shaders": a standard_surface per layer, folded by mix nodes of surfaceshaders
+        (a BSDF evaluation per layer, MaterialX's usual layering); mode "inputs": one
+        standard_surface whose base colour, metalness and roughness are each folded by mix
+        nodes over the layers' values (one BSDF, matedit's own scheme)."""
         mx = self.mx
         doc = mx.createDocument()
         doc.importLibrary(self.library)
         rng = np.random.default_rng(seed)
-        shader = None
-        for i in range(eq.layers):
-            layer = doc.addNode("standard_surface", f"layer{i}", "surfaceshader")
-            c = [float(x) for x in rng.random(3)]
-            layer.setInputValue("base_color", mx.Color3(*c))
-            layer.setInputValue("metalness", float(rng.random() > 0.5))
-            layer.setInputValue("specular_roughness", float(0.1 + 0.8 * rng.random()))
-            if shader is None:
-                shader = layer
-                continue
+        values = [(mx.Color3(*[float(x) for x in rng.random(3)]), float(rng.random() > 0.5),
+                   float(0.1 + 0.8 * rng.random())) for _ in range(eq.layers)]
+        masks = []
+        for i in range(1, eq.layers):
             uv = doc.addNode("texcoord", f"uv{i}", "vector2")
             mask = doc.addNode("noise2d", f"mask{i}", "float")
             mask.setConnectedNode("texcoord", uv)
-            mix = doc.addNode("mix", f"blend{i}", "surfaceshader")
-            mix.setConnectedNode("bg", shader)
-            mix.setConnectedNode("fg", layer)
-            mix.setConnectedNode("mix", mask)
-            shader = mix
+            masks.append(mask)
+        names = (("base_color", "color3"), ("metalness", "float"),
+                 ("specular_roughness", "float"))
+        if mode == "inputs":
+            shader = doc.addNode("standard_surface", "surface", "surfaceshader")
+            for k, (name, kind) in enumerate(names):
+                if eq.layers == 1:
+                    shader.setInputValue(name, values[0][k])
+                    continue
+                prev = None
+                for i in range(1, eq.layers):
+                    mix = doc.addNode("mix", f"{name}_blend{i}", kind)
+                    if prev is None:
+                        mix.setInputValue("bg", values[0][k])
+                    else:
+                        mix.setConnectedNode("bg", prev)
+                    mix.setInputValue("fg", values[i][k])
+                    mix.setConnectedNode("mix", masks[i - 1])
+                    prev = mix
+                shader.setConnectedNode(name, prev)
+        else:
+            shader = None
+            for i in range(eq.layers):
+                layer = doc.addNode("standard_surface", f"layer{i}", "surfaceshader")
+                for k, (name, _) in enumerate(names):
+                    layer.setInputValue(name, values[i][k])
+                if shader is None:
+                    shader = layer
+                    continue
+                mix = doc.addNode("mix", f"blend{i}", "surfaceshader")
+                mix.setConnectedNode("bg", shader)
+                mix.setConnectedNode("fg", layer)
+                mix.setConnectedNode("mix", masks[i - 1])
+                shader = mix
         material = doc.addMaterialNode("equivalent", shader)
         ok, message = doc.validate()
         if not ok:
@@ -168,10 +199,11 @@ class MaterialXSide:
         ctx.finish()
         vao.release()
 
-    def structural_edit(self, eq: Equivalent, repeat: int = 3, seed: int = 0) -> dict:
+    def structural_edit(self, eq: Equivalent, repeat: int = 3, seed: int = 0,
+                        mode: str = "shaders") -> dict:
         """Median seconds: generate GLSL, link, first draw (JIT + draw), and the total; and a
         second draw of the same program (the steady frame)."""
-        _, material = self.build(eq, seed)
+        doc, material = self.build(eq, seed, mode)  # keep the document alive while generating
         rows = []
         steady = []
         size = 0
@@ -192,6 +224,7 @@ class MaterialXSide:
                 steady.append(time.perf_counter() - t4)
             prog.release()
             size = len(frag)
+        del doc
         rows.sort(key=lambda r: r[3])
         gen, link, first, total = rows[len(rows) // 2]
         return {"generate": gen, "link": link, "first_frame": first, "total": total,
@@ -218,8 +251,9 @@ def main() -> None:
     print("|---|---|---:|---:|---:|---:|")
     for path in sorted((graphs_dir() / "materials").glob("*.json")):
         eq = equivalent_of(path)
-        r = side.structural_edit(eq, repeat=1)
-        print(f"| {path.stem} | {eq.describe()} | {r['generate'] * 1000:.1f} | "
+        mode = sys.argv[1] if len(sys.argv) > 1 else "shaders"
+        r = side.structural_edit(eq, repeat=1, mode=mode)
+        print(f"| {path.stem} | {eq.describe(mode)} | {r['generate'] * 1000:.1f} | "
               f"{r['link'] * 1000:.0f} | {r['first_frame'] * 1000:.0f} | "
               f"{r['total'] * 1000:.0f} |")
     side.release()

@@ -167,3 +167,22 @@ def test_matedit_with_a_file_opens_the_editor_and_subcommands_still_work(monkeyp
     assert main([str(graphs_dir() / "functions" / "rotate_uv.json")]) == 2
     assert main(["validate", str(SAMPLE)]) == 0
     assert len(opened) == 2
+
+
+def test_a_function_tab_autosaves_and_is_recovered(qtbot, sample_copy):
+    fn_path = sample_copy.parent.parent / "functions" / "uv_tile_rotate.json"
+    w = make_window(qtbot, sample_copy, track=False)
+    tab = w.tabs.open_function(fn_path)
+    assert tab is not None and tab.is_function
+    node = next(iter(sorted(tab.controller.document.graph.nodes)))
+    from matedit.graph.commands import SetLabel
+
+    assert tab.controller.push(SetLabel(node, "edited"))
+    assert tab.actions.autosave() is not None
+    shiboken6.delete(w)
+    w2 = make_window(qtbot, sample_copy)
+    tab2 = w2.tabs.open_function(fn_path)
+    assert tab2.controller.document.graph.nodes[node].label == "edited"
+    assert tab2.controller.dirty
+    assert tab2.actions.save()
+    assert load(fn_path).graph.nodes[node].label == "edited"

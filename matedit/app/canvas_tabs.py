@@ -125,8 +125,14 @@ class CanvasTabs(QWidget):
             return self.material
         controller = DocumentController(doc, self)
         actions = DocumentActions(self.window(), controller)
-        actions.show_error = self.material.actions.show_error
-        actions.ask_save_changes = lambda name: self.material.actions.ask_save_changes(name)
+        main = self.material.actions
+        actions.show_error = lambda title, text: main.show_error(title, text)
+        actions.ask_save_changes = lambda name: main.ask_save_changes(name)
+        actions.ask_recover = lambda p, rec: main.ask_recover(p, rec)
+        recovered = actions._offer_recovery(path)  # a function edited when the editor crashed
+        if recovered is not None:
+            controller.replace(recovered)
+            controller.undo_stack.resetClean()
         tab = self._add(controller, actions, parent or self.active)
         self.activate(tab)
         return tab

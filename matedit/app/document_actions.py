@@ -268,6 +268,7 @@ class DocumentActions(QObject):
                 pass
 
     def _offer_recovery(self, path: Path) -> MaterialDocument | None:
+        """The autosave of `path` if it is newer than the file and the artist wants it."""
         rec = recovery_path(path)
         if not rec.is_file():
             return None

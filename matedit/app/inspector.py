@@ -13,7 +13,6 @@ from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
-    QDoubleSpinBox,
     QFileDialog,
     QFormLayout,
     QHBoxLayout,
@@ -28,7 +27,7 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app.controller import DocumentController
-from matedit.app.fields import ColorField, FloatField, TextureField, VectorField
+from matedit.app.fields import ColorField, FloatField, TextureField, VectorField, _spin
 from matedit.app.paths import absolute_of, reference_for
 from matedit.graph import nodes
 from matedit.graph.commands import SetLabel, SetSetting, SetValue
@@ -106,7 +105,10 @@ class InspectorPanel(QScrollArea):
             self.show_node(None)
             return
         touches = self.node_id in event.node_ids
-        if event.kind == ChangeKind.VALUE and touches:
+        if event.kind == ChangeKind.VALUE and touches and event.what == "setting":
+            self._rebuild_timer.start()  # e.g. a slider's range (ui_min, ui_max) changed
+            self._ports_key = None
+        elif event.kind == ChangeKind.VALUE and touches:
             self.refresh_values()
         elif event.kind == ChangeKind.STRUCTURAL and touches:
             self._rebuild_timer.start()
@@ -239,10 +241,8 @@ class InspectorPanel(QScrollArea):
             box.toggled.connect(lambda v, n=s.name: self._set_setting(n, bool(v)))
             return box
         if s.kind == "number":
-            spin = QDoubleSpinBox()
-            spin.setRange(-1e6, 1e6)
-            spin.setDecimals(3)
-            spin.setKeyboardTracking(False)
+            spin = _spin()
+            spin.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
             spin.setValue(float(cur or 0))
             spin.setToolTip(s.doc)
             as_int = isinstance(s.default, int)

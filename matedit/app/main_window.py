@@ -274,7 +274,7 @@ class MainWindow(QMainWindow):
         """The lights panel starts with the renderer's default lights once GL is up."""
         if self.viewport.view.renderer is not None and not self.lights.lights:
             self.lights.set_lights(self.viewport.view.lights)
-        elif self.viewport.view.renderer is None and self.isVisible():
+        elif self.viewport.view.renderer is None and not self.viewport.view.problem:
             QTimer.singleShot(200, self, self._sync_lights)
 
     # --- documents -------------------------------------------------------------------------

@@ -3,10 +3,8 @@
 from __future__ import annotations
 
 import copy
-import gc
 import hashlib
 import re
-from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -97,24 +95,10 @@ def structure_hash(vertex: str, fragment: str) -> str:
     return hashlib.sha256((vertex + "\0" + fragment).encode()).hexdigest()[:16]
 
 
-@contextmanager
-def _no_gc():
-    """Compiling allocates many small objects that all live until the end: the cyclic
-    collector's passes over them cost more than the compile itself on large graphs."""
-    was = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was:
-            gc.enable()
-
-
 def lower_and_optimise(doc: MaterialDocument, resolver: FunctionResolver | None) -> MaterialIR:
-    with _no_gc():
-        ir = lower_document(doc, resolver)
-        for scope in [*ir.functions, ir.main]:
-            optimise(scope)
+    ir = lower_document(doc, resolver)
+    for scope in [*ir.functions, ir.main]:
+        optimise(scope)
     return ir
 
 
@@ -130,9 +114,8 @@ def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = 
         resolver = FileResolver()
     ir = ir if ir is not None else lower_and_optimise(doc, resolver)
     t = TARGETS[target]
-    with _no_gc():
-        vert = vertex_source(t)
-        frag, smap = fragment_source(ir, t, mode)
+    vert = vertex_source(t)
+    frag, smap = fragment_source(ir, t, mode)
     return CompiledMaterial(target, vert, frag, smap, ir, structure_hash(vert.text, frag.text))
 
 

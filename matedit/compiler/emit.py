@@ -92,10 +92,19 @@ def _expr(e: Expr, names: _Names) -> str:
     raise TypeError(f"cannot emit {e!r}")
 
 
+_TEMPLATES: dict[tuple[str, str], list] = {}
+
+
 def _inline(template: str, op: Op, args: list[str]) -> str:
-    d = nodes.REGISTRY[op.kind]
-    values = {i.name: a for i, a in zip(d.inputs, args)}
-    return re.sub(r"\{(\w+)\}", lambda m: f"{values[m.group(1)]}", template)
+    """The template with `{input}` replaced by argument expressions (parsed once a kind)."""
+    key = (op.kind, template)
+    parts = _TEMPLATES.get(key)
+    if parts is None:
+        index = {i.name: k for k, i in enumerate(nodes.REGISTRY[op.kind].inputs)}
+        pieces = re.split(r"\{(\w+)\}", template)
+        parts = [p if k % 2 == 0 else index[p] for k, p in enumerate(pieces)]
+        _TEMPLATES[key] = parts
+    return "".join(p if isinstance(p, str) else args[p] for p in parts)
 
 
 def _op_line(op: Op, names: _Names) -> str:

@@ -112,7 +112,41 @@ def remove_unused(scope: Scope) -> None:
     scope.ops = list(reversed(kept))
 
 
+def fold_and_merge(scope: Scope) -> None:
+    """fold_constants then merge_common, in one walk over the ops (the same result)."""
+    from matedit.compiler import cpu_eval
+
+    table: dict[str, Expr] = {}
+    seen: dict[str, Op] = {}
+    kept: list[Op] = []
+    for op in scope.ops:
+        op.args = [_subst(a, table) for a in op.args]
+        if (op.kind not in IMPURE and op.args
+                and all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
+                and all(t.is_numeric for _, t in op.outs)):
+            try:
+                values = cpu_eval.eval_op(op, [_as_array(a) for a in op.args], None)
+            except Exception:  # no implementation, or it refused: keep the op
+                values = None
+            if values is not None:
+                lits = [_to_lit(v, t) for v, (_, t) in zip(values, op.outs)]
+                if all(l is not None for l in lits):
+                    for (port, _), lit in zip(op.outs, lits):
+                        table[op.out(port).name] = lit
+                    continue
+        k = op.key()
+        first = seen.get(k)
+        if first is not None and first.outs == op.outs:
+            for port, _ in op.outs:
+                table[op.out(port).name] = first.out(port)
+            continue
+        seen[k] = op
+        kept.append(op)
+    scope.ops = kept
+    scope.outputs = [(n, t, _subst(e, table)) for n, t, e in scope.outputs]
+    scope.sockets = {k: _subst(e, table) for k, e in scope.sockets.items()}
+
+
 def optimise(scope: Scope) -> None:
-    fold_constants(scope)
-    merge_common(scope)
+    fold_and_merge(scope)
     remove_unused(scope)

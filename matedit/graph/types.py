@@ -21,36 +21,25 @@ class PortType(str, Enum):
     def __str__(self) -> str:
         return self.value
 
+    # Looked up by value: a str hashes once and caches it, an Enum member hashes in Python.
     @property
     def components(self) -> int:
         """Number of float components (0 for the struct and textures)."""
-        return _COMPONENTS[self]
+        return _COMPONENTS[self._value_]
 
     @property
     def is_numeric(self) -> bool:
-        return self.components > 0
+        return _COMPONENTS[self._value_] > 0
 
     @property
     def glsl(self) -> str:
-        return _GLSL[self]
+        return _GLSL[self._value_]
 
 
-_COMPONENTS = {
-    PortType.FLOAT: 1,
-    PortType.VEC2: 2,
-    PortType.VEC3: 3,
-    PortType.VEC4: 4,
-    PortType.MATERIAL: 0,
-    PortType.TEXTURE: 0,
-}
-_GLSL = {
-    PortType.FLOAT: "float",
-    PortType.VEC2: "vec2",
-    PortType.VEC3: "vec3",
-    PortType.VEC4: "vec4",
-    PortType.MATERIAL: "MaterialAttributes",
-    PortType.TEXTURE: "sampler2D",
-}
+_COMPONENTS = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4, "MaterialAttributes": 0,
+               "texture2d": 0}
+_GLSL = {"float": "float", "vec2": "vec2", "vec3": "vec3", "vec4": "vec4",
+         "MaterialAttributes": "MaterialAttributes", "texture2d": "sampler2D"}
 VECTOR_BY_SIZE = {1: PortType.FLOAT, 2: PortType.VEC2, 3: PortType.VEC3, 4: PortType.VEC4}
 NUMERIC = (PortType.FLOAT, PortType.VEC2, PortType.VEC3, PortType.VEC4)
 

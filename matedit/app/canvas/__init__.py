@@ -34,11 +34,7 @@ F frame selection; Home or A frame all; C comment around selection; M minimap;
 wheel zoom; middle drag, Alt+drag or Space+drag pan.
 """
 
-from matedit.app.canvas._compat import guard_none_refcount
-
-guard_none_refcount()  # PySide6 6.12.0 on Python < 3.12: see _compat
-
-from matedit.app.canvas.scene import NodeScene  # noqa: E402
-from matedit.app.canvas.view import NodeCanvasView  # noqa: E402
+from matedit.app.canvas.scene import NodeScene
+from matedit.app.canvas.view import NodeCanvasView
 
 __all__ = ["NodeCanvasView", "NodeScene"]

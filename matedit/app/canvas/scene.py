@@ -10,6 +10,7 @@ drag, a comment resize) go back to the model as commands through the controller.
 
 from __future__ import annotations
 
+from html import escape
 from pathlib import Path
 
 from PySide6.QtCore import QLineF, QRectF, Qt, Signal
@@ -67,9 +68,9 @@ def describe(node: Node) -> tuple[str, str, str, str]:
                              if isinstance(e, dict))
     if node.label and not sub:
         sub = kind_title
-    tip = f"<b>{title}</b> &nbsp;<i>{node.kind}</i> &nbsp;id {node.id}"
+    tip = f"<b>{escape(title)}</b> &nbsp;<i>{node.kind}</i> &nbsp;id {node.id}"
     if d is not None:
-        tip += f"<br>{d.description}"
+        tip += f"<br>{escape(d.description)}"
     return title, sub, d.category if d else "", tip
 
 

@@ -1,0 +1,155 @@
+"""Start-up: `matedit validate FILE` as a subprocess, and the editor from launch to its first
+viewport frame under Xvfb.
+
+Run: .venv/bin/python benchmarks/bench_startup.py
+
+The editor offers no exit-after-first-frame hook, so the editor side is measured by a driver:
+this file, run as a child (`--editor-child`), does what `matedit.app.app.run()` does
+(make_application, MainWindow on the built-in sample, show, exec) and connects the viewport's
+`frameDrawn` signal; it prints the CLOCK_MONOTONIC time of the first frame and of the first
+frame drawn with the material's program, then quits. The parent reads the clock just before
+it starts the child, so the figure covers interpreter start, imports, window construction,
+GL and renderer start-up (IBL bake or cache load), compile, link, JIT and the first draw.
+One Xvfb server (xvfb-run) hosts all launches so that its own start-up is not counted; the
+editor gets a fresh HOME (settings, recovery files, IBL cache), and the first launch, which
+bakes the studio environment into the empty cache, is reported apart from the warm ones.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve()
+ROOT = HERE.parent.parent
+
+
+def matedit_command() -> list[str]:
+    script = Path(sys.executable).parent / "matedit"
+    return [str(script)] if script.exists() else [sys.executable, "-m", "matedit"]
+
+
+def validate_times(path: Path, repeat: int = 5) -> dict:
+    """Median wall time of `matedit validate path` (one unmeasured warm-up run first)."""
+    cmd = [*matedit_command(), "validate", str(path)]
+    subprocess.run(cmd, check=True, capture_output=True)
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        subprocess.run(cmd, check=True, capture_output=True)
+        times.append(time.perf_counter() - t)
+    return {"median": statistics.median(times), "all": times, "command": " ".join(cmd)}
+
+
+def editor_available() -> bool:
+    app = ROOT / "matedit" / "app" / "app.py"
+    return app.exists() and "def run(" in app.read_text()
+
+
+# -- the child: the editor with a first-frame probe ---------------------------------------------
+
+
+def editor_child(timeout_s: float = 90.0) -> int:
+    from PySide6.QtCore import QTimer
+
+    from matedit.app.app import make_application
+    from matedit.app.main_window import MainWindow
+
+    app = make_application()
+    window = MainWindow(None)
+    view = window.viewport.view
+    marks: dict[str, float] = {}
+
+    def on_frame() -> None:
+        now = time.monotonic()
+        marks.setdefault("first_frame", now)
+        renderer = view.renderer
+        if renderer is not None and getattr(renderer, "_program", None) is not None:
+            marks.setdefault("material_frame", now)
+            app.quit()
+
+    view.frameDrawn.connect(on_frame)
+    QTimer.singleShot(int(timeout_s * 1000), app.quit)
+    window.show()
+    marks["shown"] = time.monotonic()
+    app.exec()
+    marks["problem"] = view.problem  # type: ignore[assignment]
+    print("STARTUP " + json.dumps(marks), flush=True)
+    return 0
+
+
+# -- the launcher (runs under xvfb-run) ---------------------------------------------------------
+
+
+def launch_editor(repeat: int) -> int:
+    """Starts the editor child `repeat + 1` times (the first into an empty cache)."""
+    home = Path(tempfile.mkdtemp(prefix="matedit-bench-home-"))
+    env = dict(os.environ, HOME=str(home), XDG_CONFIG_HOME=str(home / ".config"),
+               XDG_DATA_HOME=str(home / ".local/share"), XDG_CACHE_HOME=str(home / ".cache"))
+    env.pop("MATEDIT_CACHE_DIR", None)
+    runs = []
+    try:
+        for _ in range(repeat + 1):
+            t0 = time.monotonic()
+            proc = subprocess.run([sys.executable, str(HERE), "--editor-child"], env=env,
+                                  capture_output=True, text=True, timeout=180, cwd=ROOT)
+            line = next((x for x in proc.stdout.splitlines() if x.startswith("STARTUP ")), None)
+            if line is None:
+                runs.append({"error": (proc.stderr or proc.stdout).strip()[-800:]})
+                continue
+            marks = json.loads(line[len("STARTUP "):])
+            runs.append({k: (v - t0 if isinstance(v, float) else v) for k, v in marks.items()})
+    finally:
+        shutil.rmtree(home, ignore_errors=True)
+    print("EDITOR " + json.dumps(runs), flush=True)
+    return 0
+
+
+def editor_times(repeat: int = 3) -> dict:
+    """Launch → first viewport frame with the material, under one xvfb-run server."""
+    if not editor_available():
+        return {"skipped": "matedit/app/app.py with run() not found"}
+    xvfb = shutil.which("xvfb-run")
+    if xvfb is None and not os.environ.get("DISPLAY"):
+        return {"skipped": "xvfb-run not found (apt-get install xvfb)"}
+    cmd = [sys.executable, str(HERE), "--launch-editor", str(repeat)]
+    if xvfb and not os.environ.get("DISPLAY"):
+        cmd = [xvfb, "-a", "-s", "-screen 0 1920x1080x24", *cmd]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900, cwd=ROOT)
+    line = next((x for x in proc.stdout.splitlines() if x.startswith("EDITOR ")), None)
+    if line is None:
+        return {"skipped": "editor launcher failed: " + (proc.stderr or proc.stdout)[-800:]}
+    runs = json.loads(line[len("EDITOR "):])
+    cold, warm = runs[0], runs[1:]
+    ok = [r for r in warm if "material_frame" in r]
+    result = {"cold": cold, "warm": warm, "runs": len(warm)}
+    if ok:
+        result["material_frame"] = statistics.median(r["material_frame"] for r in ok)
+        result["first_frame"] = statistics.median(r["first_frame"] for r in ok)
+        result["shown"] = statistics.median(r["shown"] for r in ok)
+    return result
+
+
+def main(argv: list[str]) -> int:
+    if argv[:1] == ["--editor-child"]:
+        return editor_child()
+    if argv[:1] == ["--launch-editor"]:
+        return launch_editor(int(argv[1]))
+    from matedit.resources import graphs_dir
+
+    v = validate_times(graphs_dir() / "materials" / "worn_painted_steel.json")
+    print(f"matedit validate worn_painted_steel.json: {v['median'] * 1000:.0f} ms (median of 5)")
+    e = editor_times()
+    print(json.dumps(e, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
