@@ -180,7 +180,8 @@ def test_settings_editors_and_texture_picker_push_commands(qtbot, tmp_path):
     settle(qtbot, w, 10)
     assert Path(w.controller.document.graph.nodes[tex].settings["path"]) == img.resolve()
     assert hits == []  # a texture file is a value edit
-    assert not field.thumb.pixmap().isNull()
+    field = w.inspector._fields[("setting", "path")]
+    assert field.thumb.toolTip() == str(img.resolve())  # the thumbnail shows the image
 
     w.inspector.show_node(c)
     title = w.inspector.widget().findChild(QLineEdit, "inspectorTitle")

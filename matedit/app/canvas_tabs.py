@@ -14,15 +14,11 @@ from PySide6.QtCore import QTimer, Signal
 from PySide6.QtGui import QUndoGroup
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QTabWidget, QVBoxLayout, QWidget
 
+from matedit.app.canvas import NodeCanvasView
 from matedit.app.controller import DocumentController
 from matedit.app.document_actions import DocumentActions, document_title
 from matedit.app.theme import icon
 from matedit.io.document import FormatError, load
-
-try:  # the real node canvas, when it is installed
-    from matedit.app.canvas import NodeCanvasView
-except ImportError:  # pragma: no cover - depends on the canvas having landed
-    from matedit.app.canvas_placeholder import PlaceholderCanvasView as NodeCanvasView
 
 
 @dataclass
@@ -192,10 +188,7 @@ class CanvasTabs(QWidget):
         tab = self.active
         self.undo_group.setActiveStack(tab.controller.undo_stack)
         self.activeChanged.emit(tab)
-        if hasattr(tab.canvas, "selected_ids"):
-            self.selectionChanged.emit(tab.canvas.selected_ids())
-        else:
-            self.selectionChanged.emit([])
+        self.selectionChanged.emit(tab.canvas.selected_ids())
 
     def _selection(self, ids: list) -> None:
         if self.sender() is self.active.canvas:

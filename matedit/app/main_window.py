@@ -334,8 +334,7 @@ class MainWindow(QMainWindow):
     def select_node(self, node_id: str) -> None:
         canvas = self.tabs.active.canvas
         canvas.select_nodes([node_id])
-        if hasattr(canvas, "frame_selection"):
-            canvas.frame_selection()
+        canvas.frame_selection()
         self.inspector.show_node(node_id)
         self.inspector_dock.show()
         self.inspector_dock.raise_()
@@ -350,7 +349,7 @@ class MainWindow(QMainWindow):
         self._canvas_call("open_palette")
 
     def _canvas_call(self, method: str):
-        """Calls a canvas method on the active tab (the placeholder canvas lacks some)."""
+        """Calls a canvas method on the active tab's canvas."""
         fn = getattr(self.tabs.active.canvas, method, None)
         return fn() if fn is not None else None
 
