@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from matedit.ibl import BakeSettings, load_environment
+from matedit.ibl.bake import PREFILTER_GROWTH
 from matedit.ibl.builtin import studio
 from matedit.ibl.cubemap import FACE_NAMES, equirect_directions, face_directions, faces_to_cross
 from matedit.ibl.gpu import Baker
@@ -117,7 +118,8 @@ def run_matedit(path: Path, out: Path, size: int, samples: int, lut_size: int) -
     with Baker() as baker:
         cube = baker.equirect_to_cube(env.equirect, size)
         mips = baker.prefilter(
-            cube, settings.levels, samples, settings.lod_bias, growth=4, max_growth=16
+            cube, settings.levels, samples, settings.lod_bias, growth=PREFILTER_GROWTH[0],
+            max_growth=PREFILTER_GROWTH[1],
         )
         t_prefilter = time.perf_counter()
         sh_irradiance(cube)
