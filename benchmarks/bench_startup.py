@@ -72,14 +72,16 @@ def editor_child(timeout_s: float = 90.0) -> int:
         marks.setdefault("first_frame", now)
         renderer = view.renderer
         if renderer is not None and getattr(renderer, "_program", None) is not None:
-            marks.setdefault("material_frame", now)
-            app.quit()
+            if "material_frame" not in marks:
+                marks["material_frame"] = now
+                QTimer.singleShot(0, app.quit)  # not from inside paintGL
 
     view.frameDrawn.connect(on_frame)
     QTimer.singleShot(int(timeout_s * 1000), app.quit)
+    marks["show"] = time.monotonic()  # the window is built; show() may paint at once
     window.show()
-    marks["shown"] = time.monotonic()
-    app.exec()
+    if "material_frame" not in marks:
+        app.exec()
     marks["problem"] = view.problem  # type: ignore[assignment]
     print("STARTUP " + json.dumps(marks), flush=True)
     return 0
@@ -133,7 +135,7 @@ def editor_times(repeat: int = 3) -> dict:
     if ok:
         result["material_frame"] = statistics.median(r["material_frame"] for r in ok)
         result["first_frame"] = statistics.median(r["first_frame"] for r in ok)
-        result["shown"] = statistics.median(r["shown"] for r in ok)
+        result["show"] = statistics.median(r["show"] for r in ok)
     return result
 
 

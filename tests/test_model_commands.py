@@ -198,3 +198,22 @@ def test_layer_stack_ports_follow_layers(tmp_path):
     assert names == ["a_tint", "b_tint", "b_opacity", "b_mask", "b_base_height", "b_contrast"]
     assert not [x for x in validate(d, FileResolver()) if x.severity.value == "error"
                 and x.node_id == "stack"]
+
+
+def test_changing_a_layer_blend_keeps_the_mask_link(tmp_path):
+    for n in ("a", "b"):
+        _layer(tmp_path, n)
+    d = simple_material(tmp_path / "m.json")
+    node(d, "stack", "layer_stack", {"layers": [{"id": "a", "function": "a.json"},
+                                                {"id": "b", "function": "b.json"}]})
+    node(d, "mask", "scalar_parameter", {"name": "mask"})
+    Connect(Link("mask", "value", "stack", "b_mask")).apply(d.graph)
+    Connect(Link("mask", "value", "stack", "b_tint")).apply(d.graph)  # float splats to vec3
+    stack = LayerStack(d.graph, "stack", FileResolver(), d)
+    stack.set("b", blend="height").apply(d.graph)
+    assert d.graph.incoming("stack", "b_mask") is not None  # alpha and height both have a mask
+    assert d.graph.incoming("stack", "b_tint") is not None
+    Connect(Link("mask", "value", "stack", "b_contrast")).apply(d.graph)
+    stack.set("b", blend="alpha").apply(d.graph)
+    assert d.graph.incoming("stack", "b_contrast") is None  # the height-only port is gone
+    assert d.graph.incoming("stack", "b_mask") is not None

@@ -240,7 +240,8 @@ class LayersPanel(QWidget):
     # --- model -----------------------------------------------------------------------------
     @property
     def stack(self) -> LayerStack | None:
-        return LayerStack.find(self.controller.document.graph)
+        return LayerStack.find(self.controller.document.graph, self.controller.resolver,
+                               self.controller.document)
 
     def layer_ids_top_first(self) -> list[str]:
         s = self.stack

@@ -31,16 +31,33 @@ class Layer:
 class LayerStack:
     """Layers of the `layer_stack` node `node_id`, bottom (base) first."""
 
-    def __init__(self, graph: MaterialGraph, node_id: str) -> None:
+    def __init__(self, graph: MaterialGraph, node_id: str, resolver=None, owner=None) -> None:
+        """With a function resolver (and the owning document), edits cut only the links into
+        ports that the edit removes; without one, every link into an edited layer's ports."""
         if graph.nodes.get(node_id) is None or graph.nodes[node_id].kind != "layer_stack":
             raise ValueError(f"{node_id!r} is not a layer_stack node")
         self.graph = graph
         self.node_id = node_id
+        self.resolver = resolver
+        self.owner = owner
 
     @classmethod
-    def find(cls, graph: MaterialGraph) -> LayerStack | None:
+    def find(cls, graph: MaterialGraph, resolver=None, owner=None) -> LayerStack | None:
         ids = sorted(n.id for n in graph.nodes.values() if n.kind == "layer_stack")
-        return cls(graph, ids[0]) if ids else None
+        return cls(graph, ids[0], resolver, owner) if ids else None
+
+    def _surviving_ports(self, entries: list[dict]) -> set[str] | None:
+        """Input port names after `entries` replace the layers, or None if unknown."""
+        if self.resolver is None:
+            return None
+        from matedit.graph.model import Node
+        from matedit.graph.ports import node_ports
+
+        trial = Node(self.node_id, "layer_stack", settings={"layers": entries})
+        try:
+            return {p.name for p in node_ports(trial, self.resolver, self.owner).inputs}
+        except (LookupError, ValueError):
+            return None
 
     @property
     def layers(self) -> list[Layer]:
@@ -55,9 +72,15 @@ class LayerStack:
 
     def _set(self, entries: list[dict], text: str, drop_ports_of=frozenset()) -> Command:
         cmds: list[Command] = []
+        surviving = self._surviving_ports(entries)
         for link in sorted(self.graph.links):
-            if link.dst == self.node_id and any(link.dst_port.startswith(f"{lid}_")
-                                                for lid in drop_ports_of):
+            if link.dst != self.node_id:
+                continue
+            if surviving is not None:
+                gone = link.dst_port not in surviving
+            else:
+                gone = any(link.dst_port.startswith(f"{lid}_") for lid in drop_ports_of)
+            if gone:
                 cmds.append(Disconnect(link))
         cmds.append(SetSetting(self.node_id, "layers", entries))
         return Macro(cmds, text=text)
