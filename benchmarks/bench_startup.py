@@ -48,6 +48,35 @@ def validate_times(path: Path, repeat: int = 5) -> dict:
     return {"median": statistics.median(times), "all": times, "command": " ".join(cmd)}
 
 
+IMPORTS_OF_INTEREST = ("matedit.commands", "matedit.commands.validate",
+                       "matedit.commands.compile", "matedit.commands.render",
+                       "matedit.commands.bake_ibl", "matedit.commands.brdf_lut",
+                       "matedit.graph.validate", "networkx", "numpy", "moderngl")
+
+
+def import_breakdown(path: Path) -> dict:
+    """One `python -X importtime -m matedit validate path`: the cumulative import time (ms)
+    of the top-level imports, and of a few packages wherever they are first imported."""
+    cmd = [sys.executable, "-X", "importtime", "-m", "matedit", "validate", str(path)]
+    t = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    top, named = 0.0, {}
+    for line in proc.stderr.splitlines():
+        if not line.startswith("import time:") or "|" not in line:
+            continue
+        _, cumulative, name = line.split("|")
+        if not cumulative.strip().isdigit():
+            continue
+        us = int(cumulative)
+        module = name.strip()
+        if not name[1:].startswith(" "):  # indentation 0: a top-level import
+            top += us
+        if module in IMPORTS_OF_INTEREST and module not in named:
+            named[module] = us / 1000
+    return {"wall_ms": wall * 1000, "imports_ms": top / 1000, "named_ms": named}
+
+
 def editor_available() -> bool:
     app = ROOT / "matedit" / "app" / "app.py"
     return app.exists() and "def run(" in app.read_text()

@@ -21,6 +21,7 @@ import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -36,6 +37,9 @@ OPTIONAL_BENCHES = (
     ("bench_editor.py", "Editor responsiveness"),
 )
 OPTIONAL_TIMEOUT_S = 240
+IMPORT_ROWS = ("matedit.commands", "matedit.commands.validate", "matedit.graph.validate",
+               "networkx", "matedit.commands.compile", "numpy", "matedit.commands.render",
+               "matedit.commands.bake_ibl")
 
 GOALS = {
     "structural_ms": 50.0,
@@ -125,11 +129,64 @@ def child_gl(quick: bool) -> dict:
     return out
 
 
-def child_gl_nopt(quick: bool) -> dict:
-    """The layered sample's structural edit and frame with llvmpipe's LLVM optimisation off
-    (GALLIVM_PERF=nopt, set by the parent): how much of the edit is the JIT's optimiser."""
+def _variant(cm, fragment_text: str, tag: str):
+    """`cm` with another fragment shader (and structure hash, so that it links anew)."""
+    import dataclasses
+
+    frag = dataclasses.replace(cm.fragment, text=fragment_text)
+    return dataclasses.replace(cm, fragment=frag, structure_hash=cm.structure_hash + tag)
+
+
+def child_jit(quick: bool) -> dict:
+    """Link + first frame of variants of the layered sample's program, under whatever
+    GALLIVM_PERF the parent set: the sample as compiled; the same with the reference-IBL
+    branch removed (what one program per IBL mode would give); the hand-written floor
+    (constant material, same lighting library)."""
     import moderngl
-    from bench_render import frame_time, structural_edit
+    from bench_render import floor_material, frame_time
+
+    from matedit.compiler import compile_document
+    from matedit.io.document import FileResolver, load
+    from matedit.render import Renderer
+    from matedit.resources import graphs_dir
+
+    ctx = moderngl.create_standalone_context(backend="egl")
+    r = Renderer(ctx, (512, 512))
+    r.render()
+    ctx.finish()
+    cm = compile_document(load(graphs_dir() / "materials" / "worn_painted_steel.json"),
+                          FileResolver())
+    branch = "if (mode == IBL_MODE_REFERENCE) {"
+    variants = {"worn_painted_steel": cm,
+                "worn_painted_steel, split-sum branch only": _variant(
+                    cm, cm.fragment_text.replace(branch, "if (false) {"), "-splitsum"),
+                "hand-written floor": floor_material()}
+    out = {"gallivm_perf": os.environ.get("GALLIVM_PERF", ""), "variants": []}
+    for name, material in variants.items():
+        rows = []
+        for _ in range(1 if quick else 3):
+            r._programs.clear()
+            t0 = time.perf_counter()
+            r.set_material(material)
+            ctx.finish()
+            t1 = time.perf_counter()
+            r.render()
+            ctx.finish()
+            t2 = time.perf_counter()
+            rows.append((t1 - t0, t2 - t1, t2 - t0))
+        rows.sort(key=lambda x: x[2])
+        link, first, total = rows[len(rows) // 2]
+        out["variants"].append({"name": name, "link": link, "first_frame": first,
+                                "total": total, "frame": frame_time(r, ctx, frames=3),
+                                "fragment_chars": len(material.fragment_text)})
+    r.release()
+    return out
+
+
+def child_edit_loop(quick: bool) -> dict:
+    """Structural edits of the layered sample, for py-spy to sample."""
+    import moderngl
+    from bench_render import structural_edit
 
     from matedit.io.document import load
     from matedit.render import Renderer
@@ -140,11 +197,47 @@ def child_gl_nopt(quick: bool) -> dict:
     r.render()
     ctx.finish()
     doc = load(graphs_dir() / "materials" / "worn_painted_steel.json")
-    c, li, f, tot = structural_edit(r, ctx, doc, repeat=1 if quick else 3)
-    frame = frame_time(r, ctx, frames=3 if quick else 5)
+    structural_edit(r, ctx, doc, repeat=3 if quick else 5)
     r.release()
-    return {"gallivm_perf": os.environ.get("GALLIVM_PERF", ""), "compile": c, "link": li,
-            "first_frame": f, "total": tot, "frame": frame}
+    return {}
+
+
+NATIVE_BUCKETS = (
+    ("matedit compile (Python)", lambda s: "compile_document" in s),
+    ("GL link: Mesa's GLSL compiler (set_material)", lambda s: "set_material" in s),
+    ("first draw: LLVM JIT (libLLVM)", lambda s: "Renderer.render" in s and "libLLVM" in s),
+    ("first draw: resolve/copy, waiting for the raster threads",
+     lambda s: "copy_framebuffer" in s or "Context.finish" in s),
+    ("first draw: Mesa draw setup, other", lambda s: "Renderer.render" in s),
+)
+
+
+def native_profile(quick: bool) -> dict:
+    """py-spy --native over `--child edit-loop`: shares of the structural edits' samples on
+    the main thread (llvmpipe's raster threads are not Python threads and are not seen)."""
+    pyspy = shutil.which("py-spy") or str(Path(sys.executable).parent / "py-spy")
+    if not Path(pyspy).exists():
+        return {"error": "py-spy not installed (pip install py-spy)"}
+    raw = Path(tempfile.mkdtemp(prefix="matedit-pyspy-")) / "edit.raw"
+    cmd = [pyspy, "record", "--native", "-r", "100", "-f", "raw", "-o", str(raw), "--",
+           sys.executable, str(Path(__file__).resolve()), "--child", "edit-loop"]
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=240, cwd=ROOT)
+    except subprocess.TimeoutExpired:
+        return {"error": "py-spy timed out"}
+    if not raw.exists():
+        return {"error": f"py-spy failed: {(proc.stderr or proc.stdout)[-600:]}"}
+    counts = dict.fromkeys([b[0] for b in NATIVE_BUCKETS] + ["other"], 0)
+    total = 0
+    for line in raw.read_text().splitlines():
+        stack, _, n = line.rpartition(" ")
+        if "structural_edit" not in stack or not n.isdigit():
+            continue
+        total += int(n)
+        name = next((b[0] for b in NATIVE_BUCKETS if b[1](stack)), "other")
+        counts[name] += int(n)
+    shutil.rmtree(raw.parent, ignore_errors=True)
+    return {"samples": total, "shares": {k: v / max(total, 1) for k, v in counts.items()}}
 
 
 def child_compile(quick: bool) -> dict:
@@ -176,9 +269,10 @@ def child_ibl(quick: bool) -> dict:
 
 
 def child_profile(quick: bool) -> dict:
-    """pyinstrument over one structural edit of the layered sample: where the Python time
-    goes, and how much is spent inside the GL calls (llvmpipe)."""
+    """pyinstrument over one structural edit of the layered sample (where the Python time
+    goes, and how much is inside the GL calls), and over compiles of the 1,000-node graph."""
     import moderngl
+    from common import synthetic_material
     from pyinstrument import Profiler
 
     from matedit.compiler import compile_document
@@ -186,6 +280,7 @@ def child_profile(quick: bool) -> dict:
     from matedit.render import Renderer
     from matedit.resources import graphs_dir
 
+    options = {"filter_threshold": 0.02}
     ctx = moderngl.create_standalone_context(backend="egl")
     r = Renderer(ctx, (512, 512))
     r.render()
@@ -199,13 +294,21 @@ def child_profile(quick: bool) -> dict:
     r.render()
     ctx.finish()
     profiler.stop()
-    text = profiler.output_text(unicode=False, color=False, show_all=False)
+    edit = profiler.output_text(processor_options=options)
     r.release()
-    return {"text": text}
+
+    big = synthetic_material(1000)
+    compile_document(big, FileResolver())
+    profiler = Profiler(interval=0.0005)
+    profiler.start()
+    for _ in range(10):
+        compile_document(big, FileResolver())
+    profiler.stop()
+    return {"edit": edit, "compile": profiler.output_text(processor_options=options)}
 
 
-CHILDREN = {"gl": child_gl, "gl-nopt": child_gl_nopt, "compile": child_compile,
-            "ibl": child_ibl, "profile": child_profile}
+CHILDREN = {"gl": child_gl, "jit": child_jit, "edit-loop": child_edit_loop,
+            "compile": child_compile, "ibl": child_ibl, "profile": child_profile}
 
 
 def run_child(name: str, quick: bool, timeout: float, env: dict | None = None) -> dict:
@@ -467,6 +570,14 @@ def startup_section(rep: Report, st: dict, goals: list) -> None:
                     ", ".join(ms(x) for x in v["all"])]])
         goals.append(["`matedit validate` one file", "< 0.3 s", f"{v['median']:.2f} s",
                       verdict(v["median"] * 1000 < GOALS["validate_ms"])])
+        imp = st.get("imports")
+        if imp:
+            named = imp["named_ms"]
+            parts = ", ".join(f"`{k}` {named[k]:.0f}" for k in IMPORT_ROWS if k in named)
+            rep.add(f"Where it goes (`python -X importtime -m matedit validate`, one run of "
+                    f"{imp['wall_ms']:.0f} ms): top-level imports {imp['imports_ms']:.0f} ms; "
+                    f"cumulative ms, each counted where first imported: {parts}.")
+            rep.add()
     elif v:
         rep.add(f"`matedit validate` not measured: {v['error']}")
         rep.add()
@@ -537,13 +648,20 @@ def optional_section(rep: Report, opt: dict) -> None:
         rep.add()
 
 
+def load_average() -> str:
+    try:
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+    except OSError:
+        return "?"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--child", choices=sorted(CHILDREN))
     parser.add_argument("--quick", action="store_true", help="fewer repetitions, smaller IBL")
     parser.add_argument("--out", default=str(HERE / "RESULTS.md"))
     parser.add_argument("--skip", default="", help="comma-separated sections to skip: "
-                        "gl,gl-nopt,compile,ibl,profile,startup,optional")
+                        "gl,jit,compile,ibl,profile,native,startup,optional")
     args = parser.parse_args(argv)
     if args.child:
         result = CHILDREN[args.child](args.quick)
@@ -553,17 +671,25 @@ def main(argv=None) -> int:
     skip = set(filter(None, args.skip.split(",")))
     started = time.perf_counter()
     when = datetime.datetime.now().astimezone()
+    load_before = load_average()
     results: dict = {}
-    budget = {"gl": 600, "gl-nopt": 120, "compile": 240, "ibl": 400, "profile": 120}
-    for name in ("gl", "gl-nopt", "compile", "ibl", "profile"):
-        if name in skip:
-            results[name] = {"error": "skipped (--skip)"}
+    plan = [("gl", "gl", 660, None), ("jit", "jit", 120, None),
+            ("jit-nopt", "jit", 120, {"GALLIVM_PERF": "nopt"}),
+            ("compile", "compile", 240, None), ("ibl", "ibl", 420, None),
+            ("profile", "profile", 120, None)]
+    for key, child, timeout, env in plan:
+        if child in skip:
+            results[key] = {"error": "skipped (--skip)"}
             continue
-        print(f"[run_all] {name} …", file=sys.stderr, flush=True)
-        env = {"GALLIVM_PERF": "nopt"} if name == "gl-nopt" else None
-        results[name] = run_child(name, args.quick, budget[name], env)
-        print(f"[run_all] {name}: {results[name].get('wall', 0):.0f} s", file=sys.stderr,
+        print(f"[run_all] {key} …", file=sys.stderr, flush=True)
+        results[key] = run_child(child, args.quick, timeout, env)
+        print(f"[run_all] {key}: {results[key].get('wall', 0):.0f} s", file=sys.stderr,
               flush=True)
+    if "native" in skip:
+        results["native"] = {"error": "skipped (--skip)"}
+    else:
+        print("[run_all] native profile …", file=sys.stderr, flush=True)
+        results["native"] = native_profile(args.quick)
     startup: dict = {}
     if "startup" not in skip:
         import bench_startup
@@ -572,9 +698,10 @@ def main(argv=None) -> int:
 
         print("[run_all] startup …", file=sys.stderr, flush=True)
         t0 = time.perf_counter()
+        sample = graphs_dir() / "materials" / "worn_painted_steel.json"
         try:
-            startup["validate"] = bench_startup.validate_times(
-                graphs_dir() / "materials" / "worn_painted_steel.json")
+            startup["validate"] = bench_startup.validate_times(sample)
+            startup["imports"] = bench_startup.import_breakdown(sample)
         except (subprocess.CalledProcessError, OSError) as exc:
             startup["validate"] = {"error": str(exc)}
         try:
@@ -585,6 +712,7 @@ def main(argv=None) -> int:
     optional: dict = {}
     if "optional" not in skip:
         for script, _ in OPTIONAL_BENCHES:
+            print(f"[run_all] {script} …", file=sys.stderr, flush=True)
             optional[script] = run_optional(script, OPTIONAL_TIMEOUT_S)
     total = time.perf_counter() - started
 
@@ -594,12 +722,18 @@ def main(argv=None) -> int:
         ["python", "benchmarks/run_all.py", *(argv if argv is not None else sys.argv[1:])])
     rep.add("# matedit benchmark results")
     rep.add()
+    rep.add("Written by `benchmarks/run_all.py`; every figure below comes from the run "
+            "described here (medians; ratios of figures measured side by side in this run).")
+    rep.add()
     rep.add(f"- Date: {when:%Y-%m-%d %H:%M %Z}")
-    rep.add(f"- Machine: {platform.node()}, {os.cpu_count()} cores, "
-            f"{platform.platform()}, Python {platform.python_version()}")
-    rep.add(f"- GL: {gl.get('gl_renderer', '?')} ({gl.get('gl_version', '?')}), headless EGL; "
-            f"MESA_SHADER_CACHE_DISABLE={os.environ.get('MESA_SHADER_CACHE_DISABLE')}")
-    rep.add(f"- Command: `{command}`" + (" (quick mode)" if args.quick else ""))
+    rep.add(f"- Machine: {os.cpu_count()} cores, {platform.platform()}, "
+            f"Python {platform.python_version()}; load average before / after the run: "
+            f"{load_before} / {load_average()} (other work on the machine shows up as noise)")
+    rep.add(f"- GL: {gl.get('gl_renderer', '?')}, {gl.get('gl_version', '?')}, headless EGL "
+            f"through moderngl; MESA_SHADER_CACHE_DISABLE="
+            f"{os.environ.get('MESA_SHADER_CACHE_DISABLE')}")
+    rep.add(f"- Command: `{command}`" + (" (quick mode: fewer repetitions)" if args.quick
+                                         else ""))
     rep.add(f"- Wall time of the whole run: {total / 60:.1f} min")
     rep.add()
     goals: list = []
@@ -608,13 +742,14 @@ def main(argv=None) -> int:
     frame_section(rep, gl, goals)
     compile_section(rep, results["compile"], goals)
     ibl_section(rep, results["ibl"], goals)
-    startup_section(rep, startup, goals) if startup else None
-    optional_section(rep, optional) if optional else None
-    nopt = results["gl-nopt"]
-    extra_sections(rep, gl, nopt, results["profile"])
+    if startup:
+        startup_section(rep, startup, goals)
+    if optional:
+        optional_section(rep, optional)
     rep.add("## Goals")
     rep.add()
     rep.table(["goal", "target", "measured", "verdict"], "llll", goals)
+    profile_sections(rep, gl, results)
     notes = HERE / "RESULTS_NOTES.md"
     if notes.exists():
         rep.add(notes.read_text().rstrip())
@@ -624,40 +759,59 @@ def main(argv=None) -> int:
     return 0
 
 
-def extra_sections(rep: Report, gl: dict, nopt: dict, prof: dict) -> None:
-    rep.add("## Where a structural edit's time goes")
+def _tree(text: str, limit: int = 60) -> str:
+    lines = [x for x in text.splitlines() if x.strip()]
+    body = [x for x in lines if not x.lstrip().startswith(("_", "/", "Recorded", "Program"))]
+    return "\n".join(body[:limit])
+
+
+def profile_sections(rep: Report, gl: dict, results: dict) -> None:
+    rep.add("## Profiles: where the time goes")
     rep.add()
-    layered = next((r for r in gl.get("structural", []) if r["sample"] == "worn_painted_steel"),
-                   None)
-    if layered and "error" not in nopt:
-        jit = layered["first_frame"] - layered["steady_frame"]
-        rep.add(f"`worn_painted_steel`: compile {ms(layered['compile'], 1)} ms, GL link "
-                f"{ms(layered['link'])} ms, first frame {ms(layered['first_frame'])} ms of "
-                f"which about {ms(jit)} ms is more than a steady frame "
-                f"({ms(layered['steady_frame'])} ms): llvmpipe compiles the fragment shader's "
-                "LLVM IR to machine code when the program is first drawn.")
+    rep.add("### Structural edit on llvmpipe")
+    rep.add()
+    native = results.get("native", {})
+    if "shares" in native:
+        rep.add(f"py-spy `--native` over structural edits of `worn_painted_steel` "
+                f"({native['samples']} samples of the main thread, 100 Hz; shares, since "
+                "sampling slows the process):")
         rep.add()
-        rep.add("The same edit with llvmpipe's LLVM optimisation passes turned off "
-                "(`GALLIVM_PERF=nopt`, a child process):")
+        rep.table(["where", "share"], "lr",
+                  [[k, f"{v * 100:.0f} %"] for k, v in native["shares"].items()])
+    elif "error" in native:
+        rep.add(f"py-spy profile not taken: {native['error']}")
         rep.add()
-        rep.table(["GALLIVM_PERF", "compile (ms)", "link (ms)", "first frame (ms)",
-                   "total (ms)", "steady frame (ms)"], "lrrrrr",
-                  [["(default)", ms(layered["compile"], 1), ms(layered["link"]),
-                    ms(layered["first_frame"]), ms(layered["total"]),
-                    ms(layered["steady_frame"])],
-                   ["nopt", ms(nopt["compile"], 1), ms(nopt["link"]), ms(nopt["first_frame"]),
-                    ms(nopt["total"]), ms(nopt["frame"])]])
-    if "text" in prof:
-        rep.add("pyinstrument over one structural edit of `worn_painted_steel` (Python view; "
-                "time inside `render`/`finish` is llvmpipe's native JIT and rasterisation):")
+    jit, nopt = results.get("jit", {}), results.get("jit-nopt", {})
+    if "variants" in jit:
+        rep.add("Link and first frame of variants of the same program (median of 3 each, "
+                "512²), with llvmpipe's LLVM optimisation passes on (default) and off "
+                "(`GALLIVM_PERF=nopt`); *split-sum branch only* removes the reference-IBL "
+                "loop from the fragment shader text (what linking one program per IBL mode "
+                "would give); the floor is constant material inputs with the same lighting:")
         rep.add()
-        rep.add("```")
-        text = "\n".join(x for x in prof["text"].splitlines() if x.strip())
-        rep.add(text[:6000])
-        rep.add("```")
-        rep.add()
-    elif "error" in prof:
-        rep.add(f"Profile not taken: {prof['error'][:400]}")
+        rows = []
+        for label, res in (("default", jit), ("nopt", nopt)):
+            for v in res.get("variants", []):
+                rows.append([v["name"], label, f"{v['fragment_chars']:,}", ms(v["link"]),
+                             ms(v["first_frame"]), f"**{ms(v['total'])}**", ms(v["frame"])])
+        rep.table(["program", "GALLIVM_PERF", "fragment chars", "link (ms)",
+                   "first frame (ms)", "link + first frame (ms)", "next frame (ms)"],
+                  "llrrrrr", rows)
+    prof = results.get("profile", {})
+    for key, title in (("edit", "pyinstrument over one structural edit of "
+                                "`worn_painted_steel` (Python's view: time inside moderngl's "
+                                "`render`/`copy_framebuffer` is llvmpipe)"),
+                       ("compile", "pyinstrument over 10 compiles of the 1,000-node synthetic "
+                                   "graph")):
+        if key in prof:
+            rep.add(title + ":")
+            rep.add()
+            rep.add("```")
+            rep.add(_tree(prof[key]))
+            rep.add("```")
+            rep.add()
+    if "error" in prof:
+        rep.add(f"pyinstrument profiles not taken: {prof['error'][:400]}")
         rep.add()
 
 

@@ -16,6 +16,7 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QTabWidget, QVBo
 
 from matedit.app.canvas import NodeCanvasView
 from matedit.app.controller import DocumentController
+from matedit.app.previews import NodePreviews
 from matedit.app.document_actions import DocumentActions, document_title
 from matedit.app.theme import icon
 from matedit.io.document import FormatError, load
@@ -28,6 +29,7 @@ class CanvasTab:
     actions: DocumentActions
     parent: CanvasTab | None = None
     children: list[CanvasTab] = field(default_factory=list)
+    previews: NodePreviews | None = None  # node thumbnails (material tabs)
 
     @property
     def is_function(self) -> bool:
@@ -75,6 +77,8 @@ class CanvasTabs(QWidget):
              parent: CanvasTab | None) -> CanvasTab:
         canvas = NodeCanvasView(controller, self)
         tab = CanvasTab(controller, canvas, actions, parent)
+        if not controller.document.is_function:
+            tab.previews = NodePreviews(controller, canvas, self)
         if parent is not None:
             parent.children.append(tab)
         self._tabs.append(tab)

@@ -33,10 +33,10 @@ def absolute_of(doc: MaterialDocument, ref: str) -> Path | None:
 def relativise_references(doc: MaterialDocument, new_path: Path) -> None:
     """Absolute references (made while the document was unsaved) become relative to the
     file it is about to be saved as. Called just before the first save."""
-    from matedit.io.document import _ref_fields
+    from matedit.io.document import reference_fields
 
     base = Path(new_path).resolve().parent
-    for container, key in _ref_fields(doc):
+    for container, key in reference_fields(doc):
         ref = container[key]
         if isinstance(ref, str) and ref and Path(ref).is_absolute():
             try:

@@ -208,8 +208,8 @@ def dumps(doc: MaterialDocument) -> str:
 
 # --- relative references ---------------------------------------------------------------------
 
-def _ref_fields(doc: MaterialDocument):
-    """(node, container, key) for every stored file reference, for rebasing on save-as."""
+def reference_fields(doc: MaterialDocument):
+    """(container, key) for every stored file reference (functions, layers, textures)."""
     for n in doc.graph.nodes.values():
         if n.kind == "function_call" and isinstance(n.settings.get("function"), str):
             yield n.settings, "function"
@@ -232,7 +232,7 @@ def rebase_references(doc: MaterialDocument, new_path: Path) -> None:
     new_dir = Path(new_path).resolve().parent
     if old_dir == new_dir:
         return
-    for container, key in _ref_fields(doc):
+    for container, key in reference_fields(doc):
         ref = container[key]
         if not ref or Path(ref).is_absolute():
             continue

@@ -1,0 +1,134 @@
+"""Live preview thumbnails on canvas nodes, from the CPU evaluator.
+
+After each edit settles, the material is lowered (not optimised, so every socket
+exists) and evaluated with numpy on a small preview sphere, so that masks built
+from normals and positions read as well as those built from UVs; each shown
+node's first float, vector or MaterialAttributes output becomes a thumbnail:
+floats as grey, vectors as colour, MaterialAttributes as their base colour, all
+display-encoded (sRGB). Thumbnails show on pattern nodes (noise, checker,
+gradient, textures, function calls, layer stacks) and on the selected nodes, so
+they do not crowd the graph; large graphs skip them: previews never slow editing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QObject, QTimer
+from PySide6.QtGui import QImage
+
+from matedit.compiler.cpu_eval import evaluate
+from matedit.compiler.cpu_nodes import SurfaceArrays
+from matedit.compiler.lower import CompileError, lower_document
+from matedit.graph.types import PortType
+
+SIZE = 48
+MAX_NODES = 400
+# Kinds whose output is the same everywhere, or not an image: no thumbnail.
+SKIP = {"constant", "scalar_parameter", "vector_parameter", "color_parameter",
+        "texture_parameter", "material_output", "reroute", "time", "function_output"}
+# Kinds that show a thumbnail without being selected.
+ALWAYS = {"value_noise", "checker", "gradient", "texture_sample", "function_call",
+          "layer_stack", "make_attributes", "layer_blend", "height_blend"}
+BACKGROUND = np.array([0.035, 0.04, 0.05])  # linear; matches the node body once encoded
+
+
+def preview_sphere(size: int = SIZE) -> tuple[SurfaceArrays, np.ndarray]:
+    """A unit sphere seen head-on from +Z, as the mesh preview's UVs lay it out; and the mask
+    of pixels that see it (top row first)."""
+    t = (np.arange(size) + 0.5) / size * 2 - 1
+    x, y = np.meshgrid(t, -t)
+    r2 = x * x + y * y
+    inside = (r2 < 1.0).ravel()
+    z = np.sqrt(np.clip(1 - r2, 0, 1))
+    n = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+    # the preview UV sphere: u around +Y from +X, v from the south pole up
+    u = (np.arctan2(-n[:, 2], n[:, 0]) / (2 * np.pi)) % 1.0
+    v = 1.0 - np.arccos(np.clip(n[:, 1], -1, 1)) / np.pi
+    view = np.tile([0.0, 0.0, 1.0], (len(n), 1))
+    return SurfaceArrays(np.stack([u, v], axis=1), n.copy(), n, view, 0.0), inside
+
+
+def to_image(value, inside: np.ndarray | None = None, size: int = SIZE) -> QImage | None:
+    if isinstance(value, dict):
+        value = value.get("baseColor")
+    if value is None:
+        return None
+    a = np.asarray(value, dtype=np.float64)
+    if a.ndim == 1:
+        rgb = np.repeat(a[:, None], 3, axis=1)
+    elif a.shape[1] == 2:
+        rgb = np.concatenate([a, np.zeros((len(a), 1))], axis=1)
+    else:
+        rgb = a[:, :3]
+    rgb = np.clip(np.nan_to_num(rgb), 0.0, 1.0)
+    if inside is not None:
+        rgb = np.where(inside[:, None], rgb, BACKGROUND)
+    srgb = np.where(rgb <= 0.0031308, 12.92 * rgb, 1.055 * rgb ** (1 / 2.4) - 0.055)
+    pixels = np.ascontiguousarray((srgb * 255 + 0.5).astype(np.uint8).reshape(size, size, 3))
+    img = QImage(pixels.data, size, size, 3 * size, QImage.Format.Format_RGB888)
+    return img.copy()  # own the pixels
+
+
+class NodePreviews(QObject):
+    """Keeps the thumbnails of one material canvas up to date."""
+
+    def __init__(self, controller, canvas, parent=None) -> None:
+        super().__init__(parent)
+        self.controller = controller
+        self.canvas = canvas
+        self.enabled = True
+        self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
+        self._timer.setInterval(120)
+        self._timer.timeout.connect(self.refresh)
+        controller.structureChanged.connect(self._timer.start)
+        controller.valuesChanged.connect(self._timer.start)
+        controller.documentReplaced.connect(self._timer.start)
+        canvas.selectionChangedIds.connect(self._selected)
+        self._selection: set[str] = set()
+        self._shown: set[str] = set()
+        self._timer.start()
+
+    def images(self) -> dict[str, QImage]:
+        doc = self.controller.document
+        if doc.is_function or len(doc.graph.nodes) > MAX_NODES:
+            return {}
+        try:
+            ir = lower_document(doc, self.controller.resolver)
+            probe: dict = {}
+            surface, inside = preview_sphere()
+            evaluate(ir, surface, probe=probe)
+        except (CompileError, LookupError, ValueError, KeyError, TypeError,
+                FloatingPointError):
+            return {}
+        out: dict[str, QImage] = {}
+        for nid, node in doc.graph.nodes.items():
+            if node.kind in SKIP or (node.kind not in ALWAYS and nid not in self._selection):
+                continue
+            for port, t in self._outputs(nid):
+                if t.is_numeric or t == PortType.MATERIAL:
+                    value = probe.get(f"{nid}.{port}")
+                    if value is not None:
+                        img = to_image(value, inside)
+                        if img is not None:
+                            out[nid] = img
+                    break
+        return out
+
+    def _outputs(self, nid: str):
+        a = self.controller.analysis
+        if a is None or nid not in a.out_types:
+            return []
+        return list(a.out_types[nid].items())
+
+    def _selected(self, ids: list) -> None:
+        self._selection = set(ids)
+        self._timer.start()
+
+    def refresh(self) -> None:
+        images = self.images() if self.enabled else {}
+        for nid in self._shown - set(images):
+            self.canvas.set_node_preview(nid, None)
+        for nid, img in images.items():
+            self.canvas.set_node_preview(nid, img)
+        self._shown = set(images)
