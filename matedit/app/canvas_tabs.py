@@ -16,8 +16,8 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QTabWidget, QVBo
 
 from matedit.app.canvas import NodeCanvasView
 from matedit.app.controller import DocumentController
-from matedit.app.previews import NodePreviews
 from matedit.app.document_actions import DocumentActions, document_title
+from matedit.app.previews import NodePreviews
 from matedit.app.theme import icon
 from matedit.io.document import FormatError, load
 
