@@ -22,20 +22,21 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
     // Karis 2013, "Real Shading in Unreal Engine 4", image-based lighting (eq 6-8, reference)
     int mode = int(uIbl.params.w + 0.5);
     if (mode == IBL_MODE_NONE) return vec3(0.0);
-    vec3 color;
+#ifndef MATEDIT_SPLIT_SUM_ONLY
+    // The reference estimator is a large loop; the preview's split-sum programs leave it out.
     if (mode == IBL_MODE_REFERENCE) {
         uint count = uint(max(uIbl.params.z, 1.0));
-        color = referenceIBL(uEnvironment, diffuseColor, F0, roughness, N, V, count,
-                             uIbl.sampleOffset.xy);
-    } else {
-        vec3 sh[9];
-        for (int i = 0; i < 9; i++) sh[i] = uIbl.sh[i].xyz;
-        float NoV = saturate(dot(N, V));
-        vec3 R = reflect(-V, N);
-        vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
-        vec2 AB = environmentBRDF(uBrdfLut, NoV, roughness);
-        color = diffuseIrradianceSH9(sh, N, diffuseColor) + splitSumSpecular(prefiltered, AB, F0);
+        return referenceIBL(uEnvironment, diffuseColor, F0, roughness, N, V, count,
+                            uIbl.sampleOffset.xy) * uIbl.params.y;
     }
+#endif
+    vec3 sh[9];
+    for (int i = 0; i < 9; i++) sh[i] = uIbl.sh[i].xyz;
+    float NoV = saturate(dot(N, V));
+    vec3 R = reflect(-V, N);
+    vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
+    vec2 AB = environmentBRDF(uBrdfLut, NoV, roughness);
+    vec3 color = diffuseIrradianceSH9(sh, N, diffuseColor) + splitSumSpecular(prefiltered, AB, F0);
     return color * uIbl.params.y;
 }
 

@@ -17,15 +17,65 @@ def _private_cache(tmp_path_factory):
     yield
 
 
+def _release_egl_thread() -> None:
+    """Unbinds this thread from EGL. While a thread has an EGL context current, GLVND refuses
+    it a GLX one, so Qt's QOpenGLWidget (GLX under Xvfb) could not start in a later test."""
+    import ctypes
+    import ctypes.util
+
+    name = ctypes.util.find_library("EGL") or "libEGL.so.1"
+    try:
+        ctypes.CDLL(name).eglReleaseThread()
+    except (OSError, AttributeError):  # pragma: no cover - no EGL at all
+        pass
+
+
+def _release_qt_gl() -> None:
+    """Makes Qt's current OpenGL context (GLX) not current, so that EGL can be made current:
+    GLVND binds a thread to one window-system API at a time, and a refused eglMakeCurrent
+    would leave GL calls going to Qt's context."""
+    import sys
+
+    if "PySide6.QtGui" not in sys.modules:
+        return
+    from PySide6.QtGui import QOpenGLContext
+
+    current = QOpenGLContext.currentContext()
+    if current is not None:
+        current.doneCurrent()
+
+
+_SESSION_GL: dict = {}
+
+
+@pytest.fixture(autouse=True)
+def _thread_free_of_egl_for_qt(request):
+    """GUI tests get a thread with no EGL context current (Qt's viewport needs GLX there);
+    afterwards the headless context is made current again for the GL tests that follow."""
+    if "qtbot" not in request.fixturenames:
+        yield
+        return
+    _release_egl_thread()
+    yield
+    _release_qt_gl()
+    ctx = _SESSION_GL.get("ctx")
+    if ctx is not None:
+        ctx.__enter__()
+
+
 @pytest.fixture(scope="session")
 def gl_ctx():
     moderngl = pytest.importorskip("moderngl")
+    _release_qt_gl()
     try:
         ctx = moderngl.create_standalone_context(require=330, backend="egl")
     except Exception as exc:  # pragma: no cover - depends on the machine
         pytest.fail(f"cannot create a headless EGL context: {exc}")
+    _SESSION_GL["ctx"] = ctx
     yield ctx
+    _SESSION_GL.clear()
     ctx.release()
+    _release_egl_thread()
 
 
 @pytest.fixture

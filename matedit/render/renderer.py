@@ -96,7 +96,7 @@ class Renderer:
         self.link_count = 0
         self.difference_mean: float | None = None
         self.bake_settings = bake_settings
-        self._programs: dict[str, moderngl.Program] = {}
+        self._programs: dict[tuple[str, str], moderngl.Program] = {}  # (hash, variant)
         self._compiled: CompiledMaterial | None = None
         self._program: moderngl.Program | None = None
         self._values: dict[str, Any] = {}
@@ -145,14 +145,7 @@ class Renderer:
         if (width, height) == self._size:
             return
         self._size = (width, height)
-        for name in ("_msaa_fbo", "_resolve_fbo", "_accum_fbo", "_split_fbo"):
-            fbo = getattr(self, name, None)
-            if fbo is not None:
-                for a in fbo.color_attachments:
-                    a.release()
-                if fbo.depth_attachment is not None:
-                    fbo.depth_attachment.release()
-                fbo.release()
+        self._release_targets()
         ctx = self.ctx
         s = self.samples
         self._msaa_fbo = ctx.framebuffer(
@@ -163,6 +156,23 @@ class Renderer:
         self._split_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
         self._out_fbo = None
         self.reset_accumulation()
+
+    def _release_targets(self) -> None:
+        """Releases the internal render targets. Framebuffer 0 is bound first: moderngl would
+        otherwise bind a released framebuffer again later (GL_INVALID_OPERATION)."""
+        if any(getattr(self, n, None) is not None for n in self._TARGETS):
+            self.ctx.detect_framebuffer(0).use()
+        for name in self._TARGETS:
+            fbo = getattr(self, name, None)
+            if fbo is not None:
+                for a in fbo.color_attachments:
+                    a.release()
+                if fbo.depth_attachment is not None:
+                    fbo.depth_attachment.release()
+                fbo.release()
+                setattr(self, name, None)
+
+    _TARGETS = ("_msaa_fbo", "_resolve_fbo", "_accum_fbo", "_split_fbo", "_out_fbo")
 
     def reset_accumulation(self) -> None:
         self._accum_frames = 0
@@ -207,13 +217,36 @@ class Renderer:
         self.reset_accumulation()
 
     # --- material -------------------------------------------------------------------------
+    def _link(self, compiled: CompiledMaterial, variant: str) -> moderngl.Program:
+        """The program of one variant: "splitsum" leaves the reference estimator out (a third
+        less for llvmpipe to compile at the first draw), "full" keeps it."""
+        key = (compiled.structure_hash, variant)
+        prog = self._programs.get(key)
+        if prog is None:
+            frag = compiled.fragment_text
+            if variant == "splitsum":
+                first, rest = frag.split("\n", 1)  # after #version, before any #line
+                frag = f"{first}\n#define MATEDIT_SPLIT_SUM_ONLY 1\n{rest}"
+            prog = self.ctx.program(vertex_shader=compiled.vertex_text, fragment_shader=frag)
+            self.link_count += 1
+            self._bind_program(prog)
+            self._programs[key] = prog
+        return prog
+
+    def _program_for(self, ibl_mode: int) -> moderngl.Program | None:
+        if ibl_mode != IBL_MODE_REFERENCE or self._compiled is None:
+            return self._program
+        try:
+            return self._link(self._compiled, "full")
+        except moderngl.Error:
+            return self._program  # cannot happen when the split-sum variant linked
+
     def set_material(self, compiled: CompiledMaterial) -> MaterialStatus:
         """Structural edit: link (or reuse) the program; keep the last good one on failure."""
-        prog = self._programs.get(compiled.structure_hash)
+        prog = self._programs.get((compiled.structure_hash, "splitsum"))
         if prog is None:
             try:
-                prog = self.ctx.program(vertex_shader=compiled.vertex_text,
-                                        fragment_shader=compiled.fragment_text)
+                prog = self._link(compiled, "splitsum")
             except moderngl.Error as exc:
                 log = str(exc)
                 located = compiled.locate_error(log)
@@ -223,9 +256,6 @@ class Renderer:
                     errors = [("", next((m for _, _, _, m in located if "error" in m.lower()),
                                         log.strip().splitlines()[-1] if log.strip() else log))]
                 return MaterialStatus(False, errors, log)
-            self.link_count += 1
-            self._bind_program(prog)
-            self._programs[compiled.structure_hash] = prog
         self._program = prog
         self._compiled = compiled
         self._values = {u.name: u.default for u in compiled.ir.uniforms}
@@ -338,7 +368,8 @@ class Renderer:
             self._bg["uIntensity"].value = float(self.environment_intensity)
             self._fs_vaos[self._bg.glo].render(vertices=3)
         ctx.enable(moderngl.DEPTH_TEST)
-        if self._program is not None and self._mesh is not None:
+        program = self._program_for(ibl_mode)
+        if program is not None and self._mesh is not None:
             self._lights_buf.bind_to_uniform_block(LIGHTS_BINDING)
             mode = ibl_mode if self._ibl is not None else IBL_MODE_NONE
             self._ibl_buf.write(pack_ibl_block(self._sh, float(self._env_levels),
@@ -354,10 +385,10 @@ class Renderer:
             for i, t in enumerate(self._compiled.ir.textures):
                 unit = FIRST_TEXTURE_BINDING + i
                 self._textures[t.name].use(location=unit)
-                _set(self._program, t.name, unit)
+                _set(program, t.name, unit)
             ctx.enable(moderngl.BLEND)
             ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-            self._mesh.render(self._program)
+            self._mesh.render(program)
             ctx.disable(moderngl.BLEND)
         if self.show_gizmos:
             self._draw_gizmos(vp)
@@ -491,6 +522,7 @@ class Renderer:
                 return frames
 
     def release(self) -> None:
+        self._release_targets()
         for p in self._programs.values():
             if self._mesh is not None:
                 self._mesh.forget(p)
