@@ -7,9 +7,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli import UsageError
-from matedit.compiler import TARGETS, CompileError, compile_all
-from matedit.io.atomic import atomic_write_text
-from matedit.io.document import FileResolver, FormatError, load
+from matedit.compiler.targets import TARGETS
 
 
 def register(sub) -> None:
@@ -23,6 +21,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    # Imported here, not at the top, so that other subcommands start without the compiler.
+    from matedit.compiler import CompileError, compile_all
+    from matedit.io.atomic import atomic_write_text
+    from matedit.io.document import FileResolver, FormatError, load
+
     path = Path(args.file)
     try:
         doc = load(path)
