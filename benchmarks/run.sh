@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs every benchmark and writes benchmarks/RESULTS.md.
-#   benchmarks/run.sh            the full run (about 10 minutes on 2 cores with llvmpipe)
+#   benchmarks/run.sh            the full run (about 6 minutes on 2 cores with llvmpipe)
 #   benchmarks/run.sh --quick    fewer repetitions and a smaller IBL bake, to try it out
 # Benchmark-only dependencies are set up here and nowhere else: MaterialX, pyinstrument and
 # py-spy go into .venv; Filament's cmgen (libfilament-tools) and Xvfb come from apt.
@@ -8,8 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 if [[ ! -x .venv/bin/python ]]; then
-  echo "benchmarks/run.sh: no .venv; run ./dev.sh setup first" >&2
-  exit 2
+  ./dev.sh setup  # a fresh checkout: the project and its test tools first
 fi
 
 if ! .venv/bin/python -c "import MaterialX, pyinstrument" 2>/dev/null \
