@@ -44,53 +44,6 @@ def _to_lit(value, t: PortType) -> Lit | None:
     return Lit(tuple(float(x) for x in arr), t)
 
 
-def fold_constants(scope: Scope) -> None:
-    """Evaluates ops whose operands are all literals with the numpy implementation."""
-    from matedit.compiler import cpu_eval
-
-    table: dict[str, Expr] = {}
-    kept: list[Op] = []
-    for op in scope.ops:
-        op.args = [_subst(a, table) for a in op.args]
-        numeric = all(t.is_numeric for _, t in op.outs)
-        if (op.kind not in IMPURE and numeric and op.args
-                and all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)):
-            try:
-                values = cpu_eval.eval_op(op, [_as_array(a) for a in op.args], None)
-            except Exception:  # no implementation, or it refused: keep the op
-                values = None
-            if values is not None:
-                lits = [_to_lit(v, t) for v, (_, t) in zip(values, op.outs)]
-                if all(l is not None for l in lits):
-                    for (port, _), lit in zip(op.outs, lits):
-                        table[op.out(port).name] = lit
-                    continue
-        kept.append(op)
-    scope.ops = kept
-    scope.outputs = [(n, t, _subst(e, table)) for n, t, e in scope.outputs]
-    scope.sockets = {k: _subst(e, table) for k, e in scope.sockets.items()}
-
-
-def merge_common(scope: Scope) -> None:
-    """Reuses the first of several ops with the same kind, data and operands."""
-    seen: dict[str, Op] = {}
-    table: dict[str, Expr] = {}
-    kept: list[Op] = []
-    for op in scope.ops:
-        op.args = [_subst(a, table) for a in op.args]
-        k = op.key()
-        first = seen.get(k)
-        if first is not None and first.outs == op.outs:
-            for port, _ in op.outs:
-                table[op.out(port).name] = first.out(port)
-            continue
-        seen[k] = op
-        kept.append(op)
-    scope.ops = kept
-    scope.outputs = [(n, t, _subst(e, table)) for n, t, e in scope.outputs]
-    scope.sockets = {k: _subst(e, table) for k, e in scope.sockets.items()}
-
-
 def _vars(e: Expr):
     if isinstance(e, Var):
         yield e.name
@@ -112,28 +65,36 @@ def remove_unused(scope: Scope) -> None:
     scope.ops = list(reversed(kept))
 
 
-def fold_and_merge(scope: Scope) -> None:
-    """fold_constants then merge_common, in one walk over the ops (the same result)."""
+def _fold(op: Op) -> list[Lit] | None:
+    """The op's outputs as literals when all its operands are literals (numpy evaluation)."""
     from matedit.compiler import cpu_eval
 
+    if (op.kind in IMPURE or not op.args
+            or not all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
+            or not all(t.is_numeric for _, t in op.outs)):
+        return None
+    try:
+        values = cpu_eval.eval_op(op, [_as_array(a) for a in op.args], None)
+    except Exception:  # no implementation, or it refused: keep the op
+        return None
+    lits = [_to_lit(v, t) for v, (_, t) in zip(values, op.outs)]
+    return lits if all(l is not None for l in lits) else None
+
+
+def fold_and_merge(scope: Scope) -> None:
+    """Constant folding and common-subexpression merging, in one walk over the ops: an op
+    whose operands are all literals becomes literals; an op equal to an earlier one (same
+    kind, data and operands) is replaced by the earlier one's outputs."""
     table: dict[str, Expr] = {}
     seen: dict[str, Op] = {}
     kept: list[Op] = []
     for op in scope.ops:
         op.args = [_subst(a, table) for a in op.args]
-        if (op.kind not in IMPURE and op.args
-                and all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
-                and all(t.is_numeric for _, t in op.outs)):
-            try:
-                values = cpu_eval.eval_op(op, [_as_array(a) for a in op.args], None)
-            except Exception:  # no implementation, or it refused: keep the op
-                values = None
-            if values is not None:
-                lits = [_to_lit(v, t) for v, (_, t) in zip(values, op.outs)]
-                if all(l is not None for l in lits):
-                    for (port, _), lit in zip(op.outs, lits):
-                        table[op.out(port).name] = lit
-                    continue
+        lits = _fold(op)
+        if lits is not None:
+            for (port, _), lit in zip(op.outs, lits):
+                table[op.out(port).name] = lit
+            continue
         k = op.key()
         first = seen.get(k)
         if first is not None and first.outs == op.outs:
