@@ -169,7 +169,12 @@ def test_tab_palette_adds_a_node_at_the_cursor(view, qtbot):
     spot = QPoint(300, 450)
     QTest.mouseMove(vp, spot + QPoint(7, 3))  # Qt drops a move to where the mouse already is
     QTest.mouseMove(vp, spot)
-    QTest.qWait(20)
+    # Under Xvfb the warped pointer's own motion events can arrive late: wait for the last.
+    qtbot.waitUntil(lambda: view._last_pos == spot, timeout=2000)
+    QTest.qWait(50)
+    if view._last_pos != spot:  # a late event from the first move
+        QTest.mouseMove(vp, spot)
+        qtbot.waitUntil(lambda: view._last_pos == spot, timeout=2000)
     view.setFocus()
     QTest.keyClick(view, Qt.Key.Key_Tab)
     pal = view.node_palette

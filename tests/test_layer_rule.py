@@ -43,3 +43,16 @@ def test_renderer_side_imports_without_qt():
 def test_blocker_really_blocks():
     r = _run(["PySide6.QtCore"], ["PySide6"])
     assert r.returncode != 0 and "layer rule" in r.stderr
+
+
+def test_only_render_and_app_create_gl_contexts():
+    """Nothing above matedit/render creates an OpenGL context (ARCHITECTURE.md, layers)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1] / "matedit"
+    offenders = [
+        str(p.relative_to(root)) for p in root.rglob("*.py")
+        if p.relative_to(root).parts[0] not in ("render", "app")
+        and ("create_standalone_context" in p.read_text() or "create_context(" in p.read_text())
+    ]
+    assert offenders == []

@@ -124,7 +124,7 @@ def test_white_furnace_reference_returns_lut_a_plus_b(fresh):
     from matedit.ibl import bake
     from matedit.shading.ibl import sample_lut
 
-    table = bake(constant_env(1.0), SMALL).lut  # (N, N, 2): row roughness, column NoV
+    table = bake(constant_env(1.0), SMALL, ctx=fresh.ctx).lut  # (N, N, 2): roughness, NoV
     hit, P, V = _sphere_hits(fresh)
     N = P
     NoV = np.clip(np.sum(N * V, -1), 0, 1)

@@ -62,9 +62,14 @@ def run(args: argparse.Namespace) -> int:
     for warning in env.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     env.warnings = []  # printed already
-    result = bake(
-        env, settings, use_cache=not args.no_cache, progress=terminal_progress("bake-ibl")
-    )
+    from matedit.render.context import headless_context
+
+    ctx = headless_context()
+    try:
+        result = bake(env, settings, ctx=ctx, use_cache=not args.no_cache,
+                      progress=terminal_progress("bake-ibl"))
+    finally:
+        ctx.release()
     for warning in result.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     try:

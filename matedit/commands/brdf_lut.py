@@ -42,10 +42,15 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"{out}: is a folder")
     if not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
+    from matedit.render.context import headless_context
+
+    ctx = headless_context()
     try:
-        lut = bake_brdf_lut(args.size, args.samples, use_cache=not args.no_cache)
+        lut = bake_brdf_lut(args.size, args.samples, ctx=ctx, use_cache=not args.no_cache)
     except ValueError as exc:
         raise UsageError(f"{out}: {exc}") from exc
+    finally:
+        ctx.release()
     try:
         write_lut(out, lut)
     except ImageError as exc:

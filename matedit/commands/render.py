@@ -77,15 +77,11 @@ def run(args) -> int:
         d = exc.diagnostics[0]
         raise UsageError(f"{d.file or path}: {d.format()}") from None
 
-    import moderngl
-
     from matedit.ibl import EnvironmentMapError
     from matedit.render import MeshError, Renderer
+    from matedit.render.context import headless_context
 
-    try:
-        ctx = moderngl.create_standalone_context(require=330, backend="egl")
-    except Exception:
-        ctx = moderngl.create_standalone_context(require=330)
+    ctx = headless_context()
     env = args.env or doc.preview.get("environment") or "studio"
     mesh = args.mesh or doc.preview.get("mesh") or "sphere"
     tty = sys.stderr.isatty()

@@ -343,10 +343,20 @@ def validate(doc: MaterialDocument, resolver: FunctionResolver | None = None) ->
     return analyse(doc, resolver).diagnostics
 
 
+def type_error_keys(doc: MaterialDocument, resolver: FunctionResolver | None = None) -> set:
+    """The document's present type errors, as `check_connect` compares them: compute it once
+    and pass it as `baseline` when checking many candidate links into the same document."""
+    return {(d.node_id, d.port, d.message) for d in _type_errors(doc, resolver)}
+
+
 def check_connect(
-    doc: MaterialDocument, link: Link, resolver: FunctionResolver | None = None
+    doc: MaterialDocument, link: Link, resolver: FunctionResolver | None = None,
+    baseline: set | None = None,
 ) -> str | None:
-    """None if `link` may be made now, else the reason it is refused (type or cycle)."""
+    """None if `link` may be made now, else the reason it is refused (type or cycle).
+
+    A link is refused for type errors it would add; `baseline` (from `type_error_keys` of
+    the same document) spares re-analysing the document itself for every candidate."""
     g = doc.graph
     for end in (link.src, link.dst):
         if end not in g.nodes:
@@ -371,7 +381,7 @@ def check_connect(
     if old is not None:
         trial.graph.links.discard(old)
     trial.graph.links.add(link)
-    before = {(d.node_id, d.port, d.message) for d in _type_errors(doc, resolver)}
+    before = baseline if baseline is not None else type_error_keys(doc, resolver)
     for d in _type_errors(trial, resolver):
         if (d.node_id, d.port, d.message) not in before:
             return d.message

@@ -3,9 +3,12 @@
 Public API (see each module):
 
     load_environment(path_or_name, size=256) -> Environment      # EnvironmentMapError
-    bake(env="studio", BakeSettings(...), ctx=None) -> IBLBake   # cached on disk
-    bake_brdf_lut(size=128, samples=1024) -> np.ndarray          # cached on disk
-    brdf_lut(size, samples, ctx=None, method="quadrature")       # uncached
+    bake(env="studio", BakeSettings(...), ctx=ctx) -> IBLBake    # cached on disk
+    bake_brdf_lut(size=128, samples=1024, ctx=ctx) -> np.ndarray # cached on disk
+    brdf_lut(size, samples, ctx=ctx, method="quadrature")        # uncached
+
+Baking runs in a moderngl context the caller provides (matedit.render.headless_context,
+or the viewport's); a cache hit needs none.
     upload(ctx, ibl_bake) -> IBLTextures                         # moderngl textures
     write_bake(ibl_bake, folder) -> list[Path]                   # EXR + sh.json
     eval_irradiance(sh, normals)                                  # E(N) on the CPU

@@ -102,10 +102,12 @@ def bake_brdf_lut(
     samples: int = 1024,
     *,
     baker: gpu.Baker | None = None,
+    ctx=None,
     use_cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
 ) -> np.ndarray:
-    """The environment BRDF LUT (size, size, 2), from the cache when possible."""
+    """The environment BRDF LUT (size, size, 2), from the cache when possible; a miss is
+    computed with `baker`, or in the moderngl context `ctx`."""
     BakeSettings(lut_size=size, lut_samples=samples).resolved()  # validates
     key = cache.make_key("brdf-lut", size=size, samples=samples, method="quadrature")
     path = _cache_dir(cache_dir) / f"lut-{key}.npz"
@@ -114,7 +116,7 @@ def bake_brdf_lut(
         if hit is not None and hit.get("lut", np.empty(0)).shape == (size, size, 2):
             return hit["lut"].astype(np.float32)
     own = baker is None
-    b = baker if baker is not None else gpu.Baker()
+    b = baker if baker is not None else gpu.Baker(ctx)
     try:
         lut = b.brdf_lut(size, samples)
     finally:
@@ -161,9 +163,9 @@ def bake(
 ) -> IBLBake:
     """Bake `env` (an Environment, a file path or a built-in name) on the GPU, or load it.
 
-    ctx: a moderngl context to bake in (default: a headless one, created and released
-    here); a given context gets its framebuffer binding and viewport back, but is left
-    with BLEND, DEPTH_TEST and CULL_FACE disabled and seamless cube filtering enabled.
+    ctx: the moderngl context to bake in (needed unless the bake is cached); it gets its
+    framebuffer binding and viewport back, but is left with BLEND, DEPTH_TEST and CULL_FACE
+    disabled and seamless cube filtering enabled.
     progress(fraction, message) is called as work proceeds. Raises EnvironmentMapError
     for unusable files and ValueError for bad settings.
     """

@@ -29,14 +29,6 @@ class BakeShaderError(RuntimeError):
     """A bake shader failed to compile: an internal error, never bad user input."""
 
 
-def create_context() -> moderngl.Context:
-    """A headless OpenGL 3.3+ context (EGL first, then the platform default)."""
-    try:
-        return moderngl.create_standalone_context(require=330, backend="egl")
-    except Exception:
-        return moderngl.create_standalone_context(require=330)
-
-
 def _gauss_legendre01(n: int) -> tuple[np.ndarray, np.ndarray]:
     x, w = np.polynomial.legendre.leggauss(n)
     return ((x + 1.0) * 0.5).astype(np.float32), (w * 0.5).astype(np.float32)
@@ -48,11 +40,13 @@ def samples_for_mip(samples: int, mip: int, growth: int = 4, max_growth: int = 1
 
 
 class Baker:
-    """Owns the bake programs for one moderngl context (given, or created and owned)."""
+    """Owns the bake programs for one moderngl context, which the caller provides (contexts
+    are created in matedit.render or the application, never in this layer)."""
 
-    def __init__(self, ctx: moderngl.Context | None = None) -> None:
-        self._owns = ctx is None
-        self.ctx = ctx if ctx is not None else create_context()
+    def __init__(self, ctx: moderngl.Context) -> None:
+        if ctx is None:
+            raise ValueError("baking needs a moderngl context (matedit.render.headless_context)")
+        self.ctx = ctx
         self._programs: dict[tuple[str, str], moderngl.Program] = {}
         self._vaos: dict[tuple[str, str], moderngl.VertexArray] = {}
         self._default_fbo: moderngl.Framebuffer | None = None
@@ -64,8 +58,6 @@ class Baker:
             prog.release()
         self._vaos.clear()
         self._programs.clear()
-        if self._owns:
-            self.ctx.release()
 
     def __enter__(self) -> Baker:
         return self

@@ -48,7 +48,7 @@ def brdf_lut(
     size: int = DEFAULT_LUT_SIZE,
     samples: int = DEFAULT_LUT_SAMPLES,
     *,
-    ctx: moderngl.Context | None = None,
+    ctx: moderngl.Context,
     method: str = "quadrature",
 ) -> np.ndarray:
     """(size, size, 2) float32: [k, i] = (A, B) at roughness (k+.5)/size, NoV (i+.5)/size.

@@ -94,7 +94,8 @@ class Renderer:
         self.reference_samples = 32  # per pixel per frame
         self.reference_frames = 64  # frames to converge (32 x 64 = 2048 samples a pixel)
         self.link_count = 0
-        self.difference_mean: float | None = None
+        self._difference_cache: tuple[int, float] | None = None
+        self._frames_drawn = 0
         self.bake_settings = bake_settings
         self._programs: dict[tuple[str, str], moderngl.Program] = {}  # (hash, variant)
         self._compiled: CompiledMaterial | None = None
@@ -453,6 +454,7 @@ class Renderer:
                 self._split_fbo.use()
                 self.ctx.copy_framebuffer(self._split_fbo, self._resolve_fbo)
         self._display_pass(target, source, scale)
+        self._frames_drawn += 1
 
     def _display_pass(self, target, source, scale: float) -> None:
         target.use()
@@ -469,8 +471,6 @@ class Renderer:
             d["uReferenceScale"].value = scale
             d["uMode"].value = 1
             d["uHeatRange"].value = 0.1
-            self.difference_mean = float(np.mean(np.abs(self.read_hdr("splitsum")
-                                                        - self.read_hdr("reference"))))
         else:
             source.color_attachments[0].use(location=0)
             d["uImage"].value = 0
@@ -481,6 +481,17 @@ class Renderer:
         d["uExposure"].value = float(self.exposure)
         target.use()
         self._fs_vaos[d.glo].render(vertices=3)
+
+    @property
+    def difference_mean(self) -> float | None:
+        """Mean |split-sum - reference| of the last difference frame, linear HDR (read back
+        from the GPU when asked, once per frame drawn, not on every frame)."""
+        if self.mode != "difference" or self._accum_frames == 0:
+            return None
+        if self._difference_cache is None or self._difference_cache[0] != self._frames_drawn:
+            mean = float(np.mean(np.abs(self.read_hdr("splitsum") - self.read_hdr("reference"))))
+            self._difference_cache = (self._frames_drawn, mean)
+        return self._difference_cache[1]
 
     def _output_fbo(self) -> moderngl.Framebuffer:
         w, h = self._size

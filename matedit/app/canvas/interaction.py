@@ -21,7 +21,7 @@ from matedit.app.canvas.reroute_item import RerouteItem
 from matedit.graph.model import Link, Node
 from matedit.graph.ports import NodePorts, node_ports
 from matedit.graph.types import PortType, can_convert
-from matedit.graph.validate import check_connect
+from matedit.graph.validate import check_connect, type_error_keys
 
 GENERIC = "T"
 
@@ -120,6 +120,7 @@ class WireDrag:
             else GENERIC
         self.target: PortItem | None = None
         self._verdicts: dict[tuple[str, str, bool], str | None] = {}
+        self._baseline: set | None = None  # the document's own type errors, once per drag
         self.live = LiveWire(anchor.scenePos(), anchor.is_output, anchor.type_name)
         scene.addItem(self.live)
 
@@ -137,7 +138,10 @@ class WireDrag:
                 self._verdicts[key] = None
             else:
                 c = self.scene.controller
-                self._verdicts[key] = check_connect(c.document, link, c.resolver)
+                if self._baseline is None:
+                    self._baseline = type_error_keys(c.document, c.resolver)
+                self._verdicts[key] = check_connect(c.document, link, c.resolver,
+                                                    self._baseline)
         return self._verdicts[key]
 
     def _target_at(self, scene_pos: QPointF, radius: float) -> PortItem | None:
