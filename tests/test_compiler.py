@@ -196,7 +196,9 @@ def test_compile_command_writes_files_and_reflection(tmp_path):
     for t in TARGETS:
         assert (tmp_path / f"{stem}.{t}.vert").is_file()
         assert (tmp_path / f"{stem}.{t}.frag").is_file()
-    refl = json.loads((tmp_path / f"{stem}.json").read_text())
+    refl = json.loads((tmp_path / f"{stem}.reflection.json").read_text())
+    assert not (tmp_path / f"{stem}.json").exists()
+    assert str(tmp_path) not in json.dumps(refl) and "/work" not in json.dumps(refl)
     assert set(refl["targets"]) == set(TARGETS)
     for t in refl["targets"].values():
         assert {"uniforms", "textures", "attributes", "structure_hash", "target"} <= set(t)

@@ -155,7 +155,7 @@ def test_function_document_rules():
     node(f, "x", "function_input", {"name": "bad name", "type": "float"})
     msgs = [e.message for e in errors(f)]
     assert any("Function Output" in m for m in msgs)
-    assert any("not an identifier" in m for m in msgs)
+    assert any("must be an ASCII identifier" in m for m in msgs)
 
 
 def test_duplicate_parameter_names():

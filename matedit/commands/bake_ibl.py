@@ -7,6 +7,7 @@ name (studio, sky). The files written are described in matedit/ibl/output.py.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -55,6 +56,16 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise UsageError(f"{out}: exists and is not a folder")
+    if args.env not in ("studio", "sky"):
+        from matedit.io.inputs import OverwriteError, refuse_overwrite
+
+        names = ["brdf_lut.exr", "sh.json", "ibl.json"]
+        names += [f"prefiltered_mip{m}.exr" for m in range(16)]
+        try:
+            refuse_overwrite([out / n for n in names],
+                             {Path(os.path.realpath(args.env)): "the environment"})
+        except OverwriteError as exc:
+            raise UsageError(str(exc)) from None
     try:
         env = load_environment(args.env, settings.size)
     except EnvironmentMapError as exc:

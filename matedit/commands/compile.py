@@ -1,4 +1,7 @@
-"""`matedit compile FILE -o DIR [--target glsl330|glsl450|essl300|all]`."""
+"""`matedit compile FILE -o DIR [--target glsl330|glsl450|essl300|all]`.
+
+Writes DIR/STEM.TARGET.vert, DIR/STEM.TARGET.frag and DIR/STEM.reflection.json; refuses an
+output that is, or resolves to, the document or a file it references."""
 
 from __future__ import annotations
 
@@ -25,6 +28,7 @@ def run(args) -> int:
     from matedit.compiler import CompileError, compile_all
     from matedit.io.atomic import atomic_write_text
     from matedit.io.document import FileResolver, FormatError, load
+    from matedit.io.inputs import OverwriteError, document_inputs, refuse_overwrite
 
     path = Path(args.file)
     try:
@@ -33,9 +37,10 @@ def run(args) -> int:
         raise UsageError(str(exc)) from None
     if doc.is_function:
         raise UsageError(f"{path}: is a material function; compile a material that calls it")
+    resolver = FileResolver()
     targets = list(TARGETS) if args.target == "all" else [args.target]
     try:
-        compiled = compile_all(doc, FileResolver(), targets)
+        compiled = compile_all(doc, resolver, targets)
     except CompileError as exc:
         for d in exc.diagnostics[1:]:
             print(f"error: {d.file or path}: {d.format()}", file=sys.stderr)
@@ -46,16 +51,26 @@ def run(args) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"{out}: exists and is not a folder")
     stem = path.name[:-5] if path.name.endswith(".json") else path.stem
-    reflection = {"source": str(path), "targets": {}}
+    files: dict[Path, str] = {}
+    reflection = {"source": path.name, "targets": {}}
     for name, cm in compiled.items():
-        atomic_write_text(out / f"{stem}.{name}.vert", cm.vertex_text)
-        atomic_write_text(out / f"{stem}.{name}.frag", cm.fragment_text)
+        files[out / f"{stem}.{name}.vert"] = cm.vertex_text
+        files[out / f"{stem}.{name}.frag"] = cm.fragment_text
         reflection["targets"][name] = cm.reflection()
     first = next(iter(compiled.values())).reflection()
     for key in ("attributes", "uniforms", "textures", "uniform_block"):
         reflection[key] = first[key]
-    atomic_write_text(out / f"{stem}.json",
-                      json.dumps(reflection, sort_keys=True, indent=2) + "\n")
+    files[out / f"{stem}.reflection.json"] = json.dumps(reflection, sort_keys=True,
+                                                        indent=2) + "\n"
+    try:
+        refuse_overwrite(files, document_inputs(doc, resolver))
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    for target, text in files.items():
+        try:
+            atomic_write_text(target, text)
+        except OSError as exc:
+            raise UsageError(f"{target}: cannot write: {exc.strerror or exc}") from None
     if sys.stderr.isatty():
         print(f"compiled {path} for {', '.join(targets)} into {out}", file=sys.stderr)
     return 0

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 import sys
 from pathlib import Path
@@ -40,23 +41,32 @@ def write_png(path: Path, rgb) -> None:
     import numpy as np
     import OpenImageIO as oiio
 
-    from matedit.io.atomic import atomic_write_bytes
+    from matedit.io.images import ImageError, write_oiio
 
     h, w, _ = rgb.shape
     pixels = np.clip(np.rint(rgb * 255.0), 0, 255).astype(np.uint8)
-    tmp = path.with_name(f".{path.stem}.render-tmp.png")
-    out = oiio.ImageOutput.create(str(tmp))
-    if out is None or not out.open(str(tmp), oiio.ImageSpec(w, h, 3, "uint8")):
-        raise UsageError(f"{path}: cannot write PNG: {oiio.geterror()}")
-    out.write_image(pixels)
-    out.close()
-    atomic_write_bytes(path, tmp.read_bytes())
-    tmp.unlink()
+    try:
+        write_oiio(path, oiio.ImageSpec(w, h, 3, "uint8"), pixels)
+    except ImageError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def _builtin(doc, key: str, fallback: str) -> str:
+    value = doc.preview.get(key) if isinstance(doc.preview, dict) else None
+    return value if isinstance(value, str) and value else fallback
 
 
 def run(args) -> int:
     from matedit.compiler import CompileError, compile_document
     from matedit.io.document import FileResolver, FormatError, load
+    from matedit.io.inputs import (
+        BUILTIN_ENVIRONMENTS,
+        BUILTIN_MESHES,
+        OverwriteError,
+        document_inputs,
+        preview_file,
+        refuse_overwrite,
+    )
 
     size = _size(args.size)
     path = Path(args.file)
@@ -71,8 +81,17 @@ def run(args) -> int:
         raise UsageError(str(exc)) from None
     if doc.is_function:
         raise UsageError(f"{path}: is a material function; render a material that uses it")
+    resolver = FileResolver()
+    inputs = document_inputs(doc, resolver)
+    for given in (args.mesh, args.env):
+        if given and given not in BUILTIN_MESHES | BUILTIN_ENVIRONMENTS:
+            inputs.setdefault(Path(os.path.realpath(given)), "an input file")
     try:
-        compiled = compile_document(doc, FileResolver(), "glsl330")
+        refuse_overwrite([out], inputs)
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    try:
+        compiled = compile_document(doc, resolver, "glsl330")
     except CompileError as exc:
         d = exc.diagnostics[0]
         raise UsageError(f"{d.file or path}: {d.format()}") from None
@@ -82,8 +101,8 @@ def run(args) -> int:
     from matedit.render.context import headless_context
 
     ctx = headless_context()
-    env = args.env or doc.preview.get("environment") or "studio"
-    mesh = args.mesh or doc.preview.get("mesh") or "sphere"
+    env = args.env or preview_file(doc, "environment") or _builtin(doc, "environment", "studio")
+    mesh = args.mesh or preview_file(doc, "mesh") or _builtin(doc, "mesh", "sphere")
     tty = sys.stderr.isatty()
     try:
         renderer = Renderer(ctx, size, environment=None)

@@ -54,11 +54,11 @@ class CompiledMaterial:
                 for u in self.ir.uniforms
             ],
             "textures": [
-                {"name": t.name, "binding": FIRST_TEXTURE_BINDING + i, "path": t.path,
+                {"name": t.name, "binding": FIRST_TEXTURE_BINDING + i, "path": t.ref,
                  "node": t.node, "parameter": t.parameter, "srgb": t.srgb}
                 for i, t in enumerate(self.ir.textures)
             ],
-            "functions": [f.source for f in self.ir.functions],
+            "functions": [f.name for f in self.ir.functions],
         }
 
     def pack_uniforms(self, values: dict[str, Any] | None = None) -> bytes:

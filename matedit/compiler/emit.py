@@ -53,7 +53,9 @@ class _Writer:
 
 
 class _Names:
-    """Variable names `<node>_<port>`, made unique and legal deterministically."""
+    """Local variable names: `l_<node>_<port>` (IR names are `node.port`), in a name space of
+    their own (no uniform, parameter, function or library name starts with `l_`), made unique
+    within the function deterministically."""
 
     def __init__(self) -> None:
         self.taken: dict[str, str] = {}
@@ -62,8 +64,7 @@ class _Names:
     def __call__(self, raw: str) -> str:
         if raw in self.taken:
             return self.taken[raw]
-        name = raw if not raw.startswith("gl_") else "n_" + raw
-        name = re.sub(r"__+", "_", name)
+        name = "l_" + re.sub(r"_+", "_", raw.replace(".", "_"))
         base, i = name, 2
         while name in self.used:
             name, i = f"{base}_{i}", i + 1
@@ -145,7 +146,7 @@ def _scope(w: _Writer, scope: Scope, main: bool) -> None:
         params = [f"{t.glsl} {n}" for n, t in scope.params]
         params += [f"out {t.glsl} out_{n}" for n, t, _ in scope.outputs]
         w.add(f"void {scope.name}({', '.join(params)}) {{")
-        w.add(f"    // material function {scope.source}")
+        w.add(f"    // material function {scope.name}")
     for op in scope.ops:
         w.add("    " + _op_line(op, names), op.node, scope.source)
     if main:

@@ -95,7 +95,7 @@ class Op:
     def out(self, port: str) -> Var:
         cache = self.__dict__.get("_out_vars")
         if cache is None:
-            cache = {name: Var(f"{self.var}_{name}", t) for name, t in self.outs}
+            cache = {name: Var(f"{self.var}.{name}", t) for name, t in self.outs}
             self.__dict__["_out_vars"] = cache
         return cache[port]
 
@@ -124,6 +124,7 @@ class TextureInfo:
     path: str
     srgb: bool
     parameter: str
+    ref: str = ""  # the path as the document stores it (relative to the document)
 
 
 @dataclass

@@ -8,7 +8,6 @@ conversions (a float splatted to a vector) are made explicit here.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,6 +28,7 @@ from matedit.compiler.ir import (
 )
 from matedit.graph import nodes
 from matedit.graph.model import MaterialDocument
+from matedit.graph.names import mangle
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, MA, MESH_UV
 from matedit.graph.ports import FunctionResolver, function_interface, layer_entries
 from matedit.graph.types import PortType, coerce_value
@@ -59,12 +59,6 @@ def _doc_key(doc: MaterialDocument) -> str:
     return str(Path(doc.path).resolve()) if doc.path else f"<unsaved {id(doc)}>"
 
 
-def _ident(s: str) -> str:
-    s = re.sub(r"[^A-Za-z0-9_]", "_", s)
-    s = re.sub(r"_+", "_", s).strip("_") or "f"
-    return s if s[0].isalpha() else "f" + s
-
-
 def literal(t: PortType, value: Any) -> Lit:
     v = coerce_value(t, value)
     return Lit(v if isinstance(v, float) else tuple(v), t)
@@ -90,6 +84,7 @@ class _Ctx:
     uniforms: dict[str, UniformInfo] = field(default_factory=dict)
     textures: dict[str, TextureInfo] = field(default_factory=dict)
     kinds: set[str] = field(default_factory=set)
+    input_uniforms: dict[tuple[str, str], str] = field(default_factory=dict)
 
 
 class _Lowerer:
@@ -106,7 +101,7 @@ class _Lowerer:
     def source(self, nid: str, port: str) -> Expr:
         if (nid, port) in self.alias:
             return self.alias[(nid, port)]
-        return Var(f"{nid}_{port}", self.a.out_types[nid][port])
+        return Var(f"{nid}.{port}", self.a.out_types[nid][port])
 
     def arg(self, nid: str, port: str, t: PortType, default: Any) -> Expr:
         link = self.incoming[nid].get(port)
@@ -124,7 +119,7 @@ class _Lowerer:
         if value is None:
             value = 0.0
         if self.top:
-            name = f"u_{nid}_{port}"
+            name = self._input_uniform_name(nid, port)
             self._uniform(UniformInfo(name, t, coerce_value(t, value), nid, port))
             return Uni(name, t)
         return literal(t, value)
@@ -132,6 +127,20 @@ class _Lowerer:
     @property
     def file(self) -> str | None:
         return str(self.doc.path) if self.doc.path else None
+
+    def _input_uniform_name(self, nid: str, port: str) -> str:
+        """`u_<node>_<port>`, with a numbered suffix where two (node, port) pairs would meet
+        (node `a_b` port `c` and node `a` port `b_c`): one name per pair, never shared."""
+        key = (nid, port)
+        taken = self.ctx.input_uniforms
+        if key in taken:
+            return taken[key]
+        base = f"u_{nid}_{port}"
+        name, i = base, 2
+        while name in self.ctx.uniforms or name in taken.values():
+            name, i = f"{base}_{i}", i + 1
+        taken[key] = name
+        return name
 
     def _uniform(self, info: UniformInfo) -> None:
         old = self.ctx.uniforms.get(info.name)
@@ -223,7 +232,8 @@ class _Lowerer:
             path = str((Path(self.doc.path).parent / path).resolve())
         if name not in self.ctx.textures:
             self.ctx.textures[name] = TextureInfo(name, nid, path,
-                                                  bool(node.settings.get("srgb", True)), pname)
+                                                  bool(node.settings.get("srgb", True)), pname,
+                                                  str(node.settings.get("path", "")))
         self.alias[(nid, "texture")] = Uni(name, PortType.TEXTURE)
 
     def _k_reroute(self, nid, node) -> None:
@@ -305,7 +315,7 @@ class _Lowerer:
             lid = layer["id"]
             iface = function_interface(self.ctx.resolver.resolve(layer["function"], self.doc))
             args = {p.name: port(f"{lid}_{p.name}") for p in iface.inputs}
-            op, _ = self._call(nid, f"{nid}_{lid}", layer["function"], args)
+            op, _ = self._call(nid, f"{nid}.{lid}", layer["function"], args)
             ma_out = next(o for o, t in op.outs if t == PortType.MATERIAL)
             value = op.out(ma_out)
             if not layer.get("visible", True) and i > 0:
@@ -317,16 +327,16 @@ class _Lowerer:
             blend = layer.get("blend", "alpha")
             opacity = port(f"{lid}_opacity")
             if blend == "alpha":
-                w = self.emit(Op(f"{nid}_{lid}_w", nid, "weight", [port(f"{lid}_mask"), opacity],
+                w = self.emit(Op(f"{nid}.{lid}.w", nid, "weight", [port(f"{lid}_mask"), opacity],
                                  [("result", PortType.FLOAT)], {}))
-                blended = self.emit(Op(f"{nid}_{lid}_blend", nid, "blend",
+                blended = self.emit(Op(f"{nid}.{lid}.blend", nid, "blend",
                                        [acc, value, w.out("result")],
                                        [("result", PortType.MATERIAL)], {}))
             else:
                 if blend == "height":
                     self.ctx.kinds.add("height_blend")
                     shaped = self.emit(Op(
-                        f"{nid}_{lid}_h", nid, "height_blend",
+                        f"{nid}.{lid}.h", nid, "height_blend",
                         [acc, value, port(f"{lid}_base_height"), port(f"{lid}_mask"),
                          port(f"{lid}_contrast")],
                         [("result", PortType.MATERIAL)], {"glsl": "node_height_blend"}))
@@ -337,9 +347,9 @@ class _Lowerer:
                     for p in biface.inputs:
                         if p.name not in bargs:
                             bargs[p.name] = port(f"{lid}_{p.name}")
-                    shaped, _ = self._call(nid, f"{nid}_{lid}_b", blend, bargs)
+                    shaped, _ = self._call(nid, f"{nid}.{lid}.b", blend, bargs)
                 out_name = next(o for o, t in shaped.outs if t == PortType.MATERIAL)
-                blended = self.emit(Op(f"{nid}_{lid}_blend", nid, "blend",
+                blended = self.emit(Op(f"{nid}.{lid}.blend", nid, "blend",
                                        [acc, shaped.out(out_name), convert(opacity,
                                                                            PortType.FLOAT)],
                                        [("result", PortType.MATERIAL)], {}))
@@ -366,7 +376,7 @@ def lower_function(ctx: _Ctx, doc: MaterialDocument) -> Scope:
     key = _doc_key(doc)
     if key in ctx.functions:
         return ctx.functions[key]
-    stem = _ident("fn_" + (Path(doc.path).stem if doc.path else doc.name or "function"))
+    stem = "fn_" + mangle(Path(doc.path).stem if doc.path else doc.name or "function")
     name, i = stem, 2
     while name in ctx.names:
         name, i = f"{stem}_{i}", i + 1

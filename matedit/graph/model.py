@@ -16,11 +16,12 @@ from enum import Enum
 from pathlib import Path
 from typing import Any, NamedTuple
 
-_ID = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")
+_ID = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z", re.ASCII)
 
 
 def valid_id(s: object) -> bool:
-    """Node ids are identifiers: they name GLSL variables (`<node>_<port>`)."""
+    """Node ids are ASCII identifiers of at most 64 characters with no '__': they take part
+    in generated names (always behind a prefix, so a keyword such as `out` is a fine id)."""
     return isinstance(s, str) and bool(_ID.match(s)) and "__" not in s
 
 

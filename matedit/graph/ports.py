@@ -8,10 +8,12 @@ Material functions are found through a `FunctionResolver` the caller provides
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Protocol
 
 from matedit.graph import nodes
 from matedit.graph.model import MaterialDocument, Node
+from matedit.graph.names import identifier_problem
 from matedit.graph.nodes import GENERIC, MA
 from matedit.graph.types import PortType, parse_type
 
@@ -92,6 +94,11 @@ def function_interface(doc: MaterialDocument) -> NodePorts:
         order = s.get("order", 0)
         order = order if isinstance(order, (int, float)) else 0
         key = (order, str(s["name"]), node.id)
+        why = identifier_problem(s["name"])
+        if why:
+            where = f" in {Path(doc.path).name}" if doc.path else ""
+            raise PortError(node.id, "name", f"function {node.kind.split('_')[1]} name "
+                            f"{s['name']!r}{where} {why}")
         if node.kind == "function_input":
             ins.append((key, PortSpec(str(s["name"]), t, s.get("default"), None,
                                       f"function input {s['name']}", t in (MA, "texture2d")
@@ -186,8 +193,10 @@ def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
         if not isinstance(layer, dict):
             raise PortError(node.id, f"layers[{index}]", "a layer must be an object")
         lid = layer.get("id")
-        if not isinstance(lid, str) or not lid.isidentifier() or lid in seen:
-            raise PortError(node.id, f"layers[{index}].id", f"bad or duplicate layer id {lid!r}")
+        why = identifier_problem(lid)
+        if why or lid in seen:
+            raise PortError(node.id, f"layers[{index}].id",
+                            f"layer id {lid!r} {why}" if why else f"duplicate layer id {lid!r}")
         seen.add(lid)
         ref = layer.get("function")
         if not isinstance(ref, str) or not ref:

@@ -16,6 +16,7 @@ import networkx as nx
 
 from matedit.graph import nodes
 from matedit.graph.model import Link, MaterialDocument
+from matedit.graph.names import identifier_problem
 from matedit.graph.ports import (
     FunctionResolver,
     NodePorts,
@@ -227,8 +228,9 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                     diags.append(error(f"two {n.kind.replace('_', ' ')}s named {key[1]!r} "
                                        f"({names[key]} and {n.id})", n.id, "name", f))
                 names[key] = n.id
-                if not str(key[1]).isidentifier():
-                    diags.append(error(f"name {key[1]!r} is not an identifier", n.id, "name", f))
+                why = identifier_problem(n.settings.get("name", ""))
+                if why:
+                    diags.append(error(f"name {key[1]!r} {why}", n.id, "name", f))
                 if n.kind == "function_input":
                     diags.extend(_check_input_default(n, f))
     else:
@@ -251,9 +253,9 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                                          n.id, "path", f))
         if n.kind.endswith("_parameter"):
             name = str(n.settings.get("name", ""))
-            if not name.isidentifier():
-                diags.append(error(f"parameter name {name!r} is not an identifier", n.id,
-                                   "name", f))
+            why = identifier_problem(n.settings.get("name", ""))
+            if why:
+                diags.append(error(f"parameter name {name!r} {why}", n.id, "name", f))
             elif name in params:
                 diags.append(error(f"parameter name {name!r} is used by {params[name]} too",
                                    n.id, "name", f))

@@ -26,6 +26,7 @@ import numpy as np
 
 from matedit.ibl.bake import IBLBake
 from matedit.ibl.cubemap import faces_to_cross
+from matedit.io.atomic import atomic_write_text
 from matedit.io.images import write_image
 
 SH_BASIS_NAMES = (
@@ -49,9 +50,7 @@ def write_lut(path: str | os.PathLike, lut: np.ndarray) -> Path:
 
 
 def _write_json(path: Path, data: dict) -> None:
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_text(json.dumps(data, indent=2, sort_keys=True) + "\n")
-    os.replace(tmp, path)
+    atomic_write_text(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 
 def write_bake(result: IBLBake, folder: str | os.PathLike) -> list[Path]:

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from matedit.io.atomic import atomic_output, check_readable_file
+
 try:  # OpenImageIO is a hard dependency, but keep the import error readable.
     import OpenImageIO as oiio
 except ImportError as exc:  # pragma: no cover - broken install
@@ -28,6 +30,15 @@ _LDR_BASETYPES = {
     oiio.UINT16,
     oiio.INT16,
 }
+
+
+MAX_IMAGE_PIXELS = 16384 * 8192
+
+
+def _reason(exc: OSError) -> str:
+    text = str(exc)
+    return text.split(": ", 1)[1] if ": " in text and not exc.strerror else (
+        exc.strerror or text)
 
 
 class ImageError(ValueError):
@@ -74,10 +85,14 @@ def read_image(path: str | os.PathLike) -> ImageData:
     """Read the first subimage of `path` as float32 (H, W, C); raises ImageError."""
     p = Path(path)
     name = str(p)
-    if not p.exists():
-        raise ImageError(f"{name}: no such file")
-    if p.is_dir():
-        raise ImageError(f"{name}: is a directory, not an image")
+    try:
+        check_readable_file(p)
+    except FileNotFoundError:
+        raise ImageError(f"{name}: no such file") from None
+    except IsADirectoryError:
+        raise ImageError(f"{name}: is a directory, not an image") from None
+    except OSError as exc:
+        raise ImageError(f"{name}: {_reason(exc)}") from None
     if p.stat().st_size == 0:
         raise ImageError(f"{name}: empty file")
     inp = oiio.ImageInput.open(name)
@@ -88,6 +103,9 @@ def read_image(path: str | os.PathLike) -> ImageData:
         w, h, c = spec.width, spec.height, spec.nchannels
         if w <= 0 or h <= 0 or c <= 0:
             raise ImageError(f"{name}: image has no pixels ({w}x{h}, {c} channels)")
+        if w * h > MAX_IMAGE_PIXELS or c > 64:
+            raise ImageError(f"{name}: image is too large ({w}x{h}, {c} channels; at most "
+                             f"{MAX_IMAGE_PIXELS} pixels)")
         pixels = inp.read_image(0, 0, 0, c, "float")
         err = inp.geterror() if inp.has_error else ""
         if pixels is None or err:
@@ -125,24 +143,26 @@ def write_image(path: str | os.PathLike, pixels: np.ndarray, *, half: bool = Fal
     if arr.ndim != 3 or arr.shape[0] == 0 or arr.shape[1] == 0:
         raise ImageError(f"{name}: cannot write an image of shape {arr.shape}")
     h, w, c = arr.shape
-    tmp = p.with_name(f".{p.stem}.tmp{os.getpid()}{p.suffix}")
-    out = oiio.ImageOutput.create(str(tmp))
-    if out is None:
-        raise ImageError(f"{name}: no image writer for this file type: {_oiio_error()}")
     spec = oiio.ImageSpec(w, h, c, "half" if half else "float")
     if c in (3, 4):
         spec.channelnames = ("R", "G", "B", "A")[:c]
     elif c == 2:
         spec.channelnames = ("R", "G")
+    write_oiio(p, spec, arr)
+
+
+def write_oiio(path: Path, spec, pixels: np.ndarray) -> None:
+    """Write `pixels` with OpenImageIO, atomically, through `atomic_output`."""
+    name = str(path)
     try:
-        ok = out.open(str(tmp), spec) and out.write_image(np.ascontiguousarray(arr))
-        err = "" if ok else _oiio_error(out)
-        out.close()
-        if not ok:
-            raise ImageError(f"{name}: cannot write image: {err}")
-        os.replace(tmp, p)
+        with atomic_output(path) as tmp:
+            out = oiio.ImageOutput.create(str(tmp))
+            if out is None:
+                raise ImageError(f"{name}: no image writer for this file type: {_oiio_error()}")
+            ok = out.open(str(tmp), spec) and out.write_image(np.ascontiguousarray(pixels))
+            err = "" if ok else _oiio_error(out)
+            out.close()
+            if not ok:
+                raise ImageError(f"{name}: cannot write image: {err}")
     except OSError as exc:
         raise ImageError(f"{name}: cannot write image: {exc.strerror or exc}") from exc
-    finally:
-        if tmp.exists():
-            tmp.unlink()
