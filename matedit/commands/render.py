@@ -32,8 +32,8 @@ def register(sub) -> None:
 
 def _size(text: str) -> tuple[int, int]:
     m = re.fullmatch(r"(\d+)x(\d+)", text.strip())
-    if not m or not (1 <= int(m.group(1)) <= 8192 and 1 <= int(m.group(2)) <= 8192):
-        raise UsageError(f"--size must be WxH with 1..8192, e.g. 512x512, got {text!r}")
+    if not m or not (1 <= int(m.group(1)) <= 16384 and 1 <= int(m.group(2)) <= 16384):
+        raise UsageError(f"--size must be WxH with 1..16384, e.g. 512x512, got {text!r}")
     return int(m.group(1)), int(m.group(2))
 
 
@@ -49,6 +49,36 @@ def write_png(path: Path, rgb) -> None:
         write_oiio(path, oiio.ImageSpec(w, h, 3, "uint8"), pixels)
     except ImageError as exc:
         raise UsageError(str(exc)) from None
+
+
+def gl_size_limit(ctx) -> int:
+    """The largest width or height this GL implementation can render to."""
+    info = ctx.info
+    dims = info.get("GL_MAX_VIEWPORT_DIMS", (16384, 16384))
+    return int(min(info.get("GL_MAX_RENDERBUFFER_SIZE", 16384),
+                   info.get("GL_MAX_TEXTURE_SIZE", 16384), *dims))
+
+
+def _renderer(ctx, size: tuple[int, int], cls):
+    """A renderer of `size`, or a UsageError that names the limit (queried from GL)."""
+    import moderngl
+
+    limit = gl_size_limit(ctx)
+    if max(size) > limit:
+        raise UsageError(f"--size {size[0]}x{size[1]}: this GL implementation renders at most "
+                         f"{limit}x{limit} (GL_MAX_RENDERBUFFER_SIZE)")
+    samples = max(1, min(4, int(ctx.info.get("GL_MAX_SAMPLES", 4))))
+    try:
+        return cls(ctx, size, samples=samples, environment=None)
+    except moderngl.Error:
+        pass  # too large multisampled: one sample a pixel may still fit
+    try:
+        return cls(ctx, size, samples=1, environment=None)
+    except moderngl.Error as exc:
+        raise UsageError(f"--size {size[0]}x{size[1]}: this GL implementation cannot allocate "
+                         f"the float colour and depth render targets at this size, with {samples} or 1 "
+                         f"samples ("
+                         f"{' '.join(str(exc).split())[:80]}); try a smaller size") from None
 
 
 def _builtin(doc, key: str, fallback: str) -> str:
@@ -105,7 +135,7 @@ def run(args) -> int:
     mesh = args.mesh or preview_file(doc, "mesh") or _builtin(doc, "mesh", "sphere")
     tty = sys.stderr.isatty()
     try:
-        renderer = Renderer(ctx, size, environment=None)
+        renderer = _renderer(ctx, size, Renderer)
         try:
             renderer.set_mesh(mesh)
         except MeshError as exc:

@@ -32,8 +32,21 @@ def problems(path: Path, resolver: FileResolver) -> list[tuple[str, str]]:
     except FormatError as exc:
         return [("error", str(exc))]
     lines = []
-    for d in analyse(doc, resolver).diagnostics:
-        lines.append((d.severity.value, f"{path}: {d.format()}"))
+    diagnostics = analyse(doc, resolver).diagnostics
+    for d in diagnostics:
+        lines.append((d.severity.value, f"{d.file or path}: {d.format()}"))
+    if not doc.is_function and not any(d.severity == Severity.ERROR for d in diagnostics):
+        # What validate accepts must compile: the functions it calls are checked in full, and
+        # anything only the compiler can see (names, emission) is reported here too.
+        from matedit.compiler import CompileError, compile_document
+
+        try:
+            compile_document(doc, resolver, "glsl330")
+        except CompileError as exc:
+            for d in exc.diagnostics:
+                lines.append(("error", f"{d.file or path}: {d.format()}"))
+        except (RecursionError, ValueError, LookupError) as exc:
+            lines.append(("error", f"{path}: does not compile: {exc}"))
     return lines
 
 

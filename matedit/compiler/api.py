@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from matedit.compiler.emit import SourceMap, fragment_source, std140_layout, vertex_source
-from matedit.compiler.ir import MaterialIR
+from matedit.compiler.ir import MaterialIR, Splat, Uni
 from matedit.compiler.lower import CompileError, lower_document
 from matedit.compiler.passes import optimise
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, MATERIAL_BINDING, TARGETS
@@ -110,11 +110,43 @@ def _no_gc():
             gc.enable()
 
 
+def _uniforms_in(e, out: set[str]) -> None:
+    while isinstance(e, Splat):
+        e = e.expr
+    if isinstance(e, Uni):
+        out.add(e.name)
+
+
+def prune(ir: MaterialIR) -> None:
+    """After dead-code removal: drop the uniforms, textures and functions no live code uses,
+    so unconnected nodes cost nothing (9,000 of them must not overflow the uniform block)."""
+    called: set[str] = set()
+    by_name = {f.name: f for f in ir.functions}
+    todo = [ir.main]
+    used: set[str] = set()
+    while todo:
+        scope = todo.pop()
+        for op in scope.ops:
+            for a in op.args:
+                _uniforms_in(a, used)
+            fn = op.data.get("function") if op.kind == "call" else None
+            if fn and fn not in called:
+                called.add(fn)
+                if fn in by_name:
+                    todo.append(by_name[fn])
+        for _, _, e in scope.outputs:
+            _uniforms_in(e, used)
+    ir.functions = [f for f in ir.functions if f.name in called]
+    ir.uniforms = [u for u in ir.uniforms if u.name in used]
+    ir.textures = [t for t in ir.textures if t.name in used]
+
+
 def lower_and_optimise(doc: MaterialDocument, resolver: FunctionResolver | None) -> MaterialIR:
     with _no_gc():
         ir = lower_document(doc, resolver)
         for scope in [*ir.functions, ir.main]:
             optimise(scope)
+        prune(ir)
     return ir
 
 

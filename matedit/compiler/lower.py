@@ -364,8 +364,8 @@ class _Lowerer:
             self.written.setdefault(acc.key(), ALL_FIELDS)
 
 
-def _check(doc: MaterialDocument, resolver) -> Analysis:
-    a = analyse(doc, resolver)
+def _check(doc: MaterialDocument, resolver, top: bool = True) -> Analysis:
+    a = analyse(doc, resolver, calls=top)  # the top document's check covers every callee
     errors = [d for d in a.diagnostics if d.severity == Severity.ERROR]
     if errors:
         raise CompileError(errors)
@@ -381,7 +381,7 @@ def lower_function(ctx: _Ctx, doc: MaterialDocument) -> Scope:
     while name in ctx.names:
         name, i = f"{stem}_{i}", i + 1
     ctx.names.add(name)
-    a = _check(doc, ctx.resolver)
+    a = _check(doc, ctx.resolver, top=False)
     scope = Scope(name=name, source=str(doc.path or doc.name))
     iface = function_interface(doc)
     scope.params = [(f"in_{p.name}", PortType(p.type)) for p in iface.inputs]

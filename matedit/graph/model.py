@@ -47,6 +47,8 @@ class Node:
     settings: dict[str, Any] = field(default_factory=dict)
     values: dict[str, Any] = field(default_factory=dict)
     label: str = ""
+    # Fields of the file's node object this version does not know: kept and written back.
+    extra: dict[str, Any] = field(default_factory=dict)
 
     def clone(self) -> Node:
         return copy.deepcopy(self)
@@ -72,6 +74,7 @@ class Comment:
     text: str = ""
     rect: tuple[float, float, float, float] = (0.0, 0.0, 200.0, 120.0)
     color: tuple[float, float, float] = (0.3, 0.3, 0.3)
+    extra: dict[str, Any] = field(default_factory=dict)  # unknown fields, kept on save
 
 
 Listener = Callable[[ChangeEvent], None]
@@ -218,6 +221,10 @@ class MaterialDocument:
     path: Path | None = None  # where it was loaded from / saved to
     # Preview settings stored with the file (environment, mesh); layout-only for the compiler.
     preview: dict[str, Any] = field(default_factory=dict)
+    # Fields this version does not know, kept and written back on save: at the top level,
+    # and per link (links are plain tuples, so theirs are held here, keyed by the link).
+    extra: dict[str, Any] = field(default_factory=dict)
+    link_extra: dict[Link, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def is_function(self) -> bool:

@@ -92,7 +92,13 @@ def stable_order(g: nx.DiGraph) -> list[str]:
     return [n for gen in nx.topological_generations(g) for n in sorted(gen)]
 
 
-def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None) -> Analysis:
+MAX_CALL_DEPTH = 64  # material functions nested deeper than this are refused
+
+
+def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
+            calls: bool = True) -> Analysis:
+    """Ports, types, evaluation order and diagnostics of one document. `calls=False` skips
+    the walk over the functions it calls (done once for the top document by the compiler)."""
     f = _file(doc)
     diags: list[Diagnostic] = []
     graph = doc.graph
@@ -206,7 +212,8 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None) -> 
                                      nid, name, f))
 
     diags.extend(_document_rules(doc, ports, f))
-    diags.extend(_call_cycles(doc, resolver))
+    if calls:
+        diags.extend(_call_cycles(doc, resolver))
     return Analysis(ports, in_types, out_types, order, diags)
 
 
@@ -248,7 +255,14 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
             tex = n.settings.get("path", "")
             if isinstance(tex, str) and tex:
                 base = Path(doc.path).parent if doc.path else Path.cwd()
-                if not (base / tex).is_file():
+                try:
+                    found = (base / tex).is_file()
+                except (OSError, ValueError) as exc:
+                    diags.append(error(f"texture path cannot be used: "
+                                       f"{getattr(exc, 'strerror', None) or exc}",
+                                       n.id, "path", f))
+                    found = True
+                if not found:
                     diags.append(warning(f"texture file {tex!r} not found; it shows as a checker",
                                          n.id, "path", f))
         if n.kind.endswith("_parameter"):
@@ -332,6 +346,12 @@ def _call_cycles(doc: MaterialDocument, resolver: FunctionResolver | None) -> li
     try:
         cycle = nx.find_cycle(calls, source=_doc_key(doc))
     except nx.NetworkXNoCycle:
+        depth = nx.dag_longest_path_length(calls)
+        if depth > MAX_CALL_DEPTH:
+            return [error(f"material functions nest {depth} calls deep; at most "
+                          f"{MAX_CALL_DEPTH} levels are allowed", next(iter(first_hop.values()),
+                                                                       None), "function",
+                          _file(doc))]
         return []
     names = [Path(a).name for a, _ in cycle] + [Path(cycle[0][0]).name]
     node = first_hop.get(cycle[0][1]) if cycle[0][0] == _doc_key(doc) else None

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
-from matedit.io.atomic import atomic_write_text
+from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
 from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
 
 FORMATS = {"matedit.material": DocumentKind.MATERIAL, "matedit.function": DocumentKind.FUNCTION}
@@ -42,32 +42,99 @@ def _no_constants(name: str) -> Any:
     raise ValueError(f"{name} is not valid JSON")
 
 
+class _DuplicateKey(ValueError):
+    pass
+
+
+def _object(pairs: list[tuple[str, Any]]) -> dict:
+    out: dict[str, Any] = {}
+    for k, v in pairs:
+        if k in out:
+            raise _DuplicateKey(k)
+        out[k] = v
+    return out
+
+
+def _where(raw: Any, path: list) -> tuple[str | None, str]:
+    """(node id, field) for a position inside the raw document, for error messages."""
+    node, rest = None, path
+    if len(path) >= 2 and path[0] in ("nodes", "comments") and isinstance(path[1], int):
+        try:
+            nid = raw[path[0]][path[1]].get("id")
+        except (AttributeError, IndexError, KeyError, TypeError):
+            nid = None
+        if isinstance(nid, str):
+            node, rest = nid, path[2:]
+    parts: list[str] = []
+    for p in rest:
+        parts.append(f"[{p}]" if isinstance(p, int) else ("." if parts else "") + str(p))
+    return node, "".join(parts) or "<top>"
+
+
+def _check_numbers(raw: Any, file: str | None) -> None:
+    """Every number must fit a 64-bit float (1e400 parses to infinity and cannot be saved)."""
+    stack: list[tuple[Any, list]] = [(raw, [])]
+    while stack:
+        value, path = stack.pop()
+        bad = None
+        if isinstance(value, float):
+            if value != value or value in (float("inf"), float("-inf")):
+                bad = "number is too large for a 64-bit float"
+        elif isinstance(value, int) and not isinstance(value, bool):
+            if abs(value) > 2**1023:
+                bad = "integer is too large for a 64-bit float"
+        elif isinstance(value, dict):
+            stack.extend((v, [*path, k]) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend((v, [*path, i]) for i, v in enumerate(value))
+        if bad:
+            node, fld = _where(raw, path)
+            raise FormatError(file, bad, node, fld)
+
+
 def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
     """Parse a document from JSON text (`path` anchors its relative references)."""
+    if text.startswith("\ufeff"):
+        raise FormatError(file, "starts with a UTF-8 byte-order mark; save the file as UTF-8 "
+                          "without a BOM")
     try:
-        raw = json.loads(text, parse_constant=_no_constants)
+        raw = json.loads(text, parse_constant=_no_constants, object_pairs_hook=_object)
+    except _DuplicateKey as exc:
+        raise FormatError(file, f"key {exc.args[0]!r} appears twice in one JSON object",
+                          field=str(exc.args[0])) from None
     except (ValueError, RecursionError) as exc:
         raise FormatError(file, f"not valid JSON: {exc}") from None
-    return from_dict(raw, file, path)
+    _check_numbers(raw, file)
+    doc = from_dict(raw, file, path)
+    try:
+        dumps(doc)
+    except (TypeError, ValueError) as exc:
+        raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
+    return doc
+
+
+def read_document_text(path: str | os.PathLike) -> str:
+    """The text of a document file: a regular file of at most MAX_FILE_BYTES, in UTF-8."""
+    p = Path(path)
+    try:
+        data = read_bounded(p, MAX_FILE_BYTES)
+    except FileNotFoundError:
+        raise FormatError(str(p), "file not found") from None
+    except IsADirectoryError:
+        raise FormatError(str(p), "is a directory, not a material file") from None
+    except UnsafeFileError as exc:
+        raise FormatError(str(p), str(exc).split(": ", 1)[-1]) from None
+    except OSError as exc:
+        raise FormatError(str(p), f"cannot read: {exc.strerror or exc}") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise FormatError(str(p), "not UTF-8 text") from None
 
 
 def load(path: str | os.PathLike) -> MaterialDocument:
     p = Path(path)
-    try:
-        if p.is_dir():
-            raise FormatError(str(p), "is a directory, not a material file")
-        if p.stat().st_size > MAX_FILE_BYTES:
-            raise FormatError(str(p), f"file is larger than {MAX_FILE_BYTES >> 20} MiB")
-        data = p.read_bytes()
-    except FileNotFoundError:
-        raise FormatError(str(p), "file not found") from None
-    except OSError as exc:
-        raise FormatError(str(p), f"cannot read: {exc.strerror or exc}") from None
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise FormatError(str(p), "not UTF-8 text") from None
-    return loads(text, str(p), p)
+    return loads(read_document_text(p), str(p), p)
 
 
 def _expect(cond: bool, file, msg, node=None, field=None) -> None:
@@ -100,12 +167,17 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> Ma
         raise FormatError(file, f"cannot migrate from version {version}: {exc}") from None
 
     doc = MaterialDocument(kind=FORMATS[fmt], path=Path(path) if path else None)
+    doc.extra = _unknown(raw, TOP_FIELDS)
     for key in ("name", "description"):
         val = raw.get(key, "")
         _expect(isinstance(val, str), file, f"'{key}' must be a string", field=key)
         setattr(doc, key, val)
     preview = raw.get("preview", {})
     _expect(isinstance(preview, dict), file, "'preview' must be an object", field="preview")
+    for key in ("mesh", "environment"):
+        _expect(key not in preview or isinstance(preview[key], str), file,
+                f"'preview.{key}' must be a string (a built-in name or a file path)",
+                field=f"preview.{key}")
     doc.preview = preview
 
     nodes = raw.get("nodes", [])
@@ -129,7 +201,7 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> Ma
         label = n.get("label", "")
         _expect(isinstance(label, str), file, "label must be a string", nid, "label")
         doc.graph.nodes[nid] = Node(nid, kind, (float(pos[0]), float(pos[1])), settings,
-                                    values, label)
+                                    values, label, _unknown(n, NODE_FIELDS))
 
     links = raw.get("links", [])
     _expect(isinstance(links, list), file, "'links' must be a list", field="links")
@@ -143,6 +215,9 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> Ma
         _expect(link not in doc.graph.links, file, f"links[{i}] is listed twice",
                 node=link.dst, field=link.dst_port)
         doc.graph.links.add(link)
+        extra = _unknown(l, LINK_FIELDS)
+        if extra:
+            doc.link_extra[link] = extra
 
     comments = raw.get("comments", [])
     _expect(isinstance(comments, list), file, "'comments' must be a list", field="comments")
@@ -160,23 +235,35 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> Ma
         _expect(c["id"] not in doc.graph.comments and c["id"] not in doc.graph.nodes, file,
                 "duplicate id", c["id"], "id")
         doc.graph.comments[c["id"]] = Comment(c["id"], text, tuple(float(x) for x in rect),
-                                              tuple(float(x) for x in color))
+                                              tuple(float(x) for x in color),
+                                              _unknown(c, COMMENT_FIELDS))
     return doc
+
+
+TOP_FIELDS = frozenset({"format", "version", "name", "description", "preview", "nodes",
+                        "links", "comments"})
+NODE_FIELDS = frozenset({"id", "kind", "position", "settings", "values", "label"})
+LINK_FIELDS = frozenset({"from", "to"})
+COMMENT_FIELDS = frozenset({"id", "text", "rect", "color"})
+
+
+def _unknown(raw: dict, known: frozenset) -> dict[str, Any]:
+    return {k: v for k, v in raw.items() if k not in known}
 
 
 def to_dict(doc: MaterialDocument) -> dict:
     g = doc.graph
-    out: dict[str, Any] = {
+    out: dict[str, Any] = {**doc.extra,
         "format": FORMAT_OF[doc.kind],
         "version": CURRENT_VERSION,
         "name": doc.name,
         "description": doc.description,
         "nodes": [],
-        "links": [l.to_json() for l in sorted(g.links)],
+        "links": [{**doc.link_extra.get(l, {}), **l.to_json()} for l in sorted(g.links)],
     }
     for nid in sorted(g.nodes):
         n = g.nodes[nid]
-        entry: dict[str, Any] = {"id": n.id, "kind": n.kind,
+        entry: dict[str, Any] = {**n.extra, "id": n.id, "kind": n.kind,
                                  "position": [_num(n.position[0]), _num(n.position[1])]}
         if n.settings:
             entry["settings"] = n.settings
@@ -187,7 +274,7 @@ def to_dict(doc: MaterialDocument) -> dict:
         out["nodes"].append(entry)
     if g.comments:
         out["comments"] = [
-            {"id": c.id, "text": c.text, "rect": [_num(x) for x in c.rect],
+            {**c.extra, "id": c.id, "text": c.text, "rect": [_num(x) for x in c.rect],
              "color": [_num(x) for x in c.color]}
             for c in (g.comments[k] for k in sorted(g.comments))
         ]

@@ -12,6 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from matedit.io.atomic import UnsafeFileError, read_bounded
+
+MAX_OBJ_BYTES = 256 * 1024 * 1024
+
 BUILTIN_MESHES = ("sphere", "cube", "plane", "cylinder")
 
 
@@ -185,11 +189,14 @@ def load_obj(path: str | Path) -> MeshData:
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8", errors="strict")
+        text = read_bounded(path, MAX_OBJ_BYTES).decode("utf-8", errors="strict")
     except FileNotFoundError:
         raise MeshError(f"{path}: file not found") from None
+    except UnsafeFileError as exc:
+        raise MeshError(str(exc)) from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise MeshError(f"{path}: cannot read as an OBJ text file ({exc})") from None
+        raise MeshError(f"{path}: cannot read as an OBJ text file "
+                        f"({getattr(exc, 'strerror', None) or exc})") from None
     vs, vts, vns = [], [], []
     corners: dict[tuple[int, int, int], int] = {}
     out_p, out_uv, out_n, tris = [], [], [], []
@@ -239,6 +246,13 @@ def load_obj(path: str | Path) -> MeshData:
         raise MeshError(f"{path}: vertex positions are not finite")
     idx = np.asarray(tris, np.uint32)
     n = np.asarray(out_n, np.float64)
+    uv = np.asarray(out_uv, np.float64)
+    if not np.all(np.isfinite(uv)):
+        raise MeshError(f"{path}: texture coordinates (vt) are not finite")
+    if not np.all(np.isfinite(n)):
+        raise MeshError(f"{path}: normals (vn) are not finite")
+    if float(np.max(np.abs(p))) > 1e30:
+        raise MeshError(f"{path}: vertex positions are too large (beyond 1e30)")
     if not has_n:
         n = np.zeros_like(p)
         fn = np.cross(p[idx[:, 1]] - p[idx[:, 0]], p[idx[:, 2]] - p[idx[:, 0]])
@@ -249,7 +263,7 @@ def load_obj(path: str | Path) -> MeshData:
     p = p - centre
     scale = np.max(np.linalg.norm(p, axis=1))
     p = p / (scale if scale > 0 else 1.0)
-    return _finish(p, n, out_uv, idx)
+    return _finish(p, n, uv, idx)
 
 
 def _obj_index(field: str, count: int, what: str) -> int:

@@ -10,6 +10,7 @@ drag, a comment resize) go back to the model as commands through the controller.
 
 from __future__ import annotations
 
+import dataclasses
 from html import escape
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from matedit.app.canvas.wire_item import WireItem
 from matedit.app.controller import DocumentController
 from matedit.graph import nodes
 from matedit.graph.commands import MoveNodes, PutComment
-from matedit.graph.model import ChangeEvent, Comment, Link, Node
+from matedit.graph.model import ChangeEvent, Link, Node
 from matedit.graph.ports import node_ports
 from matedit.graph.validate import Analysis
 
@@ -368,7 +369,7 @@ class NodeScene(QGraphicsScene):
         old = self.graph.comments.get(comment_id)
         if old is None:
             return
-        new = Comment(comment_id, old.text, tuple(float(x) for x in rect), old.color)
+        new = dataclasses.replace(old, rect=tuple(float(x) for x in rect))
         commands = [PutComment(comment_id, new, text="move comment")]
         moved = {nid: p for nid, p in positions.items()
                  if nid in self.graph.nodes and tuple(p) != self.graph.nodes[nid].position}

@@ -12,6 +12,7 @@ through the controller; what the canvas shows comes back from the model's events
 
 from __future__ import annotations
 
+import dataclasses
 import re
 
 from PySide6.QtCore import QEvent, QPoint, QPointF, QRectF, Qt, Signal
@@ -598,5 +599,5 @@ class NodeCanvasView(QGraphicsView):
             return
         text, ok = QInputDialog.getText(self, "Comment", "Text:", text=old.text)
         if ok and text != old.text:
-            self.controller.push(PutComment(comment_id, Comment(comment_id, text, old.rect,
-                                                                old.color), text="edit comment"))
+            self.controller.push(PutComment(comment_id, dataclasses.replace(old, text=text),
+                                            text="edit comment"))
