@@ -76,7 +76,7 @@ def _renderer(ctx, size: tuple[int, int], cls):
         return cls(ctx, size, samples=1, environment=None)
     except moderngl.Error as exc:
         raise UsageError(f"--size {size[0]}x{size[1]}: this GL implementation cannot allocate "
-                         f"the float colour and depth render targets at this size, with {samples} or 1 "
+                         f"float colour and depth targets of this size with {samples} or 1 "
                          f"samples ("
                          f"{' '.join(str(exc).split())[:80]}); try a smaller size") from None
 
