@@ -114,8 +114,9 @@ def test_recent_files_and_new_document(qtbot, sample_copy):
 
 
 def test_export_writes_the_same_files_as_matedit_compile(qtbot, tmp_path):
-    from matedit.app.export_dialog import ExportDialog, export_shaders
+    from matedit.app.export_dialog import ExportDialog
     from matedit.cli import main
+    from matedit.compiler.export import export_shaders
 
     w = make_window(qtbot, SAMPLE)
     ours = tmp_path / "ours"
@@ -125,7 +126,7 @@ def test_export_writes_the_same_files_as_matedit_compile(qtbot, tmp_path):
     assert main(["compile", str(SAMPLE), "-o", str(theirs), "--target", "glsl330"]) == 0
     names = {p.name for p in written}
     assert {"rusty_painted_metal.glsl330.frag", "rusty_painted_metal.glsl330.vert",
-            "rusty_painted_metal.essl300.frag", "rusty_painted_metal.json"} <= names
+            "rusty_painted_metal.essl300.frag", "rusty_painted_metal.reflection.json"} <= names
     for name in ("rusty_painted_metal.glsl330.frag", "rusty_painted_metal.glsl330.vert"):
         assert (ours / name).read_text() == (theirs / name).read_text()
     dlg = ExportDialog(w.controller.document, w.controller.resolver, w)
@@ -133,6 +134,43 @@ def test_export_writes_the_same_files_as_matedit_compile(qtbot, tmp_path):
     dlg.folder.setText(str(tmp_path / "dialog"))
     assert dlg.run_export()
     assert (tmp_path / "dialog" / "rusty_painted_metal.glsl450.frag").is_file()
+
+
+def test_export_next_to_the_material_keeps_it_and_refuses_a_link_to_it(qtbot, tmp_path,
+                                                                      monkeypatch):
+    """Exporting into the material's own folder once replaced the material with the
+    reflection; now the reflection has its own name, and an output that resolves to the
+    document (here a symbolic link planted at an output name) is refused before anything is
+    written, with a message box, not an exception."""
+    import shutil
+
+    from PySide6.QtWidgets import QMessageBox
+
+    from matedit.app.export_dialog import ExportDialog
+    from matedit.io import document as fmt
+
+    folder = tmp_path / "mat"
+    shutil.copytree(SAMPLE.parent.parent, folder / "graphs")
+    doc_path = folder / "graphs" / "materials" / SAMPLE.name
+    before = doc_path.read_bytes()
+    w = make_window(qtbot, doc_path)
+    dlg = ExportDialog(w.controller.document, w.controller.resolver, w)
+    dlg.folder.setText(str(doc_path.parent))
+    assert dlg.run_export()
+    assert doc_path.read_bytes() == before
+    assert fmt.load(doc_path).graph.nodes  # still a material
+    stem = SAMPLE.name[:-5]
+    assert (doc_path.parent / f"{stem}.reflection.json").is_file()
+    trap = tmp_path / "out"
+    trap.mkdir()
+    (trap / f"{stem}.glsl330.vert").symlink_to(doc_path)
+    shown = []
+    monkeypatch.setattr(QMessageBox, "critical", lambda *a: shown.append(a[2]))
+    dlg.folder.setText(str(trap))
+    assert not dlg.run_export()
+    assert shown and "refusing to write over the document" in shown[0]
+    assert doc_path.read_bytes() == before
+    assert not (trap / f"{stem}.glsl330.frag").exists()  # nothing written at all
 
 
 def test_dock_layout_is_restored(qtbot):

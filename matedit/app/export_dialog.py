@@ -1,9 +1,9 @@
 """Export compiled shaders: targets and a folder; the same files as `matedit compile`
-(STEM.TARGET.vert, STEM.TARGET.frag and STEM.json with the reflection)."""
+(STEM.TARGET.vert, STEM.TARGET.frag and STEM.reflection.json), never over the material or a
+file it uses."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from PySide6.QtCore import QSettings
@@ -20,38 +20,13 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
-from matedit.compiler import TARGETS, CompileError, compile_all
+from matedit.compiler import TARGETS, CompileError
+from matedit.compiler.export import export_shaders
 from matedit.graph.model import MaterialDocument
-from matedit.io.atomic import atomic_write_text
 from matedit.io.document import FileResolver
+from matedit.io.inputs import OverwriteError
 
 FOLDER_KEY = "export/folder"
-
-
-def export_shaders(doc: MaterialDocument, resolver: FileResolver | None, targets: list[str],
-                   folder: Path) -> list[Path]:
-    """Writes the compiled shaders and reflection; raises CompileError or OSError."""
-    compiled = compile_all(doc, resolver, targets)
-    folder = Path(folder)
-    if folder.exists() and not folder.is_dir():
-        raise OSError(f"{folder} exists and is not a folder")
-    name = Path(doc.path).name if doc.path else (doc.name or "material").replace(" ", "_")
-    stem = name[:-5] if name.endswith(".json") else name
-    written = []
-    reflection = {"source": str(doc.path) if doc.path else stem, "targets": {}}
-    for target, cm in compiled.items():
-        for ext, text in (("vert", cm.vertex_text), ("frag", cm.fragment_text)):
-            out = folder / f"{stem}.{target}.{ext}"
-            atomic_write_text(out, text)
-            written.append(out)
-        reflection["targets"][target] = cm.reflection()
-    first = next(iter(compiled.values())).reflection()
-    for key in ("attributes", "uniforms", "textures", "uniform_block"):
-        reflection[key] = first[key]
-    out = folder / f"{stem}.json"
-    atomic_write_text(out, json.dumps(reflection, sort_keys=True, indent=2) + "\n")
-    written.append(out)
-    return written
 
 
 class ExportDialog(QDialog):
@@ -104,6 +79,9 @@ class ExportDialog(QDialog):
         except CompileError as exc:
             QMessageBox.critical(self, "Export shaders", "The material does not compile:\n"
                                  + "\n".join(d.format() for d in exc.diagnostics[:10]))
+            return False
+        except OverwriteError as exc:
+            QMessageBox.critical(self, "Export shaders", f"Nothing was written: {exc}")
             return False
         except OSError as exc:
             QMessageBox.critical(self, "Export shaders", f"Cannot write to {folder}:\n{exc}")

@@ -5,7 +5,6 @@ output that is, or resolves to, the document or a file it references."""
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -26,9 +25,9 @@ def register(sub) -> None:
 def run(args) -> int:
     # Imported here, not at the top, so that other subcommands start without the compiler.
     from matedit.compiler import CompileError, compile_all
-    from matedit.io.atomic import atomic_write_text
+    from matedit.compiler.export import export_shaders
     from matedit.io.document import FileResolver, FormatError, load
-    from matedit.io.inputs import OverwriteError, document_inputs, refuse_overwrite
+    from matedit.io.inputs import OverwriteError
 
     path = Path(args.file)
     try:
@@ -48,29 +47,13 @@ def run(args) -> int:
         raise UsageError(f"{first.file or path}: {first.format()}" if first else str(exc)) \
             from None
     out = Path(args.output)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"{out}: exists and is not a folder")
-    stem = path.name[:-5] if path.name.endswith(".json") else path.stem
-    files: dict[Path, str] = {}
-    reflection = {"source": path.name, "targets": {}}
-    for name, cm in compiled.items():
-        files[out / f"{stem}.{name}.vert"] = cm.vertex_text
-        files[out / f"{stem}.{name}.frag"] = cm.fragment_text
-        reflection["targets"][name] = cm.reflection()
-    first = next(iter(compiled.values())).reflection()
-    for key in ("attributes", "uniforms", "textures", "uniform_block"):
-        reflection[key] = first[key]
-    files[out / f"{stem}.reflection.json"] = json.dumps(reflection, sort_keys=True,
-                                                        indent=2) + "\n"
     try:
-        refuse_overwrite(files, document_inputs(doc, resolver))
-    except OverwriteError as exc:
+        export_shaders(doc, resolver, targets, out, compiled)
+    except (OverwriteError, NotADirectoryError) as exc:
         raise UsageError(str(exc)) from None
-    for target, text in files.items():
-        try:
-            atomic_write_text(target, text)
-        except OSError as exc:
-            raise UsageError(f"{target}: cannot write: {exc.strerror or exc}") from None
+    except OSError as exc:
+        raise UsageError(f"{getattr(exc, 'filename', None) or out}: cannot write: "
+                         f"{exc.strerror or exc}") from None
     if sys.stderr.isatty():
         print(f"compiled {path} for {', '.join(targets)} into {out}", file=sys.stderr)
     return 0

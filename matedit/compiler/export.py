@@ -1,0 +1,57 @@
+"""The compiled-shader files of one material: what `matedit compile` and the editor's
+Export write, the same bytes from both.
+
+DIR/STEM.TARGET.vert, DIR/STEM.TARGET.frag per target, and DIR/STEM.reflection.json. No file
+may replace the document or anything it reads (`matedit.io.inputs`); nothing written names a
+folder of this machine (the reflection's `source` is the document's file name).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from matedit.compiler.api import CompiledMaterial, compile_all
+from matedit.graph.model import MaterialDocument
+from matedit.io.atomic import atomic_write_text
+from matedit.io.inputs import document_inputs, refuse_overwrite
+
+
+def stem_of(doc: MaterialDocument) -> str:
+    name = Path(doc.path).name if doc.path else (doc.name or "material").replace(" ", "_")
+    return name[:-5] if name.endswith(".json") else name
+
+
+def shader_files(doc: MaterialDocument, compiled: dict[str, CompiledMaterial],
+                 folder: Path) -> dict[Path, str]:
+    """Output path -> text for every file of the export."""
+    folder = Path(folder)
+    stem = stem_of(doc)
+    files: dict[Path, str] = {}
+    reflection: dict = {"source": Path(doc.path).name if doc.path else stem, "targets": {}}
+    for name, cm in compiled.items():
+        files[folder / f"{stem}.{name}.vert"] = cm.vertex_text
+        files[folder / f"{stem}.{name}.frag"] = cm.fragment_text
+        reflection["targets"][name] = cm.reflection()
+    first = next(iter(compiled.values())).reflection()
+    for key in ("attributes", "uniforms", "textures", "uniform_block"):
+        reflection[key] = first[key]
+    files[folder / f"{stem}.reflection.json"] = json.dumps(reflection, sort_keys=True,
+                                                           indent=2) + "\n"
+    return files
+
+
+def export_shaders(doc: MaterialDocument, resolver, targets: list[str], folder: Path,
+                   compiled: dict[str, CompiledMaterial] | None = None) -> list[Path]:
+    """Compile (unless given) and write; raises CompileError, OverwriteError or OSError.
+    Every output is checked against the inputs before the first file is written."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise NotADirectoryError(f"{folder}: exists and is not a folder")
+    if compiled is None:
+        compiled = compile_all(doc, resolver, targets)
+    files = shader_files(doc, compiled, folder)
+    refuse_overwrite(files, document_inputs(doc, resolver))
+    for path, text in files.items():
+        atomic_write_text(path, text)
+    return list(files)
