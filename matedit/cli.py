@@ -6,6 +6,17 @@ import argparse
 import sys
 
 
+def one_line(text: object) -> str:
+    """Text for one line of a terminal report: line breaks and other control characters from
+    file names or fields are shown escaped, so a message is always exactly one line."""
+    return "".join(c if c.isprintable() or c == " " else
+                   c.encode("unicode_escape").decode("ascii") for c in str(text))
+
+
+def report(severity: str, message: object) -> None:
+    print(f"{severity}: {one_line(message)}", file=sys.stderr)
+
+
 class UsageError(Exception):
     """Bad input: reported as one `error: ...` line and exit status 2."""
 
@@ -67,13 +78,13 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         return int(args.run(args) or 0)
     except UsageError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        report("error", exc)
         return 2
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130
     except Exception as exc:  # internal failure: still one line, status 1
-        print(f"error: internal: {type(exc).__name__}: {exc}", file=sys.stderr)
+        report("error", f"internal: {type(exc).__name__}: {exc}")
         if "MATEDIT_DEBUG" in __import__("os").environ:
             raise
         return 1

@@ -11,7 +11,7 @@ import os
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError
+from matedit.cli import UsageError, report
 
 
 def register(subparsers) -> None:
@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     except EnvironmentMapError as exc:
         raise UsageError(str(exc)) from exc
     for warning in env.warnings:
-        print(f"warning: {warning}", file=sys.stderr)
+        report("warning", warning)
     env.warnings = []  # printed already
     from matedit.render.context import headless_context
 
@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         ctx.release()
     for warning in result.warnings:
-        print(f"warning: {warning}", file=sys.stderr)
+        report("warning", warning)
     try:
         written = write_bake(result, out)
     except ImageError as exc:

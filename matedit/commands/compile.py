@@ -8,7 +8,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError
+from matedit.cli import UsageError, report
 from matedit.compiler.targets import TARGETS
 
 
@@ -42,7 +42,7 @@ def run(args) -> int:
         compiled = compile_all(doc, resolver, targets)
     except CompileError as exc:
         for d in exc.diagnostics[1:]:
-            print(f"error: {d.file or path}: {d.format()}", file=sys.stderr)
+            report("error", f"{d.file or path}: {d.format()}")
         first = exc.diagnostics[0] if exc.diagnostics else None
         raise UsageError(f"{first.file or path}: {first.format()}" if first else str(exc)) \
             from None

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
+from matedit.cli import report
 from matedit.graph.validate import Severity, analyse
 from matedit.io.document import FileResolver, FormatError, load
 
@@ -55,6 +55,6 @@ def run(args) -> int:
     failed = False
     for path in expand(args.files):
         for severity, message in problems(path, resolver):
-            print(f"{severity}: {message}", file=sys.stderr)
+            report(severity, message)
             failed |= severity == Severity.ERROR.value
     return 2 if failed else 0

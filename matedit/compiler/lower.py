@@ -8,6 +8,7 @@ conversions (a float splatted to a vector) are made explicit here.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -56,7 +57,7 @@ class CompileError(Exception):
 
 
 def _doc_key(doc: MaterialDocument) -> str:
-    return str(Path(doc.path).resolve()) if doc.path else f"<unsaved {id(doc)}>"
+    return os.path.realpath(doc.path) if doc.path else f"<unsaved {id(doc)}>"
 
 
 def literal(t: PortType, value: Any) -> Lit:
@@ -229,7 +230,7 @@ class _Lowerer:
         name = f"t_{pname}"
         path = str(node.settings.get("path", ""))
         if path and self.doc.path is not None and not Path(path).is_absolute():
-            path = str((Path(self.doc.path).parent / path).resolve())
+            path = os.path.abspath(Path(self.doc.path).parent / path)
         if name not in self.ctx.textures:
             self.ctx.textures[name] = TextureInfo(name, nid, path,
                                                   bool(node.settings.get("srgb", True)), pname,

@@ -22,7 +22,8 @@ _ID = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}\Z", re.ASCII)
 def valid_id(s: object) -> bool:
     """Node ids are ASCII identifiers of at most 64 characters with no '__': they take part
     in generated names (always behind a prefix, so a keyword such as `out` is a fine id)."""
-    return isinstance(s, str) and bool(_ID.match(s)) and "__" not in s
+    return (isinstance(s, str) and bool(_ID.match(s)) and "__" not in s
+            and not s.startswith("gl_"))
 
 
 class ChangeKind(str, Enum):

@@ -8,6 +8,7 @@ output nodes. `check_connect` answers, before a link is made, whether it may be.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
@@ -256,7 +257,13 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
             if isinstance(tex, str) and tex:
                 base = Path(doc.path).parent if doc.path else Path.cwd()
                 try:
-                    found = (base / tex).is_file()
+                    if "\0" in tex:
+                        raise ValueError("the path holds a NUL character")
+                    found = os.path.isfile(base / tex)
+                    os.path.realpath(base / tex)
+                    if len(os.fsencode(tex)) > 4095 or any(
+                            len(part) > 255 for part in os.fsencode(tex).split(b"/")):
+                        raise ValueError("the path is longer than the system allows")
                 except (OSError, ValueError) as exc:
                     diags.append(error(f"texture path cannot be used: "
                                        f"{getattr(exc, 'strerror', None) or exc}",
@@ -315,7 +322,7 @@ def function_refs(doc: MaterialDocument) -> list[tuple[str, str]]:
 
 
 def _doc_key(doc: MaterialDocument) -> str:
-    return str(Path(doc.path).resolve()) if doc.path else f"<unsaved {id(doc)}>"
+    return os.path.realpath(doc.path) if doc.path else f"<unsaved {id(doc)}>"
 
 
 def _call_cycles(doc: MaterialDocument, resolver: FunctionResolver | None) -> list[Diagnostic]:

@@ -39,7 +39,7 @@ def resolve_target(path: str | os.PathLike) -> Path:
     """The file a write to `path` must replace: symbolic links are followed to their target."""
     p = Path(path)
     if p.is_symlink():
-        return p.resolve()
+        return Path(os.path.realpath(p))
     return p
 
 

@@ -186,7 +186,8 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> Ma
         _expect(isinstance(n, dict), file, f"nodes[{i}] must be an object", field=f"nodes[{i}]")
         nid = n.get("id")
         _expect(valid_id(nid), file,
-                f"nodes[{i}]: id must be an identifier (letters, digits, _; no '__'), got {nid!r}",
+                f"nodes[{i}]: id must be an ASCII identifier of at most 64 letters, digits and _, "
+                f"starting with a letter, with no '__' and no 'gl_' prefix, got {nid!r}",
                 field="id")
         _expect(nid not in doc.graph.nodes, file, "duplicate node id", node=nid, field="id")
         kind = n.get("kind")
@@ -315,15 +316,15 @@ def rebase_references(doc: MaterialDocument, new_path: Path) -> None:
     """Rewrites relative references so they still point at the same files from `new_path`."""
     if doc.path is None:
         return
-    old_dir = Path(doc.path).resolve().parent
-    new_dir = Path(new_path).resolve().parent
+    old_dir = Path(os.path.realpath(doc.path)).parent
+    new_dir = Path(os.path.realpath(new_path)).parent
     if old_dir == new_dir:
         return
     for container, key in reference_fields(doc):
         ref = container[key]
         if not ref or Path(ref).is_absolute():
             continue
-        target = (old_dir / ref).resolve()
+        target = Path(os.path.realpath(old_dir / ref))
         container[key] = Path(os.path.relpath(target, new_dir)).as_posix()
 
 
@@ -346,14 +347,14 @@ class FileResolver:
 
     def path_of(self, ref: str, owner: MaterialDocument | None) -> Path:
         base = Path(owner.path).parent if owner is not None and owner.path else Path.cwd()
-        return (base / ref).resolve()
+        return Path(os.path.realpath(base / ref))
 
     def resolve(self, ref: str, owner: MaterialDocument | None) -> MaterialDocument:
-        p = self.path_of(ref, owner)
         try:
+            p = self.path_of(ref, owner)
             mtime = p.stat().st_mtime
-        except OSError:
-            raise LookupError(f"{ref}: file not found ({p})") from None
+        except (OSError, ValueError):
+            raise LookupError(f"{ref}: file not found") from None
         hit = self._cache.get(p)
         if hit and hit[0] == mtime:
             return hit[1]

@@ -98,4 +98,7 @@ def refuse_overwrite(outputs: Iterable[str | os.PathLike], inputs: dict[Path, st
 
 
 def _real(p: str | os.PathLike) -> Path:
-    return Path(os.path.realpath(os.fspath(p)))
+    try:
+        return Path(os.path.realpath(os.fspath(p)))
+    except (OSError, ValueError):  # a NUL byte or an over-long name: no file has that path
+        return Path(os.path.abspath(os.fspath(p)).replace("\0", "\\0"))
