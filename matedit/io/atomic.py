@@ -5,6 +5,7 @@ Writes (`atomic_write_bytes`, `atomic_write_text`, `atomic_output`):
   unpredictable name beside the target, is flushed to disk, then renamed over the target,
   so the target is either the old file or the complete new one;
 - a failure at any step removes the temporary file and leaves the old target untouched;
+- `atomic_write_bytes` creates missing folders; `atomic_output` (images) expects the folder;
 - new files get the user's umask (created 0o666 & ~umask); replacing a file keeps its mode;
 - a target that is a symbolic link is written through: the link's final target is replaced
   and the link stays in place.
@@ -112,7 +113,8 @@ def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
     """For writers that open a file by name: yields a name to write to; on a clean exit the
     file is moved over `path` (atomically), on an exception nothing of it remains."""
     target = resolve_target(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    if not target.parent.is_dir():
+        raise FileNotFoundError(2, "the folder does not exist", str(target.parent))
     if target.is_dir():
         raise IsADirectoryError(f"{path}: is a folder")
     mode = _existing_mode(target)
