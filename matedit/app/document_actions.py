@@ -59,6 +59,21 @@ def document_title(doc: MaterialDocument) -> str:
     return doc.name or "Untitled"
 
 
+def display_name(doc: MaterialDocument) -> str:
+    """What a tab or breadcrumb calls a document: its own name, unless that is the
+    placeholder of unsaved work and the document has a file now (then the file's stem)."""
+    if doc.name and not (doc.name == "Untitled" and doc.path is not None):
+        return doc.name
+    if doc.path is not None:
+        return Path(doc.path).stem
+    return doc.name or "Untitled"
+
+
+def no_mnemonic(text: str) -> str:
+    """`text` for a Qt widget that reads '&' as a mnemonic marker (tabs, buttons, menus)."""
+    return text.replace("&", "&&")
+
+
 class DocumentActions(QObject):
     """Owns the file-level state of one document controller inside a window."""
 

@@ -119,8 +119,10 @@ class MainWindow(QMainWindow):
         lights_scroll.setWidgetResizable(True)
         lights_scroll.setFrameShape(QScrollArea.Shape.NoFrame)
         lights_scroll.setWidget(lights_host)
-        self.lights_dock = self._dock("Lights && Environment", "lightsDock", lights_scroll, R,
+        self.lights_dock = self._dock("Lights & Environment", "lightsDock", lights_scroll, R,
                                       "light")
+        # The title bar shows the text as it is; the View menu's action reads '&' as a mnemonic.
+        self.lights_dock.toggleViewAction().setText("Lights && Environment")
         self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
                                            B, "warning")
         self.code_dock = self._dock("GLSL", "codeDock", self.code, B)
@@ -398,7 +400,7 @@ class MainWindow(QMainWindow):
                 if p.node_id and p.severity == "error":
                     merr[p.node_id] = p.message
             m.canvas.set_node_errors(merr)
-        n = sum(1 for p in problems if p.severity == "error")
+        n = sum(1 for p in self.diagnostics.problems if p.severity == "error")  # the rows
         title = "Diagnostics" + (f" ({n})" if n else "")
         self.diagnostics_dock.setWindowTitle(title)
         self._retitle()
