@@ -105,8 +105,10 @@ class CanvasTabs(QWidget):
     def activate(self, tab: CanvasTab) -> None:
         self.tabs.setCurrentIndex(self._tabs.index(tab))
 
-    def open_function(self, path: str | Path, parent: CanvasTab | None = None) -> CanvasTab | None:
-        """Opens a material function in a tab (or shows the tab that has it)."""
+    def open_function(self, path: str | Path, parent: CanvasTab | None = None,
+                      recovered=None) -> CanvasTab | None:
+        """Opens a material function in a tab (or shows the tab that has it); `recovered`:
+        its autosaved content, already chosen by the artist, opened as unsaved work."""
         path = Path(path).resolve()
         for tab in self._tabs:
             if tab.controller.document.path and Path(tab.controller.document.path).resolve() \
@@ -129,7 +131,8 @@ class CanvasTabs(QWidget):
         actions.show_error = lambda title, text: main.show_error(title, text)
         actions.ask_save_changes = lambda name: main.ask_save_changes(name)
         actions.ask_recover = lambda p, rec: main.ask_recover(p, rec)
-        recovered = actions._offer_recovery(path)  # a function edited when the editor crashed
+        if recovered is None:  # a function edited when the editor crashed
+            recovered = actions._offer_recovery(path)
         if recovered is not None:
             controller.replace(recovered)
             controller.undo_stack.resetClean()

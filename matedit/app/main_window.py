@@ -73,6 +73,10 @@ class MainWindow(QMainWindow):
         self.undo_group.setActiveStack(self.controller.undo_stack)
         self._on_active(self.tabs.active)
         self._retitle()
+        self.extra_windows: list[MainWindow] = []  # recovered materials opened at start-up
+        self.actions.open_recovered_function = lambda e, doc: self.tabs.open_function(
+            e.document, self.tabs.material, recovered=doc)
+        self.actions.open_recovered_material = self._open_recovered_material
         if start:
             self.actions.start(path, sample_path() if sample else None)
             self.compiler.recompile()
@@ -284,6 +288,16 @@ class MainWindow(QMainWindow):
         if not self.tabs.close_functions():
             return False
         return self.actions.open(path)
+
+    def _open_recovered_material(self, entry, doc) -> None:
+        """A second recovered material gets a window of its own."""
+        w = MainWindow(restore_layout=False, start=False)
+        for name in ("ask_save_changes", "ask_recover", "show_error"):
+            setattr(w.actions, name, getattr(self.actions, name))
+        w.actions._adopt(entry, doc)
+        w.compiler.recompile()
+        w.show()
+        self.extra_windows.append(w)
 
     def save_active(self) -> bool:
         return self.tabs.active.actions.save()
