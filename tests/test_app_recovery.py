@@ -31,8 +31,11 @@ def _crash(w) -> None:
     shiboken6.delete(w)
 
 
+KEEP_ALL = {"recover_all": lambda entries: {e.rec: "keep" for e in entries}}
+
+
 def _untitled_with_output(qtbot, label: str):
-    w = make_window(qtbot, track=False)
+    w = make_window(qtbot, track=False, answers=KEEP_ALL)  # earlier crashes stay put
     nid = w.tabs.material.canvas.add_node_at("material_output", QPointF(0, 0))
     assert w.controller.push(SetLabel(nid, label))
     assert w.actions.autosave() is not None
