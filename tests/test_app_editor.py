@@ -237,17 +237,18 @@ def test_library_function_opens_in_a_tab_with_breadcrumbs_back(qtbot):
 
 
 def test_diagnostics_click_selects_the_node(qtbot):
-    from matedit.graph.commands import Disconnect
+    from matedit.graph.commands import Connect
+    from matedit.graph.model import Link
 
     w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json")
-    link = w.controller.document.graph.incoming("out", "attributes")
-    w.controller.push(Disconnect(link))
+    # A wire from an output that does not exist (an unconnected input only warns now).
+    w.controller.push(Connect(Link("mask_noise", "nope", "mask", "value")))
     settle(qtbot, w, 10)
     assert w.compiler.current is None
     problems = w.diagnostics.problems
-    assert any(p.node_id == "out" and p.severity == "error" for p in problems)
+    assert any(p.node_id == "mask_noise" and p.severity == "error" for p in problems)
     item = next(w.diagnostics.topLevelItem(i) for i in range(w.diagnostics.topLevelItemCount())
-                if w.diagnostics.topLevelItem(i).text(1) == "out")
+                if w.diagnostics.topLevelItem(i).text(1) == "mask_noise")
     w.diagnostics.itemClicked.emit(item, 0)
-    assert w.tabs.material.canvas.selected_ids() == ["out"]
-    assert w.inspector.node_id == "out"
+    assert w.tabs.material.canvas.selected_ids() == ["mask_noise"]
+    assert w.inspector.node_id == "mask_noise"

@@ -47,8 +47,8 @@ def app_env(qapp):
 def make_window(qtbot, path=None, *, sample: bool = False, show: bool = False,
                 answers: dict | None = None, track: bool = True):
     """A main window on `path` (or an empty material). Questions are answered from
-    `answers` (`save_changes`: save/discard/cancel; `recover`: bool or a callable), never
-    by a modal dialog."""
+    `answers` (`save_changes`: save/discard/cancel; `recover`: bool or a callable;
+    `recover_all`: the start-up list's answers), never by a modal dialog."""
     from matedit.app.main_window import MainWindow
 
     answers = {"save_changes": "discard", "recover": True, **(answers or {})}
@@ -59,6 +59,12 @@ def make_window(qtbot, path=None, *, sample: bool = False, show: bool = False,
     w.actions.ask_save_changes = lambda name: answers["save_changes"]
     recover = answers["recover"]
     w.actions.ask_recover = recover if callable(recover) else (lambda p, rec: recover)
+    if "recover_all" in answers:  # {rec: "recover"|"discard"|"keep"} from the entries found
+        w.actions.ask_recover_all = answers["recover_all"]
+    else:  # each entry answered as `recover` answers the one-file question
+        w.actions.ask_recover_all = lambda entries: {
+            e.rec: "recover" if w.actions.ask_recover(e.document or e.rec, e.rec)
+            else "discard" for e in entries}
     w.actions.show_error = lambda title, text: errors.append((title, text))
     w.shown_errors = errors
     w.actions.start(path, None if not sample else Path(sample))

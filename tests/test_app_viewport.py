@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
 
-from matedit.graph.commands import Disconnect, SetValue
+from matedit.graph.commands import Connect, SetValue
+from matedit.graph.model import Link
 from matedit.resources import graphs_dir
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
@@ -61,8 +62,8 @@ def test_viewport_draws_and_a_parameter_edit_changes_it_without_relinking(window
 def test_a_broken_edit_keeps_the_last_good_image(window, qtbot):
     view = window.viewport.view
     good = frame(qtbot, view)
-    link = window.controller.document.graph.incoming("out", "attributes")
-    assert window.controller.push(Disconnect(link))  # the graph no longer compiles
+    # A wire from an output that does not exist: the graph no longer compiles.
+    assert window.controller.push(Connect(Link("mask_noise", "nope", "mask", "value")))
     settle(qtbot, window)
     assert window.compiler.current is None
     assert any(p.severity == "error" for p in window.diagnostics.problems)

@@ -206,8 +206,10 @@ def test_compile_command_writes_files_and_reflection(tmp_path):
 
 def test_compile_command_bad_input_exits_2(tmp_path):
     bad = tmp_path / "bad.json"
+    # (an unconnected output is only a warning now: it takes the default material)
     bad.write_text('{"format": "matedit.material", "version": 2, "nodes": '
-                   '[{"id": "o", "kind": "material_output"}]}')
+                   '[{"id": "o", "kind": "material_output"}], "links": '
+                   '[{"from": ["ghost", "value"], "to": ["o", "attributes"]}]}')
     r = subprocess.run([sys.executable, "-m", "matedit", "compile", str(bad), "-o",
                         str(tmp_path / "o")], capture_output=True, text=True)
     assert r.returncode == 2

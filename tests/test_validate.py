@@ -54,11 +54,21 @@ def test_float_splats_into_vectors():
     assert errors(d) == []
 
 
-def test_missing_required_link():
+def test_missing_required_link_is_a_warning_that_names_the_default():
+    # Unconnected, the output takes the default material: the rest keeps compiling (issue 18).
     d = simple_material()
     d.graph.links.discard(d.graph.incoming("out", "attributes"))
-    (e,) = errors(d)
-    assert (e.node_id, e.port) == ("out", "attributes")
+    assert errors(d) == []
+    (w,) = [x for x in validate(d) if x.severity == Severity.WARNING]
+    assert (w.node_id, w.port) == ("out", "attributes") and "default" in w.message
+
+
+def test_unconnected_texture_sample_is_a_warning_not_an_error():
+    d = simple_material()
+    node(d, "ts", "texture_sample")
+    assert errors(d) == []
+    assert any((x.node_id, x.port, x.severity) == ("ts", "texture", Severity.WARNING)
+               and "checker" in x.message for x in validate(d))
 
 
 def test_cycle_is_reported():

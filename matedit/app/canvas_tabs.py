@@ -16,7 +16,7 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QTabWidget, QVBo
 
 from matedit.app.canvas import NodeCanvasView
 from matedit.app.controller import DocumentController
-from matedit.app.document_actions import DocumentActions, document_title
+from matedit.app.document_actions import DocumentActions, display_name, no_mnemonic
 from matedit.app.previews import NodePreviews
 from matedit.app.theme import icon
 from matedit.io.document import FormatError, load
@@ -105,8 +105,10 @@ class CanvasTabs(QWidget):
     def activate(self, tab: CanvasTab) -> None:
         self.tabs.setCurrentIndex(self._tabs.index(tab))
 
-    def open_function(self, path: str | Path, parent: CanvasTab | None = None) -> CanvasTab | None:
-        """Opens a material function in a tab (or shows the tab that has it)."""
+    def open_function(self, path: str | Path, parent: CanvasTab | None = None,
+                      recovered=None) -> CanvasTab | None:
+        """Opens a material function in a tab (or shows the tab that has it); `recovered`:
+        its autosaved content, already chosen by the artist, opened as unsaved work."""
         path = Path(path).resolve()
         for tab in self._tabs:
             if tab.controller.document.path and Path(tab.controller.document.path).resolve() \
@@ -129,7 +131,8 @@ class CanvasTabs(QWidget):
         actions.show_error = lambda title, text: main.show_error(title, text)
         actions.ask_save_changes = lambda name: main.ask_save_changes(name)
         actions.ask_recover = lambda p, rec: main.ask_recover(p, rec)
-        recovered = actions._offer_recovery(path)  # a function edited when the editor crashed
+        if recovered is None:  # a function edited when the editor crashed
+            recovered = actions._offer_recovery(path)
         if recovered is not None:
             controller.replace(recovered)
             controller.undo_stack.resetClean()
@@ -181,9 +184,9 @@ class CanvasTabs(QWidget):
         if tab not in self._tabs:
             return
         i = self._tabs.index(tab)
+        name = display_name(tab.controller.document)
+        self.tabs.setTabText(i, no_mnemonic(name) + ("*" if tab.controller.dirty else ""))
         doc = tab.controller.document
-        name = doc.name or document_title(doc)
-        self.tabs.setTabText(i, name + ("*" if tab.controller.dirty else ""))
         self.tabs.setTabToolTip(i, str(doc.path) if doc.path else "not saved yet")
         self._refresh_crumbs()
 
@@ -218,12 +221,12 @@ class CanvasTabs(QWidget):
                 sep = QLabel("›")
                 sep.setObjectName("fieldLabel")
                 self.crumb_layout.addWidget(sep)
-            doc = tab.controller.document
-            b = QPushButton(doc.name or document_title(doc))
+            name = display_name(tab.controller.document)
+            b = QPushButton(no_mnemonic(name))
             b.setObjectName("crumb")
             b.setIcon(icon("function" if tab.is_function else "material"))
             b.setEnabled(i < len(chain) - 1)
-            b.setToolTip("Back to " + (doc.name or document_title(doc)))
+            b.setToolTip("Back to " + name)
             b.clicked.connect(lambda _=False, t=tab: t in self._tabs and self.activate(t))
             self.crumb_layout.addWidget(b)
         self.crumb_layout.addStretch(1)

@@ -2,26 +2,39 @@
 recovery after a crash, and the close prompt.
 
 Saves are atomic (`matedit.io.document.save`). Every 30 s a dirty document is
-written to a recovery file in AppDataLocation/recovery/ (atomically too), which a
-clean save or close removes; a recovery file newer than its document at open time
-means the editor did not close cleanly, and recovering it is offered. Questions to
-the artist go through replaceable callables so tests can answer them.
+written to its own recovery file (`matedit.app.recovery`, atomically too), which a
+clean save or close removes. At start-up every recovery file left behind is offered,
+and one is deleted only once the artist has answered for it. Questions to the artist
+go through replaceable callables so tests can answer them.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 import time
+import weakref
 from collections.abc import Callable
 from pathlib import Path
 
-from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal
+import shiboken6
+from PySide6.QtCore import QObject, QSettings, QTimer, Signal
 from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
 
 from matedit.app.controller import DocumentController
 from matedit.app.paths import relativise_references
+from matedit.app.recovery import DISCARD as REC_DISCARD
+from matedit.app.recovery import (
+    RECOVER,
+    RecoveryEntry,
+    ask_recover_all,
+    find_recoveries,
+    meta_path,
+    new_untitled_key,
+    recovery_dir,  # noqa: F401 - part of this module's API (tests, the window)
+    recovery_path,
+    remove_recovery,
+    write_meta_text,
+)
 from matedit.graph.model import MaterialDocument
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import FormatError, dumps, load, loads, save
@@ -30,27 +43,8 @@ AUTOSAVE_MS = 30_000
 MAX_RECENT = 10
 RECENT_KEY = "files/recent"
 FILE_FILTER = "matedit graphs (*.json);;All files (*)"
-UNTITLED = "untitled"
 
 SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
-
-
-def recovery_dir() -> Path:
-    base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
-    return Path(base or Path.home() / ".matedit") / "recovery"
-
-
-def recovery_path(doc_path: Path | None) -> Path:
-    """The recovery file of a document (one per document path; one for untitled work)."""
-    if doc_path is None:
-        return recovery_dir() / f"{UNTITLED}.json"
-    key = hashlib.sha1(str(Path(doc_path).resolve()).encode()).hexdigest()[:12]
-    stem = Path(doc_path).name.removesuffix(".json")
-    return recovery_dir() / f"{stem}-{key}.json"
-
-
-def _meta_path(rec: Path) -> Path:
-    return rec.with_suffix(".meta")
 
 
 def document_title(doc: MaterialDocument) -> str:
@@ -59,8 +53,25 @@ def document_title(doc: MaterialDocument) -> str:
     return doc.name or "Untitled"
 
 
+def display_name(doc: MaterialDocument) -> str:
+    """What a tab or breadcrumb calls a document: its own name, unless that is the
+    placeholder of unsaved work and the document has a file now (then the file's stem)."""
+    if doc.name and not (doc.name == "Untitled" and doc.path is not None):
+        return doc.name
+    if doc.path is not None:
+        return Path(doc.path).stem
+    return doc.name or "Untitled"
+
+
+def no_mnemonic(text: str) -> str:
+    """`text` for a Qt widget that reads '&' as a mnemonic marker (tabs, buttons, menus)."""
+    return text.replace("&", "&&")
+
+
 class DocumentActions(QObject):
     """Owns the file-level state of one document controller inside a window."""
+
+    _live: weakref.WeakSet = weakref.WeakSet()  # this process's documents (their autosaves)
 
     opened = Signal(object)  # Path | None: a document replaced the previous one
     saved = Signal(object)  # Path
@@ -71,6 +82,8 @@ class DocumentActions(QObject):
         self.window = window
         self.controller = controller
         self._autosaved_index: int | None = None
+        self.untitled_key = new_untitled_key()  # an untitled document's own recovery file
+        DocumentActions._live.add(self)
         self.autosave_timer = QTimer(self)
         self.autosave_timer.setInterval(AUTOSAVE_MS)
         self.autosave_timer.timeout.connect(self.autosave)
@@ -78,6 +91,13 @@ class DocumentActions(QObject):
         # Questions, replaceable by tests.
         self.ask_save_changes: Callable[[str], str] = self._ask_save_changes
         self.ask_recover: Callable[[Path, Path], bool] = self._ask_recover
+        self.ask_recover_all: Callable[[list[RecoveryEntry]], dict[Path, str]] = \
+            lambda entries: ask_recover_all(entries, self.window)
+        # Where recovered work goes that this window's material cannot hold (set by the window).
+        self.open_recovered_function: Callable[[RecoveryEntry, MaterialDocument], None] | \
+            None = None
+        self.open_recovered_material: Callable[[RecoveryEntry, MaterialDocument], None] | \
+            None = None
         self.ask_open_path: Callable[[], str] = self._ask_open_path
         self.ask_save_path: Callable[[str], str] = self._ask_save_path
         self.show_error: Callable[[str, str], None] = self._show_error
@@ -98,11 +118,16 @@ class DocumentActions(QObject):
 
     def _ask_recover(self, doc_path: Path, rec: Path) -> bool:
         when = time.strftime("%Y-%m-%d %H:%M", time.localtime(rec.stat().st_mtime))
+        try:
+            newer = rec.stat().st_mtime >= Path(doc_path).stat().st_mtime
+        except OSError:
+            newer = True
         answer = QMessageBox.question(
             self.window, "Recover unsaved work",
             f"matedit did not close cleanly while editing {doc_path.name}.\n\n"
-            f"An autosave from {when} is newer than the file. Recover it?\n"
-            "(Recovered work is unsaved until you save it.)",
+            f"An autosave from {when} is {'newer' if newer else 'OLDER'} than the file. "
+            "Recover it?\n(Recovered work is unsaved until you save it; No deletes the "
+            "autosave.)",
             QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
             QMessageBox.StandardButton.Yes)
         return answer == QMessageBox.StandardButton.Yes
@@ -131,6 +156,10 @@ class DocumentActions(QObject):
     def title(self) -> str:
         return document_title(self.document)
 
+    def recovery_file(self) -> Path:
+        """Where this document autosaves (its own file, untitled or not)."""
+        return recovery_path(self.document.path, self.untitled_key)
+
     # --- new / open ------------------------------------------------------------------------
     def maybe_save(self) -> bool:
         """Before the document goes away: True to go on (saved or discarded), False to stop."""
@@ -145,6 +174,7 @@ class DocumentActions(QObject):
         if not self.maybe_save():
             return False
         self.discard_recovery()
+        self.untitled_key = new_untitled_key()
         self.controller.replace(MaterialDocument(name="Untitled"))
         self.opened.emit(None)
         return True
@@ -163,8 +193,9 @@ class DocumentActions(QObject):
             self.show_error("Cannot open file", f"{path}: {type(exc).__name__}: {exc}")
         return None
 
-    def open(self, path: str | os.PathLike, ask: bool = True) -> bool:
-        """Opens a material (the current one is kept if the file is bad)."""
+    def open(self, path: str | os.PathLike, ask: bool = True, offer: bool = True) -> bool:
+        """Opens a material (the current one is kept if the file is bad); `offer`: ask about
+        the file's recovery file, if there is one."""
         if ask and not self.maybe_save():
             return False
         doc = self.read(path)
@@ -176,7 +207,7 @@ class DocumentActions(QObject):
             return False
         if ask:  # leaving a document the artist has just saved or discarded
             self.discard_recovery()
-        recovered = self._offer_recovery(Path(path))
+        recovered = self._offer_recovery(Path(path)) if offer else None
         self.controller.replace(recovered or doc)
         if recovered is not None:
             self.controller.undo_stack.resetClean()  # recovered work is unsaved
@@ -185,19 +216,50 @@ class DocumentActions(QObject):
         return True
 
     def start(self, path: str | os.PathLike | None, fallback: Path | None) -> None:
-        """At start-up: open `path` (or the fallback sample), offering crash recovery."""
-        if path is not None and self.open(path, ask=False):
-            return
-        rec = recovery_path(None)
-        if rec.is_file() and self.ask_recover(Path(UNTITLED), rec):
-            doc = self._read_recovery(rec, None)
-            if doc is not None:
-                self.controller.replace(doc)
-                self.controller.undo_stack.resetClean()
-                self.opened.emit(None)
-                return
-        if fallback is not None:
-            self.open(fallback, ask=False)
+        """At start-up: open `path` (or the fallback sample), and offer every recovery file
+        that an editor which did not close cleanly left behind, `path`'s among them."""
+        entries = find_recoveries(skip={a.recovery_file() for a in list(DocumentActions._live)
+                                        if a is not self and shiboken6.isValid(a)})
+        decisions = self.ask_recover_all(entries) if entries else {}
+        chosen: list[tuple[RecoveryEntry, MaterialDocument]] = []
+        for e in entries:
+            answer = decisions.get(e.rec)
+            if answer == REC_DISCARD:
+                remove_recovery(e.rec)
+            elif answer == RECOVER:
+                doc = self._read_recovery(e.rec, e.document)
+                if doc is not None:
+                    chosen.append((e, doc))
+        target = Path(path).resolve() if path is not None else None
+        mine = next((c for c in chosen if not c[0].is_function and c[0].document is not None
+                     and target is not None and c[0].document.resolve() == target), None)
+        if mine is None and target is None:
+            mine = next((c for c in chosen if not c[0].is_function), None)
+        opened = False
+        if path is not None:
+            opened = self.open(path, ask=False, offer=False)
+        if mine is not None and (opened or target is None):
+            self._adopt(*mine)
+            opened = True
+        if not opened and fallback is not None:
+            self.open(fallback, ask=False, offer=False)
+        for e, doc in chosen:
+            if (e, doc) is mine or mine is not None and e == mine[0]:
+                continue
+            sink = self.open_recovered_function if e.is_function else \
+                self.open_recovered_material
+            if sink is not None:
+                sink(e, doc)
+            else:
+                self.message.emit(f"{e.name}: kept in {e.rec.name} (nowhere to open it)")
+
+    def _adopt(self, entry: RecoveryEntry, doc: MaterialDocument) -> None:
+        """Recovered work becomes this window's document, unsaved, autosaving to the same
+        recovery file (deleted once it is saved or knowingly dropped)."""
+        self.untitled_key = entry.untitled_key or self.untitled_key
+        self.controller.replace(doc)
+        self.controller.undo_stack.resetClean()
+        self.opened.emit(doc.path)
 
     # --- save ------------------------------------------------------------------------------
     def save(self) -> bool:
@@ -215,7 +277,7 @@ class DocumentActions(QObject):
 
     def _write(self, path: Path) -> bool:
         old_path = self.document.path
-        old_recovery = recovery_path(old_path)
+        old_recovery = self.recovery_file()
         try:
             if old_path is None:
                 relativise_references(self.document, path)
@@ -237,14 +299,13 @@ class DocumentActions(QObject):
         if not self.controller.dirty:
             return None
         index = self.controller.undo_stack.index()
-        rec = recovery_path(self.document.path)
+        rec = self.recovery_file()
         if index == self._autosaved_index and rec.is_file():
             return None
         try:
             atomic_write_text(rec, dumps(self.document))
-            atomic_write_text(_meta_path(rec), json.dumps(
-                {"document": str(self.document.path) if self.document.path else None,
-                 "time": time.time()}) + "\n")
+            atomic_write_text(meta_path(rec), write_meta_text(
+                self.document.path, display_name(self.document), self.document.is_function))
         except (OSError, ValueError) as exc:
             self.message.emit(f"autosave failed: {exc}")
             return None
@@ -254,32 +315,19 @@ class DocumentActions(QObject):
 
     def discard_recovery(self) -> None:
         """The current document's work is saved or knowingly dropped: forget its autosave."""
-        self._remove_recovery(recovery_path(self.document.path))
+        self._remove_recovery(self.recovery_file())
         self._autosaved_index = None
 
     @staticmethod
     def _remove_recovery(rec: Path) -> None:
-        for p in (rec, _meta_path(rec)):
-            try:
-                p.unlink()
-            except FileNotFoundError:
-                pass
-            except OSError:
-                pass
+        remove_recovery(rec)
 
     def _offer_recovery(self, path: Path) -> MaterialDocument | None:
-        """The autosave of `path` if it is newer than the file and the artist wants it."""
+        """The autosave of `path` if the artist wants it (declined: it is deleted)."""
         rec = recovery_path(path)
         if not rec.is_file():
             return None
-        try:
-            newer = rec.stat().st_mtime > Path(path).stat().st_mtime
-        except OSError:
-            newer = True
-        if not newer:
-            self._remove_recovery(rec)  # stale: the file was saved after it
-            return None
-        if not self.ask_recover(path, rec):
+        if not self.ask_recover(path, rec):  # deleted only once the artist has answered
             self._remove_recovery(rec)
             return None
         return self._read_recovery(rec, path)
@@ -288,8 +336,12 @@ class DocumentActions(QObject):
         try:
             return loads(rec.read_text(encoding="utf-8"), str(rec), path)
         except (FormatError, OSError, UnicodeDecodeError) as exc:
-            self.show_error("Cannot recover", f"The autosave {rec} is unreadable:\n{exc}")
-            self._remove_recovery(rec)
+            aside = rec.with_name(rec.name + ".unreadable")
+            try:  # kept for a person to look at, never offered again
+                os.replace(rec, aside)
+            except OSError:
+                aside = rec
+            self.show_error("Cannot recover", f"The autosave {aside} is unreadable:\n{exc}")
             return None
 
     def close(self) -> bool:

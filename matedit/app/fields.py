@@ -206,7 +206,7 @@ class ColorField(QWidget):
         lay.addWidget(self.swatch, 1)
         lay.addWidget(QLabel("×"))
         lay.addWidget(self.intensity)
-        self._base = [0.5, 0.5, 0.5]
+        self._base: list[float] = []  # the first value is split afresh
         self.set_value(value)
         self.dialog_factory = QColorDialog.getColor  # tests replace it
 
@@ -215,11 +215,27 @@ class ColorField(QWidget):
         return [round(c * k, 6) for c in self._base]
 
     def set_value(self, value: list[float]) -> None:
-        self._base, k = split_hdr([float(x) for x in value])
+        rgb = [float(x) for x in value]
+        k = self._same_hue_intensity(rgb)
+        if k is None:  # a new colour: split it afresh
+            self._base, k = split_hdr(rgb)
         self.intensity.blockSignals(True)
         self.intensity.setValue(k)
         self.intensity.blockSignals(False)
         self._paint()
+
+    def _same_hue_intensity(self, rgb: list[float]) -> float | None:
+        """The intensity that makes the shown colour `rgb`, if `rgb` is the shown colour
+        scaled (an intensity edit coming back from the model, or its undo): the field keeps
+        what the artist typed instead of re-splitting (4 must stay 4)."""
+        peak = max(self._base) if self._base else 0.0
+        if peak <= 0.0 or len(rgb) != len(self._base):
+            return None
+        k = max(rgb) / peak
+        if k < 0 or any(abs(b * k - c) > 1e-5 * max(1.0, abs(c)) for b, c in zip(self._base,
+                                                                                rgb)):
+            return None
+        return k
 
     def _paint(self) -> None:
         r, g, b = (int(round(linear_to_srgb(c) * 255)) for c in self._base)

@@ -31,8 +31,16 @@ from matedit.app.controller import DocumentController
 from matedit.app.fields import FloatField
 from matedit.app.paths import reference_for
 from matedit.app.theme import icon
-from matedit.graph.commands import AddNode, CommandError, Connect, Macro, SetValue
-from matedit.graph.layers import Layer, LayerStack
+from matedit.graph.commands import (
+    AddNode,
+    CommandError,
+    Connect,
+    Disconnect,
+    Macro,
+    SetSetting,
+    SetValue,
+)
+from matedit.graph.layers import Layer, LayerStack, parked_wires
 from matedit.graph.model import ChangeEvent, ChangeKind, Link, Node
 from matedit.graph.ports import LAYER_BLENDS
 from matedit.io.document import FormatError, load
@@ -54,10 +62,37 @@ def layer_title(path: Path) -> str:
         return path.stem
 
 
+def wire_report(cmd) -> str:
+    """What a layer edit did to wires, in words ("" when it touched none): no layer edit
+    cuts a wire without saying so."""
+    subs = cmd.commands if isinstance(cmd, Macro) else [cmd]
+    cut = [c.link for c in subs if isinstance(c, Disconnect)]
+    back = [c.link for c in subs if isinstance(c, Connect)]
+    parked_ports: set[str] = set()
+    for c in subs:
+        if isinstance(c, SetSetting) and c.name == "layers" and c.value and \
+                isinstance(c.value[0], dict):
+            base = c.value[0]
+            parked_ports = {f"{base.get('id')}_{w.get('port')}" for w in parked_wires(base)}
+    parts = []
+    parked_now = sum(1 for lk in cut if lk.dst_port in parked_ports)
+    if parked_now:
+        parts.append(f"{parked_now} wire{'s' if parked_now != 1 else ''} parked on the base "
+                     "layer (they come back when it is moved up)")
+    if len(cut) > parked_now:
+        n = len(cut) - parked_now
+        parts.append(f"{n} wire{'s' if n != 1 else ''} removed: "
+                     + ", ".join(sorted(lk.dst_port for lk in cut)[:4]))
+    if back:
+        parts.append(f"{len(back)} parked wire{'s' if len(back) != 1 else ''} reconnected")
+    return "; ".join(parts)
+
+
 class _LayerRow(QWidget):
     """Eye, name, blend and opacity of one layer."""
 
-    def __init__(self, panel: LayersPanel, layer: Layer, is_base: bool, opacity: float):
+    def __init__(self, panel: LayersPanel, layer: Layer, is_base: bool, opacity: float,
+                 parked: list[dict] | None = None):
         super().__init__()
         self.setObjectName("layerRow")
         self.layer_id = layer.id
@@ -93,6 +128,20 @@ class _LayerRow(QWidget):
             self.blend.currentTextChanged.connect(lambda b: panel.set_blend(layer.id, b))
         top.addWidget(self.blend)
         lay.addLayout(top)
+        self.parked = None
+        if is_base and parked:
+            n = len(parked)
+            self.parked = QLabel(f"{n} blend wire{'s' if n != 1 else ''} parked")
+            self.parked.setObjectName("fieldLabel")
+            self.parked.setToolTip(
+                "The base layer blends over nothing, so these wires wait here and come back "
+                "when the layer is moved up:\n" + "\n".join(
+                    f"{w['from'][0]}.{w['from'][1]} → {w.get('port')}" for w in parked
+                    if isinstance(w.get("from"), list) and len(w["from"]) == 2))
+            row = QHBoxLayout()
+            row.addSpacing(26)
+            row.addWidget(self.parked, 1)
+            lay.addLayout(row)
         self.opacity: FloatField | None = None
         if not is_base:
             row = QHBoxLayout()
@@ -224,7 +273,7 @@ class LayersPanel(QWidget):
         hint.setWordWrap(True)
         el.addWidget(hint)
         self.create_button = QPushButton("Create layer stack")
-        self.create_button.clicked.connect(self.create_stack)
+        self.create_button.clicked.connect(lambda _checked=False: self.create_stack())
         el.addWidget(self.create_button)
         el.addStretch(1)
         lay.addWidget(self.empty)
@@ -267,12 +316,15 @@ class LayersPanel(QWidget):
         if s is None:
             return
         layers = s.layers
-        values = self.controller.document.graph.nodes[s.node_id].values
+        node = self.controller.document.graph.nodes[s.node_id]
+        entries = node.settings.get("layers", [])
+        values = node.values
         for index in range(len(layers) - 1, -1, -1):
             layer = layers[index]
             opacity = values.get(f"{layer.id}_opacity", 1.0)
             row = _LayerRow(self, layer, index == 0,
-                            float(opacity) if isinstance(opacity, (int, float)) else 1.0)
+                            float(opacity) if isinstance(opacity, (int, float)) else 1.0,
+                            parked_wires(entries[index]) if index == 0 else None)
             item = QListWidgetItem()
             item.setData(Qt.ItemDataRole.UserRole, layer.id)
             item.setSizeHint(row.sizeHint())
@@ -317,7 +369,12 @@ class LayersPanel(QWidget):
         except CommandError as exc:
             self.message.emit(str(exc))
             return False
-        return self.controller.push(cmd)
+        if not self.controller.push(cmd):
+            return False
+        report = wire_report(cmd)
+        if report:
+            self.message.emit(report)
+        return True
 
     # --- edits -----------------------------------------------------------------------------
     def set_visible(self, layer_id: str, on: bool) -> None:

@@ -73,6 +73,10 @@ class MainWindow(QMainWindow):
         self.undo_group.setActiveStack(self.controller.undo_stack)
         self._on_active(self.tabs.active)
         self._retitle()
+        self.extra_windows: list[MainWindow] = []  # recovered materials opened at start-up
+        self.actions.open_recovered_function = lambda e, doc: self.tabs.open_function(
+            e.document, self.tabs.material, recovered=doc)
+        self.actions.open_recovered_material = self._open_recovered_material
         if start:
             self.actions.start(path, sample_path() if sample else None)
             self.compiler.recompile()
@@ -119,8 +123,10 @@ class MainWindow(QMainWindow):
         lights_scroll.setWidgetResizable(True)
         lights_scroll.setFrameShape(QScrollArea.Shape.NoFrame)
         lights_scroll.setWidget(lights_host)
-        self.lights_dock = self._dock("Lights && Environment", "lightsDock", lights_scroll, R,
+        self.lights_dock = self._dock("Lights & Environment", "lightsDock", lights_scroll, R,
                                       "light")
+        # The title bar shows the text as it is; the View menu's action reads '&' as a mnemonic.
+        self.lights_dock.toggleViewAction().setText("Lights && Environment")
         self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
                                            B, "warning")
         self.code_dock = self._dock("GLSL", "codeDock", self.code, B)
@@ -283,6 +289,16 @@ class MainWindow(QMainWindow):
             return False
         return self.actions.open(path)
 
+    def _open_recovered_material(self, entry, doc) -> None:
+        """A second recovered material gets a window of its own."""
+        w = MainWindow(restore_layout=False, start=False)
+        for name in ("ask_save_changes", "ask_recover", "show_error"):
+            setattr(w.actions, name, getattr(self.actions, name))
+        w.actions._adopt(entry, doc)
+        w.compiler.recompile()
+        w.show()
+        self.extra_windows.append(w)
+
     def save_active(self) -> bool:
         return self.tabs.active.actions.save()
 
@@ -398,7 +414,7 @@ class MainWindow(QMainWindow):
                 if p.node_id and p.severity == "error":
                     merr[p.node_id] = p.message
             m.canvas.set_node_errors(merr)
-        n = sum(1 for p in problems if p.severity == "error")
+        n = sum(1 for p in self.diagnostics.problems if p.severity == "error")  # the rows
         title = "Diagnostics" + (f" ({n})" if n else "")
         self.diagnostics_dock.setWindowTitle(title)
         self._retitle()

@@ -12,6 +12,8 @@ they do not crowd the graph; large graphs skip them: previews never slow editing
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from PySide6.QtCore import QObject, QTimer
 from PySide6.QtGui import QImage
@@ -69,6 +71,52 @@ def to_image(value, inside: np.ndarray | None = None, size: int = SIZE) -> QImag
     return img.copy()  # own the pixels
 
 
+class TextureCache:
+    """Texture images for the CPU evaluator, as the viewport samples them: float RGBA, row 0
+    at v = 0; 8-bit colour files flagged sRGB decoded to linear. Kept small (thumbnails need
+    no detail) and keyed by path and modification time, so an edit re-reads nothing."""
+
+    MAX_SIZE = 128
+
+    def __init__(self) -> None:
+        self._cache: dict[tuple, np.ndarray | None] = {}
+
+    def get(self, path: str, srgb: bool) -> np.ndarray | None:
+        """The image at `path`, or None (a missing or bad file: the evaluator's checker)."""
+        if not path:
+            return None
+        p = Path(path)
+        try:
+            key = (str(p), p.stat().st_mtime_ns, bool(srgb))
+        except OSError:
+            return None
+        if key not in self._cache:
+            self._cache[key] = self._load(p, srgb)
+        return self._cache[key]
+
+    def _load(self, path: Path, srgb: bool) -> np.ndarray | None:
+        from matedit.io.images import read_image
+
+        try:
+            data = read_image(path)
+        except (ValueError, OSError):
+            return None
+        px = data.pixels
+        step = max(1, max(px.shape[:2]) // self.MAX_SIZE)
+        px = px[::step, ::step].astype(np.float64)
+        if px.shape[2] == 1:
+            px = np.repeat(px, 3, axis=2)
+        elif px.shape[2] == 2:  # grey and alpha
+            px = np.concatenate([np.repeat(px[:, :, :1], 3, axis=2), px[:, :, 1:]], axis=2)
+        if px.shape[2] == 3:
+            px = np.concatenate([px, np.ones(px.shape[:2] + (1,))], axis=2)
+        px = px[:, :, :4]
+        if srgb and data.is_ldr:
+            c = px[:, :, :3]
+            px[:, :, :3] = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+        return np.ascontiguousarray(px[::-1])  # row 0 = v = 0, as the renderer uploads it
+
+
 class NodePreviews(QObject):
     """Keeps the thumbnails of one material canvas up to date."""
 
@@ -87,6 +135,7 @@ class NodePreviews(QObject):
         canvas.selectionChangedIds.connect(self._selected)
         self._selection: set[str] = set()
         self._shown: set[str] = set()
+        self.textures = TextureCache()
         self._timer.start()
 
     def images(self) -> dict[str, QImage]:
@@ -97,7 +146,9 @@ class NodePreviews(QObject):
             ir = lower_document(doc, self.controller.resolver)
             probe: dict = {}
             surface, inside = preview_sphere()
-            evaluate(ir, surface, probe=probe)
+            textures = {t.name: self.textures.get(t.path, t.srgb) for t in ir.textures}
+            evaluate(ir, surface, textures={k: v for k, v in textures.items() if v is not None},
+                     probe=probe)
         except (CompileError, LookupError, ValueError, KeyError, TypeError,
                 FloatingPointError):
             return {}

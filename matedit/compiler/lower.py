@@ -114,6 +114,11 @@ class _Lowerer:
             return SurfaceUV()
         if t == MA:
             return Lit(None, PortType.MATERIAL)  # defaultMaterialAttributes()
+        if t == PortType.TEXTURE:  # unconnected: a texture with no image, shown as a checker
+            name = f"u_{nid}_{port}" if self.top else f"u_{self.scope.name}_{nid}_{port}"
+            self.ctx.textures.setdefault(
+                name, TextureInfo(name, nid if self.top else "", "", False, ""))
+            return Uni(name, PortType.TEXTURE)
         if not t.is_numeric:
             raise CompileError([Diagnostic(Severity.ERROR, f"input {port!r} must be connected",
                                            nid, port, self.file)])
@@ -165,7 +170,9 @@ class _Lowerer:
             node = self.doc.graph.nodes[nid]
             getattr(self, f"_k_{node.kind}", self._generic)(nid, node)
         for (nid, port), e in self.alias.items():
-            self.scope.sockets.setdefault((nid, port), e)
+            # An alias is what the node outputs (a layer stack's blended result), even where
+            # the node also emitted ops under its id (the layers' calls).
+            self.scope.sockets[(nid, port)] = e
 
     def _inputs(self, nid: str) -> list[Expr]:
         ins = self.a.in_types[nid]

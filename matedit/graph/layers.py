@@ -10,9 +10,18 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass
 
-from matedit.graph.commands import Command, CommandError, Disconnect, Macro, SetSetting
-from matedit.graph.model import MaterialGraph
+from matedit.graph.commands import Command, CommandError, Connect, Disconnect, Macro, SetSetting
+from matedit.graph.model import Link, MaterialGraph
 from matedit.graph.ports import LAYER_BLENDS, layer_entries
+
+# Ports a layer has only when it is not the base (the blend inputs).
+BLEND_SUFFIXES = ("_mask", "_opacity", "_base_height", "_contrast")
+
+
+def parked_wires(entry: dict) -> list[dict]:
+    """The blend wires a base layer keeps for when it is no longer the base."""
+    parked = entry.get("parked")
+    return [w for w in parked if isinstance(w, dict)] if isinstance(parked, list) else []
 
 
 @dataclass
@@ -71,19 +80,47 @@ class LayerStack:
         return copy.deepcopy(layer_entries(self.graph.nodes[self.node_id]))
 
     def _set(self, entries: list[dict], text: str, drop_ports_of=frozenset()) -> Command:
+        """The macro that makes `entries` the layers: links into ports that vanish are cut,
+        except the blend wires of the layer that becomes the base, which are parked in its
+        entry (`parked`) and brought back once it is no longer the base."""
         cmds: list[Command] = []
         surviving = self._surviving_ports(entries)
+        base = entries[0] if entries else None
+        base_id = base["id"] if base else None
         for link in sorted(self.graph.links):
             if link.dst != self.node_id:
                 continue
+            on_base = base_id is not None and base_id not in drop_ports_of and \
+                link.dst_port.startswith(f"{base_id}_")
             if surviving is not None:
                 gone = link.dst_port not in surviving
             else:
-                gone = any(link.dst_port.startswith(f"{lid}_") for lid in drop_ports_of)
+                gone = any(link.dst_port.startswith(f"{lid}_") for lid in drop_ports_of) or (
+                    on_base and link.dst_port.endswith(BLEND_SUFFIXES))
+            if gone and on_base:
+                base.setdefault("parked", []).append(
+                    {"port": link.dst_port[len(base_id) + 1:],
+                     "from": [link.src, link.src_port]})
             if gone:
                 cmds.append(Disconnect(link))
+        restore: list[Command] = []
+        for index, entry in enumerate(entries):
+            parked = entry.get("parked")
+            if index == 0 or not parked:
+                continue
+            entry.pop("parked")
+            for wire in parked if isinstance(parked, list) else []:
+                try:
+                    src, src_port = wire["from"]
+                    port = f"{entry['id']}_{wire['port']}"
+                except (KeyError, TypeError, ValueError):
+                    continue
+                if src not in self.graph.nodes or (surviving is not None
+                                                   and port not in surviving):
+                    continue
+                restore.append(Connect(Link(src, src_port, self.node_id, port)))
         cmds.append(SetSetting(self.node_id, "layers", entries))
-        return Macro(cmds, text=text)
+        return Macro(cmds + restore, text=text)
 
     def new_layer_id(self, stem: str = "layer") -> str:
         taken = {e["id"] for e in self._entries()}
@@ -111,7 +148,7 @@ class LayerStack:
         return self._set(entries, f"remove layer {layer_id}", {layer_id})
 
     def move(self, layer_id: str, index: int) -> Command:
-        """Moves a layer to `index` (0 = base). Links into blend ports that vanish are cut."""
+        """Moves a layer to `index` (0 = base). The new base parks its blend wires."""
         entries = self._entries()
         old = next((i for i, e in enumerate(entries) if e["id"] == layer_id), None)
         if old is None:
@@ -120,16 +157,8 @@ class LayerStack:
             raise CommandError(f"layer index {index} out of range 0..{len(entries) - 1}")
         entry = entries.pop(old)
         entries.insert(index, entry)
-        # Whichever layer becomes or stops being the base gains or loses blend ports.
-        touched = {entries[0]["id"]} if old == 0 or index == 0 else set()
-        drop = set()
-        if touched:
-            blend_suffixes = ("_mask", "_opacity", "_base_height", "_contrast")
-            for link in self.graph.links:
-                if link.dst == self.node_id and link.dst_port.startswith(f"{entries[0]['id']}_") \
-                        and link.dst_port.endswith(blend_suffixes):
-                    drop.add(entries[0]["id"])
-        return self._set(entries, f"move layer {layer_id}", drop)
+        # The layer that becomes the base parks its blend wires; the old base gets its back.
+        return self._set(entries, f"move layer {layer_id}")
 
     def set(self, layer_id: str, **changes) -> Command:
         """Changes a layer's name, blend, visibility or function."""

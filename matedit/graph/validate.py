@@ -52,6 +52,14 @@ class Diagnostic:
         return f"{loc}{self.message}"
 
 
+# What an unconnected required input of these types becomes (the compiler lowers it so),
+# instead of an error that stops the whole material; reroutes and function outputs pass a
+# value through, so they have none of their own.
+_UNCONNECTED_DEFAULT = {PortType.MATERIAL: "the default material attributes",
+                        PortType.TEXTURE: "a checker texture"}
+_NO_DEFAULT = {"reroute", "function_output"}
+
+
 def error(msg, node=None, port=None, file=None) -> Diagnostic:
     return Diagnostic(Severity.ERROR, msg, node, port, file)
 
@@ -186,7 +194,13 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
                 continue
             t = ins.get(spec.name)
             if spec.required or (t is not None and not t.is_numeric):
-                if not blocked:
+                if blocked:
+                    continue
+                fallback = _UNCONNECTED_DEFAULT.get(t) if node.kind not in _NO_DEFAULT else None
+                if fallback is not None:  # the rest of the graph keeps compiling
+                    diags.append(warning(f"input {spec.name!r} ({t}) is not connected: it "
+                                         f"uses {fallback}", nid, spec.name, f))
+                else:
                     diags.append(error(f"input {spec.name!r} ({t}) must be connected",
                                        nid, spec.name, f))
                 continue

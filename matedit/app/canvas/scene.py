@@ -40,8 +40,9 @@ def _fmt(value) -> str:
     return str(value)
 
 
-def describe(node: Node) -> tuple[str, str, str, str]:
-    """(title, subtitle, category, tooltip) a node shows, from its kind, label and settings."""
+def describe(node: Node, function_name: str = "") -> tuple[str, str, str, str]:
+    """(title, subtitle, category, tooltip) a node shows, from its kind, label and settings;
+    a function call is titled with the function's own name when it is known."""
     d = nodes.REGISTRY.get(node.kind)
     kind_title = d.title if d else node.kind
     title = node.label or kind_title
@@ -55,8 +56,8 @@ def describe(node: Node) -> tuple[str, str, str, str]:
         sub = _fmt(s.get("value", 0.0))
     elif node.kind == "function_call":
         stem = Path(str(s.get("function", ""))).stem
-        if stem and not node.label:
-            title = stem.replace("_", " ").capitalize()  # name the function, as Unreal does
+        if stem and not node.label:  # name the function, as Unreal does
+            title = function_name or stem.replace("_", " ").capitalize()
         sub = f"{stem}.json" if stem else "no function chosen"
     elif node.kind in ("function_input", "function_output"):
         sub = f"{s.get('name', '')} : {s.get('type', 'float')}"
@@ -183,9 +184,19 @@ class NodeScene(QGraphicsScene):
                    for r in ins]
             outs = [PortRow(r.name, str(ot[r.name]), r.doc, r.generic) if r.name in ot else r
                     for r in outs]
-        title, sub, category, tip = describe(node)
+        title, sub, category, tip = describe(node, self.function_name(node))
         item.set_content(title, sub, category, ins, outs, tip)
         self._update_connected(node_id)
+
+    def function_name(self, node: Node) -> str:
+        """The name a called function gives itself ("" if unknown or not a call)."""
+        ref = node.settings.get("function") if node.kind == "function_call" else None
+        if not isinstance(ref, str) or not ref:
+            return ""
+        try:
+            return self.controller.resolver.resolve(ref, self.controller.document).name or ""
+        except (LookupError, ValueError, OSError):
+            return ""
 
     def _add_wire(self, link: Link) -> None:
         if link in self.wire_items:
