@@ -556,6 +556,22 @@ class Renderer:
         raw = fbo.read(components=4, dtype="f4")
         return np.frombuffer(raw, np.float32).reshape(h, w, 4)[::-1, :, :3] * scale
 
+    def read_linear(self) -> np.ndarray:
+        """The scene-referred linear radiance of the current mode's frame, (H, W, 3), top row
+        first, before exposure and the display transform: split sum, the reference average,
+        or in difference mode split sum minus reference (signed)."""
+        if self.mode == "difference":
+            return self.read_hdr("splitsum") - self.read_hdr("reference")
+        return self.read_hdr()
+
+    def set_reference_samples(self, total: int) -> None:
+        """Reference mode's samples a pixel: up to 32 a frame, accumulated over frames."""
+        total = max(1, int(total))
+        per_frame = min(32, total)
+        self.reference_samples = per_frame
+        self.reference_frames = max(1, math.ceil(total / per_frame))
+        self.reset_accumulation()
+
     def render_converged(self, target=None, max_frames: int | None = None) -> int:
         """Renders until reference/difference mode has converged; returns frames drawn."""
         frames = 0
