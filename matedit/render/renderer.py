@@ -94,6 +94,8 @@ class Renderer:
         self.environment_intensity = 1.0
         self.reference_samples = 32  # per pixel per frame
         self.reference_frames = 64  # frames to converge (32 x 64 = 2048 samples a pixel)
+        # reference mode integrates sphere and tube lights by Monte Carlo over their shapes
+        self.reference_lights = True
         self.link_count = 0
         self._difference_cache: tuple[int, float] | None = None
         self._frames_drawn = 0
@@ -407,9 +409,10 @@ class Renderer:
         if program is not None and self._mesh is not None:
             self._lights_buf.bind_to_uniform_block(LIGHTS_BINDING)
             mode = ibl_mode if self._ibl is not None else IBL_MODE_NONE
-            self._ibl_buf.write(pack_ibl_block(self._sh, float(self._env_levels),
-                                               self.environment_intensity,
-                                               self.reference_samples, mode, offset))
+            self._ibl_buf.write(pack_ibl_block(
+                self._sh, float(self._env_levels), self.environment_intensity,
+                self.reference_samples, mode, offset,
+                reference_lights=ibl_mode == IBL_MODE_REFERENCE and self.reference_lights))
             self._ibl_buf.bind_to_uniform_block(IBL_BINDING)
             self._frame_buf.bind_to_uniform_block(FRAME_BINDING)
             self._params_buf.bind_to_uniform_block(MATERIAL_BINDING)
