@@ -47,12 +47,6 @@ vec3 diffuseIrradianceSH9(vec3 sh[9], vec3 N, vec3 diffuseColor) {
     return diffuseColor * irradianceSH9(sh, N) * INV_PI;
 }
 
-// Point i of the n-point sample set, rotated per frame (Cranley-Patterson) by `offset`.
-vec2 rotatedHammersley(uint i, uint n, vec2 offset) {
-    // Cranley and Patterson 1976, "Randomization of Number Theoretic Methods": fract(x + u)
-    return fract(hammersley(i, n) + offset);
-}
-
 // Importance-sampled estimate of the specular integral from the unfiltered environment.
 vec3 referenceSpecularIBL(samplerCube env, vec3 F0, float roughness, vec3 N, vec3 V,
                           uint sampleCount, vec2 offset) {

@@ -9,7 +9,9 @@
 //   offset 144: vec4 params  x = mip count M of uPrefilteredEnv, y = environment intensity,
 //                            z = reference-mode sample count, w = mode (0 split sum, 1 reference,
 //                            2 no image-based light)
-//   offset 160: vec4 sampleOffset  xy = per-frame offset of the reference sample set, zw = 0
+//   offset 160: vec4 sampleOffset  xy = per-frame offset of the reference sample set,
+//                            z = 1: sphere and tube lights by Monte Carlo over their shapes
+//                            (lights_reference.glsl; reference mode), else 0; w = 0
 // Total 176 bytes. matedit.shading.ibl.pack_ibl_block writes exactly these bytes.
 
 #include "bindings.glsl"

@@ -18,6 +18,12 @@ vec2 hammersley(uint i, uint n) {
     return vec2(float(i) / float(n), radicalInverse_VdC(i));
 }
 
+// Point i of the n-point sample set, rotated per frame (Cranley-Patterson) by `offset`.
+vec2 rotatedHammersley(uint i, uint n, vec2 offset) {
+    // Cranley and Patterson 1976, "Randomization of Number Theoretic Methods": fract(x + u)
+    return fract(hammersley(i, n) + offset);
+}
+
 // Orthonormal tangent frame around N (the notes' choice of up vector).
 void tangentFrame(vec3 N, out vec3 T, out vec3 B) {
     // Karis 2013, ImportanceSampleGGX: UpVector = abs(N.z) < 0.999 ? Z : X

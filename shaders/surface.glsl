@@ -5,6 +5,9 @@
 #include "lights_block.glsl"
 #include "ibl_inputs.glsl"
 #include "ibl.glsl"
+#ifndef MATEDIT_SPLIT_SUM_ONLY
+#include "lights_reference.glsl"
+#endif
 
 // Sum of all analytic lights of the block.
 vec3 directLighting(ShadingContext s) {
@@ -16,6 +19,21 @@ vec3 directLighting(ShadingContext s) {
     }
     return sum;
 }
+
+#ifndef MATEDIT_SPLIT_SUM_ONLY
+// Sum of all analytic lights, sphere and tube lights by Monte Carlo over their shapes
+// (reference mode; uIbl.params.z samples a frame, offset uIbl.sampleOffset.xy).
+vec3 directLightingReference(ShadingContext s) {
+    // matedit reference mode (lights_reference.glsl)
+    uint count = uint(max(uIbl.params.z, 1.0));
+    vec3 sum = vec3(0.0);
+    int n = lightCount();
+    for (int i = 0; i < n; i++) {
+        sum += evaluateLightReference(s, getLight(i), count, uIbl.sampleOffset.xy);
+    }
+    return sum;
+}
+#endif
 
 // Image-based lighting from the block's environment, split sum or reference by uIbl.params.w.
 vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughness) {
@@ -48,7 +66,13 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V) {
     vec3 F0 = computeF0(m.baseColor, m.metallic);
     float roughness = saturate(m.roughness);
     ShadingContext s = makeShadingContext(P, N, V, diffuseColor, F0, roughness);
-    vec3 direct = directLighting(s);
+    vec3 direct;
+#ifndef MATEDIT_SPLIT_SUM_ONLY
+    // uIbl.sampleOffset.z = 1: the area lights' reference (reference mode's frames)
+    if (uIbl.sampleOffset.z > 0.5) direct = directLightingReference(s);
+    else
+#endif
+    direct = directLighting(s);
     vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness);
     return (direct + ibl) * m.cavity + m.emissive;
 }

@@ -52,6 +52,7 @@ class LightsPanel(QWidget):
     """Edits a list of `Light`s and emits `lightsChanged(list)` after each change."""
 
     lightsChanged = Signal(list)
+    rigMessage = Signal(str)  # a light-rig file could not be loaded or saved
 
     def __init__(self, lights: list[Light] | None = None, parent=None) -> None:
         super().__init__(parent)
@@ -77,6 +78,9 @@ class LightsPanel(QWidget):
         bar.addWidget(title, 1)
         bar.addWidget(self.add_button)
         bar.addWidget(self.remove_button)
+        from matedit.app.rig_actions import install_rig_actions
+
+        install_rig_actions(self, bar)  # load / save the rig as a file (matedit.io.rig)
         lay.addLayout(bar)
         self.list = QListWidget()
         self.list.setMinimumHeight(84)

@@ -1,5 +1,7 @@
-"""`matedit render FILE -o OUT.png [--size WxH] [--mesh ...] [--env PATH|studio] [--ibl ...]
-[--exposure EV]`: a headless, deterministic preview render."""
+"""`matedit render FILE -o OUT.png|OUT.exr [--size WxH] [--mesh ...] [--env PATH|studio]
+[--ibl ...] [--exposure EV] [--lights default|none|RIG.json] [--samples N]`: a headless,
+deterministic preview render. A .png is display-referred (exposure, ACES, sRGB); an .exr
+holds the scene-referred linear radiance of the same frame, before exposure and display."""
 
 from __future__ import annotations
 
@@ -16,7 +18,9 @@ def register(sub) -> None:
                        description="Render a material on a preview mesh under the default "
                        "light rig and an environment, headless (EGL), to a PNG.")
     p.add_argument("file", metavar="FILE")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.png")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.png|OUT.exr",
+                   help=".png: display-referred 8-bit sRGB; .exr: scene-referred linear "
+                   "radiance (RGBA float, A = 1), before exposure and the display transform")
     p.add_argument("--size", default="512x512", metavar="WxH")
     p.add_argument("--mesh", default=None,
                    help="sphere, cube, plane, cylinder or an OBJ file (default: the file's "
@@ -27,6 +31,12 @@ def register(sub) -> None:
                    help="split-sum approximation, converged importance-sampled reference, "
                    "or a heat map of their difference")
     p.add_argument("--exposure", type=float, default=None, metavar="EV")
+    p.add_argument("--lights", default="default", metavar="default|none|RIG.json",
+                   help="the built-in light rig, no analytic lights, or a light-rig file "
+                   "(format matedit.lightrig)")
+    p.add_argument("--samples", type=int, default=None, metavar="N",
+                   help="reference-mode samples a pixel (default 2048)")
+    p.add_argument("--half", action="store_true", help="EXR output as half floats")
     p.set_defaults(run=run)
 
 
@@ -81,6 +91,43 @@ def _renderer(ctx, size: tuple[int, int], cls):
                          f"{' '.join(str(exc).split())[:80]}); try a smaller size") from None
 
 
+def write_exr(path: Path, rgb, half: bool = False) -> None:
+    """Scene-referred linear radiance as RGBA (A = 1: the frame is opaque)."""
+    import numpy as np
+
+    from matedit.io.images import ImageError, write_image
+
+    rgba = np.concatenate([rgb, np.ones(rgb.shape[:2] + (1,), np.float32)], axis=2)
+    try:
+        write_image(path, rgba, half=half)
+    except ImageError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def _lights(spec: str):
+    """None for the default rig (the renderer's own), [] for none, else the rig file's."""
+    if spec == "default":
+        return None
+    if spec == "none":
+        return []
+    from matedit.io.rig import RigError, load
+
+    try:
+        return load(spec)
+    except RigError as exc:
+        raise UsageError(str(exc)) from None
+
+
+def _check_texture_spaces(compiled, path: Path) -> None:
+    from matedit.shading.colorspace import ColorSpaceError, check_space, effective_space
+
+    for t in compiled.ir.textures:
+        try:
+            check_space(effective_space(t.color_space, t.srgb))
+        except ColorSpaceError as exc:
+            raise UsageError(f"{path}: node {t.node}: field color_space: {exc}") from None
+
+
 def _builtin(doc, key: str, fallback: str) -> str:
     value = doc.preview.get(key) if isinstance(doc.preview, dict) else None
     return value if isinstance(value, str) and value else fallback
@@ -101,8 +148,11 @@ def run(args) -> int:
     size = _size(args.size)
     path = Path(args.file)
     out = Path(args.output)
-    if out.suffix.lower() != ".png":
-        raise UsageError(f"{out}: the output must be a .png file")
+    if out.suffix.lower() not in (".png", ".exr"):
+        raise UsageError(f"{out}: the output must be a .png or .exr file")
+    if args.samples is not None and not 1 <= args.samples <= 1 << 20:
+        raise UsageError(f"--samples must be 1..{1 << 20}, got {args.samples}")
+    lights = _lights(args.lights)
     if not out.parent.exists():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
     try:
@@ -113,8 +163,8 @@ def run(args) -> int:
         raise UsageError(f"{path}: is a material function; render a material that uses it")
     resolver = FileResolver()
     inputs = document_inputs(doc, resolver)
-    for given in (args.mesh, args.env):
-        if given and given not in BUILTIN_MESHES | BUILTIN_ENVIRONMENTS:
+    for given in (args.mesh, args.env, args.lights):
+        if given and given not in BUILTIN_MESHES | BUILTIN_ENVIRONMENTS | {"default", "none"}:
             inputs.setdefault(Path(os.path.realpath(given)), "an input file")
     try:
         refuse_overwrite([out], inputs)
@@ -125,6 +175,7 @@ def run(args) -> int:
     except CompileError as exc:
         d = exc.diagnostics[0]
         raise UsageError(f"{d.file or path}: {d.format()}") from None
+    _check_texture_spaces(compiled, path)
 
     from matedit.ibl import EnvironmentMapError
     from matedit.render import MeshError, Renderer
@@ -155,6 +206,10 @@ def run(args) -> int:
             raise UsageError(f"{path}: node {node}: GLSL: {msg}" if node else f"{path}: {msg}")
         if args.exposure is not None:
             renderer.exposure = args.exposure
+        if lights is not None:
+            renderer.set_lights(lights)
+        if args.samples is not None:
+            renderer.set_reference_samples(args.samples)
         renderer.mode = args.ibl
         frames = 0
         while True:
@@ -167,7 +222,10 @@ def run(args) -> int:
                 break
         if tty and renderer.mode != "splitsum":
             print(file=sys.stderr)
-        write_png(out, renderer.read_image())
+        if out.suffix.lower() == ".exr":
+            write_exr(out, renderer.read_linear(), half=args.half)
+        else:
+            write_png(out, renderer.read_image())
         if renderer.mode == "difference":
             print(f"mean |split-sum - reference| (linear HDR): {renderer.difference_mean:.5f}")
         renderer.release()

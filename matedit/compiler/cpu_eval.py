@@ -126,11 +126,29 @@ def evaluate(ir: MaterialIR, surface, uniforms: dict[str, Any] | None = None,
     """The MaterialAttributes of the material at each pixel of `surface`.
 
     `uniforms` overrides the defaults by uniform name; pass a dict as `probe` to
-    receive every top-level socket's value as "node.port".
+    receive every top-level socket's value as "node.port". `textures` gives linear arrays
+    by uniform name; the others are read from their files and decoded to linear by their
+    colour space, as the renderer does (a missing or unreadable file shows the checker).
     """
     n = np.asarray(surface.uv).shape[0]
     values = {u.name: u.default for u in ir.uniforms}
     values.update(uniforms or {})
-    env = Env(surface, n, values, dict(textures or {}), {f.name: f for f in ir.functions})
+    tex = dict(textures or {})
+    for t in ir.textures:
+        if t.name not in tex and t.path:
+            tex[t.name] = _linear_texture(t)
+    env = Env(surface, n, values, tex, {f.name: f for f in ir.functions})
     (attrs,) = eval_scope(ir.main, {}, env, probe)
     return attrs
+
+
+def _linear_texture(t) -> np.ndarray:
+    """A texture file decoded to linear RGBA by its colour space (matedit.shading.colorspace),
+    or the checker when the file cannot be read."""
+    from matedit.shading.colorspace import effective_space, load_texture_cached
+
+    try:
+        space = effective_space(getattr(t, "color_space", ""), t.srgb)
+        return load_texture_cached(t.path, space).linear
+    except (ValueError, OSError):
+        return checker_texture()

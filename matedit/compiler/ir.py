@@ -125,6 +125,7 @@ class TextureInfo:
     srgb: bool
     parameter: str
     ref: str = ""  # the path as the document stores it (relative to the document)
+    color_space: str = ""  # the node's color_space setting; empty: srgb decides
 
 
 @dataclass

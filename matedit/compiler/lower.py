@@ -241,7 +241,8 @@ class _Lowerer:
         if name not in self.ctx.textures:
             self.ctx.textures[name] = TextureInfo(name, nid, path,
                                                   bool(node.settings.get("srgb", True)), pname,
-                                                  str(node.settings.get("path", "")))
+                                                  str(node.settings.get("path", "")),
+                                                  str(node.settings.get("color_space", "")))
         self.alias[(nid, "texture")] = Uni(name, PortType.TEXTURE)
 
     def _k_reroute(self, nid, node) -> None:

@@ -175,7 +175,11 @@ register(NodeDef(
     outputs=(_o("texture", "texture2d"),),
     settings=_PARAM_SETTINGS + (
         SettingDef("path", "path", "", "image file, relative to the material", structural=False),
-        SettingDef("srgb", "bool", True, "colour data stored as sRGB", structural=False),
+        SettingDef("srgb", "bool", True, "colour data stored as sRGB (decoded to linear "
+                   "before filtering); off for data: normals, roughness, masks"),
+        SettingDef("color_space", "string", "", "colour space: srgb, linear or an "
+                   "OpenColorIO space of OpenImageIO's built-in config (e.g. ACEScg); "
+                   "empty: the srgb setting decides"),
     ),
     inline="{texture}", numpy="texture_parameter",
 ))

@@ -35,6 +35,7 @@ from matedit.shading.lights_block import pack_lights
 MODES = ("splitsum", "reference", "difference")
 LIGHTS_BINDING, IBL_BINDING = 0, 1
 PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = 2, 3, 4
+GL_SRGB8_ALPHA8 = 0x8C43
 # SH irradiance coefficients -> radiance coefficients: divide by the cosine lobe's A_l
 # (Ramamoorthi and Hanrahan 2001): pi, 2pi/3, pi/4 for bands 0, 1, 2.
 _SH_BAND_SCALE = np.array([math.pi] + [2 * math.pi / 3] * 3 + [math.pi / 4] * 5)
@@ -93,6 +94,8 @@ class Renderer:
         self.environment_intensity = 1.0
         self.reference_samples = 32  # per pixel per frame
         self.reference_frames = 64  # frames to converge (32 x 64 = 2048 samples a pixel)
+        # reference mode integrates sphere and tube lights by Monte Carlo over their shapes
+        self.reference_lights = True
         self.link_count = 0
         self._difference_cache: tuple[int, float] | None = None
         self._frames_drawn = 0
@@ -102,6 +105,7 @@ class Renderer:
         self._program: moderngl.Program | None = None
         self._values: dict[str, Any] = {}
         self._textures: dict[str, moderngl.Texture] = {}
+        self._texture_keys: dict[str, tuple[str | None, str]] = {}  # name: (path, space)
         self._accum_frames = 0
         self._frame_index = 0
         self._size = (0, 0)
@@ -289,46 +293,78 @@ class Renderer:
         self._params_buf.write(self._compiled.pack_uniforms(self._values))
         self.reset_accumulation()
 
-    def set_texture(self, name: str, path: str | None) -> None:
-        """Loads a material texture (a value edit); a missing file shows a checker."""
+    def set_texture(self, name: str, path: str | None, color_space: str | None = None) -> None:
+        """Loads a material texture (a value edit); a missing file shows a checker. The colour
+        space defaults to the compiled material's setting for that texture (srgb, linear or an
+        OpenColorIO space; matedit.shading.colorspace)."""
         old = self._textures.pop(name, None)
         if old is not None:
             old.release()
-        self._textures[name] = self._texture_from(path)
+        space = color_space or self._texture_space(name)
+        self._textures[name] = self._texture_from(path, space)
+        self._texture_keys[name] = (path, space)
         self.reset_accumulation()
 
-    def _texture_from(self, path: str | None) -> moderngl.Texture:
-        from matedit.compiler.cpu_eval import checker_texture
+    def _texture_space(self, name: str) -> str:
+        from matedit.shading.colorspace import effective_space
 
-        img = None
+        for t in (self._compiled.ir.textures if self._compiled is not None else ()):
+            if t.name == name:
+                return effective_space(getattr(t, "color_space", ""), t.srgb)
+        return "srgb"
+
+    def _texture_from(self, path: str | None, space: str = "srgb") -> moderngl.Texture:
+        """sRGB 8-bit files go to an sRGB internal format (decoded before filtering), their
+        mips built in linear space and encoded back; everything else is linear float RGBA,
+        decoded on the CPU (matedit.shading.colorspace), mips in linear space."""
+        from matedit.compiler.cpu_eval import checker_texture
+        from matedit.shading.colorspace import linear_to_srgb, load_texture_cached, mip_chain
+
+        image = None
         if path:
             try:
-                from matedit.io.images import read_image
-
-                data = read_image(path).pixels
-                if data.shape[2] == 1:
-                    data = np.repeat(data, 3, axis=2)
-                if data.shape[2] == 3:
-                    data = np.concatenate([data, np.ones(data.shape[:2] + (1,), "f4")], 2)
-                img = np.ascontiguousarray(data[::-1, :, :4], dtype="f4")  # row 0 = v = 0
+                image = load_texture_cached(path, space)
             except (ValueError, OSError):
-                img = None
-        if img is None:
-            img = checker_texture(8)
-        tex = self.ctx.texture((img.shape[1], img.shape[0]), 4, img.tobytes(), dtype="f4")
-        tex.build_mipmaps()
+                image = None
+        linear = image.linear if image is not None else checker_texture(8)
+        levels = mip_chain(linear)
+        size = (linear.shape[1], linear.shape[0])
+        if image is not None and image.srgb8 is not None:
+            tex = self.ctx.texture(size, 4, image.srgb8.tobytes(), dtype="f1",
+                                   internal_format=GL_SRGB8_ALPHA8)
+            tex.build_mipmaps()  # allocates the chain; every level is rewritten below
+            for i, lev in enumerate(levels[1:], start=1):
+                codes = np.concatenate([linear_to_srgb(lev[..., :3]), lev[..., 3:]], axis=2)
+                tex.write(np.rint(codes * 255.0).clip(0, 255).astype(np.uint8).tobytes(),
+                          level=i)
+        else:
+            tex = self.ctx.texture(size, 4, np.ascontiguousarray(linear, "f4").tobytes(),
+                                   dtype="f4")
+            tex.build_mipmaps()
+            for i, lev in enumerate(levels[1:], start=1):
+                tex.write(np.ascontiguousarray(lev, "f4").tobytes(), level=i)
         tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
         tex.repeat_x = tex.repeat_y = True
         return tex
 
     def _load_textures(self, compiled: CompiledMaterial) -> None:
+        from matedit.shading.colorspace import effective_space
+
         wanted = {t.name: t for t in compiled.ir.textures}
         for name in list(self._textures):
             if name not in wanted:
                 self._textures.pop(name).release()
+                self._texture_keys.pop(name, None)
         for name, info in wanted.items():
-            if name not in self._textures:
-                self._textures[name] = self._texture_from(info.path)
+            key = (info.path, effective_space(getattr(info, "color_space", ""), info.srgb))
+            if name not in self._textures or self._texture_keys.get(name, key)[1] != key[1]:
+                old = self._textures.pop(name, None)
+                if old is not None:
+                    old.release()
+                path = self._texture_keys.get(name, key)[0] if name in self._texture_keys \
+                    else info.path
+                self._textures[name] = self._texture_from(path, key[1])
+                self._texture_keys[name] = (path, key[1])
 
     # --- drawing --------------------------------------------------------------------------
     @property
@@ -373,9 +409,10 @@ class Renderer:
         if program is not None and self._mesh is not None:
             self._lights_buf.bind_to_uniform_block(LIGHTS_BINDING)
             mode = ibl_mode if self._ibl is not None else IBL_MODE_NONE
-            self._ibl_buf.write(pack_ibl_block(self._sh, float(self._env_levels),
-                                               self.environment_intensity,
-                                               self.reference_samples, mode, offset))
+            self._ibl_buf.write(pack_ibl_block(
+                self._sh, float(self._env_levels), self.environment_intensity,
+                self.reference_samples, mode, offset,
+                reference_lights=ibl_mode == IBL_MODE_REFERENCE and self.reference_lights))
             self._ibl_buf.bind_to_uniform_block(IBL_BINDING)
             self._frame_buf.bind_to_uniform_block(FRAME_BINDING)
             self._params_buf.bind_to_uniform_block(MATERIAL_BINDING)
@@ -521,6 +558,22 @@ class Renderer:
             fbo, scale = self._resolve_fbo, 1.0
         raw = fbo.read(components=4, dtype="f4")
         return np.frombuffer(raw, np.float32).reshape(h, w, 4)[::-1, :, :3] * scale
+
+    def read_linear(self) -> np.ndarray:
+        """The scene-referred linear radiance of the current mode's frame, (H, W, 3), top row
+        first, before exposure and the display transform: split sum, the reference average,
+        or in difference mode split sum minus reference (signed)."""
+        if self.mode == "difference":
+            return self.read_hdr("splitsum") - self.read_hdr("reference")
+        return self.read_hdr()
+
+    def set_reference_samples(self, total: int) -> None:
+        """Reference mode's samples a pixel: up to 32 a frame, accumulated over frames."""
+        total = max(1, int(total))
+        per_frame = min(32, total)
+        self.reference_samples = per_frame
+        self.reference_frames = max(1, math.ceil(total / per_frame))
+        self.reset_accumulation()
 
     def render_converged(self, target=None, max_frames: int | None = None) -> int:
         """Renders until reference/difference mode has converged; returns frames drawn."""

@@ -149,10 +149,13 @@ def pack_ibl_block(
     samples: int = 64,
     mode: int = IBL_MODE_SPLIT_SUM,
     sample_offset: tuple[float, float] = (0.0, 0.0),
+    reference_lights: bool = False,
 ) -> bytes:
-    """Bytes of IblBlock (std140, 176 bytes): vec4 sh[9], vec4 params, vec4 sampleOffset."""
+    """Bytes of IblBlock (std140, 176 bytes): vec4 sh[9], vec4 params, vec4 sampleOffset
+    (z = 1: sphere and tube lights by Monte Carlo, lights_reference.glsl)."""
     data = np.zeros((11, 4), dtype="<f4")
     data[:9, :3] = f64(sh).reshape(9, 3)
     data[9] = (mip_count, intensity, samples, mode)
     data[10, :2] = sample_offset
+    data[10, 2] = 1.0 if reference_lights else 0.0
     return data.tobytes()

@@ -22,6 +22,8 @@ LIGHT_TYPES = {
 }
 LIGHT_FALLOFF_EPS = 0.01
 MIN_ANALYTIC_ROUGHNESS = 0.03
+# a' = a + sourceRadius / (AREA_WIDEN_DIVISOR d): lights.glsl's MATEDIT_AREA_WIDEN_DIVISOR.
+AREA_WIDEN_DIVISOR = 2.0
 
 LightKind = Literal["point", "directional", "sphere", "tube"]
 
@@ -101,13 +103,14 @@ def sphereRepresentativePoint(Lc, R, sourceRadius) -> np.ndarray:
 
 def sphereNormalization(a, sourceRadius, d) -> np.ndarray:
     a = f64(a)
-    a_prime = saturate(a + f64(sourceRadius) / (3.0 * np.maximum(f64(d), 1e-8)))
+    a_prime = saturate(a + f64(sourceRadius) / (AREA_WIDEN_DIVISOR * np.maximum(f64(d), 1e-8)))
     return sq(a / a_prime)
 
 
 def lineNormalization(a, sourceLength, d) -> np.ndarray:
     a = f64(a)
-    a_prime = saturate(a + 0.5 * f64(sourceLength) / (3.0 * np.maximum(f64(d), 1e-8)))
+    a_prime = saturate(a + 0.5 * f64(sourceLength) / (AREA_WIDEN_DIVISOR
+                                                       * np.maximum(f64(d), 1e-8)))
     return a / a_prime
 
 

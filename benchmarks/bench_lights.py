@@ -1,0 +1,143 @@
+"""Measured specular energy of the area lights: rendered / true (not a test).
+
+    .venv/bin/python benchmarks/bench_lights.py [--quick] [--gpu]
+
+Geometry (tests/light_energy_ref.py): a white metal (F0 = 1) with N = +Z, the light straight
+above at d = 2 m, intensity 1; energy = the specular radiant exitance (outgoing specular
+radiance integrated over all view directions, weighted by N.V). True: a uniform sphere of
+radius r (Le = I / (pi r^2)) or a capsule of radius 0.02 m and length l along X (Le =
+I / (2 r l + pi r^2)), integrated over its solid angle against the GGX albedo. Rendered:
+the representative-point lights, evaluated by matedit.shading (the numpy twin the tests hold
+to the GLSL at 1e-4; `--gpu` evaluates the GLSL itself), for the widening divisor of
+a' = a + r / (c d): c = 3 (SHADING.md's reading, before) and c = 2 (the default now).
+The tests (tests/test_shading_light_energy.py) check a subset on the GPU.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+
+from light_energy_ref import (  # noqa: E402
+    capsule_true_energy,
+    exitance_axisymmetric,
+    sphere_true_energy,
+    tube_view_grid,
+)
+
+import matedit.shading.lights as lights  # noqa: E402
+
+D = 2.0
+TUBE_RADIUS = 0.02
+ROUGHNESS = (0.1, 0.2, 0.3, 0.5, 0.7, 0.9)
+SPHERE_RD = (0.01, 0.05, 0.1, 0.25, 0.5)
+TUBE_LENGTHS = (0.25, 0.5, 1.0, 2.0)
+
+
+def _twin(V, kind, radius, length, rough):
+    n = len(V)
+    s = lights.makeShadingContext(np.zeros((n, 3)), np.tile([0.0, 0.0, 1.0], (n, 1)), V,
+                                  np.zeros((n, 3)), np.ones((n, 3)), np.full(n, rough))
+    light = lights.Light(kind, position=(0.0, 0.0, D), direction=(1.0, 0.0, 0.0),
+                         intensity=1.0, influence_radius=1e4, source_radius=radius,
+                         source_length=length)
+    return lights.evaluateLight(s, light)[:, 0]
+
+
+def _gpu(ctx):
+    from gpu_eval import gpu_eval_many
+    from test_shading_light_energy import BODY
+
+    def spec(V, kind, radius, length, rough):
+        n = len(V)
+        f = lambda x: np.full(n, x, np.float32)  # noqa: E731
+        k = {"sphere": 2, "tube": 3}[kind]
+        out = gpu_eval_many(ctx, BODY, {"V": V.astype(np.float32), "kind": f(k), "dist": f(D),
+                                        "radius": f(radius), "len": f(length),
+                                        "rough": f(rough)}, {"spec": "float"},
+                            includes=["lights.glsl"])
+        return out["spec"].astype(np.float64)
+    return spec
+
+
+def table(spec, quick: bool) -> tuple[list, list]:
+    n_view = 8000 if quick else 20000
+    grid = tube_view_grid(400, 400) if quick else tube_view_grid(800, 800)
+    spheres, tubes = [], []
+    for rd in SPHERE_RD:
+        row = []
+        for rough in ROUGHNESS:
+            true = sphere_true_energy(rd * D, D, rough)
+            e = exitance_axisymmetric(
+                lambda V, rd=rd, rough=rough: spec(V, "sphere", rd * D, 0.0, rough), n=n_view)
+            row.append(e / true)
+        spheres.append((rd, row))
+    V, w = grid
+    for length in TUBE_LENGTHS:
+        row = []
+        for rough in ROUGHNESS:
+            true = capsule_true_energy(TUBE_RADIUS, length, D, rough)
+            row.append(float(np.sum(spec(V, "tube", TUBE_RADIUS, length, rough) * w)) / true)
+        tubes.append((length, row))
+    return spheres, tubes
+
+
+def markdown(title: str, spheres, tubes) -> str:
+    head = "| light | " + " | ".join(f"rough {r}" for r in ROUGHNESS) + " |"
+    sep = "|---|" + "---|" * len(ROUGHNESS)
+    lines = [f"**{title}**", "", head, sep]
+    for rd, row in spheres:
+        lines.append(f"| sphere r/d {rd} | " + " | ".join(f"{x:.2f}" for x in row) + " |")
+    for length, row in tubes:
+        lines.append(f"| tube {length} m | " + " | ".join(f"{x:.2f}" for x in row) + " |")
+    return "\n".join(lines)
+
+
+def goal(spheres, tubes) -> str:
+    inside = [x for rd, row in spheres if rd <= 0.25 for r, x in zip(ROUGHNESS, row) if r >= 0.2]
+    inside += [x for _, row in tubes for r, x in zip(ROUGHNESS, row) if r >= 0.2]
+    ok = all(0.75 <= x <= 1.25 for x in inside)
+    return (f"goal (within +-25 % for sphere r/d <= 0.25 and every tube, roughness >= 0.2): "
+            f"{'met' if ok else 'missed'}; range {min(inside):.2f} .. {max(inside):.2f}")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--gpu", action="store_true", help="evaluate the GLSL (llvmpipe: slower)")
+    args = ap.parse_args()
+    ctx = None
+    if args.gpu:
+        from matedit.render.context import headless_context
+
+        ctx = headless_context()
+    saved = lights.AREA_WIDEN_DIVISOR
+    try:
+        for c in (3.0, saved):
+            if ctx is not None and c != saved:
+                continue  # the GLSL is compiled with its own default
+            lights.AREA_WIDEN_DIVISOR = c
+            t0 = time.perf_counter()
+            spec = _gpu(ctx) if ctx is not None else _twin
+            spheres, tubes = table(spec, args.quick)
+            label = "before" if c == 3.0 else "now (default)"
+            print(markdown(f"rendered / true specular energy, a' = a + r / ({c:g} d), {label}, "
+                           f"{'GLSL' if ctx else 'numpy twin'}", spheres, tubes))
+            print()
+            print(goal(spheres, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
+            print()
+    finally:
+        lights.AREA_WIDEN_DIVISOR = saved
+        if ctx is not None:
+            ctx.release()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

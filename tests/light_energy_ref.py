@@ -1,0 +1,121 @@
+"""Independent numpy references for the area lights' specular energy (no matedit import).
+
+Setup: a surface point at the origin, N = +Z, a white metal (F0 = 1, so F = 1), a light of
+intensity I = 1 straight above at distance d. "Specular energy" is the reflected radiant
+exitance, the outgoing specular radiance integrated over the hemisphere of view directions
+weighted by N.V.
+
+True energy: the light is a uniform emitter of radiance Le, a sphere (radius r; Le =
+I / (pi r^2), so its irradiance is that of the point light the model uses for diffuse) or a
+capsule (radius r, segment length l along X; Le = I / (2 r l + pi r^2), its broadside
+projected area, so the sphere is the l -> 0 limit). Swapping the two integrals,
+    E_true = Le * integral over the light's solid angle of rho(l) (N.l) dl,
+where rho(l) is the specular's directional albedo for incidence l (by reciprocity the
+integral of f(l, v) N.v over v): GGX D, Schlick-Smith G with k = (roughness + 1)^2 / 8.
+
+Representative-point energy: the caller gives the model's outgoing specular radiance for
+arrays of view directions; `exitance_*` integrate it over the hemisphere.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def ggx_albedo(mu: np.ndarray, roughness: float, ny: int = 2048, nphi: int = 64) -> np.ndarray:
+    """rho(mu) = integral of f_spec(l, v) N.l dl for a view at cos mu (F = 1), by a midpoint
+    quadrature in the GGX half-vector CDF variables: the integrand is G VoH / (NoH NoV)."""
+    a = roughness * roughness
+    k = (roughness + 1.0) ** 2 / 8.0
+    y = (np.arange(ny) + 0.5) / ny
+    phi = (np.arange(nphi) + 0.5) / nphi * 2 * np.pi
+    cos_h = np.sqrt((1 - y) / (1 + (a * a - 1) * y))
+    sin_h = np.sqrt(np.maximum(0.0, 1 - cos_h ** 2))
+    hx = sin_h[:, None] * np.cos(phi)[None, :]
+    hz = np.broadcast_to(cos_h[:, None], hx.shape)
+    out = np.empty(len(mu))
+    for i, c in enumerate(np.asarray(mu, np.float64)):
+        c = max(c, 1e-6)
+        vx = math.sqrt(max(0.0, 1 - c * c))
+        voh = vx * hx + c * hz
+        nol = 2 * voh * hz - c
+        g = (nol / (nol * (1 - k) + k)) * (c / (c * (1 - k) + k))
+        out[i] = np.where(nol > 0, g * voh / (hz * c), 0.0).mean()
+    return out
+
+
+def _albedo_table(roughness: float):
+    mu = np.linspace(0.0, 1.0, 257)
+    return mu, ggx_albedo(mu, roughness)
+
+
+def sphere_true_energy(radius: float, d: float, roughness: float) -> float:
+    """Le * 2 pi * integral over the cone (cos from cos(theta_max) to 1) of rho(mu) mu dmu."""
+    le = 1.0 / (math.pi * radius * radius)
+    cmax = math.sqrt(max(0.0, 1.0 - (radius / d) ** 2))
+    mu_t, rho_t = _albedo_table(roughness)
+    n = 4096
+    mu = cmax + (np.arange(n) + 0.5) / n * (1.0 - cmax)
+    integrand = np.interp(mu, mu_t, rho_t) * mu
+    return le * 2 * math.pi * integrand.mean() * (1.0 - cmax)
+
+
+def capsule_true_energy(radius: float, length: float, d: float, roughness: float,
+                        nx: int = 3000, ny: int = 300) -> float:
+    """Ray-cast quadrature over the plane z = d: the direction to (x, y, d) sees the capsule
+    (axis along X through (0, 0, d), segment half-length length / 2) when the ray passes
+    within `radius` of the segment; dOmega = d dx dy / |q|^3."""
+    h = length / 2
+    le = 1.0 / (2 * radius * length + math.pi * radius * radius)
+    mu_t, rho_t = _albedo_table(roughness)
+    ext = h + radius
+    # The capsule is seen within |x| <= ext (1 + small) on the plane at height d; rays from
+    # the origin hitting it at depth d +- r land within that box widened by r / d.
+    xs = (np.arange(nx) + 0.5) / nx * 2 - 1
+    ys = (np.arange(ny) + 0.5) / ny * 2 - 1
+    wx = ext * (1 + radius / d) + radius
+    wy = radius * (1 + ext / d) * 1.05 + 1e-9
+    x, y = np.meshgrid(xs * wx, ys * wy, indexing="ij")
+    q = np.stack([x, y, np.full_like(x, d)], axis=-1)
+    qn = np.linalg.norm(q, axis=-1)
+    u = q / qn[..., None]
+    ux, uz = u[..., 0], u[..., 2]
+    den = np.maximum(1 - ux * ux, 1e-12)
+    t = np.clip(d * ux * uz / den, -h, h)
+    # squared distance from the ray (through the origin along u) to the point (t, 0, d)
+    s_dot_u = t * ux + d * uz
+    dist2 = t * t + d * d - s_dot_u ** 2
+    hit = dist2 <= radius * radius
+    domega = d * (2 * wx / nx) * (2 * wy / ny) / qn ** 3
+    mu = uz
+    return float(le * np.sum(np.where(hit, np.interp(mu, mu_t, rho_t) * mu * domega, 0.0)))
+
+
+def exitance_axisymmetric(spec_of_view, n: int = 40000) -> float:
+    """2 pi * integral over theta_v of L(theta_v) cos sin: `spec_of_view(V)` takes (n, 3) unit
+    view vectors in the XZ plane and returns the specular radiance (n,). Quadrature nodes
+    theta = (pi/2) s^2, dense near the normal where the highlight of an overhead light is."""
+    s = (np.arange(n) + 0.5) / n
+    theta = 0.5 * math.pi * s * s
+    dtheta = math.pi * s / n
+    V = np.stack([np.sin(theta), np.zeros_like(theta), np.cos(theta)], axis=1)
+    L = np.asarray(spec_of_view(V), np.float64)
+    return float(2 * math.pi * np.sum(L * np.cos(theta) * np.sin(theta) * dtheta))
+
+
+def tube_view_grid(nb: int = 1600, ng: int = 1600):
+    """View directions for a tube along X overhead, and their solid-angle weights times N.V:
+    the mirror direction R = (-Vx, -Vy, Vz) is (sin b, cos b sin g, cos b cos g), b along the
+    tube, g across it (dOmega = cos b db dg); g = (pi/2) s |s| is dense across the strip."""
+    b = ((np.arange(nb) + 0.5) / nb * 2 - 1) * 0.5 * math.pi
+    s = (np.arange(ng) + 0.5) / ng * 2 - 1
+    g = 0.5 * math.pi * s * np.abs(s)
+    dg = math.pi * np.abs(s) * (2.0 / ng)
+    db = math.pi / nb
+    B, G = np.meshgrid(b, g, indexing="ij")
+    R = np.stack([np.sin(B), np.cos(B) * np.sin(G), np.cos(B) * np.cos(G)], axis=-1)
+    V = np.stack([-R[..., 0], -R[..., 1], R[..., 2]], axis=-1).reshape(-1, 3)
+    w = (np.cos(B) * db * dg[None, :] * R[..., 2]).reshape(-1)
+    return V, w
