@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+
+QUIT_AFTER_FIRST_FRAME = "MATEDIT_QUIT_AFTER_FIRST_FRAME"
 
 
 def one_line(text: object) -> str:
@@ -30,6 +33,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="matedit", description="Node-based material editor (Karis 2013). "
                      "`matedit [FILE]` opens the editor (no FILE: the built-in sample "
                      "layered material); the commands below run headless.")
+    parser.add_argument("--version", action="store_true",
+                        help="print the version and exit")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
     from matedit import commands
 
@@ -62,7 +67,56 @@ def open_editor(argv: list[str]) -> int:
             raise UsageError(f"{path}: is a material function; open a material that uses it")
     from matedit.app.app import run
 
+    if os.environ.get(QUIT_AFTER_FIRST_FRAME):
+        _quit_after_first_frame(os.environ[QUIT_AFTER_FIRST_FRAME])
     return run(path)
+
+
+def _quit_after_first_frame(setting: str) -> None:
+    """MATEDIT_QUIT_AFTER_FIRST_FRAME=SECONDS: the editor exits with status 0 once its
+    viewport has drawn a frame with the material's program, or with status 1 and an
+    `error:` line when it has not within SECONDS (a non-number means 120). For smoke tests
+    of an installed build; it changes nothing else."""
+    from PySide6.QtCore import QTimer
+
+    from matedit.app.app import make_application
+    from matedit.app.viewport import ViewportWidget
+
+    try:
+        limit = float(setting)
+    except ValueError:
+        limit = 120.0
+    if not limit > 1:
+        limit = 120.0
+    app = make_application()  # run() reuses this instance
+
+    def arm() -> None:
+        views = [v for w in app.topLevelWidgets() for v in w.findChildren(ViewportWidget)]
+        if not views:
+            QTimer.singleShot(20, arm)
+            return
+        view = views[0]
+        compiler = getattr(view.window(), "compiler", None)
+
+        def on_frame() -> None:
+            # A compiled material reaches the renderer before the frame after it is drawn.
+            if view.renderer is not None and getattr(compiler, "current", None) is not None:
+                print(f"matedit: viewport frame drawn, {view.width()}x{view.height()}",
+                      file=sys.stderr)
+                app.exit(0)
+
+        view.frameDrawn.connect(on_frame)
+        view.update()  # the first frame may already be on screen: ask for one more
+
+    def give_up() -> None:
+        view = next((v for w in app.topLevelWidgets() for v in w.findChildren(ViewportWidget)),
+                    None)
+        why = (view.problem if view is not None else "") or "no viewport frame"
+        print(f"error: no first frame within {limit:g} s: {why}", file=sys.stderr)
+        app.exit(1)
+
+    QTimer.singleShot(0, arm)
+    QTimer.singleShot(int(limit * 1000), give_up)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -73,6 +127,11 @@ def main(argv: list[str] | None = None) -> int:
                         subcommand_names(parser)):
             return open_editor(argv)
         args = parser.parse_args(argv)
+        if args.version and not args.command:
+            from matedit import __version__
+
+            print(f"matedit {__version__}")
+            return 0
         if not getattr(args, "run", None):
             parser.print_help()
             return 0

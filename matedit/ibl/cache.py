@@ -1,7 +1,8 @@
 """On-disk cache of bakes: one .npz per (environment content, settings, bake shaders) key.
 
-Location: ``$MATEDIT_CACHE_DIR/ibl`` when that variable is set, else
-``${XDG_CACHE_HOME:-~/.cache}/matedit/ibl``. Files are written to a temporary name in the
+Location: ``matedit.dirs.cache_dir() / "ibl"``, that is ``$MATEDIT_CACHE_DIR/ibl`` when
+that variable is set, else the platform's user cache folder (on Linux
+``${XDG_CACHE_HOME:-~/.cache}/matedit/ibl``). Files are written to a temporary name in the
 same folder and renamed into place, so a reader never sees half a file; an unreadable
 entry counts as a miss and is baked again.
 """
@@ -11,13 +12,13 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-import os
 import zipfile
 from functools import cache
 from pathlib import Path
 
 import numpy as np
 
+from matedit.dirs import cache_dir
 from matedit.io.atomic import atomic_write_bytes
 from matedit.resources import shaders_dir
 
@@ -27,12 +28,7 @@ CACHE_FORMAT = 1
 
 def cache_root() -> Path:
     """The matedit cache folder (not created)."""
-    override = os.environ.get("MATEDIT_CACHE_DIR")
-    if override:
-        return Path(override).expanduser()
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    base = Path(xdg).expanduser() if xdg else Path.home() / ".cache"
-    return base / "matedit"
+    return cache_dir()
 
 
 def ibl_cache_dir() -> Path:

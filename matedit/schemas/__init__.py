@@ -1,0 +1,1 @@
+"""JSON Schema files of the matedit document formats (package data)."""

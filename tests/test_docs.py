@@ -1,0 +1,136 @@
+"""The documentation stays true: Markdown links resolve, cli.md covers every command and
+option, and the user guide's screenshots are the ones docs/screenshots.py makes."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+import pytest
+
+from matedit.cli import build_parser
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = ROOT / "docs"
+SKIP_DIRS = {".venv", "dist", "build", "node_modules", "__pycache__"}
+LINK = re.compile(r"!?\[(?:[^\]\\]|\\.)*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
+
+
+def markdown_files() -> list[Path]:
+    out = []
+    for p in ROOT.rglob("*.md"):
+        rel = p.relative_to(ROOT)
+        if any(part in SKIP_DIRS or part.startswith(".") for part in rel.parts[:-1]):
+            continue
+        out.append(p)
+    return sorted(out)
+
+
+def without_code(text: str) -> str:
+    text = re.sub(r"```.*?```", "", text, flags=re.S)
+    return re.sub(r"`[^`\n]*`", "", text)
+
+
+def slug(heading: str) -> str:
+    """GitHub's anchor of a heading: lower case, punctuation dropped, spaces to '-'."""
+    h = re.sub(r"[`*_]", "", heading.strip().lower())
+    h = re.sub(r"[^\w\- ]", "", h)
+    return h.replace(" ", "-")
+
+
+def anchors(path: Path) -> set[str]:
+    text = re.sub(r"```.*?```", "", path.read_text(), flags=re.S)
+    return {slug(m.group(1)) for m in re.finditer(r"^#+\s+(.*)$", text, re.M)}
+
+
+def links(path: Path) -> list[str]:
+    return LINK.findall(without_code(path.read_text()))
+
+
+def test_the_repository_has_its_docs():
+    for name in ("architecture", "file-format", "shading", "cli", "user-guide"):
+        assert (DOCS / f"{name}.md").is_file(), name
+    assert (ROOT / "README.md") in markdown_files()
+
+
+def broken_links(path: Path) -> list[str]:
+    broken = []
+    for target in links(path):
+        if re.match(r"^[a-z][a-z0-9+.-]*:", target):  # http:, https:, mailto:
+            continue
+        file_part, _, anchor = target.partition("#")
+        dest = (path.parent / file_part).resolve() if file_part else path
+        if not dest.exists():
+            broken.append(target)
+        elif anchor and dest.suffix == ".md" and anchor not in anchors(dest):
+            broken.append(target + " (no such heading)")
+    return broken
+
+
+@pytest.mark.parametrize("path", markdown_files(), ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_markdown_links_resolve(path):
+    broken = broken_links(path)
+    assert broken == [], f"{path.relative_to(ROOT)} links to missing paths: {broken}"
+
+
+def test_link_checker_sees_a_broken_link(tmp_path):
+    page = tmp_path / "page.md"
+    page.write_text("See [this](missing.md), `[not](code.md)` and [web](https://x.org).\n"
+                    "```\n[neither](block.md)\n```\n![img](pic.png) [me](#nowhere)\n"
+                    "## A heading, `here`\n[ok](#a-heading-here)\n")
+    assert links(page) == ["missing.md", "https://x.org", "pic.png", "#nowhere",
+                           "#a-heading-here"]
+    assert broken_links(page) == ["missing.md", "pic.png", "#nowhere (no such heading)"]
+
+
+def test_readme_points_at_nothing_outside_the_repository():
+    text = (ROOT / "README.md").read_text()
+    assert "ARCHITECTURE.md" not in text and "SHADING.md" not in text
+    assert "docs/user-guide.md" in text and "packaging/build.sh" in text
+
+
+def _commands() -> dict[str, argparse.ArgumentParser]:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return dict(sub.choices)
+
+
+def test_cli_doc_covers_every_command_and_option():
+    text = (DOCS / "cli.md").read_text()
+    assert "`matedit --version`" in text
+    for name, parser in _commands().items():
+        assert f"## `matedit {name}" in text, f"docs/cli.md: no section for {name}"
+        section = text.split(f"## `matedit {name}", 1)[1].split("\n## ", 1)[0]
+        for action in parser._actions:
+            for opt in action.option_strings:
+                if opt in ("-h", "--help"):
+                    continue
+                assert f"`{opt}" in section or f"{opt}`" in section or f"`{opt} " in section, \
+                    f"docs/cli.md, {name}: option {opt} is not documented"
+            for choice in action.choices or ():
+                assert f"`{choice}`" in section, f"docs/cli.md, {name}: {choice} missing"
+    for status in ("| 0 |", "| 1 |", "| 2 |"):
+        assert status in text
+
+
+def test_user_guide_images_are_the_screenshot_scripts():
+    guide = (DOCS / "user-guide.md").read_text()
+    used = {Path(t).name for t in links(DOCS / "user-guide.md") if t.startswith("images/")}
+    script = (DOCS / "screenshots.py").read_text()
+    made = set(re.findall(r'"([a-z0-9-]+\.png)"', script))
+    on_disk = {p.name for p in (DOCS / "images").glob("*.png")}
+    assert used <= made, f"the guide shows images the script does not make: {used - made}"
+    assert made == on_disk, "docs/images/ is out of date: run docs/screenshots.py"
+    assert used == on_disk, f"screenshots the guide does not show: {on_disk - used}"
+    assert "docs/screenshots.py" in guide
+
+
+def test_shading_doc_names_the_command_of_each_table():
+    text = (DOCS / "shading.md").read_text()
+    assert "### Command: `.venv/bin/python docs/accuracy.py`" in text
+    assert "### Command: `benchmarks/run.sh`" in text
+    assert (DOCS / "accuracy.py").is_file()
+    for header in ("Environment BRDF LUT", "Prefiltered environment", "Sphere light",
+                   "Split sum against the reference", "White furnace"):
+        assert header in text and header in (DOCS / "accuracy.py").read_text()
