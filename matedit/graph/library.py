@@ -13,8 +13,9 @@ same footprint from the evaluator's pixel grid (`SurfaceArrays.grid`).
 
 from __future__ import annotations
 
-from matedit.graph.nodes import GENERIC, MESH_UV, NodeDef, _i, _o, _op, register
+from matedit.graph.nodes import GENERIC, MESH_UV, REGISTRY, NodeDef, _i, _o, _op, register
 
+_BEFORE = frozenset(REGISTRY)
 T = GENERIC
 UNIT = (0.0, 1.0)
 _FILTER = ("filter_width", "float", 1.0, "edge blur in pixels (0: hard edges)", (0.0, 4.0))
@@ -354,3 +355,6 @@ _fn("curvature", "Curvature", "Mask",
     "baked maps.",
     [_i("scale", "float", 0.5, "metres: mask reaches 1 at curvature 1/scale", (0.0, 10.0))],
     [_o("curvature", "float"), _o("convex", "float"), _o("concave", "float")])
+
+# The kinds this module adds, in registration order.
+KINDS: tuple[str, ...] = tuple(k for k in REGISTRY if k not in _BEFORE)
