@@ -92,39 +92,39 @@ _op("fwidth", "Pixel Footprint", "fwidth({value})", [_i("value", T)],
 
 # --- colour ----------------------------------------------------------------------------------
 _C = ("color", "vec3", [0.5, 0.5, 0.5], "linear RGB")
-_fn("luminance", "Luminance", "Color", "Rec. 709 luminance of a linear colour.",
+_fn("luminance", "Luminance", "Colour", "Rec. 709 luminance of a linear colour.",
     [_i(*_C)], [_o("value", "float")], mtlx=_mx("luminance", color="in"))
-_fn("rgb_to_hsv", "RGB to HSV", "Color", "Hue (turns), saturation and value of a colour.",
+_fn("rgb_to_hsv", "RGB to HSV", "Colour", "Hue (turns), saturation and value of a colour.",
     [_i(*_C)], [_o("hsv", "vec3")], mtlx=_mx("rgbtohsv", color="in"))
-_fn("hsv_to_rgb", "HSV to RGB", "Color", "The colour of a hue (turns), saturation, value.",
+_fn("hsv_to_rgb", "HSV to RGB", "Colour", "The colour of a hue (turns), saturation, value.",
     [_i("hsv", "vec3", [0.0, 1.0, 1.0])], [_o("color", "vec3")],
     mtlx=_mx("hsvtorgb", hsv="in"))
-_fn("hsv_adjust", "HSV Adjust", "Color",
+_fn("hsv_adjust", "HSV Adjust", "Colour",
     "Rotates hue, scales saturation and value (in HSV space).",
     [_i(*_C), _i("hue", "float", 0.0, "hue shift in turns", (-0.5, 0.5)),
      _i("saturation", "float", 1.0, "saturation multiplier", (0.0, 2.0)),
      _i("value", "float", 1.0, "value multiplier", (0.0, 2.0))],
     [_o("result", "vec3")])
-_fn("brightness_contrast", "Brightness / Contrast", "Color",
+_fn("brightness_contrast", "Brightness / Contrast", "Colour",
     "Adds brightness and scales contrast about mid grey; never below 0.",
     [_i(*_C), _i("brightness", "float", 0.0, "", (-1.0, 1.0)),
      _i("contrast", "float", 0.0, "", (-1.0, 1.0))], [_o("result", "vec3")])
-_fn("gamma", "Gamma", "Color", "color raised to gamma (negative components read 0).",
+_fn("gamma", "Gamma", "Colour", "color raised to gamma (negative components read 0).",
     [_i(*_C), _i("gamma", "float", 1.0, "", (0.01, 10.0))], [_o("result", "vec3")])
-_fn("invert", "Invert", "Color", "1 − color, by amount.",
+_fn("invert", "Invert", "Colour", "1 − color, by amount.",
     [_i(*_C), _i("amount", "float", 1.0, "", UNIT)], [_o("result", "vec3")])
-_fn("levels", "Levels", "Color",
+_fn("levels", "Levels", "Colour",
     "Input black/white points, midtone gamma and output range, like an image editor's.",
     [_i(*_C), _i("in_black", "float", 0.0, "", UNIT), _i("in_white", "float", 1.0, "", UNIT),
      _i("gamma", "float", 1.0, "midtone gamma (>1 brightens)", (0.1, 10.0)),
      _i("out_black", "float", 0.0, "", UNIT), _i("out_white", "float", 1.0, "", UNIT)],
     [_o("result", "vec3")])
-_fn("saturation", "Saturation", "Color", "Mixes between grey (0) and the colour (1) and past.",
+_fn("saturation", "Saturation", "Colour", "Mixes between grey (0) and the colour (1) and past.",
     [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")],
     mtlx=_mx("saturate", color="in", amount="amount"))
-_fn("srgb_to_linear", "sRGB to Linear", "Color", "Decodes sRGB-encoded values (IEC 61966-2-1).",
+_fn("srgb_to_linear", "sRGB to Linear", "Colour", "Decodes sRGB-encoded values (IEC 61966-2-1).",
     [_i("color", "vec3", [0.5, 0.5, 0.5], "sRGB-encoded")], [_o("result", "vec3")])
-_fn("linear_to_srgb", "Linear to sRGB", "Color", "Encodes linear values as sRGB.",
+_fn("linear_to_srgb", "Linear to sRGB", "Colour", "Encodes linear values as sRGB.",
     [_i(*_C)], [_o("result", "vec3")])
 _BLENDS = {
     "multiply": ("Multiply", "base × blend: darkens.", None),
@@ -140,7 +140,7 @@ _BLENDS = {
     "darken": ("Darken", "The smaller of base and blend.", None),
 }
 for _name, (_title, _doc, _mxn) in _BLENDS.items():
-    _fn(f"blend_{_name}", f"Blend: {_title}", "Color",
+    _fn(f"blend_{_name}", f"Blend: {_title}", "Colour",
         f"{_doc} Mixed over base by opacity.",
         [_i("base", "vec3", [0.5, 0.5, 0.5]), _i("blend", "vec3", [0.5, 0.5, 0.5]),
          _i("opacity", "float", 1.0, "", UNIT)], [_o("result", "vec3")],
@@ -148,7 +148,7 @@ for _name, (_title, _doc, _mxn) in _BLENDS.items():
 RAMP_STOPS = 6
 _GREYS = (0.0, 1.0, 1.0, 1.0, 1.0, 1.0)
 register(NodeDef(
-    "color_ramp", "Colour Ramp", "Color",
+    "color_ramp", "Colour Ramp", "Colour",
     "Maps a value through colour stops (position, colour), linearly between them; edit the "
     "stops in the inspector. Stops past `stops` are ignored.",
     inputs=(_i("value", "float", 0.5, "", UNIT),
