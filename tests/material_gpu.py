@@ -43,7 +43,7 @@ def surface(w: int, h: int, time: float = 1.25) -> SurfaceArrays:
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     view = np.array(CAMERA) - pos
     view /= np.linalg.norm(view, axis=1, keepdims=True)
-    return SurfaceArrays(uv, pos, nrm, view, time)
+    return SurfaceArrays(uv, pos, nrm, view, time, grid=(h, w))  # the footprint: this image
 
 
 def render_attributes(ctx, compiled, w: int = 64, h: int = 64, uniforms=None,

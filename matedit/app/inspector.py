@@ -177,6 +177,9 @@ class InspectorPanel(QScrollArea):
                               else "color: #e5b94a;")
             lay.addWidget(msg)
         if d is not None:
+            if node.kind == "color_ramp":  # the stops editor (matedit/app/ramp_widget.py)
+                from matedit.app.ramp_widget import RampEditor
+                lay.addWidget(RampEditor(self.controller, node.id))
             self._build_settings(lay, node, d)
             self._build_values(lay, node, d)
             self._build_inputs(lay, node)

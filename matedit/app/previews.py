@@ -47,7 +47,8 @@ def preview_sphere(size: int = SIZE) -> tuple[SurfaceArrays, np.ndarray]:
     u = (np.arctan2(-n[:, 2], n[:, 0]) / (2 * np.pi)) % 1.0
     v = 1.0 - np.arccos(np.clip(n[:, 1], -1, 1)) / np.pi
     view = np.tile([0.0, 0.0, 1.0], (len(n), 1))
-    return SurfaceArrays(np.stack([u, v], axis=1), n.copy(), n, view, 0.0), inside
+    return SurfaceArrays(np.stack([u, v], axis=1), n.copy(), n, view, 0.0,
+                         grid=(size, size)), inside  # the footprint: filtered edges, bumps
 
 
 def to_image(value, inside: np.ndarray | None = None, size: int = SIZE) -> QImage | None:

@@ -5,7 +5,7 @@ Each module exposes `register(subparsers)`, which adds its parser and sets
 Bad input raises `matedit.cli.UsageError` (one line, exit 2).
 """
 
-from matedit.commands import bake_ibl, brdf_lut, render, validate
+from matedit.commands import bake_ibl, brdf_lut, contact_sheet, nodes, render, validate
 from matedit.commands import compile as compile_cmd
 
 REGISTRY = [
@@ -14,4 +14,6 @@ REGISTRY = [
     render.register,
     bake_ibl.register,
     brdf_lut.register,
+    nodes.register,
+    contact_sheet.register,
 ]

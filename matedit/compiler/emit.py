@@ -214,6 +214,7 @@ SHADE_MAIN = """void main() {
     g_surface.normal = Ng;
     g_surface.view = V;
     g_surface.time = uFrame.params.x;
+    nodeSurfaceFrame(v_tangent, uFrame.model, uFrame.viewProjection);
     MaterialAttributes m = evaluateMaterial();
     vec3 N = Ng;
 #ifdef MATERIAL_HAS_NORMAL
@@ -231,6 +232,7 @@ ATTRIBUTES_MAIN = """void main() {
     g_surface.normal = normalize(v_normal);
     g_surface.view = normalize(uFrame.cameraPosition.xyz - v_position);
     g_surface.time = uFrame.params.x;
+    nodeSurfaceFrame(v_tangent, uFrame.model, uFrame.viewProjection);
     MaterialAttributes m = evaluateMaterial();
     out0 = vec4(m.baseColor, m.metallic);
     out1 = vec4(m.normal, m.roughness);

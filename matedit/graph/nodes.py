@@ -71,6 +71,9 @@ class NodeDef:
     values: tuple[InputDef, ...] = ()
     # Output type rule for generic nodes: "T" (same as inputs) or fixed per output.
     keywords: tuple[str, ...] = field(default_factory=tuple)
+    # MaterialX standard-library equivalent: a node name (same port names) or
+    # {"node": name, "inputs": {our port: its input}, "outputs": {...}}; None: not expressible.
+    mtlx: str | dict[str, Any] | None = None
 
     def input(self, name: str) -> InputDef | None:
         return next((i for i in self.inputs if i.name == name), None)
@@ -119,11 +122,12 @@ def _o(name, type_, doc="") -> OutputDef:
     return OutputDef(name, type_, doc)
 
 
-def _op(kind, title, inline, inputs, doc, out_type=GENERIC, category="Math", glsl=None):
+def _op(kind, title, inline, inputs, doc, out_type=GENERIC, category="Math", glsl=None,
+        mtlx=None):
     register(NodeDef(
         kind=kind, title=title, category=category, description=doc,
         inputs=tuple(inputs), outputs=(_o("result", out_type),),
-        inline=inline if glsl is None else None, glsl=glsl, numpy=kind,
+        inline=inline if glsl is None else None, glsl=glsl, numpy=kind, mtlx=mtlx,
     ))
 
 
@@ -305,9 +309,11 @@ register(NodeDef(
     glsl="node_value_noise", numpy="value_noise",
 ))
 register(NodeDef(
-    "checker", "Checker", "Procedural", "A two-colour checkerboard over uv.",
+    "checker", "Checker", "Procedural",
+    "A two-colour checkerboard over uv; edges box-filtered over the pixel footprint.",
     inputs=(_i("uv", "vec2", MESH_UV), _i("scale", "float", 8.0, "squares per UV unit"),
-            _i("color_a", "vec3", [0.9, 0.9, 0.9]), _i("color_b", "vec3", [0.1, 0.1, 0.1])),
+            _i("color_a", "vec3", [0.9, 0.9, 0.9]), _i("color_b", "vec3", [0.1, 0.1, 0.1]),
+            _i("filter_width", "float", 1.0, "edge blur in pixels (0: hard edges)", (0.0, 4.0))),
     outputs=(_o("color", "vec3"), _o("mask", "float")),
     glsl="node_checker", numpy="checker",
 ))
@@ -436,3 +442,7 @@ register(NodeDef(
     inputs=(_i("attributes", MA, None, required=True),),
     inline="", numpy="material_output",
 ))
+
+
+# The library beyond the basics lives in its own module, registered on import.
+from matedit.graph import library as _library  # noqa: E402,F401

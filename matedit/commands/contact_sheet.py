@@ -1,0 +1,125 @@
+"""`matedit contact-sheet [FILE|DIR ...] -o OUT.png [--size N] [--columns N] [--mesh M]`:
+every material rendered side by side and labelled, one PNG (the shipped samples by default).
+
+Each tile is what `matedit render` draws for that file (its preview mesh, the studio
+environment unless it names another, split-sum IBL), rendered in one GL context.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+from matedit.cli import UsageError
+
+
+def register(sub) -> None:
+    p = sub.add_parser("contact-sheet", help="render every material side by side to a PNG",
+                       description="Render materials (default: the shipped samples) to one "
+                       "labelled PNG, a tile each.")
+    p.add_argument("files", nargs="*", metavar="FILE|DIR")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.png")
+    p.add_argument("--size", type=int, default=256, metavar="N", help="tile size in pixels")
+    p.add_argument("--columns", type=int, default=4, metavar="N")
+    p.add_argument("--mesh", default=None, help="override every file's preview mesh")
+    p.set_defaults(run=run)
+
+
+def materials(files: list[str]) -> list[Path]:
+    from matedit.resources import graphs_dir
+
+    if not files:
+        return sorted((graphs_dir() / "materials").glob("*.json"))
+    out: list[Path] = []
+    for f in files:
+        p = Path(f)
+        if p.is_dir():
+            out.extend(sorted(p.glob("*.json")))
+        elif p.is_file():
+            out.append(p)
+        else:
+            raise UsageError(f"{p}: no such file or folder")
+    if not out:
+        raise UsageError("no material files found")
+    return out
+
+
+def _label(tile, text: str):
+    import numpy as np
+    import OpenImageIO as oiio
+
+    h, w, _ = tile.shape
+    buf = oiio.ImageBuf(oiio.ImageSpec(w, 26, 3, "float"))
+    oiio.ImageBufAlgo.render_text(buf, 6, 19, text, 15, "", (0.92, 0.92, 0.92))
+    band = np.asarray(buf.get_pixels(oiio.FLOAT)).reshape(26, w, 3)
+    out = tile.copy()
+    out[h - 26:] = np.maximum(out[h - 26:] * 0.35, band)
+    return out
+
+
+def run(args) -> int:
+    import numpy as np
+
+    from matedit.commands.render import write_png
+    from matedit.compiler import CompileError, compile_document
+    from matedit.io.document import FileResolver, FormatError, load
+
+    out = Path(args.output)
+    if out.suffix.lower() != ".png":
+        raise UsageError(f"{out}: the output must be a .png file")
+    if not out.parent.exists():
+        raise UsageError(f"{out}: folder {out.parent} does not exist")
+    if not 16 <= args.size <= 2048:
+        raise UsageError(f"--size must be 16..2048, got {args.size}")
+    if args.columns < 1:
+        raise UsageError(f"--columns must be at least 1, got {args.columns}")
+    paths = materials(args.files)
+    if out.resolve() in {p.resolve() for p in paths}:
+        raise UsageError(f"{out}: would overwrite an input")
+    docs = []
+    for path in paths:
+        try:
+            doc = load(path)
+        except FormatError as exc:
+            raise UsageError(str(exc)) from None
+        if doc.is_function:
+            continue
+        try:
+            docs.append((path, doc, compile_document(doc, FileResolver(), "glsl330")))
+        except CompileError as exc:
+            d = exc.diagnostics[0]
+            raise UsageError(f"{d.file or path}: {d.format()}") from None
+
+    from matedit.render import Renderer
+    from matedit.render.context import headless_context
+
+    n = args.size
+    cols = min(args.columns, max(len(docs), 1))
+    rows = max(math.ceil(len(docs) / cols), 1)
+    sheet = np.full((rows * n, cols * n, 3), 0.06)
+    ctx = headless_context()
+    try:
+        renderer = Renderer(ctx, (n, n), environment=None)
+        env = None
+        for i, (path, doc, compiled) in enumerate(docs):
+            want = doc.preview.get("environment") or "studio"
+            if want != env:
+                renderer.set_environment(want)
+                env = want
+            renderer.set_mesh(args.mesh or doc.preview.get("mesh") or "sphere")
+            status = renderer.set_material(compiled)
+            if not status.ok:
+                node, msg = status.errors[0]
+                raise UsageError(f"{path}: node {node}: GLSL: {msg}")
+            renderer.render()
+            tile = _label(np.asarray(renderer.read_image(), dtype=np.float64),
+                          doc.name or path.stem)
+            r, c = divmod(i, cols)
+            sheet[r * n:(r + 1) * n, c * n:(c + 1) * n] = tile
+            print(f"{i + 1}/{len(docs)} {path.name}", file=sys.stderr)
+        renderer.release()
+    finally:
+        ctx.release()
+    write_png(out, sheet)
+    return 0

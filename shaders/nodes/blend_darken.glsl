@@ -1,0 +1,9 @@
+// Blend: darken node, mixed over base by opacity.
+
+void node_blend_darken(vec3 base, vec3 blend, float opacity, out vec3 result) {
+    // W3C Compositing Level 1: darken, min(a, b)
+    vec3 a = base;
+    vec3 b = blend;
+    vec3 r = min(a, b);
+    result = mix(a, r, opacity);
+}
