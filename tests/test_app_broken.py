@@ -220,7 +220,13 @@ def test_ampersand_in_names_is_shown_not_eaten(qtbot):
     texts = [b.text() for b in crumbs if b is not None and hasattr(b, "isFlat")]
     assert "UV Tile && Rotate" in texts, texts
     # The call node is titled with the function's own name, not its file name.
-    item = w.tabs.material.canvas.scene().node_items["uv"]
+    from matedit.graph.commands import AddNode
+    from matedit.graph.model import Node
+
+    w.tabs.material.controller.push(AddNode(Node(
+        "uvcall", "function_call", (0.0, 0.0),
+        {"function": "../functions/uv_tile_rotate.json"})))
+    item = w.tabs.material.canvas.scene().node_items["uvcall"]
     assert item.title == "UV Tile & Rotate"
 
 

@@ -13,6 +13,7 @@ import copy
 import json
 import os
 import threading
+from datetime import timedelta
 
 import pytest
 from hostile import (
@@ -33,9 +34,12 @@ from matedit.io.document import FormatError, load, loads
 
 pytestmark = pytest.mark.timeout(20)
 EXAMPLES = int(os.environ.get("HOSTILE_EXAMPLES", "60"))
-HSET = settings(max_examples=EXAMPLES, deadline=None, derandomize=True,
+# Generated cases: each example within 20 s (hypothesis' deadline), the whole property
+# within the sum (pytest-timeout, which also ends a hang).
+HSET = settings(max_examples=EXAMPLES, deadline=timedelta(seconds=20), derandomize=True,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,
                                        HealthCheck.too_slow])
+HTIMEOUT = pytest.mark.timeout(20 * EXAMPLES + 60)
 
 # --- every string field of a material, one payload at a time --------------------------------
 
@@ -191,6 +195,7 @@ names = st.one_of(
 )
 
 
+@HTIMEOUT
 @HSET
 @given(node_id=names, param=names, param2=names)
 def test_generated_names_never_collide(tmp_path_factory, node_id, param, param2):
@@ -247,6 +252,7 @@ numbers = st.one_of(st.floats(allow_nan=False, allow_infinity=False, width=64),
                                      "890", "0.1e309"]))
 
 
+@HTIMEOUT
 @HSET
 @given(value=numbers, where=st.sampled_from(["value", "position", "constant", "default"]))
 def test_numbers_either_work_or_name_their_field(tmp_path_factory, value, where):
@@ -458,6 +464,7 @@ json_values = st.recursive(
 )
 
 
+@HTIMEOUT
 @HSET
 @given(mutation=st.lists(st.tuples(st.sampled_from(["top", "node", "link", "settings"]),
                                    st.text(max_size=10), json_values), min_size=1, max_size=4))
