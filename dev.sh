@@ -14,7 +14,7 @@ APT_PACKAGES=(
   libxcb-render-util0 libxcb-shape0 libxcb-xinerama0 libxcb-xkb1 libxkbcommon-x11-0
   libxkbcommon0 libfontconfig1 libdbus-1-3
   glslang-tools
-  desktop-file-utils appstream shared-mime-info dpkg-dev binutils
+  desktop-file-utils appstream shared-mime-info dpkg-dev binutils libglib2.0-bin
 )
 
 setup_system() {

@@ -113,7 +113,10 @@ def main() -> int:
         pump(0.3)
 
     # 4. The node palette (Tab on the canvas).
+    canvas.frame_all()
+    pump(0.3)
     canvas.open_palette(canvas.mapToScene(canvas.viewport().rect().center()))
+    canvas.node_palette.search.setText("blend")  # what typing does: the list filters
     pump(0.5)
     save(w.tabs, "palette.png")
     canvas.node_palette.close_palette()

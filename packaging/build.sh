@@ -18,7 +18,7 @@ fi
 if ! "$PY" -c "import PyInstaller, build" 2>/dev/null; then
   "$PY" -m pip install -q "pyinstaller>=6.3" "build>=1.0"
 fi
-for tool in dpkg-deb readelf desktop-file-validate appstreamcli update-mime-database; do
+for tool in dpkg-deb readelf strip desktop-file-validate appstreamcli update-mime-database; do
   command -v "$tool" >/dev/null || { echo "build.sh: $tool is missing; run ./dev.sh setup" >&2; exit 2; }
 done
 
@@ -37,6 +37,10 @@ echo "build.sh: [2/4] PyInstaller bundle"
 MATEDIT_VERSION="$VERSION" "$PY" -m PyInstaller packaging/matedit.spec --noconfirm \
   --distpath dist --workpath build/pyinstaller >build/pyinstaller.log 2>&1 \
   || { tail -30 build/pyinstaller.log >&2; exit 1; }
+# The interpreter's shared library carries its symbol tables (17 MB of 23); nothing needs
+# them at run time. Only this one is stripped: auditwheel-patched libraries (numpy's
+# OpenBLAS) no longer load once strip has rewritten them.
+strip --strip-unneeded dist/"$BUNDLE"/_internal/libpython3*.so*
 "dist/$BUNDLE/matedit" --version >/dev/null
 
 echo "build.sh: [3/4] desktop entry and AppStream metainfo"

@@ -7,7 +7,8 @@ desktop entry, hicolor icons (48, 128, 256 rasterised here from the SVG with Qt,
 SVG itself), AppStream metainfo and the shared-mime-info types. `Depends` is computed:
 the shared libraries that the bundle's ELF files need and that the bundle does not carry,
 mapped to the Debian packages that hold them on this machine, plus libc6 at the highest
-GLIBC symbol version any file asks for.
+GLIBC symbol version any file asks for, plus fontconfig's configuration (data the bundled
+libfontconfig reads).
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ ICON_SIZES = (48, 128, 256)
 # Loaded with dlopen (moderngl's glcontext: EGL headless, GLX in the editor), so no ELF
 # file names them; they are NEEDED by Qt too, but say so in one place.
 DLOPENED = ("libEGL.so.1", "libGL.so.1")
+# Data the bundled libraries read from the system: fontconfig's configuration (and through
+# it a font), without which Qt draws no text.
+DATA_DEPENDS = ("fontconfig-config",)
 
 
 def is_elf(path: Path) -> bool:
@@ -96,6 +100,7 @@ def compute_depends(bundle: Path) -> tuple[str, list[str]]:
         if lib not in known:
             raise SystemExit(f"make_deb: the bundle needs {lib}, which this machine lacks")
         packages.add(package_of(known[lib]))
+    packages.update(DATA_DEPENDS)
     libc = max(glibc) if glibc else (2, 17)
     deps = []
     for pkg in sorted(packages):
