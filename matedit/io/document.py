@@ -104,13 +104,7 @@ def loads(text: str, file: str | None = None, path: Path | None = None) -> Mater
                           field=str(exc.args[0])) from None
     except (ValueError, RecursionError) as exc:
         raise FormatError(file, f"not valid JSON: {exc}") from None
-    _check_numbers(raw, file)
-    doc = from_dict(raw, file, path)
-    try:
-        dumps(doc)
-    except (TypeError, ValueError) as exc:
-        raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
-    return doc
+    return from_dict(raw, file, path)
 
 
 def read_document_text(path: str | os.PathLike) -> str:
@@ -148,6 +142,17 @@ def _number(x) -> bool:
 
 
 def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> MaterialDocument:
+    """A document from parsed JSON; raises FormatError. A document that loads also saves."""
+    _check_numbers(raw, file)
+    doc = _from_dict(raw, file, path)
+    try:
+        dumps(doc)
+    except (TypeError, ValueError) as exc:
+        raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
+    return doc
+
+
+def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocument:
     _expect(isinstance(raw, dict), file, "top level must be a JSON object")
     fmt = raw.get("format")
     _expect(isinstance(fmt, str) and fmt in FORMATS, file,
@@ -166,6 +171,9 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> Ma
     except (TypeError, AttributeError) as exc:
         raise FormatError(file, f"cannot migrate from version {version}: {exc}") from None
 
+    from matedit.io.schema import check_document_shape
+
+    check_document_shape(raw, file)  # the published JSON Schema (matedit/schemas/)
     doc = MaterialDocument(kind=FORMATS[fmt], path=Path(path) if path else None)
     doc.extra = _unknown(raw, TOP_FIELDS)
     for key in ("name", "description"):
