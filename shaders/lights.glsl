@@ -43,6 +43,7 @@ struct ShadingContext {
     float roughness;        // clamped to MIN_ANALYTIC_ROUGHNESS
     float a;                // roughness^2
     float k;                // Schlick-Smith k for analytic lights
+    vec3 specularScale;     // 1, or the multiple-scattering compensation (ibl.glsl)
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -58,6 +59,7 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
     s.roughness = clamp(roughness, MIN_ANALYTIC_ROUGHNESS, 1.0);
     s.a = s.roughness * s.roughness;
     s.k = k_Analytic(s.roughness);
+    s.specularScale = vec3(1.0);
     return s;
 }
 
@@ -88,7 +90,7 @@ vec3 specularTowards(ShadingContext s, vec3 L) {
     float VoH = saturate(dot(s.V, H));
     vec3 NxH = cross(s.N, H);
     float D = D_GGX(NoH, s.a, dot(NxH, NxH));
-    return D * V_SchlickSmith(s.NoV, NoL, s.k) * F_Schlick(s.F0, VoH) * NoL;
+    return D * V_SchlickSmith(s.NoV, NoL, s.k) * F_Schlick(s.F0, VoH) * NoL * s.specularScale;
 }
 
 // Point on a sphere closest to the reflection ray, as an unnormalised vector from P.

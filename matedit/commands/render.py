@@ -37,6 +37,10 @@ def register(sub) -> None:
     p.add_argument("--samples", type=int, default=None, metavar="N",
                    help="reference-mode samples a pixel (default 2048)")
     p.add_argument("--half", action="store_true", help="EXR output as half floats")
+    p.add_argument("--energy-compensation", action="store_true",
+                   help="multiple-scattering specular compensation (Fdez-Aguera 2019), beyond "
+                   "the talk; a material can also ask for it (preview "
+                   "\"energy_compensation\": true)")
     p.set_defaults(run=run)
 
 
@@ -178,6 +182,8 @@ def run(args) -> int:
             renderer.exposure = args.exposure
         if lights is not None:
             renderer.set_lights(lights)
+        if args.energy_compensation:
+            renderer.set_energy_compensation(True)
         if args.samples is not None:
             renderer.set_reference_samples(args.samples)
         renderer.mode = args.ibl
