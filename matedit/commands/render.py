@@ -26,7 +26,8 @@ def register(sub) -> None:
                    help="sphere, cube, plane, cylinder or an OBJ file (default: the file's "
                    "preview mesh, else sphere)")
     p.add_argument("--env", default=None, metavar="PATH|studio|sky",
-                   help="built-in environment or an HDR/EXR file (default: studio)")
+                   help="built-in environment, an HDR/EXR file, or a folder of six cube-face "
+                   "files (px nx py ny pz nz) (default: studio)")
     p.add_argument("--ibl", default="splitsum", choices=["splitsum", "reference", "difference"],
                    help="split-sum approximation, converged importance-sampled reference, "
                    "or a heat map of their difference")
