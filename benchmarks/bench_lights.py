@@ -3,7 +3,8 @@
     .venv/bin/python benchmarks/bench_lights.py [--quick] [--gpu]
 
 Geometry (tests/light_energy_ref.py): a white metal (F0 = 1) with N = +Z, the light straight
-above at d = 2 m, intensity 1; energy = the specular radiant exitance (outgoing specular
+above at d = 2 m (one sphere table with the light 45 degrees off the normal), intensity 1;
+energy = the specular radiant exitance (outgoing specular
 radiance integrated over all view directions, weighted by N.V). True: a uniform sphere of
 radius r (Le = I / (pi r^2)) or a capsule of radius 0.02 m and length l along X (Le =
 I / (2 r l + pi r^2)), integrated over its solid angle against the GGX albedo. Rendered:
@@ -16,6 +17,7 @@ The tests (tests/test_shading_light_energy.py) check a subset on the GPU.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -28,23 +30,26 @@ from light_energy_ref import (  # noqa: E402
     capsule_true_energy,
     exitance_axisymmetric,
     sphere_true_energy,
+    sphere_true_energy_tilted,
     tube_view_grid,
 )
 
 import matedit.shading.lights as lights  # noqa: E402
 
 D = 2.0
+TILT = math.radians(45.0)  # the second sphere table: the light 45 degrees off the normal
 TUBE_RADIUS = 0.02
 ROUGHNESS = (0.1, 0.2, 0.3, 0.5, 0.7, 0.9)
 SPHERE_RD = (0.01, 0.05, 0.1, 0.25, 0.5)
 TUBE_LENGTHS = (0.25, 0.5, 1.0, 2.0)
 
 
-def _twin(V, kind, radius, length, rough):
+def _twin(V, kind, radius, length, rough, tilt=0.0):
     n = len(V)
     s = lights.makeShadingContext(np.zeros((n, 3)), np.tile([0.0, 0.0, 1.0], (n, 1)), V,
                                   np.zeros((n, 3)), np.ones((n, 3)), np.full(n, rough))
-    light = lights.Light(kind, position=(0.0, 0.0, D), direction=(1.0, 0.0, 0.0),
+    pos = (D * math.sin(tilt), 0.0, D * math.cos(tilt))
+    light = lights.Light(kind, position=pos, direction=(1.0, 0.0, 0.0),
                          intensity=1.0, influence_radius=1e4, source_radius=radius,
                          source_length=length)
     return lights.evaluateLight(s, light)[:, 0]
@@ -54,11 +59,13 @@ def _gpu(ctx):
     from gpu_eval import gpu_eval_many
     from test_shading_light_energy import BODY
 
-    def spec(V, kind, radius, length, rough):
+    def spec(V, kind, radius, length, rough, tilt=0.0):
         n = len(V)
         f = lambda x: np.full(n, x, np.float32)  # noqa: E731
         k = {"sphere": 2, "tube": 3}[kind]
-        out = gpu_eval_many(ctx, BODY, {"V": V.astype(np.float32), "kind": f(k), "dist": f(D),
+        body = BODY.replace("vec3(0.0, 0.0, dist)",
+                            f"dist * vec3({math.sin(tilt):.9f}, 0.0, {math.cos(tilt):.9f})")
+        out = gpu_eval_many(ctx, body, {"V": V.astype(np.float32), "kind": f(k), "dist": f(D),
                                         "radius": f(radius), "len": f(length),
                                         "rough": f(rough)}, {"spec": "float"},
                             includes=["lights.glsl"])
@@ -66,7 +73,7 @@ def _gpu(ctx):
     return spec
 
 
-def table(spec, quick: bool) -> tuple[list, list]:
+def table(spec, quick: bool) -> tuple[list, list, list]:
     n_view = 8000 if quick else 20000
     grid = tube_view_grid(400, 400) if quick else tube_view_grid(800, 800)
     spheres, tubes = [], []
@@ -79,28 +86,38 @@ def table(spec, quick: bool) -> tuple[list, list]:
             row.append(e / true)
         spheres.append((rd, row))
     V, w = grid
+    tilted = []
+    for rd in SPHERE_RD:
+        row = []
+        for rough in ROUGHNESS:
+            true = sphere_true_energy_tilted(rd * D, D, TILT, rough)
+            row.append(float(np.sum(spec(V, "sphere", rd * D, 0.0, rough, TILT) * w)) / true)
+        tilted.append((rd, row))
     for length in TUBE_LENGTHS:
         row = []
         for rough in ROUGHNESS:
             true = capsule_true_energy(TUBE_RADIUS, length, D, rough)
             row.append(float(np.sum(spec(V, "tube", TUBE_RADIUS, length, rough) * w)) / true)
         tubes.append((length, row))
-    return spheres, tubes
+    return spheres, tilted, tubes
 
 
-def markdown(title: str, spheres, tubes) -> str:
+def markdown(title: str, spheres, tilted, tubes) -> str:
     head = "| light | " + " | ".join(f"rough {r}" for r in ROUGHNESS) + " |"
     sep = "|---|" + "---|" * len(ROUGHNESS)
     lines = [f"**{title}**", "", head, sep]
     for rd, row in spheres:
         lines.append(f"| sphere r/d {rd} | " + " | ".join(f"{x:.2f}" for x in row) + " |")
+    for rd, row in tilted:
+        lines.append(f"| sphere r/d {rd}, 45° | " + " | ".join(f"{x:.2f}" for x in row) + " |")
     for length, row in tubes:
         lines.append(f"| tube {length} m | " + " | ".join(f"{x:.2f}" for x in row) + " |")
     return "\n".join(lines)
 
 
-def goal(spheres, tubes) -> str:
-    inside = [x for rd, row in spheres if rd <= 0.25 for r, x in zip(ROUGHNESS, row) if r >= 0.2]
+def goal(spheres, tilted, tubes) -> str:
+    inside = [x for rd, row in spheres + tilted if rd <= 0.25
+              for r, x in zip(ROUGHNESS, row) if r >= 0.2]
     inside += [x for _, row in tubes for r, x in zip(ROUGHNESS, row) if r >= 0.2]
     ok = all(0.75 <= x <= 1.25 for x in inside)
     return (f"goal (within +-25 % for sphere r/d <= 0.25 and every tube, roughness >= 0.2): "
@@ -125,12 +142,12 @@ def main() -> int:
             lights.AREA_WIDEN_DIVISOR = c
             t0 = time.perf_counter()
             spec = _gpu(ctx) if ctx is not None else _twin
-            spheres, tubes = table(spec, args.quick)
+            spheres, tilted, tubes = table(spec, args.quick)
             label = "before" if c == 3.0 else "now (default)"
             print(markdown(f"rendered / true specular energy, a' = a + r / ({c:g} d), {label}, "
-                           f"{'GLSL' if ctx else 'numpy twin'}", spheres, tubes))
+                           f"{'GLSL' if ctx else 'numpy twin'}", spheres, tilted, tubes))
             print()
-            print(goal(spheres, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
+            print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
     finally:
         lights.AREA_WIDEN_DIVISOR = saved

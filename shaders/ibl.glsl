@@ -24,6 +24,21 @@ vec3 splitSumSpecular(vec3 prefiltered, vec2 envBRDF, vec3 F0) {
     return prefiltered * (F0 * envBRDF.x + envBRDF.y);
 }
 
+// Multiple-scattering energy compensation from the environment BRDF: the specular's scale
+// (single + multiple scattering over single) and what is left for the diffuse.
+void energyCompensation(vec3 F0, vec2 envBRDF, out vec3 specularScale, out vec3 diffuseScale) {
+    // Fdez-Aguera 2019, "A Multiple-Scattering Microfacet Model for Real-Time Image-based
+    // Lighting": Ess = A + B, Fms = FssEss Favg / (1 - Ems Favg), Favg = F0 + (1 - F0) / 21
+    vec3 FssEss = F0 * envBRDF.x + envBRDF.y;
+    float Ess = envBRDF.x + envBRDF.y;
+    float Ems = 1.0 - Ess;
+    vec3 Favg = F0 + (1.0 - F0) / 21.0;
+    vec3 Fms = FssEss * Favg / max(1.0 - Ems * Favg, vec3(1e-4));
+    vec3 total = FssEss + Fms * Ems;
+    specularScale = 1.0 + Fms * Ems / max(FssEss, vec3(1e-6));
+    diffuseScale = saturate(1.0 - total);
+}
+
 // Irradiance E(N) from 9 SH coefficients of the radiance (order L00, L1-1, L10, L11,
 // L2-2, L2-1, L20, L21, L22). A constant environment L gives E = pi L.
 vec3 irradianceSH9(vec3 sh[9], vec3 N) {

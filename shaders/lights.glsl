@@ -14,9 +14,9 @@ const float LIGHT_FALLOFF_EPS = 0.01;
 // Smallest perceptual roughness analytic lights see: a mirror has no finite peak.
 const float MIN_ANALYTIC_ROUGHNESS = 0.03;
 // Widening of the highlight by a sphere or tube light: a' = a + sourceRadius / (DIVISOR d).
-// 2: the form implementations of the notes ship (UE4: a + 0.5 * sourceRadius / d); measured
-// within -22 % .. +5 % of the true specular energy for r/d <= 0.5 (benchmarks/bench_lights.py),
-// where 3 (SHADING.md's earlier reading) gives up to x2.06.
+// 2: the form most public implementations of the notes use (a + 0.5 * sourceRadius / d);
+// measured within 0.78 .. 1.20 of the true specular energy for r/d <= 0.25 at roughness >= 0.2
+// (benchmarks/LIGHTS_ENERGY.md), where 3 (SHADING.md's earlier reading) reaches x2.15.
 #ifndef MATEDIT_AREA_WIDEN_DIVISOR
 #define MATEDIT_AREA_WIDEN_DIVISOR 2.0
 #endif
@@ -43,6 +43,7 @@ struct ShadingContext {
     float roughness;        // clamped to MIN_ANALYTIC_ROUGHNESS
     float a;                // roughness^2
     float k;                // Schlick-Smith k for analytic lights
+    vec3 specularScale;     // 1, or the multiple-scattering compensation (ibl.glsl)
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -58,6 +59,7 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
     s.roughness = clamp(roughness, MIN_ANALYTIC_ROUGHNESS, 1.0);
     s.a = s.roughness * s.roughness;
     s.k = k_Analytic(s.roughness);
+    s.specularScale = vec3(1.0);
     return s;
 }
 
@@ -88,7 +90,7 @@ vec3 specularTowards(ShadingContext s, vec3 L) {
     float VoH = saturate(dot(s.V, H));
     vec3 NxH = cross(s.N, H);
     float D = D_GGX(NoH, s.a, dot(NxH, NxH));
-    return D * V_SchlickSmith(s.NoV, NoL, s.k) * F_Schlick(s.F0, VoH) * NoL;
+    return D * V_SchlickSmith(s.NoV, NoL, s.k) * F_Schlick(s.F0, VoH) * NoL * s.specularScale;
 }
 
 // Point on a sphere closest to the reflection ray, as an unnormalised vector from P.

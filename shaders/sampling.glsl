@@ -24,10 +24,12 @@ vec2 rotatedHammersley(uint i, uint n, vec2 offset) {
     return fract(hammersley(i, n) + offset);
 }
 
-// Orthonormal tangent frame around N (the notes' choice of up vector).
+// Orthonormal tangent frame around N: the notes' up vector Z, except near +-Z, where the
+// notes' X would turn the frame of N = +Z by 90 degrees (T = -Y); Y there gives T = X,
+// B = Y, the identity, so a sample's local (x, y, z) is its world direction at N = +Z.
 void tangentFrame(vec3 N, out vec3 T, out vec3 B) {
-    // Karis 2013, ImportanceSampleGGX: UpVector = abs(N.z) < 0.999 ? Z : X
-    vec3 up = abs(N.z) < 0.999 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0);
+    // Karis 2013, ImportanceSampleGGX: UpVector = abs(N.z) < 0.999 ? Z : X (X replaced by Y)
+    vec3 up = abs(N.z) < 0.999 ? vec3(0.0, 0.0, 1.0) : vec3(0.0, 1.0, 0.0);
     T = normalize(cross(up, N));
     B = cross(N, T);
 }

@@ -36,7 +36,8 @@ vec3 directLightingReference(ShadingContext s) {
 #endif
 
 // Image-based lighting from the block's environment, split sum or reference by uIbl.params.w.
-vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughness) {
+vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughness,
+                        vec3 specularScale) {
     // Karis 2013, "Real Shading in Unreal Engine 4", image-based lighting (eq 6-8, reference)
     int mode = int(uIbl.params.w + 0.5);
     if (mode == IBL_MODE_NONE) return vec3(0.0);
@@ -44,8 +45,9 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
     // The reference estimator is a large loop; the preview's split-sum programs leave it out.
     if (mode == IBL_MODE_REFERENCE) {
         uint count = uint(max(uIbl.params.z, 1.0));
-        return referenceIBL(uEnvironment, diffuseColor, F0, roughness, N, V, count,
-                            uIbl.sampleOffset.xy) * uIbl.params.y;
+        return (referenceDiffuseIBL(uEnvironment, diffuseColor, N, count, uIbl.sampleOffset.xy)
+              + referenceSpecularIBL(uEnvironment, F0, roughness, N, V, count,
+                                     uIbl.sampleOffset.xy) * specularScale) * uIbl.params.y;
     }
 #endif
     vec3 sh[9];
@@ -54,7 +56,8 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
     vec3 R = reflect(-V, N);
     vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
     vec2 AB = environmentBRDF(uBrdfLut, NoV, roughness);
-    vec3 color = diffuseIrradianceSH9(sh, N, diffuseColor) + splitSumSpecular(prefiltered, AB, F0);
+    vec3 color = diffuseIrradianceSH9(sh, N, diffuseColor)
+               + splitSumSpecular(prefiltered, AB, F0) * specularScale;
     return color * uIbl.params.y;
 }
 
@@ -66,6 +69,15 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V) {
     vec3 F0 = computeF0(m.baseColor, m.metallic);
     float roughness = saturate(m.roughness);
     ShadingContext s = makeShadingContext(P, N, V, diffuseColor, F0, roughness);
+#ifdef MATEDIT_ENERGY_COMPENSATION
+    // Beyond the talk (off by default): multiple-scattering compensation of the specular,
+    // the diffuse keeping what the specular leaves (ibl.glsl, energyCompensation)
+    vec3 diffuseScale;
+    energyCompensation(F0, environmentBRDF(uBrdfLut, saturate(dot(N, V)), roughness),
+                       s.specularScale, diffuseScale);
+    s.diffuseColor *= diffuseScale;
+    diffuseColor *= diffuseScale;
+#endif
     vec3 direct;
 #ifndef MATEDIT_SPLIT_SUM_ONLY
     // uIbl.sampleOffset.z = 1: the area lights' reference (reference mode's frames)
@@ -73,6 +85,6 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V) {
     else
 #endif
     direct = directLighting(s);
-    vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness);
+    vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale);
     return (direct + ibl) * m.cavity + m.emissive;
 }

@@ -119,3 +119,21 @@ def tube_view_grid(nb: int = 1600, ng: int = 1600):
     V = np.stack([-R[..., 0], -R[..., 1], R[..., 2]], axis=-1).reshape(-1, 3)
     w = (np.cos(B) * db * dg[None, :] * R[..., 2]).reshape(-1)
     return V, w
+
+
+def sphere_true_energy_tilted(radius: float, d: float, tilt: float, roughness: float,
+                              n: int = 512) -> float:
+    """As sphere_true_energy for a sphere whose centre lies `tilt` radians from the normal
+    (in the XZ plane): a solid-angle grid over its cone, clipped at the horizon."""
+    le = 1.0 / (math.pi * radius * radius)
+    cmax = math.sqrt(max(0.0, 1.0 - (radius / d) ** 2))
+    mu_t, rho_t = _albedo_table(roughness)
+    c = cmax + (np.arange(n) + 0.5) / n * (1.0 - cmax)
+    phi = (np.arange(2 * n) + 0.5) / (2 * n) * 2 * math.pi
+    C, P = np.meshgrid(c, phi, indexing="ij")
+    s = np.sqrt(1 - C * C)
+    # cone around the axis (sin t, 0, cos t): z of the direction
+    z = C * math.cos(tilt) - s * np.cos(P) * math.sin(tilt)
+    w = (1.0 - cmax) * 2 * math.pi / C.size
+    zc = np.clip(z, 0.0, 1.0)
+    return float(le * np.sum(np.where(z > 0, np.interp(zc, mu_t, rho_t) * zc, 0.0)) * w)

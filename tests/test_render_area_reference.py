@@ -158,13 +158,13 @@ def test_area_light_reference_converges_to_brute_force(ctx):
 
 
 def test_fewer_samples_still_converge(ctx):
-    """The renderer's 32 a frame accumulated over rotated frames: 64 x 32 samples."""
+    """The renderer's 32 a frame accumulated over rotated frames: 32 x 32 samples."""
     from matedit.render.renderer import r2_offset
 
     cases = make_cases()[:4]
     truth = np.array([brute_force(c) for c in cases])
     acc = np.zeros_like(truth)
-    frames = 64
+    frames = 32
     for f in range(frames):
         o = r2_offset(f)
         body = BODY.replace("vec2(0.0)", f"vec2({o[0]:.9f}, {o[1]:.9f})")

@@ -26,7 +26,8 @@ def register(sub) -> None:
                    help="sphere, cube, plane, cylinder or an OBJ file (default: the file's "
                    "preview mesh, else sphere)")
     p.add_argument("--env", default=None, metavar="PATH|studio|sky",
-                   help="built-in environment or an HDR/EXR file (default: studio)")
+                   help="built-in environment, an HDR/EXR file, or a folder of six cube-face "
+                   "files (px nx py ny pz nz) (default: studio)")
     p.add_argument("--ibl", default="splitsum", choices=["splitsum", "reference", "difference"],
                    help="split-sum approximation, converged importance-sampled reference, "
                    "or a heat map of their difference")
@@ -37,6 +38,10 @@ def register(sub) -> None:
     p.add_argument("--samples", type=int, default=None, metavar="N",
                    help="reference-mode samples a pixel (default 2048)")
     p.add_argument("--half", action="store_true", help="EXR output as half floats")
+    p.add_argument("--energy-compensation", action="store_true",
+                   help="multiple-scattering specular compensation (Fdez-Aguera 2019), beyond "
+                   "the talk; a material can also ask for it (preview "
+                   "\"energy_compensation\": true)")
     p.set_defaults(run=run)
 
 
@@ -208,6 +213,8 @@ def run(args) -> int:
             renderer.exposure = args.exposure
         if lights is not None:
             renderer.set_lights(lights)
+        if args.energy_compensation:
+            renderer.set_energy_compensation(True)
         if args.samples is not None:
             renderer.set_reference_samples(args.samples)
         renderer.mode = args.ibl

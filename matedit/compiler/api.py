@@ -150,6 +150,9 @@ def lower_and_optimise(doc: MaterialDocument, resolver: FunctionResolver | None)
     return ir
 
 
+ENERGY_COMPENSATION_DEFINE = "MATEDIT_ENERGY_COMPENSATION"
+
+
 def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = None,
                      target: str = "glsl330", mode: str = "shade",
                      ir: MaterialIR | None = None) -> CompiledMaterial:
@@ -161,6 +164,9 @@ def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = 
 
         resolver = FileResolver()
     ir = ir if ir is not None else lower_and_optimise(doc, resolver)
+    if isinstance(doc.preview, dict) and doc.preview.get("energy_compensation") is True \
+            and ENERGY_COMPENSATION_DEFINE not in ir.defines:
+        ir.defines.append(ENERGY_COMPENSATION_DEFINE)  # the material's option (shading)
     t = TARGETS[target]
     with _no_gc():
         vert = vertex_source(t)

@@ -278,7 +278,7 @@ def fragment_source(ir: MaterialIR, target: Target, mode: str = "shade"
             includes.append(f"nodes/{kind}.glsl")
     if mode == "shade":
         includes.append("surface.glsl")
-    defines = "\n".join(f"#define {d} 1" for d in has_defines(ir))
+    defines = "\n".join(f"#define {d} 1" for d in has_defines(ir) + list(ir.defines))
     asm = assemble("\n".join(w.lines), target.version, includes, "<material>",
                    prelude=target.prelude() + "\n" + defines)
     smap = SourceMap(w.map, len(asm.sources) - 1)

@@ -149,3 +149,5 @@ class MaterialIR:
     textures: list[TextureInfo]
     node_kinds: set[str]  # node kinds whose GLSL files are needed
     attributes: list[str]  # MaterialAttributes fields the graph writes
+    defines: list[str] = field(default_factory=list)  # extra #defines, e.g. the material's
+    # MATEDIT_ENERGY_COMPENSATION option (preview "energy_compensation": true)

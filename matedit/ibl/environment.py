@@ -64,17 +64,97 @@ def builtin(name: str, size: int = 256) -> Environment:
     return Environment(name=name, equirect=builtin_environment(name, width))
 
 
+FACE_ALIASES = {"px": ("px", "posx", "right"), "nx": ("nx", "negx", "left"),
+                "py": ("py", "posy", "top", "up"), "ny": ("ny", "negy", "bottom", "down"),
+                "pz": ("pz", "posz", "front"), "nz": ("nz", "negz", "back")}
+_FACE_EXTENSIONS = {".exr", ".hdr", ".png", ".jpg", ".jpeg", ".tif", ".tiff"}
+
+
+def _face_key(stem: str) -> str | None:
+    s = stem.lower()
+    for face, names in FACE_ALIASES.items():
+        for n in names:
+            if s == n or s.endswith(("_" + n, "-" + n, "." + n)):
+                return face
+    return None
+
+
+def load_cube_faces(folder: str | os.PathLike) -> Environment:
+    """Six square face images in one folder, named by face: px nx py ny pz nz (or posx/negx...,
+    or right/left/top/bottom/front/back), optionally after a prefix and "_" or "-", e.g.
+    sky_px.hdr. Faces are in the OpenGL cube-map orientation, the same as the faces of a
+    cube cross (matedit.ibl.cubemap). LDR faces are read as sRGB, as for other files."""
+    folder = Path(folder)
+    name = str(folder)
+    found: dict[str, Path] = {}
+    for p in sorted(folder.iterdir()):
+        if p.suffix.lower() not in _FACE_EXTENSIONS or not p.is_file():
+            continue
+        key = _face_key(p.stem)
+        if key is None:
+            continue
+        if key in found:
+            raise EnvironmentMapError(f"{name}: two files for cube face {key}: "
+                                      f"{found[key].name} and {p.name}")
+        found[key] = p
+    from matedit.ibl.cubemap import FACE_NAMES
+
+    missing = [f for f in FACE_NAMES if f not in found]
+    if missing:
+        raise EnvironmentMapError(
+            f"{name}: a folder environment needs six cube-face files (px nx py ny pz nz, "
+            f"e.g. sky_px.hdr); missing {' '.join(missing)}")
+    faces, warnings = [], []
+    for f in FACE_NAMES:
+        env = load_environment_file(found[f], square=True)
+        warnings += env.warnings
+        faces.append(env.equirect)
+    sizes = {x.shape for x in faces}
+    if len(sizes) != 1:
+        raise EnvironmentMapError(f"{name}: cube faces differ in size: "
+                                  + ", ".join(f"{f} {x.shape[1]}x{x.shape[0]}"
+                                              for f, x in zip(FACE_NAMES, faces)))
+    return Environment(name=name, faces=np.ascontiguousarray(np.stack(faces)),
+                       warnings=warnings)
+
+
+def load_environment_file(path: Path, square: bool = False) -> Environment:
+    """One image file as linear RGB (`square`: a cube face, returned in `equirect`)."""
+    text = str(path)
+    try:
+        image = read_image(path)
+    except ImageError as exc:
+        raise EnvironmentMapError(str(exc)) from exc
+    warnings: list[str] = []
+    rgb = _to_rgb(image.pixels)
+    if image.is_ldr:
+        rgb = srgb_to_linear(rgb)
+        warnings.append(f"{text}: LDR image ({image.format_name}) read as sRGB and linearised")
+    bad = ~np.isfinite(rgb) | (rgb < 0)
+    if bad.any():
+        warnings.append(
+            f"{text}: {int(bad.any(axis=-1).sum())} pixels negative or not finite, set to 0")
+        rgb = np.where(bad, 0.0, rgb).astype(np.float32)
+    if square and rgb.shape[0] != rgb.shape[1]:
+        raise EnvironmentMapError(f"{text}: a cube face must be square, not "
+                                  f"{rgb.shape[1]}x{rgb.shape[0]}")
+    return Environment(name=text, equirect=np.ascontiguousarray(rgb), warnings=warnings)
+
+
 def load_environment(spec: str | os.PathLike, size: int = 256) -> Environment:
     """Load an environment from a file, or draw a built-in ('studio', 'sky').
 
     A path that exists is always read as a file; otherwise a built-in name is accepted.
     Layout comes from the aspect ratio: 2:1 is equirectangular, 4:3 or 3:4 a cube cross.
-    `size` only sets the resolution the built-ins are drawn at.
+    A folder holds six cube-face files (see `load_cube_faces`). `size` only sets the
+    resolution the built-ins are drawn at.
     """
     text = os.fspath(spec)
     path = Path(text)
     if not path.exists() and text in BUILTIN_NAMES:
         return builtin(text, size)
+    if path.is_dir():
+        return load_cube_faces(path)
     if not path.exists():
         raise EnvironmentMapError(
             f"{text}: no such file (built-in environments: {', '.join(BUILTIN_NAMES)})"

@@ -96,11 +96,14 @@ class Renderer:
         self.reference_frames = 64  # frames to converge (32 x 64 = 2048 samples a pixel)
         # reference mode integrates sphere and tube lights by Monte Carlo over their shapes
         self.reference_lights = True
+        # multiple-scattering compensation in every material (beyond the talk; off), on top
+        # of materials that ask for it themselves (preview "energy_compensation": true)
+        self.energy_compensation = False
         self.link_count = 0
         self._difference_cache: tuple[int, float] | None = None
         self._frames_drawn = 0
         self.bake_settings = bake_settings
-        self._programs: dict[tuple[str, str], moderngl.Program] = {}  # (hash, variant)
+        self._programs: dict[tuple, moderngl.Program] = {}  # (hash, variant, compensation)
         self._compiled: CompiledMaterial | None = None
         self._program: moderngl.Program | None = None
         self._values: dict[str, Any] = {}
@@ -225,13 +228,16 @@ class Renderer:
     def _link(self, compiled: CompiledMaterial, variant: str) -> moderngl.Program:
         """The program of one variant: "splitsum" leaves the reference estimator out (a third
         less for llvmpipe to compile at the first draw), "full" keeps it."""
-        key = (compiled.structure_hash, variant)
+        key = (compiled.structure_hash, variant, self.energy_compensation)
         prog = self._programs.get(key)
         if prog is None:
             frag = compiled.fragment_text
-            if variant == "splitsum":
+            extra = ["MATEDIT_SPLIT_SUM_ONLY"] if variant == "splitsum" else []
+            if self.energy_compensation and "#define MATEDIT_ENERGY_COMPENSATION" not in frag:
+                extra.append("MATEDIT_ENERGY_COMPENSATION")  # the preview's option
+            if extra:
                 first, rest = frag.split("\n", 1)  # after #version, before any #line
-                frag = f"{first}\n#define MATEDIT_SPLIT_SUM_ONLY 1\n{rest}"
+                frag = first + "\n" + "".join(f"#define {d} 1\n" for d in extra) + rest
             prog = self.ctx.program(vertex_shader=compiled.vertex_text, fragment_shader=frag)
             self.link_count += 1
             self._bind_program(prog)
@@ -248,7 +254,8 @@ class Renderer:
 
     def set_material(self, compiled: CompiledMaterial) -> MaterialStatus:
         """Structural edit: link (or reuse) the program; keep the last good one on failure."""
-        prog = self._programs.get((compiled.structure_hash, "splitsum"))
+        prog = self._programs.get((compiled.structure_hash, "splitsum",
+                                   self.energy_compensation))
         if prog is None:
             try:
                 prog = self._link(compiled, "splitsum")
@@ -283,6 +290,16 @@ class Renderer:
         _set(prog, "uPrefilteredEnv", PREFILTERED_UNIT)
         _set(prog, "uBrdfLut", LUT_UNIT)
         _set(prog, "uEnvironment", ENVIRONMENT_UNIT)
+
+    def set_energy_compensation(self, on: bool) -> None:
+        """The preview's multiple-scattering compensation option (relinks once per state)."""
+        on = bool(on)
+        if on == self.energy_compensation:
+            return
+        self.energy_compensation = on
+        if self._compiled is not None:
+            self._program = self._link(self._compiled, "splitsum")
+        self.reset_accumulation()
 
     def set_uniforms(self, values: dict[str, Any]) -> None:
         """Parameter edit: rewrite the MaterialParams buffer; never links a program."""

@@ -58,6 +58,18 @@ def environmentBRDF(brdfLut, NoV, roughness) -> np.ndarray:
     return sample_lut(brdfLut, NoV, roughness)[..., :2]
 
 
+def energyCompensation(F0, envBRDF) -> tuple[np.ndarray, np.ndarray]:
+    """Twin of ibl.glsl's: (specular scale, diffuse scale), Fdez-Aguera 2019."""
+    envBRDF, F0 = f64(envBRDF), f64(F0)
+    A, B = envBRDF[..., 0:1], envBRDF[..., 1:2]
+    FssEss = F0 * A + B
+    Ems = 1.0 - (A + B)
+    Favg = F0 + (1.0 - F0) / 21.0
+    Fms = FssEss * Favg / np.maximum(1.0 - Ems * Favg, 1e-4)
+    total = FssEss + Fms * Ems
+    return 1.0 + Fms * Ems / np.maximum(FssEss, 1e-6), np.clip(1.0 - total, 0.0, 1.0)
+
+
 def splitSumSpecular(prefiltered, envBRDF, F0) -> np.ndarray:
     envBRDF = f64(envBRDF)
     return f64(prefiltered) * (f64(F0) * envBRDF[..., 0:1] + envBRDF[..., 1:2])

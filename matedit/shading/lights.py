@@ -58,6 +58,7 @@ class ShadingContext:
     roughness: np.ndarray
     a: np.ndarray
     k: np.ndarray
+    specularScale: object = 1.0  # or the multiple-scattering compensation, (..., 3)
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -91,7 +92,7 @@ def specularTowards(s: ShadingContext, L) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         D = D_GGX(NoH, s.a, dot(NxH, NxH))
         lobe = np.where(NoL > 0.0, D * V_SchlickSmith(s.NoV, NoL, s.k) * NoL, 0.0)
-    return lobe[..., None] * F_Schlick(s.F0, VoH)
+    return lobe[..., None] * F_Schlick(s.F0, VoH) * f64(s.specularScale)
 
 
 def sphereRepresentativePoint(Lc, R, sourceRadius) -> np.ndarray:

@@ -24,10 +24,11 @@ def hammersley(i, n) -> np.ndarray:
 
 
 def tangentFrame(N) -> tuple[np.ndarray, np.ndarray]:
-    """(T, B) around N; same up-vector choice as the GLSL (Z unless N is near it, then X)."""
+    """(T, B) around N; same up-vector choice as the GLSL (Z unless N is near it, then Y, so
+    that N = +Z has the identity frame)."""
     N = f64(N)
     up = np.where(
-        (np.abs(N[..., 2]) < 0.999)[..., None], np.array([0.0, 0.0, 1.0]), np.array([1.0, 0, 0])
+        (np.abs(N[..., 2]) < 0.999)[..., None], np.array([0.0, 0.0, 1.0]), np.array([0.0, 1, 0])
     )
     T = normalize(cross(up, N))
     B = cross(N, T)

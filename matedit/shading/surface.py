@@ -12,9 +12,11 @@ from matedit.shading.ibl import (
     IBL_MODE_NONE,
     IBL_MODE_REFERENCE,
     diffuseIrradianceSH9,
+    energyCompensation,
     environmentBRDF,
     prefilteredRadiance,
-    referenceIBL,
+    referenceDiffuseIBL,
+    referenceSpecularIBL,
     splitSumSpecular,
 )
 from matedit.shading.lights import Light, ShadingContext, evaluateLight, makeShadingContext
@@ -50,13 +52,16 @@ def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
     return total
 
 
-def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs) -> np.ndarray:
+def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
+                       specularScale=1.0) -> np.ndarray:
     N, V = f64(N), f64(V)
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(N.shape, V.shape))
     if ibl.mode == IBL_MODE_REFERENCE:
-        color = referenceIBL(ibl.environment, diffuseColor, F0, roughness, N, V,
-                             max(int(ibl.samples), 1), ibl.sample_offset)  # fmt: skip
+        count = max(int(ibl.samples), 1)
+        color = (referenceDiffuseIBL(ibl.environment, diffuseColor, N, count, ibl.sample_offset)
+                 + referenceSpecularIBL(ibl.environment, F0, roughness, N, V, count,
+                                        ibl.sample_offset) * f64(specularScale))
     else:
         NoV = saturate(dot(N, V))
         R = reflect(-V, N)
@@ -65,19 +70,29 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs) -> np.
         else:
             pref = f64(ibl.prefiltered)
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV, roughness)
-        color = diffuseIrradianceSH9(ibl.sh, N, diffuseColor) + splitSumSpecular(pref, AB, F0)
+        color = diffuseIrradianceSH9(ibl.sh, N, diffuseColor) + splitSumSpecular(
+            pref, AB, F0) * f64(specularScale)
     return color * ibl.intensity
 
 
 def shadeSurface(
-    m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None
+    m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None,
+    energy_compensation: bool = False,
 ) -> np.ndarray:
-    """(direct + ibl) * cavity + emissive; N is the world shading normal."""
+    """(direct + ibl) * cavity + emissive; N is the world shading normal.
+    `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019)."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = computeF0(m.baseColor, m.metallic)
     roughness = saturate(m.roughness)
     s = makeShadingContext(P, N, V, diffuseColor, F0, roughness)
+    if energy_compensation:
+        NoV = saturate(dot(f64(N), f64(V)))
+        AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
+                                                                      roughness)
+        s.specularScale, diffuse_scale = energyCompensation(F0, AB)
+        s.diffuseColor = s.diffuseColor * diffuse_scale
+        diffuseColor = s.diffuseColor
     direct = directLighting(s, lights)
-    indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl)
+    indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale)
     return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive)
