@@ -109,3 +109,24 @@ def test_no_footprint_means_hard_edges():
     ones = np.ones(n)
     _, mask = IMPLS["checker"](s, uv, 4 * ones, np.zeros((n, 3)), np.ones((n, 3)), ones)
     np.testing.assert_array_equal(mask, (np.floor(4 * uv[:, 0]) + np.floor(4 * uv[:, 1])) % 2)
+
+
+def test_derivatives_are_quad_differences_even_on_odd_grids():
+    from matedit.compiler.cpu_nodes import derivatives, fwidth
+
+    h, w = 5, 7
+    y, x = np.mgrid[0:h, 0:w].astype(float)
+    s = SurfaceArrays(np.zeros((h * w, 2)), np.zeros((h * w, 3)), np.zeros((h * w, 3)),
+                      np.zeros((h * w, 3)), grid=(h, w))
+    ramp = (3.0 * x - 2.0 * y).ravel()
+    dx, dy = derivatives(s, ramp)
+    np.testing.assert_array_equal(dx, 3.0)  # a linear ramp: its slope everywhere
+    np.testing.assert_array_equal(dy, -2.0)
+    np.testing.assert_array_equal(fwidth(s, ramp), 5.0)
+    sq = (x * x).ravel()
+    dx, _ = derivatives(s, sq)
+    # pairs (0,1), (2,3), (4,5): both pixels of a pair get the pair's difference; the odd
+    # last column pairs backwards with column 5
+    np.testing.assert_array_equal(dx.reshape(h, w)[0], [1, 1, 5, 5, 9, 9, 11])
+    flat = SurfaceArrays(s.uv, s.position, s.normal, s.view)  # scattered points
+    assert not fwidth(flat, ramp).any()
