@@ -299,13 +299,18 @@ def test_noise_keeps_its_precision_at_uv_1000(ctx, kind):
     seed = np.full(N, 3.0, np.float32)
     gpu = _gpu_noise(ctx, kind, _noise_args(kind, far, seed))
     ref = IMPLS[kind](None, *[np.asarray(a, np.float64) for a in _noise_args(kind, far, seed)])
-    # float32 uv at 1,000 is exact to 6e-5; the noise's slope (up to ~30 per UV unit at
-    # scale 8, 5 octaves) turns that into at most ~2e-3.
+    # The cell is found from the float32 coordinate exactly and the position within it is
+    # exact too (p - floor(p)), so the GPU's float32 noise equals float64 numpy on the same
+    # inputs to ~1e-6 (measured, max over 4,096 points: gradient 1.0e-6, fBm 3.3e-7,
+    # ridged 1.2e-6, cellular 1.1e-7, value 1.1e-7); the warp's output is a UV near 1,000,
+    # itself a float32 exact to 6e-5 (measured 3.1e-5).
     for g, r in zip(gpu, ref):
+        bound = 1e-5
         if g.ndim == 2:
             g, r = g - np.asarray(far), r - np.asarray(far, np.float64)  # warp: the offset
+            bound = 1e-4
         err = np.abs(np.asarray(g, np.float64) - r)
-        assert np.percentile(err, 99.9) < 2e-3, f"{kind}: {np.percentile(err, 99.9):.2e}"
+        assert err.max() < bound, f"{kind}: {err.max():.2e}"
     v_far = np.asarray(gpu[0]).reshape(N, -1)[:, 0]
     v_near = np.asarray(IMPLS[kind](None, *_noise_args(kind, near, seed))[0]).reshape(N, -1)[:, 0]
     if kind == "domain_warp":

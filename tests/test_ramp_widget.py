@@ -92,3 +92,19 @@ def test_inspector_shows_the_editor_for_ramps(qtbot, tmp_path):
     panel.show()
     qtbot.waitExposed(panel)
     panel.grab().save(str(tmp_path / "ramp_inspector.png"))
+
+
+def test_a_closed_editor_ignores_later_edits(qtbot):
+    from PySide6.QtWidgets import QApplication
+
+    doc = material()
+    node(doc, "ramp", "color_ramp")
+    controller = DocumentController(doc)
+    e = RampEditor(controller, "ramp")
+    e.deleteLater()
+    QApplication.processEvents()
+    from PySide6.QtCore import QCoreApplication, QEvent
+
+    QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
+    controller.valuesChanged.emit()  # must not reach the deleted widget
+    del e

@@ -31,6 +31,10 @@ SKIP = {"constant", "scalar_parameter", "vector_parameter", "color_parameter",
 # Kinds that show a thumbnail without being selected.
 ALWAYS = {"value_noise", "checker", "gradient", "texture_sample", "function_call",
           "layer_stack", "make_attributes", "layer_blend", "height_blend"}
+ALWAYS |= {"gradient_noise", "gradient_noise_3d", "cellular_noise", "cellular_noise_3d", "fbm",
+           "fbm_3d", "ridged_noise", "domain_warp", "bricks", "stripes", "wave", "rings",
+           "radial_gradient", "spherical_gradient", "color_ramp", "triplanar_texture",
+           "normal_from_height", "curvature"}  # the node library's patterns
 BACKGROUND = np.array([0.035, 0.04, 0.05])  # linear; matches the node body once encoded
 
 

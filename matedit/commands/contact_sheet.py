@@ -107,7 +107,11 @@ def run(args) -> int:
             if want != env:
                 renderer.set_environment(want)
                 env = want
-            renderer.set_mesh(args.mesh or doc.preview.get("mesh") or "sphere")
+            mesh = args.mesh or doc.preview.get("mesh") or "sphere"
+            renderer.set_mesh(mesh)
+            # the cube's corners reach further than the sphere: step back so it fits a tile
+            renderer.camera.reset()
+            renderer.camera.distance *= 1.25 if mesh == "cube" else 1.0
             status = renderer.set_material(compiled)
             if not status.ok:
                 node, msg = status.errors[0]

@@ -153,9 +153,10 @@ def format_text(data: dict[str, Any]) -> str:
         if rec["category"] != category:
             category = rec["category"]
             lines += ["", f"{category}"]
-        mark = " [MaterialX: " + rec["materialx"]["node"] + "]" if rec["materialx"] else ""
-        lines.append(f"  {rec['kind']:24s} {rec['title']}{mark}")
+        lines.append(f"  {rec['kind']:24s} {rec['title']}")
         lines.append(f"  {'':24s} {rec['description']}")
+        mx = f" (MaterialX {rec['materialx']['node']})" if rec["materialx"] else ""
+        lines.append(f"  {'':24s}   targets: {' '.join(rec['targets'])}{mx}")
         for p in rec["inputs"]:
             rng = f" in [{p['range'][0]:g}, {p['range'][1]:g}]" if p.get("range") else ""
             default = _fmt_default(p.get("default"))

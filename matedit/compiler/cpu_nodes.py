@@ -898,7 +898,10 @@ def _bricks(ctx, uv, count, mortar, bevel, offset, seed, filter_width):
     border = np.minimum(f, 1.0 - f) * size
     e = np.minimum(border[:, 0], border[:, 1])
     half = 0.5 * mortar
-    mask = filtered_step(half, e, fwidth(ctx, e) * filter_width)
+    m = _clamp(_col(mortar) * np.abs(count), 0.0, 1.0)
+    w = fwidth(ctx, p) * _col(filter_width)
+    mask = (filtered_pulse(p[:, 0] - 0.5 * m[:, 0], 1.0 - m[:, 0], w[:, 0])
+            * filtered_pulse(p[:, 1] - 0.5 * m[:, 1], 1.0 - m[:, 1], w[:, 1]))
     t = _clamp((e - half) / np.maximum(bevel, 1e-6), 0.0, 1.0)
     c = _as_uint(cell)
     tile_id = hash_unit(hash_cell2(c[:, 0], c[:, 1], node_seed(seed)), uv.dtype)

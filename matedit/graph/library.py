@@ -3,8 +3,9 @@ and masks. Registered into `matedit.graph.nodes.REGISTRY` when that module is im
 
 Every kind here has a GLSL function in `shaders/nodes/<kind>.glsl` or an inline template,
 a numpy twin in `matedit.compiler.cpu_nodes`, port ranges, and `mtlx`: its MaterialX
-standard-library equivalent where one exists (a node name with the same port meaning, or
-a dict naming the node and how our ports map onto its inputs).
+standard-library equivalent where one exists, as {"node": stdlib node, "inputs": {our port:
+its input}} (ports left out have no MaterialX input: a scale, say, becomes a multiply
+before the node when exporting). None: not expressible node for node (bake it).
 
 Pattern edges are band-limited: kinds with a `filter_width` input box-filter their edges
 over `filter_width` pixels of screen-space footprint (`fwidth`); the numpy twins take the
@@ -34,27 +35,29 @@ def _mx(node, **inputs):
 # --- maths -----------------------------------------------------------------------------------
 _op("atan2", "Atan2", "atan({y}, {x})", [_i("y", T), _i("x", T, 1.0)],
     "Angle of the point (x, y) in radians, in (−π, π].", mtlx=_mx("atan2", y="iny", x="inx"))
-_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.", mtlx="exp")
+_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.",
+    mtlx=_mx("exp", value="in"))
 _op("log", "Log", "log(max({value}, 1e-30))", [_i("value", T, 1.0)],
-    "Natural logarithm; values at or below 0 read as 1e-30.", mtlx="ln")
+    "Natural logarithm; values at or below 0 read as 1e-30.", mtlx=_mx("ln", value="in"))
 _op("mod", "Modulo", "mod({a}, {b})", [_i("a", T), _i("b", T, 1.0)],
     "a − b floor(a / b): the remainder with the sign of b.",
     mtlx=_mx("modulo", a="in1", b="in2"))
-_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.", mtlx="sign")
+_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.", mtlx=_mx("sign", value="in"))
 _op("round", "Round", "floor({value} + 0.5)", [_i("value", T)],
-    "Nearest integer; halves round up.", mtlx="round")
+    "Nearest integer; halves round up.", mtlx=_mx("round", value="in"))
 _op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.",
-    mtlx="ceil")
+    mtlx=_mx("ceil", value="in"))
 _op("trunc", "Truncate", "trunc({value})", [_i("value", T)],
     "Integer part, rounding towards zero.")
 _op("negate", "Negate", "(-{value})", [_i("value", T)], "−value.")
 _op("reciprocal", "Reciprocal", "(1.0 / {value})", [_i("value", T, 1.0)],
     "1 ÷ value (zero gives the GPU's infinity).")
-_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.", mtlx="tan")
+_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.",
+    mtlx=_mx("tan", value="in"))
 _op("asin", "Arcsine", "asin(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arcsine in radians; input clamped to [−1, 1].", mtlx="asin")
+    "Arcsine in radians; input clamped to [−1, 1].", mtlx=_mx("asin", value="in"))
 _op("acos", "Arccosine", "acos(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arccosine in radians; input clamped to [−1, 1].", mtlx="acos")
+    "Arccosine in radians; input clamped to [−1, 1].", mtlx=_mx("acos", value="in"))
 _op("radians", "To Radians", "radians({value})", [_i("value", T)], "Degrees to radians.")
 _op("degrees", "To Degrees", "degrees({value})", [_i("value", T)], "Radians to degrees.")
 _op("multiply_add", "Multiply Add", "({a} * {b} + {c})",
@@ -62,7 +65,7 @@ _op("multiply_add", "Multiply Add", "({a} * {b} + {c})",
 _op("posterize", "Posterize", "(floor({value} * max({steps}, 1.0)) / max({steps}, 1.0))",
     [_i("value", T), _i("steps", T, 4.0, "levels per unit (at least 1)", (1.0, 64.0))],
     "Quantises value into steps levels per unit.")
-_op("smooth_min", "Smooth Min", None,
+_op("smooth_min", "Soft Minimum", None,
     [_i("a", T), _i("b", T), _i("smoothness", T, 0.1, "blend radius", (0.0, 1.0))],
     "The smaller of a and b with a rounded join (polynomial smooth minimum).",
     glsl="node_smooth_min")
@@ -166,7 +169,7 @@ _SCALE = ("scale", "float", 8.0, "features per UV unit", (0.0, 64.0))
 _fn("gradient_noise", "Gradient Noise", "Noise",
     "Perlin-style gradient noise over uv, in about [−1, 1], smooth (quintic fade).",
     [_i(*_UV), _i(*_SCALE), _i(*_SEED)], [_o("value", "float")],
-    mtlx=_mx("noise2d", uv="texcoord", scale="period"))
+    mtlx=_mx("noise2d", uv="texcoord"))
 _fn("gradient_noise_3d", "Gradient Noise 3D", "Noise",
     "Perlin-style gradient noise over a 3D position (e.g. world position), about [−1, 1].",
     [_i("position", "vec3", [0.0, 0.0, 0.0]), _i("scale", "float", 2.0, "features per unit",
@@ -298,7 +301,7 @@ for _a, _b in (("tangent", "world"), ("world", "tangent"), ("object", "world"),
     _fn(f"{_a}_to_{_b}", f"{_a.title()} to {_b.title()}", "Coordinates",
         f"Transforms a direction from {_a} space to {_b} space.", [_i(*_V3)],
         [_o("vector", "vec3")],
-        mtlx=_mx("transformvector") if "tangent" not in (_a, _b) else None)
+        mtlx=_mx("transformvector", vector="in") if "tangent" not in (_a, _b) else None)
 _fn("triplanar_mapping", "Triplanar Mapping", "Coordinates",
     "Three planar projections of world position (onto YZ, XZ and XY) and their blend "
     "weights from the normal: feed each UV to a procedural, then a Triplanar Blend.",
@@ -314,7 +317,7 @@ _fn("triplanar_texture", "Triplanar Texture", "Texture",
     [_i("texture", "texture2d", None, "from a Texture Parameter", required=True),
      _i("scale", "float", 1.0, "repeats per metre", (0.0, 64.0)),
      _i("sharpness", "float", 4.0, "", (1.0, 64.0))],
-    [_o("rgba", "vec4"), _o("rgb", "vec3")], mtlx=_mx("triplanarprojection"))
+    [_o("rgba", "vec4"), _o("rgb", "vec3")], mtlx=_mx("triplanarprojection", texture="filex"))
 
 # --- normals ---------------------------------------------------------------------------------
 _fn("normal_from_height", "Normal from Height", "Normal",
