@@ -44,3 +44,18 @@ def test_bad_option_exits_2():
     assert r.returncode == 2 and r.stderr.startswith("error: ")
     r = run("frobnicate")
     assert r.returncode == 2 and r.stderr.startswith("error: ")
+
+
+def test_validate_reads_light_rigs(tmp_path):
+    """Rig documents are checked like the others: fine exits 0, a bad field names it."""
+    import json
+
+    good = tmp_path / "rig.json"
+    good.write_text(json.dumps({"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "point", "position": [0, 1, 0], "intensity": 2.0}]}))
+    assert run("validate", str(good)).returncode == 0
+    bad = tmp_path / "bad_rig.json"
+    bad.write_text(json.dumps({"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "sphere", "radius": -1}]}))
+    r = run("validate", str(bad))
+    assert r.returncode == 2 and r.stderr.startswith("error: ") and "radius" in r.stderr

@@ -25,8 +25,30 @@ def expand(files: list[str]) -> list[Path]:
     return out
 
 
+def _format_of(path: Path) -> str | None:
+    """The `format` of a small JSON file, cheaply, to pick its reader; None if unknown."""
+    import json
+
+    from matedit.io.atomic import read_bounded
+
+    try:
+        raw = json.loads(read_bounded(path, 1 << 20))
+    except (OSError, ValueError):
+        return None
+    return raw.get("format") if isinstance(raw, dict) else None
+
+
 def problems(path: Path, resolver: FileResolver) -> list[tuple[str, str]]:
     """(severity, message) lines for one file."""
+    if _format_of(path) == "matedit.lightrig":
+        from matedit.io.rig import RigError
+        from matedit.io.rig import load as load_rig
+
+        try:
+            load_rig(path)
+        except RigError as exc:
+            return [("error", str(exc))]
+        return []
     try:
         doc = load(path)
     except FormatError as exc:

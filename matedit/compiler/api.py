@@ -55,7 +55,8 @@ class CompiledMaterial:
             ],
             "textures": [
                 {"name": t.name, "binding": FIRST_TEXTURE_BINDING + i, "path": t.ref,
-                 "node": t.node, "parameter": t.parameter, "srgb": t.srgb}
+                 "node": t.node, "parameter": t.parameter, "srgb": t.srgb,
+                 "color_space": t.color_space}
                 for i, t in enumerate(self.ir.textures)
             ],
             "functions": [f.name for f in self.ir.functions],
