@@ -14,6 +14,9 @@ def _private_cache(tmp_path_factory):
     """Bakes go to a per-run cache, never the user's."""
     if "MATEDIT_CACHE_DIR" not in os.environ:
         os.environ["MATEDIT_CACHE_DIR"] = str(tmp_path_factory.mktemp("cache"))
+    # Recovery files (platformdirs' user data folder) are per run too: parallel runs, and the
+    # user's own crashed work, never meet the tests'.
+    os.environ["XDG_DATA_HOME"] = str(tmp_path_factory.mktemp("data"))
     yield
 
 

@@ -39,3 +39,11 @@ def simple_material(path: Path | None = None) -> MaterialDocument:
     link(d, "m", "result", "make", "roughness")
     link(d, "make", "attributes", "out", "attributes")
     return d
+
+
+# The editor's GUI tests drive a layered material node by node (its `mask_noise`, `hi`, the
+# `uv` function call...). They use this frozen copy, so the shipped samples can keep getting
+# better without breaking them: the sample material as the tests were written against it,
+# with the layers and functions it calls.
+EDITOR_GRAPHS = Path(__file__).resolve().parent / "data" / "editor_graphs"
+EDITOR_SAMPLE = EDITOR_GRAPHS / "materials" / "rusty_painted_metal.json"

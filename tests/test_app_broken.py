@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from graphs_util import EDITOR_GRAPHS, EDITOR_SAMPLE
 from test_app_support import app_env, make_window, settle  # noqa: F401 - fixture
 
 from matedit.graph.commands import AddNode, Connect
@@ -14,8 +15,8 @@ from matedit.resources import graphs_dir
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 
-SAMPLE = graphs_dir() / "materials" / "rusty_painted_metal.json"
-LAYERS = graphs_dir() / "layers"
+SAMPLE = EDITOR_SAMPLE
+LAYERS = EDITOR_GRAPHS / "layers"
 
 
 def _stack(w) -> LayerStack:

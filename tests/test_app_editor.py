@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from graphs_util import EDITOR_SAMPLE
 from test_app_support import app_env, make_window, settle  # noqa: F401 - fixture
 
 from matedit.graph.layers import LayerStack
@@ -122,7 +123,7 @@ def test_two_layer_material_built_from_empty_saves_reopens_and_undoes_to_empty(q
 def test_inspector_slider_drag_is_one_undo_step_and_never_recompiles(qtbot):
     from matedit.app.fields import FloatField
 
-    w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json")
+    w = make_window(qtbot, EDITOR_SAMPLE)
     settle(qtbot, w)
     compiled = w.compiler.current
     assert compiled is not None
@@ -196,7 +197,7 @@ def test_layer_dropped_from_library_and_rows_reordered_by_drop(qtbot):
 
     from matedit.app.layers_panel import LAYER_MIME, ROW_MIME
 
-    w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json", show=True)
+    w = make_window(qtbot, EDITOR_SAMPLE, show=True)
     lib_layers = w.library.items("layer")
     mud = next(it for it in lib_layers if "mud" in it.data(0, Qt.ItemDataRole.UserRole))
     mime = w.library.tree.mimeData([mud])
@@ -224,7 +225,7 @@ def test_layer_dropped_from_library_and_rows_reordered_by_drop(qtbot):
 def test_library_function_opens_in_a_tab_with_breadcrumbs_back(qtbot):
     from PySide6.QtWidgets import QPushButton
 
-    w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json")
+    w = make_window(qtbot, EDITOR_SAMPLE)
     fn = next(it for it in w.library.items("function"))
     w.library._activated(fn)
     assert w.tabs.tabs.count() == 2 and w.tabs.active.is_function
@@ -240,7 +241,7 @@ def test_diagnostics_click_selects_the_node(qtbot):
     from matedit.graph.commands import Connect
     from matedit.graph.model import Link
 
-    w = make_window(qtbot, graphs_dir() / "materials" / "rusty_painted_metal.json")
+    w = make_window(qtbot, EDITOR_SAMPLE)
     # A wire from an output that does not exist (an unconnected input only warns now).
     w.controller.push(Connect(Link("mask_noise", "nope", "mask", "value")))
     settle(qtbot, w, 10)

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from graphs_util import EDITOR_SAMPLE
 from test_app_support import app_env  # noqa: F401 - fixture
 
 from matedit.app.controller import DocumentController
 from matedit.app.previews import NodePreviews, preview_sphere
 from matedit.graph.commands import SetValue
 from matedit.io.document import load
-from matedit.resources import graphs_dir
 
 pytestmark = pytest.mark.gui
 
@@ -22,7 +22,7 @@ def _image_bytes(img) -> bytes:
 def test_pattern_nodes_get_thumbnails_that_follow_value_edits(qtbot, app_env):  # noqa: F811
     from matedit.app.canvas import NodeCanvasView
 
-    doc = load(graphs_dir() / "materials" / "rusty_painted_metal.json")
+    doc = load(EDITOR_SAMPLE)
     controller = DocumentController(doc)
     canvas = NodeCanvasView(controller)
     qtbot.addWidget(canvas)

@@ -9,6 +9,7 @@ import shutil
 
 import pytest
 import shiboken6
+from graphs_util import EDITOR_GRAPHS
 from PySide6.QtCore import QPointF
 from test_app_support import app_env, make_window, settle  # noqa: F401 - fixture
 
@@ -23,6 +24,7 @@ pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 def graphs(tmp_path):
     root = tmp_path / "graphs"
     shutil.copytree(graphs_dir(), root)
+    shutil.copytree(EDITOR_GRAPHS, root, dirs_exist_ok=True)  # the frozen editor sample
     return root
 
 

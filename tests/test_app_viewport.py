@@ -7,15 +7,15 @@ import copy
 
 import numpy as np
 import pytest
+from graphs_util import EDITOR_SAMPLE
 from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
 
 from matedit.graph.commands import Connect, SetValue
 from matedit.graph.model import Link
-from matedit.resources import graphs_dir
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 
-SAMPLE = graphs_dir() / "materials" / "rusty_painted_metal.json"
+SAMPLE = EDITOR_SAMPLE
 
 
 def frame(qtbot, view) -> np.ndarray:

@@ -10,6 +10,7 @@ import os
 os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
 
 import pytest  # noqa: E402
+from graphs_util import EDITOR_SAMPLE
 from PySide6.QtCore import QPointF, Qt  # noqa: E402
 from PySide6.QtGui import QColor, QImage  # noqa: E402
 from PySide6.QtTest import QTest  # noqa: E402
@@ -29,7 +30,6 @@ from matedit.graph.commands import (  # noqa: E402
 )
 from matedit.graph.model import Comment, Link, MaterialDocument, Node  # noqa: E402
 from matedit.io.document import load  # noqa: E402
-from matedit.resources import graphs_dir  # noqa: E402
 
 pytestmark = pytest.mark.gui
 
@@ -229,13 +229,13 @@ def test_preview_image_grows_the_node(view):
 
 
 def test_document_replaced_rebuilds(view):
-    view.controller.replace(load(graphs_dir() / "materials" / "rusty_painted_metal.json"))
+    view.controller.replace(load(EDITOR_SAMPLE))
     assert_mirrors(view)
     assert "stack" in view.scene().node_items
 
 
 def test_function_call_double_click_requests_the_function_file(qtbot):
-    controller = DocumentController(load(graphs_dir() / "materials" / "rusty_painted_metal.json"))
+    controller = DocumentController(load(EDITOR_SAMPLE))
     v = NodeCanvasView(controller)
     qtbot.addWidget(v)
     v.resize(1000, 700)

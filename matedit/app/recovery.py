@@ -19,7 +19,7 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from PySide6.QtCore import QStandardPaths, Qt
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
@@ -34,9 +34,11 @@ RECOVER, DISCARD, KEEP = "recover", "discard", "keep"
 
 
 def recovery_dir() -> Path:
-    """The folder of recovery files (the one place that says where it is)."""
-    base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
-    return Path(base or Path.home() / ".matedit") / "recovery"
+    """The folder of recovery files: `matedit.dirs.recovery_dir()` (platformdirs: on Linux
+    `$XDG_DATA_HOME/matedit/recovery`), the one place that says where it is."""
+    from matedit import dirs
+
+    return dirs.recovery_dir()
 
 
 def new_untitled_key() -> str:
