@@ -148,3 +148,4 @@ class MaterialIR:
     textures: list[TextureInfo]
     node_kinds: set[str]  # node kinds whose GLSL files are needed
     attributes: list[str]  # MaterialAttributes fields the graph writes
+    switches: dict[str, bool] = field(default_factory=dict)  # static switch name -> value

@@ -92,8 +92,9 @@ def _check_numbers(raw: Any, file: str | None) -> None:
             raise FormatError(file, bad, node, fld)
 
 
-def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
-    """Parse a document from JSON text (`path` anchors its relative references)."""
+def parse_json_text(text: str, file: str | None = None) -> Any:
+    """The JSON value of a document's text: no BOM, no duplicate keys, no NaN/infinity,
+    every number a 64-bit float (shared by materials, functions and instances)."""
     if text.startswith("\ufeff"):
         raise FormatError(file, "starts with a UTF-8 byte-order mark; save the file as UTF-8 "
                           "without a BOM")
@@ -105,6 +106,12 @@ def loads(text: str, file: str | None = None, path: Path | None = None) -> Mater
     except (ValueError, RecursionError) as exc:
         raise FormatError(file, f"not valid JSON: {exc}") from None
     _check_numbers(raw, file)
+    return raw
+
+
+def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
+    """Parse a document from JSON text (`path` anchors its relative references)."""
+    raw = parse_json_text(text, file)
     doc = from_dict(raw, file, path)
     try:
         dumps(doc)
