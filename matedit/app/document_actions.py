@@ -165,6 +165,10 @@ class DocumentActions(QObject):
 
     def open(self, path: str | os.PathLike, ask: bool = True) -> bool:
         """Opens a material (the current one is kept if the file is bad)."""
+        from matedit.io.instance import is_instance_file  # instances open in their editor
+
+        if is_instance_file(path) and hasattr(self.parent(), "open_instance"):
+            return self.parent().open_instance(str(path)) is not None
         if ask and not self.maybe_save():
             return False
         doc = self.read(path)
