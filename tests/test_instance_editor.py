@@ -79,6 +79,7 @@ def test_create_override_reset_switch_save_reopen(window, qtbot, tmp_path):
     _frame(qtbot, editor)
     assert editor.compile_count == compiles + 1 and renderer.link_count == links + 1
     assert "p_rust_amount" not in renderer._values
+    assert not editor.panel.rows["rust_amount"].field.isEnabled()
     switch.setChecked(True)
     _frame(qtbot, editor)
     assert editor.compile_count == compiles + 2 and renderer.link_count == links + 1

@@ -124,6 +124,7 @@ class InstanceEditor(QWidget):
         self.problems_label.setVisible(bool(r.problems))
         self.panel.set_parameters(r.parameters, r.values, set(self.doc.parameters) &
                                   set(r.parameters), self._base())
+        self._apply_live()
         self.setWindowTitle(self._title())
 
     def _set_dirty(self, dirty: bool = True) -> None:
@@ -143,8 +144,17 @@ class InstanceEditor(QWidget):
             self.message.emit(f"cannot compile the instance: {exc}")
             return
         self.compile_count += 1
+        self._apply_live()
         self.view.set_material(self.compiled)
         self.view.set_values(self._uniforms(), self._textures())
+
+    def _apply_live(self) -> None:
+        if self.compiled is None:
+            return
+        used = {u.parameter for u in self.compiled.ir.uniforms if u.parameter}
+        used |= {t.parameter for t in self.compiled.ir.textures}
+        self.panel.set_live({n for n, p in self.parameters.items()
+                             if p.type == "switch" or n in used})
 
     def _uniforms(self) -> dict[str, Any]:
         return {f"p_{n}": v for n, v in self.resolved.values.items()

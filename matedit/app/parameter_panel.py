@@ -18,8 +18,10 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QFormLayout,
     QFrame,
+    QGraphicsOpacityEffect,
     QHBoxLayout,
     QLabel,
+    QPushButton,
     QScrollArea,
     QSizePolicy,
     QToolButton,
@@ -31,6 +33,7 @@ from matedit.app.fields import ColorField, FloatField, TextureField, VectorField
 from matedit.io.instance import ParameterInfo, sorted_groups
 
 OVERRIDDEN_STYLE = "QLabel { font-weight: bold; color: #f0b45a; }"
+LABEL_WIDTH = 110
 MARK_STYLE = "QFrame { background: #f0b45a; border: none; }"
 
 
@@ -74,13 +77,16 @@ class _Row(QWidget):
         if info.type == "texture":
             absolute = (base / value) if (base and value) else None
             return TextureField(str(value), absolute)
-        box = QCheckBox("on")
+        box = QPushButton("On" if value else "Off")  # a static switch: compile-time choice
+        box.setCheckable(True)
         box.setChecked(bool(value))
+        box.toggled.connect(lambda on, b=box: b.setText("On" if on else "Off"))
+        box.setToolTip("Static switch: changing it compiles a permutation of the shader")
         return box
 
     def value(self) -> Any:
         f = self.field
-        if isinstance(f, QCheckBox):
+        if isinstance(f, QPushButton):
             return f.isChecked()
         if isinstance(f, TextureField):
             return f.path_edit.text().strip()
@@ -90,8 +96,9 @@ class _Row(QWidget):
         f = self.field
         f.blockSignals(True)
         try:
-            if isinstance(f, QCheckBox):
+            if isinstance(f, QPushButton):
                 f.setChecked(bool(value))
+                f.setText("On" if value else "Off")
             elif isinstance(f, TextureField):
                 f.set_value(str(value), (base / value) if (base and value) else None)
             else:
@@ -148,6 +155,7 @@ class ParameterPanel(QScrollArea):
             for info in infos:
                 row = _Row(info, values.get(info.name, info.default), base, self.instance_mode)
                 label = QLabel(info.name.replace("_", " "))
+                label.setMinimumWidth(LABEL_WIDTH)  # one column across groups
                 tip = info.settings.get("tooltip") or ""
                 label.setToolTip(f"{tip}\n({info.name}, {info.type})" if tip
                                  else f"{info.name} ({info.type})")
@@ -172,7 +180,7 @@ class ParameterPanel(QScrollArea):
     def _wire(self, row: _Row) -> None:
         name = row.info.name
         f = row.field
-        if isinstance(f, QCheckBox):
+        if isinstance(f, QPushButton):
             f.toggled.connect(lambda on, n=name: self._edited(n, bool(on)))
         else:
             f.edited.connect(lambda v, _m=None, n=name: self._edited(n, v))
@@ -202,6 +210,20 @@ class ParameterPanel(QScrollArea):
         row.show_value(value, self._base)
         if overridden is not None:
             self._mark(name, overridden)
+
+    def set_live(self, live: set[str] | None) -> None:
+        """Greys out parameters a static switch compiled out (None: all live)."""
+        for name, row in self.rows.items():
+            on = live is None or name in live
+            row.field.setEnabled(on)
+            self.labels[name].setEnabled(on)
+            row.field.setToolTip("" if on else "compiled out by a static switch")
+            for w in (row.field, self.labels[name]):
+                effect = None
+                if not on:
+                    effect = QGraphicsOpacityEffect(w)
+                    effect.setOpacity(0.35)
+                w.setGraphicsEffect(effect)
 
     def is_marked(self, name: str) -> bool:
         return bool(self.labels[name].property("overridden"))
