@@ -125,3 +125,18 @@ def test_file_open_of_an_instance_opens_the_editor(window, qtbot):
     assert editor.panel.is_marked("scratch_amount")
     assert editor.value("rust_on") is resolve(load_instance(path)).values["rust_on"]
     editor.close()
+
+
+def test_material_parameters_dock_is_grouped_and_edits_by_command(qtbot):
+    w = make_window(qtbot, MASTER)
+    panel = w.parameters_panel
+    assert [g for g, _ in panel.group_order()] == ["Paint", "Rust"]
+    panel.rows["wear_amount"].field.edited.emit(0.75, None)
+    node = w.controller.document.graph.nodes["wear_amt"]
+    assert node.values["value"] == 0.75
+    w.controller.undo_stack.undo()
+    assert node.values["value"] == 0.45
+    assert panel.rows["wear_amount"].field.value() == pytest.approx(0.45)
+    panel.rows["rust_on"].field.setChecked(False)
+    assert w.controller.document.graph.nodes["rust_on"].settings["value"] is False
+    assert panel.rows["rust_on"].field.isChecked() is False

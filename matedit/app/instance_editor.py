@@ -14,6 +14,7 @@ Material…, and opening instances from the Library (listed under their parent m
 from __future__ import annotations
 
 import copy
+import os
 from pathlib import Path
 from typing import Any
 
@@ -181,6 +182,8 @@ class InstanceEditor(QWidget):
         """Override `name` with `value` (an edit of a row overrides it)."""
         if name not in self.parameters:
             return
+        if self.parameters[name].type == "texture" and value and Path(value).is_absolute():
+            value = Path(os.path.relpath(value, self._base())).as_posix()  # file-relative
         self.doc.parameters[name] = copy.deepcopy(value)
         self._re_resolve()
         self.panel.update_row(name, self.resolved.values[name], True)
@@ -281,6 +284,12 @@ def install(window) -> None:
             QMessageBox.warning(window, "Cannot open instance", str(exc))
             return None
 
+    window.parameters_panel = MaterialParameters(window.controller)
+    window.parameters_dock = window._dock("Parameters", "parametersDock",
+                                          window.parameters_panel,
+                                          Qt.DockWidgetArea.RightDockWidgetArea)
+    window.tabifyDockWidget(window.inspector_dock, window.parameters_dock)
+    window.inspector_dock.raise_()
     window.open_instance = open_path
     window.create_instance = lambda parent_file, path: show(create_instance(parent_file, path))
     window.library.instanceOpenRequested.connect(open_path)
@@ -305,6 +314,57 @@ def _new_instance_dialog(window, parent_file: str | None = None) -> None:
             window.create_instance(parent_file, path)
         except (FormatError, InstanceError, OSError) as exc:
             QMessageBox.warning(window, "Cannot create instance", str(exc))
+
+
+# --- a material's own parameters, grouped (the Parameters dock) ---------------------------
+
+class MaterialParameters(ParameterPanel):
+    """The open material's parameters, grouped and ordered; edits are undoable commands
+    (values as uniforms, a switch as a structural edit)."""
+
+    def __init__(self, controller, parent=None) -> None:
+        super().__init__(parent)
+        self.controller = controller
+        self._signature: object = None
+        self._params: dict = {}
+        controller.changed.connect(lambda _e: self.refresh())
+        controller.documentReplaced.connect(self.refresh)
+        self.valueEdited.connect(self._edit)
+        self.refresh()
+
+    def refresh(self) -> None:
+        from matedit.io.instance import material_parameters
+
+        doc = self.controller.document
+        params = material_parameters(doc) if not doc.is_function else {}
+        values = {n: p.default for n, p in params.items()}
+        signature = [(n, p.type, p.node, repr(sorted(p.settings.items())))
+                     for n, p in params.items()]
+        base = Path(doc.path).parent if doc.path else None
+        if signature != self._signature:
+            self._signature = signature
+            self.set_parameters(params, values, None, base)
+        else:
+            for n, v in values.items():
+                self.update_row(n, v)
+        self._params = params
+
+    def _edit(self, name: str, value: Any) -> None:
+        from matedit.graph.commands import SetSetting, SetValue
+
+        p = self._params.get(name)
+        if p is None:
+            return
+        if p.type == "switch":
+            cmd = SetSetting(p.node, "value", bool(value), text=f"switch {name}")
+        elif p.type == "texture":
+            from matedit.app.paths import reference_for
+
+            ref = reference_for(self.controller.document, value) if value else ""
+            cmd = SetSetting(p.node, "path", ref, text=f"set {name}")
+        else:
+            cmd = SetValue(p.node, "value", value, text=f"set {name}")
+        self.controller.push(cmd)
 
 
 # --- library: instances under their parent material --------------------------------------
