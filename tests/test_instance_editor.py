@@ -140,3 +140,33 @@ def test_material_parameters_dock_is_grouped_and_edits_by_command(qtbot):
     panel.rows["rust_on"].field.setChecked(False)
     assert w.controller.document.graph.nodes["rust_on"].settings["value"] is False
     assert panel.rows["rust_on"].field.isChecked() is False
+
+
+def test_presentation_settings_shape_the_fields(qtbot):
+    from matedit.app.parameter_panel import CurveFloatField, ParameterPanel, _ColourVector
+    from matedit.io.instance import ParameterInfo
+
+    infos = {
+        "gloss": ParameterInfo("gloss", "scalar", "g", "scalar_parameter", 0.25,
+                               {"group": "B", "order": 2, "ui_min": 0.0, "ui_max": 4.0,
+                                "exponent": 2.0, "tooltip": "how shiny"}),
+        "count": ParameterInfo("count", "scalar", "c", "scalar_parameter", 3.0,
+                               {"group": "B", "order": 1, "slider": False}),
+        "tint": ParameterInfo("tint", "vector", "t", "vector_parameter", [1, 0, 0, 1],
+                              {"group": "A", "order": 5, "usage": "color"}),
+        "loose": ParameterInfo("loose", "scalar", "l", "scalar_parameter", 0.5, {}),
+    }
+    panel = ParameterPanel()
+    qtbot.addWidget(panel)
+    panel.set_parameters(infos, {n: p.default for n, p in infos.items()})
+    assert panel.group_order() == [("Parameters", ["loose"]), ("B", ["count", "gloss"]),
+                                   ("A", ["tint"])]
+    gloss = panel.rows["gloss"].field
+    assert isinstance(gloss, CurveFloatField)
+    # exponent 2: the slider's middle is a quarter of the range (0 + 4 * 0.5^2 = 1.0)
+    assert gloss._from_steps(500) == pytest.approx(1.0)
+    assert gloss._to_steps(1.0) == 500
+    assert panel.rows["count"].field.slider.isHidden()
+    assert isinstance(panel.rows["tint"].field, _ColourVector)
+    assert "how shiny" in panel.labels["gloss"].toolTip()
+    assert not panel.rows["gloss"].check.isVisibleTo(panel)  # a material: no override column

@@ -29,12 +29,63 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from matedit.app.fields import ColorField, FloatField, TextureField, VectorField
+from matedit.app.fields import (
+    SLIDER_STEPS,
+    ColorField,
+    FloatField,
+    TextureField,
+    VectorField,
+)
 from matedit.io.instance import ParameterInfo, sorted_groups
 
 OVERRIDDEN_STYLE = "QLabel { font-weight: bold; color: #f0b45a; }"
 LABEL_WIDTH = 110
 MARK_STYLE = "QFrame { background: #f0b45a; border: none; }"
+
+
+class CurveFloatField(FloatField):
+    """A FloatField whose slider follows value = lo + (hi - lo) * t^exponent (finer control
+    near ui_min for exponent > 1); with `slider` off only the number box shows."""
+
+    def __init__(self, value: float, rng, exponent: float = 1.0, slider: bool = True) -> None:
+        self.exponent = exponent if exponent > 0 else 1.0
+        super().__init__(value, rng)
+        self.slider.setVisible(slider)
+
+    def _to_steps(self, v: float) -> int:
+        lo, hi = self.range
+        t = (v - lo) / (hi - lo) if hi > lo else 0.0
+        t = max(0.0, min(1.0, t)) ** (1.0 / self.exponent)
+        return int(round(t * SLIDER_STEPS))
+
+    def _from_steps(self, s: int) -> float:
+        lo, hi = self.range
+        return round(lo + (hi - lo) * (s / SLIDER_STEPS) ** self.exponent, 4)
+
+
+class _ColourVector(QWidget):
+    """A vec4 parameter whose usage is colour: a colour picker for xyz, a number for w."""
+
+    edited = Signal(object, object)
+
+    def __init__(self, value: list[float]) -> None:
+        super().__init__()
+        lay = QHBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        self.colour = ColorField(list(value[:3]))
+        self.w = FloatField(float(value[3]), (0.0, 1.0))
+        self.w.slider.hide()
+        lay.addWidget(self.colour, 1)
+        lay.addWidget(self.w)
+        self.colour.edited.connect(lambda *_: self.edited.emit(self.value(), None))
+        self.w.edited.connect(lambda *_: self.edited.emit(self.value(), None))
+
+    def value(self) -> list[float]:
+        return [*self.colour.value(), self.w.value()]
+
+    def set_value(self, value: list[float]) -> None:
+        self.colour.set_value(list(value[:3]))
+        self.w.set_value(float(value[3]))
 
 
 class _Row(QWidget):
@@ -68,10 +119,16 @@ class _Row(QWidget):
         s = info.settings
         if info.type == "scalar":
             lo, hi = s.get("ui_min", 0.0), s.get("ui_max", 1.0)
-            ok = all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in (lo, hi))
-            return FloatField(float(value), (float(lo), float(hi)) if ok else None)
+            num = (int, float)
+            ok = all(isinstance(x, num) and not isinstance(x, bool) for x in (lo, hi))
+            exp = s.get("exponent", 1.0)
+            exp = float(exp) if isinstance(exp, num) and not isinstance(exp, bool) else 1.0
+            return CurveFloatField(float(value), (float(lo), float(hi)) if ok else None, exp,
+                                   s.get("slider", True) is not False)
         if info.type == "color":
             return ColorField(list(value))
+        if info.type == "vector" and s.get("usage") == "color":
+            return _ColourVector(list(value))
         if info.type == "vector":
             return VectorField(list(value))
         if info.type == "texture":
