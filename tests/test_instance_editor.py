@@ -104,7 +104,7 @@ def test_create_override_reset_switch_save_reopen(window, qtbot, tmp_path):
         e.close()
 
 
-def test_library_lists_instances_under_their_parent(window):
+def test_library_lists_instances_under_their_parent(window, qtbot):
     window.library.refresh()
     mats = {it.data(0, 0x0100): it for it in window.library.items("material")}
     master = mats[str(MASTER.resolve())]
@@ -113,7 +113,7 @@ def test_library_lists_instances_under_their_parent(window):
     red = kids["Worn paint, red"]
     grand = {red.child(i).text(0) for i in range(red.childCount())}
     assert {"Worn paint, red, scuffed", "Worn paint, red, no rust"} <= grand
-    assert not red.icon(0).isNull()  # a thumbnail from the instance
+    qtbot.waitUntil(lambda: not red.icon(0).isNull(), timeout=10000)  # from the instance
 
 
 def test_file_open_of_an_instance_opens_the_editor(window, qtbot):

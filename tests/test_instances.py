@@ -385,3 +385,17 @@ def test_render_instance_shows_its_overrides(tmp_path):
     # blue paint becomes red paint: red rises and blue falls on the paint
     assert (b[..., 0] - a[..., 0]).max() > 0.2 and (a[..., 2] - b[..., 2]).max() > 0.2
     assert np.abs(a - b).max(axis=2)[:4].max() < 1e-6  # the background row is untouched
+
+
+def test_preview_settings_layer_over_the_parent(tmp_path, master):
+    m = fmt.load(master)
+    m.preview = {"mesh": "sphere", "environment": "studio_hdr.exr"}
+    fmt.save(m)
+    (tmp_path / "sub").mkdir()
+    p = instance(tmp_path / "sub" / "i.json", "../mat/master.json",
+                 preview={"mesh": "cube", "exposure": 1.5})
+    r = resolve(inst_io.load_instance(p))
+    assert r.document.preview["mesh"] == "cube" and r.document.preview["exposure"] == 1.5
+    # the parent's environment file is found from the instance's folder
+    assert (p.parent / r.document.preview["environment"]).resolve() == \
+        (tmp_path / "mat" / "studio_hdr.exr").resolve()

@@ -18,7 +18,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QFileDialog,
     QHBoxLayout,
@@ -394,7 +394,7 @@ def attach_instances(material_items: list[QTreeWidgetItem], files: list[Path],
             it.setData(0, path_role, str(f.resolve()))
             it.setData(0, kind_role, "instance")
             it.setToolTip(0, f"Instance of {Path(doc.parent).name}\n{doc.description}\n{f}")
-            _thumbnail(it, f)
+            QTimer.singleShot(0, lambda it=it, f=f: _thumbnail(it, f))  # after start-up
             by_path[str(f.resolve())] = it
             added.append(it)
             pending.remove((f, doc))
@@ -417,5 +417,5 @@ def _thumbnail(item: QTreeWidgetItem, path: Path) -> None:
         img = to_image(out["baseColor"], inside, 24)
         if img is not None:
             item.setIcon(0, QIcon(QPixmap.fromImage(img)))
-    except Exception:  # a thumbnail is decoration: a broken instance just shows no icon
+    except Exception:  # decoration: a broken instance (or a refreshed-away item) shows none
         pass
