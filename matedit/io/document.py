@@ -111,13 +111,7 @@ def parse_json_text(text: str, file: str | None = None) -> Any:
 
 def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
     """Parse a document from JSON text (`path` anchors its relative references)."""
-    raw = parse_json_text(text, file)
-    doc = from_dict(raw, file, path)
-    try:
-        dumps(doc)
-    except (TypeError, ValueError) as exc:
-        raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
-    return doc
+    return from_dict(parse_json_text(text, file), file, path)
 
 
 def read_document_text(path: str | os.PathLike) -> str:
@@ -245,6 +239,10 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> Ma
         doc.graph.comments[c["id"]] = Comment(c["id"], text, tuple(float(x) for x in rect),
                                               tuple(float(x) for x in color),
                                               _unknown(c, COMMENT_FIELDS))
+    try:  # here, not only in loads: a dict from elsewhere may hold an infinity in a kept field
+        dumps(doc)
+    except (TypeError, ValueError) as exc:
+        raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
     return doc
 
 
