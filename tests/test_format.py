@@ -16,7 +16,8 @@ from matedit.io import document as fmt
 from matedit.io.migrations import CURRENT_VERSION, MIGRATIONS, migrate
 from matedit.resources import graphs_dir
 
-SAMPLES = sorted(graphs_dir().rglob("*.json"))
+SAMPLES = sorted(p for p in graphs_dir().rglob("*.json")
+                 if p.parent.name != "instances")  # instances: tests/test_instances.py
 FUZZ_EXAMPLES = int(os.environ.get("FUZZ_EXAMPLES", "300"))
 
 

@@ -30,6 +30,7 @@ COMPILER_HANDLED = {
     "function_output", "function_call", "layer_stack", "material_output", "set_attributes",
     "component_mask", "append", "reroute",
 }  # fmt: skip
+COMPILER_HANDLED |= {"static_switch"}  # chosen at compile time (issue 14)
 VEC = {1: "float", 2: "vec2", 3: "vec3", 4: "vec4"}
 MAX_ERRORS: dict[str, tuple[float, float]] = {}  # name -> (abs, rel to |numpy| + atol)
 

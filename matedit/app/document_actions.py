@@ -195,7 +195,11 @@ class DocumentActions(QObject):
 
     def open(self, path: str | os.PathLike, ask: bool = True, offer: bool = True) -> bool:
         """Opens a material (the current one is kept if the file is bad); `offer`: ask about
-        the file's recovery file, if there is one."""
+        the file's recovery file, if there is one. An instance opens in its own editor."""
+        from matedit.io.instance import is_instance_file  # instances open in their editor
+
+        if is_instance_file(path) and hasattr(self.parent(), "open_instance"):
+            return self.parent().open_instance(str(path)) is not None
         if ask and not self.maybe_save():
             return False
         doc = self.read(path)

@@ -75,6 +75,8 @@ class LibraryPanel(QWidget):
     materialOpenRequested = Signal(str)
     functionOpenRequested = Signal(str)
     layerAddRequested = Signal(str)
+    instanceOpenRequested = Signal(str)  # see matedit.app.instance_editor
+    instanceCreateRequested = Signal(str)  # a material or instance to make an instance of
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -96,6 +98,8 @@ class LibraryPanel(QWidget):
         self.tree = LibraryTree()
         self.tree.itemDoubleClicked.connect(self._activated)
         lay.addWidget(self.tree, 1)
+        self.tree.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
+        self.tree.customContextMenuRequested.connect(self._context_menu)
         self.folder_dialog = QFileDialog.getExistingDirectory  # tests replace it
         self.refresh()
 
@@ -144,6 +148,10 @@ class LibraryPanel(QWidget):
                 if kind == "layer":
                     tip += "\nDrag onto the Layers panel, or double-click, to add it"
                 it.setToolTip(0, tip)
+        from matedit.app.instance_editor import attach_instances  # under their parents
+
+        files = [p for _, r in roots if r.is_dir() for p in sorted(r.rglob("*.json"))]
+        attach_instances(self.items("material"), files, PATH_ROLE, KIND_ROLE)
         for top in sections.values():
             top.setExpanded(True)
         self.filter(self.search.text())
@@ -182,3 +190,15 @@ class LibraryPanel(QWidget):
             self.functionOpenRequested.emit(path)
         elif kind == "layer":
             self.layerAddRequested.emit(path)
+        elif kind == "instance":
+            self.instanceOpenRequested.emit(path)
+
+    def _context_menu(self, pos) -> None:
+        item = self.tree.itemAt(pos)
+        if item is not None and item.data(0, KIND_ROLE) in ("material", "instance"):
+            from PySide6.QtWidgets import QMenu
+
+            menu = QMenu(self)
+            act = menu.addAction("Create Instance…")
+            if menu.exec(self.tree.viewport().mapToGlobal(pos)) is act:
+                self.instanceCreateRequested.emit(item.data(0, PATH_ROLE))

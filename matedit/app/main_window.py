@@ -30,6 +30,7 @@ from matedit.app.diagnostics import DiagnosticsPanel, Problem
 from matedit.app.document_actions import DocumentActions, document_title
 from matedit.app.export_dialog import ExportDialog
 from matedit.app.inspector import InspectorPanel
+from matedit.app.instance_editor import install as install_instances
 from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
@@ -67,6 +68,7 @@ class MainWindow(QMainWindow):
         self._build_menus()
         self._build_status()
         self._connect()
+        install_instances(self)  # File › New Instance, Library instances (instance_editor)
         self._default_state = self.saveState(STATE_VERSION)
         if restore_layout:
             self.restore_layout()

@@ -13,7 +13,7 @@ from matedit.compiler.targets import TARGETS
 
 
 def register(sub) -> None:
-    p = sub.add_parser("compile", help="compile a material to GLSL",
+    p = sub.add_parser("compile", help="compile a material or material instance to GLSL",
                        description="Compile a material to vertex and fragment GLSL plus a "
                        "reflection JSON (uniforms, textures, targets).")
     p.add_argument("file", metavar="FILE")
@@ -26,14 +26,17 @@ def run(args) -> int:
     # Imported here, not at the top, so that other subcommands start without the compiler.
     from matedit.compiler import CompileError, compile_all
     from matedit.compiler.export import export_shaders
-    from matedit.io.document import FileResolver, FormatError, load
+    from matedit.io.document import FileResolver, FormatError
     from matedit.io.inputs import OverwriteError
+    from matedit.io.instance import InstanceError, load_effective
 
     path = Path(args.file)
     try:
-        doc = load(path)
-    except FormatError as exc:
+        doc, notes = load_effective(path)  # a material, or an instance's effective material
+    except (FormatError, InstanceError) as exc:
         raise UsageError(str(exc)) from None
+    for note in notes:
+        report("warning", note.format())
     if doc.is_function:
         raise UsageError(f"{path}: is a material function; compile a material that calls it")
     resolver = FileResolver()

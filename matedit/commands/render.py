@@ -140,7 +140,7 @@ def _builtin(doc, key: str, fallback: str) -> str:
 
 def run(args) -> int:
     from matedit.compiler import CompileError, compile_document
-    from matedit.io.document import FileResolver, FormatError, load
+    from matedit.io.document import FileResolver, FormatError
     from matedit.io.inputs import (
         BUILTIN_ENVIRONMENTS,
         BUILTIN_MESHES,
@@ -160,10 +160,14 @@ def run(args) -> int:
     lights = _lights(args.lights)
     if not out.parent.exists():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
+    from matedit.io.instance import InstanceError, load_effective
+
     try:
-        doc = load(path)
-    except FormatError as exc:
+        doc, notes = load_effective(path)  # a material, or an instance's effective material
+    except (FormatError, InstanceError) as exc:
         raise UsageError(str(exc)) from None
+    for note in notes:
+        print(f"warning: {note.format()}", file=sys.stderr)
     if doc.is_function:
         raise UsageError(f"{path}: is a material function; render a material that uses it")
     resolver = FileResolver()

@@ -10,9 +10,9 @@ from matedit.io.document import FileResolver, FormatError, load
 
 
 def register(sub) -> None:
-    p = sub.add_parser("validate", help="check material and function files",
-                       description="Check material and material-function files (folders are "
-                       "searched for *.json).")
+    p = sub.add_parser("validate", help="check material, function and instance files",
+                       description="Check material, material-function and material-instance "
+                       "files (folders are searched for *.json).")
     p.add_argument("files", nargs="+", metavar="FILE")
     p.set_defaults(run=run)
 
@@ -49,11 +49,20 @@ def problems(path: Path, resolver: FileResolver) -> list[tuple[str, str]]:
         except RigError as exc:
             return [("error", str(exc))]
         return []
-    try:
-        doc = load(path)
-    except FormatError as exc:
-        return [("error", str(exc))]
+    from matedit.io.instance import InstanceError, is_instance_file, load_instance, resolve
+
     lines = []
+    try:
+        if is_instance_file(path):  # its own rules, then its effective material's
+            r = resolve(load_instance(path))
+            lines = [(p.severity, p.format()) for p in r.problems]
+            if r.errors:
+                return lines
+            doc = r.document
+        else:
+            doc = load(path)
+    except (FormatError, InstanceError) as exc:
+        return [("error", str(exc))]
     diagnostics = analyse(doc, resolver).diagnostics
     for d in diagnostics:
         lines.append((d.severity.value, f"{d.file or path}: {d.format()}"))

@@ -60,6 +60,7 @@ class CompiledMaterial:
                 for i, t in enumerate(self.ir.textures)
             ],
             "functions": [f.name for f in self.ir.functions],
+            **({"static_switches": dict(self.ir.switches)} if self.ir.switches else {}),
         }
 
     def pack_uniforms(self, values: dict[str, Any] | None = None) -> bytes:

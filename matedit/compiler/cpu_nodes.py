@@ -23,6 +23,7 @@ COMPILER_HANDLED = frozenset({
     "function_output", "function_call", "layer_stack", "material_output", "set_attributes",
     "component_mask", "append", "reroute",
 })  # fmt: skip
+COMPILER_HANDLED = COMPILER_HANDLED | {"static_switch"}  # chosen at compile time (issue 14)
 
 Attributes = dict[str, np.ndarray]
 

@@ -36,6 +36,8 @@ def shader_files(doc: MaterialDocument, compiled: dict[str, CompiledMaterial],
     first = next(iter(compiled.values())).reflection()
     for key in ("attributes", "uniforms", "textures", "uniform_block"):
         reflection[key] = first[key]
+    if "static_switches" in first:
+        reflection["static_switches"] = first["static_switches"]
     files[folder / f"{stem}.reflection.json"] = json.dumps(reflection, sort_keys=True,
                                                            indent=2) + "\n"
     return files

@@ -151,3 +151,4 @@ class MaterialIR:
     attributes: list[str]  # MaterialAttributes fields the graph writes
     defines: list[str] = field(default_factory=list)  # extra #defines, e.g. the material's
     # MATEDIT_ENERGY_COMPENSATION option (preview "energy_compensation": true)
+    switches: dict[str, bool] = field(default_factory=dict)  # static switch name -> value

@@ -39,7 +39,7 @@ from matedit.graph.validate import Analysis, Diagnostic, Severity, analyse
 SPECIAL_KINDS = {
     "constant", "scalar_parameter", "color_parameter", "texture_parameter", "function_input",
     "function_output", "function_call", "layer_stack", "material_output", "set_attributes",
-    "component_mask", "append", "reroute",
+    "component_mask", "append", "reroute", "static_switch",
 }
 ALL_FIELDS = frozenset(ATTRIBUTE_NAMES)
 
@@ -86,6 +86,7 @@ class _Ctx:
     textures: dict[str, TextureInfo] = field(default_factory=dict)
     kinds: set[str] = field(default_factory=set)
     input_uniforms: dict[tuple[str, str], str] = field(default_factory=dict)
+    switches: dict[str, tuple[bool, str]] = field(default_factory=dict)  # name -> (on, node)
 
 
 class _Lowerer:
@@ -244,6 +245,30 @@ class _Lowerer:
                                                   str(node.settings.get("path", "")),
                                                   str(node.settings.get("color_space", "")))
         self.alias[(nid, "texture")] = Uni(name, PortType.TEXTURE)
+
+    def _k_static_switch(self, nid, node) -> None:
+        """Compile-time choice: only the chosen input is read, so the other branch is dead
+        code (removed with its uniforms and textures by optimise and prune)."""
+        from matedit.graph.names import identifier_problem
+
+        name = node.settings.get("name", nid)
+        on = node.settings.get("value", True)
+        bad = identifier_problem(name) if isinstance(name, str) else "must be a string"
+        if bad or not isinstance(on, bool):
+            field_, why = ("name", f"switch name {name!r} {bad}") if bad else (
+                "value", f"switch value must be true or false, got {on!r}")
+            raise CompileError([Diagnostic(Severity.ERROR, why, nid, field_, self.file)])
+        if self.top:
+            other = self.ctx.switches.get(name)
+            if other is not None and other[1] != nid:
+                raise CompileError([Diagnostic(
+                    Severity.ERROR, f"static switch name {name!r} is used by {other[1]} too",
+                    nid, "name", self.file)])
+            self.ctx.switches[name] = (on, nid)
+        port = "true" if on else "false"
+        spec = self.a.ports[nid].input(port)
+        t = self.a.out_types[nid]["result"]
+        self.alias[(nid, "result")] = self.arg(nid, port, t, spec.default if spec else 0.0)
 
     def _k_reroute(self, nid, node) -> None:
         t = self.a.in_types[nid]["value"]
@@ -422,6 +447,13 @@ def lower_document(doc: MaterialDocument, resolver: FunctionResolver | None) -> 
         raise CompileError([Diagnostic(Severity.ERROR, str(exc), None, None, low.file)]) from None
     written = low._w(scope.outputs[0][2]) if scope.outputs else frozenset()
     attributes = [f for f in ATTRIBUTE_NAMES if f in written]
+    params = {u.parameter: u.node for u in ctx.uniforms.values() if u.parameter}
+    params.update({t.parameter: t.node for t in ctx.textures.values()})
+    for name, (_, nid) in sorted(ctx.switches.items()):
+        if name in params:
+            raise CompileError([Diagnostic(
+                Severity.ERROR, f"static switch name {name!r} is a parameter of "
+                f"{params[name]} too", nid, "name", low.file)])
     return MaterialIR(
         main=scope,
         functions=[ctx.functions[k] for k in ctx.order],
@@ -429,4 +461,5 @@ def lower_document(doc: MaterialDocument, resolver: FunctionResolver | None) -> 
         textures=sorted(ctx.textures.values(), key=lambda t: t.name),
         node_kinds=ctx.kinds,
         attributes=attributes,
+        switches={k: on for k, (on, _) in sorted(ctx.switches.items())},
     )

@@ -443,6 +443,44 @@ register(NodeDef(
     inline="", numpy="material_output",
 ))
 
+# --- instances: static switches and parameter presentation (issue 14) ----------------------
+# A static switch is a parameter an instance may override, fixed at compile time: the
+# compiler keeps the chosen input and drops the other branch with its uniforms and textures.
+register(NodeDef(
+    "static_switch", "Static Switch", "Parameters",
+    "Chooses one of two inputs when the shader is compiled (a named bool an instance may "
+    "override); the unused branch is compiled out with its uniforms and textures.",
+    inputs=(_i("true", T, 1.0, "used when the switch is on"),
+            _i("false", T, 0.0, "used when the switch is off")),
+    outputs=(_o("result", T),),
+    settings=_PARAM_SETTINGS + (
+        SettingDef("value", "bool", True, "on: use the 'true' input; structural"),),
+    inline="{true}",  # never emitted: matedit.compiler.lower chooses the branch
+))
+PARAMETER_KINDS = ("scalar_parameter", "vector_parameter", "color_parameter",
+                   "texture_parameter", "static_switch")
+_PRESENTATION = {
+    "*": (SettingDef("order", "number", 0, "position within its group", structural=False),
+          SettingDef("tooltip", "string", "", "help shown in parameter panels",
+                     structural=False)),
+    "scalar_parameter": (
+        SettingDef("slider", "bool", True, "edit with a slider between ui_min and ui_max",
+                   structural=False),
+        SettingDef("exponent", "number", 1.0, "slider curve: value = lo + (hi - lo) * t^e",
+                   structural=False)),
+    "vector_parameter": (
+        SettingDef("usage", "string", "data", "data or color (a colour picker for xyz)",
+                   structural=False, choices=("data", "color")),
+        SettingDef("ui_min", "number", 0.0, "field minimum", structural=False),
+        SettingDef("ui_max", "number", 1.0, "field maximum", structural=False)),
+}
+for _kind in PARAMETER_KINDS:
+    _d = REGISTRY[_kind]
+    _have = {s.name for s in _d.settings}
+    _more = tuple(s for s in _PRESENTATION["*"] + _PRESENTATION.get(_kind, ())
+                  if s.name not in _have)
+    REGISTRY[_kind] = NodeDef(**{**_d.__dict__, "settings": _d.settings + _more})
+del _kind, _d, _have, _more
 
 # The library beyond the basics lives in its own module, registered on import.
 from matedit.graph import library as _library  # noqa: E402,F401

@@ -92,8 +92,9 @@ def _check_numbers(raw: Any, file: str | None) -> None:
             raise FormatError(file, bad, node, fld)
 
 
-def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
-    """Parse a document from JSON text (`path` anchors its relative references)."""
+def parse_json_text(text: str, file: str | None = None) -> Any:
+    """The JSON value of a document's text: no BOM, no duplicate keys, no NaN/infinity,
+    every number a 64-bit float (shared by materials, functions and instances)."""
     if text.startswith("\ufeff"):
         raise FormatError(file, "starts with a UTF-8 byte-order mark; save the file as UTF-8 "
                           "without a BOM")
@@ -104,7 +105,13 @@ def loads(text: str, file: str | None = None, path: Path | None = None) -> Mater
                           field=str(exc.args[0])) from None
     except (ValueError, RecursionError) as exc:
         raise FormatError(file, f"not valid JSON: {exc}") from None
-    return from_dict(raw, file, path)
+    _check_numbers(raw, file)
+    return raw
+
+
+def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
+    """Parse a document from JSON text (`path` anchors its relative references)."""
+    return from_dict(parse_json_text(text, file), file, path)
 
 
 def read_document_text(path: str | os.PathLike) -> str:
@@ -246,6 +253,10 @@ def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocumen
         doc.graph.comments[c["id"]] = Comment(c["id"], text, tuple(float(x) for x in rect),
                                               tuple(float(x) for x in color),
                                               _unknown(c, COMMENT_FIELDS))
+    try:  # here, not only in loads: a dict from elsewhere may hold an infinity in a kept field
+        dumps(doc)
+    except (TypeError, ValueError) as exc:
+        raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
     return doc
 
 

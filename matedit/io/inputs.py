@@ -1,10 +1,11 @@
 """The files a document reads, and the rule that no output may overwrite one of them.
 
 `document_inputs` collects the document itself, every material function, layer and blend it
-calls (transitively, through the functions' own references), every texture, and the preview
-mesh and environment when they are files. `refuse_overwrite` compares output paths with
-those inputs after resolving links, `..` and hard links, and raises `OverwriteError` naming
-both paths when an output would replace an input.
+calls (transitively, through the functions' own references), every texture, the preview
+mesh and environment when they are files, and for an instance's effective material
+(`matedit.io.instance`) every file of its parent chain. `refuse_overwrite` compares output
+paths with those inputs after resolving links, `..` and hard links, and raises
+`OverwriteError` naming both paths when an output would replace an input.
 """
 
 from __future__ import annotations
@@ -67,6 +68,8 @@ def document_inputs(doc, resolver=None) -> dict[Path, str]:
                 except LookupError:
                     continue
                 todo.append((sub, kind))
+        for parent in getattr(d, "instance_chain", ()):  # an instance's parents
+            found.setdefault(_real(parent), "a parent of the instance")
         for key, what_ in (("mesh", "the preview mesh"), ("environment", "the environment")):
             f = preview_file(d, key)
             if f is not None:

@@ -1,0 +1,421 @@
+"""The instance editor: a parameter-only view of a material instance with a live preview.
+
+Opening an instance shows its parent chain, the parent's parameters grouped and ordered
+(`ParameterPanel`), and a viewport previewing the instance. Editing a scalar, vector, colour
+or texture parameter is a uniform or texture update: no compile, no link. Toggling a static
+switch compiles the instance's permutation; the renderer keeps programs by structure hash,
+so switching back links nothing. Saving writes the instance file (atomically) with the
+parent's parameter list, so orphaned overrides stay recognisable.
+
+`install(window)` adds the editor's entry points to the main window: File › New Instance of
+Material…, and opening instances from the Library (listed under their parent material).
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtWidgets import (
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QMessageBox,
+    QPushButton,
+    QSplitter,
+    QTreeWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from matedit.app.parameter_panel import ParameterPanel
+from matedit.app.viewport import ViewportWidget
+from matedit.compiler import CompileError, compile_document
+from matedit.io.document import FileResolver, FormatError
+from matedit.io.instance import (
+    InstanceDocument,
+    InstanceError,
+    ResolvedInstance,
+    is_instance_file,
+    load_instance,
+    new_instance,
+    resolve,
+    save_instance,
+)
+
+INSTANCE_FILTER = "Material instances (*.json)"
+
+
+class InstanceEditor(QWidget):
+    """One instance: parameter panel on the left, preview on the right."""
+
+    message = Signal(str)
+    dirtyChanged = Signal(bool)
+
+    def __init__(self, doc: InstanceDocument, parent=None) -> None:
+        super().__init__(parent)
+        self.setWindowFlag(Qt.WindowType.Window)
+        self.doc = doc
+        self.resolver = FileResolver()
+        self.resolved: ResolvedInstance = resolve(doc)
+        self.compiled = None
+        self.compile_count = 0
+        self.dirty = False
+        self.panel = ParameterPanel()
+        self.view = ViewportWidget()
+        self.chain_label = QLabel()
+        self.chain_label.setWordWrap(True)
+        self.chain_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.problems_label = QLabel()
+        self.problems_label.setWordWrap(True)
+        self.problems_label.setStyleSheet("color: #e0a040;")
+        self.save_button = QPushButton("Save")
+        self.save_button.clicked.connect(self.save)
+        left = QWidget()
+        ll = QVBoxLayout(left)
+        ll.setContentsMargins(0, 0, 0, 0)
+        ll.addWidget(self.chain_label)
+        ll.addWidget(self.problems_label)
+        ll.addWidget(self.panel, 1)
+        bar = QHBoxLayout()
+        bar.addStretch(1)
+        bar.addWidget(self.save_button)
+        ll.addLayout(bar)
+        split = QSplitter()
+        split.addWidget(left)
+        split.addWidget(self.view)
+        split.setStretchFactor(1, 1)
+        split.setSizes([380, 520])
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(6, 6, 6, 6)
+        lay.addWidget(split)
+        self.resize(1000, 620)
+        self.panel.valueEdited.connect(self.set_value)
+        self.panel.overrideToggled.connect(self._override_toggled)
+        self.panel.resetRequested.connect(self.reset)
+        self._rebuild()
+        self._recompile()
+
+    # --- state ---------------------------------------------------------------------------
+    @property
+    def parameters(self):
+        return self.resolved.parameters
+
+    def value(self, name: str) -> Any:
+        return self.resolved.values[name]
+
+    def is_overridden(self, name: str) -> bool:
+        return name in self.doc.parameters
+
+    def _base(self) -> Path:
+        return Path(self.doc.path).parent if self.doc.path else Path.cwd()
+
+    def _title(self) -> str:
+        name = self.doc.name or (Path(self.doc.path).stem if self.doc.path else "instance")
+        return f"{name}{' *' if self.dirty else ''} — instance — matedit"
+
+    def _rebuild(self) -> None:
+        r = self.resolved
+        names = [Path(p).name for p in r.chain]
+        self.chain_label.setText("Instance chain: " + " → ".join(names))
+        self.problems_label.setText("\n".join(p.format() for p in r.problems))
+        self.problems_label.setVisible(bool(r.problems))
+        self.panel.set_parameters(r.parameters, r.values, set(self.doc.parameters) &
+                                  set(r.parameters), self._base())
+        self._apply_live()
+        self.setWindowTitle(self._title())
+
+    def _set_dirty(self, dirty: bool = True) -> None:
+        if dirty != self.dirty:
+            self.dirty = dirty
+            self.dirtyChanged.emit(dirty)
+        self.setWindowTitle(self._title())
+
+    def _re_resolve(self) -> None:
+        self.resolved = resolve(self.doc)
+
+    # --- compile and values ------------------------------------------------------------
+    def _recompile(self) -> None:
+        try:
+            self.compiled = compile_document(self.resolved.document, self.resolver, "glsl330")
+        except CompileError as exc:
+            self.message.emit(f"cannot compile the instance: {exc}")
+            return
+        self.compile_count += 1
+        self._apply_live()
+        self.view.set_material(self.compiled)
+        self.view.set_values(self._uniforms(), self._textures())
+
+    def _apply_live(self) -> None:
+        if self.compiled is None:
+            return
+        used = {u.parameter for u in self.compiled.ir.uniforms if u.parameter}
+        used |= {t.parameter for t in self.compiled.ir.textures}
+        self.panel.set_live({n for n, p in self.parameters.items()
+                             if p.type == "switch" or n in used})
+
+    def _uniforms(self) -> dict[str, Any]:
+        return {f"p_{n}": v for n, v in self.resolved.values.items()
+                if self.parameters[n].type in ("scalar", "vector", "color")}
+
+    def _textures(self) -> dict[str, Path | None]:
+        out: dict[str, Path | None] = {}
+        for n, v in self.resolved.values.items():
+            if self.parameters[n].type == "texture":
+                out[f"t_{n}"] = (self._base() / v) if v else None
+        return out
+
+    def _push(self, name: str) -> None:
+        """A value edit: a uniform or texture update, or a permutation for a switch."""
+        kind = self.parameters[name].type
+        if kind == "switch":
+            self._recompile()
+        elif kind == "texture":
+            self.view.set_values({}, {f"t_{name}": self._textures()[f"t_{name}"]})
+        else:
+            self.view.set_values({f"p_{name}": self.resolved.values[name]}, {})
+
+    def set_value(self, name: str, value: Any) -> None:
+        """Override `name` with `value` (an edit of a row overrides it)."""
+        if name not in self.parameters:
+            return
+        if self.parameters[name].type == "texture" and value and Path(value).is_absolute():
+            value = Path(os.path.relpath(value, self._base())).as_posix()  # file-relative
+        self.doc.parameters[name] = copy.deepcopy(value)
+        self._re_resolve()
+        self.panel.update_row(name, self.resolved.values[name], True)
+        self._set_dirty()
+        self._push(name)
+
+    def _override_toggled(self, name: str, on: bool) -> None:
+        if on:
+            self.set_value(name, self.resolved.values[name])
+        else:
+            self.reset(name)
+
+    def reset(self, name: str) -> None:
+        """Reset to the parent's value: the override is removed from the file."""
+        if name not in self.doc.parameters:
+            return
+        del self.doc.parameters[name]
+        self._re_resolve()
+        self.panel.update_row(name, self.resolved.values[name], False)
+        self._set_dirty()
+        self._push(name)
+
+    # --- files ------------------------------------------------------------------------
+    def save(self) -> bool:
+        if self.doc.path is None:
+            return self.save_as()
+        try:
+            save_instance(self.doc, resolved=self.resolved)
+        except OSError as exc:
+            QMessageBox.warning(self, "Save failed", f"{self.doc.path}: {exc}")
+            return False
+        self._set_dirty(False)
+        self.message.emit(f"saved {self.doc.path}")
+        return True
+
+    def save_as(self, path: str | Path | None = None) -> bool:
+        if path is None:
+            path, _ = QFileDialog.getSaveFileName(self, "Save instance as", "", INSTANCE_FILTER)
+            if not path:
+                return False
+        save_instance(self.doc, path, resolved=self.resolved)
+        self._re_resolve()
+        self._rebuild()
+        self._set_dirty(False)
+        return True
+
+    def closeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self.dirty:
+            answer = QMessageBox.question(
+                self, "Unsaved instance", f"Save changes to {self._title()}?",
+                QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                | QMessageBox.StandardButton.Cancel)
+            if answer == QMessageBox.StandardButton.Cancel or (
+                    answer == QMessageBox.StandardButton.Save and not self.save()):
+                event.ignore()
+                return
+        super().closeEvent(event)
+
+
+def open_instance(path: str | Path, parent=None) -> InstanceEditor:
+    """An editor on an instance file; raises FormatError or InstanceError."""
+    return InstanceEditor(load_instance(path), parent)
+
+
+def create_instance(parent_file: str | Path, path: str | Path, parent=None) -> InstanceEditor:
+    """Writes a new instance of `parent_file` (a material or instance) at `path`, with no
+    overrides, and opens it."""
+    doc = new_instance(parent_file, path)
+    resolved = resolve(doc)
+    save_instance(doc, resolved=resolved)
+    return InstanceEditor(doc, parent)
+
+
+# --- main window hooks ------------------------------------------------------------------
+
+def install(window) -> None:
+    """File › New Instance of Material…, and the Library's instance entries."""
+    from PySide6.QtGui import QAction
+
+    window.instance_editors = []
+    act = QAction("New &Instance of Material…", window)
+    act.setToolTip("Create a material instance of the open material (or a chosen file)")
+    act.triggered.connect(lambda: _new_instance_dialog(window))
+    window.act_new_instance = act
+    menu = window.menuBar().actions()[0].menu()
+    menu.insertAction(menu.actions()[1], act)
+
+    def show(editor: InstanceEditor) -> InstanceEditor:
+        window.instance_editors.append(editor)
+        editor.message.connect(window.status)
+        editor.show()
+        return editor
+
+    def open_path(path: str) -> InstanceEditor | None:
+        try:
+            return show(open_instance(path))
+        except (FormatError, InstanceError) as exc:
+            QMessageBox.warning(window, "Cannot open instance", str(exc))
+            return None
+
+    window.parameters_panel = MaterialParameters(window.controller)
+    window.parameters_dock = window._dock("Parameters", "parametersDock",
+                                          window.parameters_panel,
+                                          Qt.DockWidgetArea.RightDockWidgetArea)
+    window.tabifyDockWidget(window.inspector_dock, window.parameters_dock)
+    window.inspector_dock.raise_()
+    window.open_instance = open_path
+    window.create_instance = lambda parent_file, path: show(create_instance(parent_file, path))
+    window.library.instanceOpenRequested.connect(open_path)
+    window.library.instanceCreateRequested.connect(lambda p: _new_instance_dialog(window, p))
+
+
+def _new_instance_dialog(window, parent_file: str | None = None) -> None:
+    if parent_file is None:
+        doc = window.actions.document if hasattr(window, "actions") else None
+        parent_file = str(doc.path) if doc is not None and doc.path else None
+    if parent_file is None:
+        parent_file, _ = QFileDialog.getOpenFileName(window, "Instance of which material?",
+                                                     "", INSTANCE_FILTER)
+        if not parent_file:
+            return
+    stem = Path(parent_file).stem
+    path, _ = QFileDialog.getSaveFileName(window, "Save the new instance as",
+                                          str(Path(parent_file).with_name(f"{stem}_inst.json")),
+                                          INSTANCE_FILTER)
+    if path:
+        try:
+            window.create_instance(parent_file, path)
+        except (FormatError, InstanceError, OSError) as exc:
+            QMessageBox.warning(window, "Cannot create instance", str(exc))
+
+
+# --- a material's own parameters, grouped (the Parameters dock) ---------------------------
+
+class MaterialParameters(ParameterPanel):
+    """The open material's parameters, grouped and ordered; edits are undoable commands
+    (values as uniforms, a switch as a structural edit)."""
+
+    def __init__(self, controller, parent=None) -> None:
+        super().__init__(parent)
+        self.controller = controller
+        self._signature: object = None
+        self._params: dict = {}
+        controller.changed.connect(lambda _e: self.refresh())
+        controller.documentReplaced.connect(self.refresh)
+        self.valueEdited.connect(self._edit)
+        self.refresh()
+
+    def refresh(self) -> None:
+        from matedit.io.instance import material_parameters
+
+        doc = self.controller.document
+        params = material_parameters(doc) if not doc.is_function else {}
+        values = {n: p.default for n, p in params.items()}
+        signature = [(n, p.type, p.node, repr(sorted(p.settings.items())))
+                     for n, p in params.items()]
+        base = Path(doc.path).parent if doc.path else None
+        if signature != self._signature:
+            self._signature = signature
+            self.set_parameters(params, values, None, base)
+        else:
+            for n, v in values.items():
+                self.update_row(n, v)
+        self._params = params
+
+    def _edit(self, name: str, value: Any) -> None:
+        from matedit.graph.commands import SetSetting, SetValue
+
+        p = self._params.get(name)
+        if p is None:
+            return
+        if p.type == "switch":
+            cmd = SetSetting(p.node, "value", bool(value), text=f"switch {name}")
+        elif p.type == "texture":
+            from matedit.app.paths import reference_for
+
+            ref = reference_for(self.controller.document, value) if value else ""
+            cmd = SetSetting(p.node, "path", ref, text=f"set {name}")
+        else:
+            cmd = SetValue(p.node, "value", value, text=f"set {name}")
+        self.controller.push(cmd)
+
+
+# --- library: instances under their parent material --------------------------------------
+
+def attach_instances(material_items: list[QTreeWidgetItem], files: list[Path],
+                     path_role, kind_role) -> list[QTreeWidgetItem]:
+    """Adds each instance file as a child of its parent's item (instances of instances
+    under their parent instance); returns the items added."""
+    by_path = {str(Path(it.data(0, path_role)).resolve()): it for it in material_items}
+    pending: list[tuple[Path, InstanceDocument]] = []
+    for f in files:
+        if not is_instance_file(f):
+            continue
+        try:
+            pending.append((f, load_instance(f)))
+        except FormatError:
+            continue
+    added: list[QTreeWidgetItem] = []
+    progress = True
+    while pending and progress:  # parents first, whatever the file order
+        progress = False
+        for f, doc in list(pending):
+            parent_item = by_path.get(str(doc.parent_path().resolve()))
+            if parent_item is None:
+                continue
+            it = QTreeWidgetItem(parent_item, [doc.name or f.stem])
+            it.setData(0, path_role, str(f.resolve()))
+            it.setData(0, kind_role, "instance")
+            it.setToolTip(0, f"Instance of {Path(doc.parent).name}\n{doc.description}\n{f}")
+            QTimer.singleShot(0, lambda it=it, f=f: _thumbnail(it, f))  # after start-up
+            by_path[str(f.resolve())] = it
+            added.append(it)
+            pending.remove((f, doc))
+            progress = True
+    return added
+
+
+def _thumbnail(item: QTreeWidgetItem, path: Path) -> None:
+    """The instance's base colour on a sphere, from the CPU evaluator (no GL needed)."""
+    try:
+        from PySide6.QtGui import QIcon, QPixmap
+
+        from matedit.app.previews import preview_sphere, to_image
+        from matedit.compiler.cpu_eval import evaluate
+        from matedit.compiler.lower import lower_document
+
+        r = resolve(load_instance(path))
+        surf, inside = preview_sphere(24)
+        out = evaluate(lower_document(r.document, FileResolver()), surf)
+        img = to_image(out["baseColor"], inside, 24)
+        if img is not None:
+            item.setIcon(0, QIcon(QPixmap.fromImage(img)))
+    except Exception:  # decoration: a broken instance (or a refreshed-away item) shows none
+        pass
