@@ -55,7 +55,9 @@ def test_instance_differs_from_parent_exactly_where_the_override_acts(ctx):
     # there, and no other attribute moves at all.
     cpu_moved = _err(ic["baseColor"], pc["baseColor"]) > 1e-2
     gpu_moved = _err(ig["baseColor"], pg["baseColor"]) > 1e-2
-    assert 0.05 < cpu_moved.mean() < 0.999
+    # (On the flat UV grid the curvature wear of the master finds no edges, so paint may
+    # cover every pixel: the check is that the GPU moves exactly where the CPU does.)
+    assert cpu_moved.mean() > 0.05
     assert (cpu_moved == gpu_moved).mean() > 0.995
     for field in ("metallic", "roughness", "normal", "emissive", "cavity", "opacity"):
         assert _err(ig[field], pg[field]).max() < 1e-6, field
