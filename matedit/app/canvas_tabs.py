@@ -43,6 +43,8 @@ class CanvasTabs(QWidget):
     selectionChanged = Signal(list)
     message = Signal(str)
     functionSaved = Signal(object)  # Path
+    previewRequested = Signal(str, str)  # a node's output to show in the viewport
+    materialOpenRequested = Signal(str)  # a material file dropped on a canvas
 
     def __init__(self, material: DocumentController, material_actions: DocumentActions,
                  undo_group: QUndoGroup, parent=None) -> None:
@@ -79,6 +81,7 @@ class CanvasTabs(QWidget):
         tab = CanvasTab(controller, canvas, actions, parent)
         if not controller.document.is_function:
             tab.previews = NodePreviews(controller, canvas, self)
+            canvas.previewRequested.connect(self.previewRequested)
         if parent is not None:
             parent.children.append(tab)
         self._tabs.append(tab)
@@ -86,6 +89,7 @@ class CanvasTabs(QWidget):
         canvas.selectionChangedIds.connect(self._selection)
         canvas.functionOpenRequested.connect(lambda p, t=tab: self.open_function(p, t))
         canvas.message.connect(self.message)
+        canvas.materialOpenRequested.connect(self.materialOpenRequested)
         controller.undo_stack.cleanChanged.connect(self._clean_changed)
         actions.saved.connect(lambda p, t=tab: self._saved(t, p))
         self.tabs.addTab(canvas, icon("function" if controller.document.is_function

@@ -33,6 +33,7 @@ from matedit.app.inspector import InspectorPanel
 from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
+from matedit.app.node_preview import PreviewTarget
 from matedit.app.theme import icon
 from matedit.app.viewport import EnvironmentPanel, ViewportPanel
 from matedit.graph.model import MaterialDocument
@@ -167,6 +168,9 @@ class MainWindow(QMainWindow):
         self.act_save_as = self._action("Save &As…", self.save_active_as, K.SaveAs, "save-as")
         self.act_export = self._action("&Export Shaders…", self.export_shaders, "Ctrl+E",
                                        "export", "Write GLSL for chosen targets to a folder")
+        self.act_save_image = self._action("Save &Viewport Image…",
+                                           lambda: self.viewport.save_image_dialog(), None,
+                                           "save", "The viewport's frame as PNG or linear EXR")
         self.act_quit = self._action("&Quit", self.close, K.Quit)
         self.act_undo = self.undo_group.createUndoAction(self, "&Undo")
         self.act_undo.setShortcut(K.Undo)
@@ -205,6 +209,7 @@ class MainWindow(QMainWindow):
             f.addAction(a)
         f.addSeparator()
         f.addAction(self.act_export)
+        f.addAction(self.act_save_image)
         f.addSeparator()
         f.addAction(self.act_quit)
         e = mb.addMenu("&Edit")
@@ -258,6 +263,9 @@ class MainWindow(QMainWindow):
         self.viewport.view.materialApplied.connect(self._material_applied)
         self.viewport.statusMessage.connect(self.status)
         self.viewport.environmentChanged.connect(lambda s: self.status(f"environment: {s}"))
+        self.tabs.materialOpenRequested.connect(self.open_material)
+        self.tabs.previewRequested.connect(
+            lambda nid, port: self.compiler.set_preview(PreviewTarget(nid, port)))
         self.tabs.activeChanged.connect(self._on_active)
         self.tabs.selectionChanged.connect(self.inspector.set_selection)
         self.tabs.message.connect(self.status)

@@ -38,6 +38,7 @@ MODES = {"Split-sum": "splitsum", "Reference": "reference", "Difference": "diffe
 ENVIRONMENTS = {"Studio": "studio", "Sky": "sky"}
 OPEN_ENV = "Open HDR/EXR…"
 ENV_FILTER = "HDR environments (*.hdr *.exr);;All files (*)"
+SAVE_FILTER = "PNG image, as shown (*.png);;OpenEXR, linear radiance (*.exr)"
 
 
 def _load_renderer_class():
@@ -271,6 +272,17 @@ class ViewportWidget(QOpenGLWidget):
     def _set_environment_now(self, spec: str, progress) -> None:
         self.renderer.set_environment(spec, progress=progress)
 
+    def read_hdr(self):
+        """(H, W, 3) scene-linear radiance of the last frame (before exposure and display
+        transform), or None without a renderer."""
+        if self.renderer is None:
+            return None
+        self.makeCurrent()
+        try:
+            return self.renderer.read_hdr()
+        finally:
+            self.doneCurrent()
+
     def read_image(self):
         """(H, W, 3) sRGB floats of the last frame, through the renderer."""
         if self.renderer is None:
@@ -356,6 +368,10 @@ class ViewportPanel(QWidget):
         self.exposure_label.setMinimumWidth(44)
         self.diff_label = QLabel("")
         self.diff_label.setObjectName("diffMean")
+        self.save_button = QToolButton()
+        self.save_button.setIcon(icon("save"))
+        self.save_button.setToolTip("Save the viewport image (PNG as shown, or linear EXR)")
+        self.save_button.clicked.connect(self.save_image_dialog)
         reset = QToolButton()
         reset.setIcon(icon("reset"))
         reset.setToolTip("Reset the camera (or double-click the view)")
@@ -365,13 +381,30 @@ class ViewportPanel(QWidget):
         bl.addWidget(self.exposure_label)
         bl.addWidget(self.diff_label)
         bl.addStretch(1)
+        bl.addWidget(self.save_button)
         bl.addWidget(reset)
         lay.addWidget(bar)
+        self.banner = QWidget(self)  # laid over the view's top edge: the view keeps its size
+        self.banner.setObjectName("previewBanner")
+        self.banner.setStyleSheet("#previewBanner { background: #6b4f12; }")
+        bn = QHBoxLayout(self.banner)
+        bn.setContentsMargins(8, 2, 4, 2)
+        self.banner_label = QLabel("")
+        self.banner_label.setStyleSheet("color: #ffe7a8; font-weight: bold;")
+        self.banner_clear = QToolButton()
+        self.banner_clear.setText("Show material")
+        self.banner_clear.setToolTip("Stop previewing the node: show the whole material again")
+        self.banner_clear.clicked.connect(lambda: compiler.set_preview(None))
+        bn.addWidget(self.banner_label, 1)
+        bn.addWidget(self.banner_clear)
+        self.banner.hide()
         self.view = ViewportWidget()
         lay.addWidget(self.view, 1)
         self._env_index = 0
         self._custom_envs: list[str] = []
         self.env_dialog = QFileDialog.getOpenFileName  # tests replace it
+        self.save_dialog = QFileDialog.getSaveFileName  # tests replace it
+        self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment
         self.mesh_combo.currentTextChanged.connect(self.view.set_mesh)
         self.mode_combo.currentTextChanged.connect(self._mode_changed)
         self.exposure.valueChanged.connect(self._exposure_changed)
@@ -381,6 +414,7 @@ class ViewportPanel(QWidget):
         self.view.frameDrawn.connect(self._frame_drawn)
         self.view.statusMessage.connect(self.statusMessage)
         compiler.compiled.connect(self.on_compiled)
+        compiler.previewChanged.connect(self._preview_changed)
         self.controller.valuesChanged.connect(self.push_values)
 
     # --- material --------------------------------------------------------------------------
@@ -394,6 +428,102 @@ class ViewportPanel(QWidget):
             return
         doc = self.controller.document
         self.view.set_values(uniform_values(cm, doc), texture_paths(cm, doc))
+
+    # --- saving the picture; dropped environments -------------------------------------------
+    def save_image_dialog(self) -> bool:
+        path, _ = self.save_dialog(self, "Save the viewport image", "viewport.png",
+                                   SAVE_FILTER)
+        return bool(path) and self.save_image(path)
+
+    def _inputs(self) -> set[Path]:
+        """Files the document reads: an image saved over one of them is refused."""
+        doc = self.controller.document
+        out = {Path(doc.path).resolve()} if doc.path else set()
+        cm = self.compiler.current or self.compiler.last_good
+        if cm is not None:
+            out |= {Path(p).resolve() for p in texture_paths(cm, doc).values() if p}
+        if Path(self.view._environment).suffix:
+            out.add(Path(self.view._environment).resolve())
+        return out
+
+    def save_image(self, path: str | Path) -> bool:
+        """The current frame as PNG (display-referred, as shown) or as EXR (scene-linear
+        radiance, before exposure and display transform)."""
+        path = Path(path)
+        if path.suffix.lower() not in (".png", ".exr"):
+            path = path.with_suffix(path.suffix + ".png") if path.suffix else \
+                path.with_suffix(".png")
+        if path.resolve() in self._inputs():
+            self.statusMessage.emit(f"{path.name} is a file the material reads: not "
+                                    "overwritten")
+            return False
+        if self.view.renderer is None:
+            self.statusMessage.emit("no image to save: the renderer is not running")
+            return False
+        try:
+            if path.suffix.lower() == ".exr":
+                from matedit.io.images import write_image
+
+                write_image(path, self.view.read_hdr())
+            else:
+                from PySide6.QtCore import QBuffer, QByteArray, QIODevice
+
+                from matedit.io.atomic import atomic_write_bytes
+
+                data = QByteArray()
+                buf = QBuffer(data)
+                buf.open(QIODevice.OpenModeFlag.WriteOnly)
+                if not self.view.grabFramebuffer().save(buf, "PNG"):
+                    raise OSError("PNG encoding failed")
+                buf.close()
+                atomic_write_bytes(path, bytes(data.data()))
+        except (OSError, ValueError) as exc:
+            self.statusMessage.emit(f"cannot save {path.name}: {exc}")
+            return False
+        self.statusMessage.emit(f"saved the viewport image to {path}")
+        return True
+
+    @staticmethod
+    def _dropped_environment(mime) -> str:
+        for url in mime.urls() if mime.hasUrls() else []:
+            p = url.toLocalFile()
+            if p and Path(p).suffix.lower() in (".hdr", ".exr"):
+                return p
+        return ""
+
+    def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._dropped_environment(event.mimeData()):
+            event.acceptProposedAction()
+        else:
+            event.ignore()
+
+    def dragMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        self.dragEnterEvent(event)
+
+    def dropEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        path = self._dropped_environment(event.mimeData())
+        if not path:
+            event.ignore()
+            return
+        event.acceptProposedAction()
+        self.choose_environment(path)
+
+    def _preview_changed(self, target) -> None:
+        if target is None:
+            self.banner.hide()
+            return
+        self.banner_label.setText(f"Previewing {target.label()}, not the material")
+        self._place_banner()
+        self.banner.show()
+        self.banner.raise_()
+
+    def _place_banner(self) -> None:
+        g = self.view.geometry()
+        self.banner.setGeometry(g.x(), g.y(), g.width(), self.banner.sizeHint().height())
+
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        self._place_banner()
 
     # --- bar -------------------------------------------------------------------------------
     def _mode_changed(self, text: str) -> None:

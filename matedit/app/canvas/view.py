@@ -27,6 +27,7 @@ from PySide6.QtWidgets import (
 from matedit.app.canvas import clipboard
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.comment_item import CommentItem
+from matedit.app.canvas.drops import CanvasDrops
 from matedit.app.canvas.interaction import WireDrag, compatible_port, kind_ports, port_at
 from matedit.app.canvas.minimap import MiniMap
 from matedit.app.canvas.node_item import NodeItem, PortRow, measure
@@ -38,6 +39,7 @@ from matedit.app.controller import DocumentController
 from matedit.graph import nodes
 from matedit.graph.commands import AddNode, Command, Connect, Disconnect, PutComment, RemoveNode
 from matedit.graph.model import Comment, Link, MaterialDocument, Node
+from matedit.graph.types import PortType
 from matedit.graph.validate import check_connect
 
 _DRAG_START = 4  # pixels the mouse must travel before a press on a port becomes a drag
@@ -49,12 +51,14 @@ def _id_stem(kind: str) -> str:
     return (parts[0] + "".join(p[:1].upper() + p[1:] for p in parts[1:])) if parts else "n"
 
 
-class NodeCanvasView(QGraphicsView):
+class NodeCanvasView(CanvasDrops, QGraphicsView):
     """The node canvas over one DocumentController (see `matedit.app.canvas` for the API)."""
 
     selectionChangedIds = Signal(list)
     functionOpenRequested = Signal(str)
     message = Signal(str)
+    previewRequested = Signal(str, str)  # node id, output port: show it in the viewport
+    materialOpenRequested = Signal(str)  # a material file dropped on the canvas
 
     def __init__(self, controller: DocumentController, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -81,6 +85,8 @@ class NodeCanvasView(QGraphicsView):
         self.setMouseTracking(True)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setStyleSheet("QGraphicsView { background: #1b1e24; border: none; }")
+        self.setAcceptDrops(True)
+        self.run_menu = lambda menu, at: menu.exec(at)  # tests read the menu instead
 
         self.node_palette = NodePalette(self)
         self.node_palette.chosen.connect(self._palette_chosen)
@@ -160,6 +166,25 @@ class NodeCanvasView(QGraphicsView):
         """The node palette at `scene_pos` (default: the cursor, else the middle of the view)."""
         self._palette_anchor = None
         self._show_palette(self._resolve_pos(scene_pos), None, "Add node")
+
+    def previewable_output(self, node_id: str, port: str = "") -> str:
+        """`port` if the node has that output with a value to show, else its first such
+        output ("" if none: a texture object, say)."""
+        a = self.controller.analysis
+        outs = a.out_types.get(node_id, {}) if a is not None else {}
+        ok = [p for p, t in outs.items() if t.is_numeric or t == PortType.MATERIAL]
+        if port in ok:
+            return port
+        return ok[0] if ok else ""
+
+    def preview_node(self, node_id: str, port: str = "") -> bool:
+        """Asks the viewport to show one of the node's outputs (see `previewRequested`)."""
+        port = self.previewable_output(node_id, port)
+        if not port:
+            self.refuse(f"{node_id} has no output the viewport can show")
+            return False
+        self.previewRequested.emit(node_id, port)
+        return True
 
     def set_minimap_visible(self, visible: bool) -> None:
         self.minimap.setVisible(visible)
@@ -505,6 +530,15 @@ class NodeCanvasView(QGraphicsView):
             item.setSelected(True)
         menu = QMenu(self)
         menu.addAction("Add node…\tTab", lambda: self.open_palette(sp))
+        if isinstance(item, NodeItem) and not self.controller.document.is_function:
+            port = port_at(self._scene, sp, self._hit_radius(), want_output=True)
+            name = port.name if port is not None and port.node_id == item.node_id else ""
+            name = self.previewable_output(item.node_id, name)
+            act = menu.addAction(f"Preview in viewport ({name})" if name else
+                                 "Preview in viewport",
+                                 lambda n=item.node_id, p=name: self.preview_node(n, p))
+            act.setEnabled(bool(name))
+            menu.addSeparator()
         has_sel = bool(self._scene.selectedItems() or self._scene.selected_wires)
         for text, slot, key, enabled in (
                 ("Copy", self.copy_selection, "Ctrl+C", has_sel),
@@ -516,7 +550,7 @@ class NodeCanvasView(QGraphicsView):
                 ("Frame all", self.frame_all, "Home", True)):
             action = menu.addAction(f"{text}\t{key}", slot)
             action.setEnabled(enabled)
-        menu.exec(event.globalPos())
+        self.run_menu(menu, event.globalPos())
 
     # --- keys --------------------------------------------------------------------------------
     _OWN_KEYS = (QKeySequence.StandardKey.Copy, QKeySequence.StandardKey.Paste,
