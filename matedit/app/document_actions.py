@@ -35,7 +35,7 @@ from matedit.app.recovery import (
     remove_recovery,
     write_meta_text,
 )
-from matedit.graph.model import MaterialDocument
+from matedit.graph.model import MaterialDocument, Node
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import FormatError, dumps, load, loads, save
 
@@ -45,6 +45,13 @@ RECENT_KEY = "files/recent"
 FILE_FILTER = "matedit graphs (*.json);;All files (*)"
 
 SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
+
+
+def new_material() -> MaterialDocument:
+    """What File > New makes: an untitled material with its Material Output in place."""
+    doc = MaterialDocument(name="Untitled")
+    doc.graph.nodes["out"] = Node("out", "material_output", (300.0, 0.0))
+    return doc
 
 
 def document_title(doc: MaterialDocument) -> str:
@@ -98,6 +105,7 @@ class DocumentActions(QObject):
             None = None
         self.open_recovered_material: Callable[[RecoveryEntry, MaterialDocument], None] | \
             None = None
+        self.open_function: Callable[[Path], None] | None = None  # File > Open on a function
         self.ask_open_path: Callable[[], str] = self._ask_open_path
         self.ask_save_path: Callable[[str], str] = self._ask_save_path
         self.show_error: Callable[[str, str], None] = self._show_error
@@ -175,7 +183,7 @@ class DocumentActions(QObject):
             return False
         self.discard_recovery()
         self.untitled_key = new_untitled_key()
-        self.controller.replace(MaterialDocument(name="Untitled"))
+        self.controller.replace(new_material())
         self.opened.emit(None)
         return True
 
@@ -196,14 +204,18 @@ class DocumentActions(QObject):
     def open(self, path: str | os.PathLike, ask: bool = True, offer: bool = True) -> bool:
         """Opens a material (the current one is kept if the file is bad); `offer`: ask about
         the file's recovery file, if there is one."""
-        if ask and not self.maybe_save():
-            return False
         doc = self.read(path)
         if doc is None:
             return False
-        if doc.is_function:
+        if doc.is_function:  # a function opens in a canvas tab; the material stays
+            if self.open_function is not None:
+                self.open_function(Path(path))
+                self.add_recent(Path(path))
+                return True
             self.show_error("Not a material", f"{Path(path).name} is a material function; "
                             "open it from the Library to edit it in a tab.")
+            return False
+        if ask and not self.maybe_save():
             return False
         if ask:  # leaving a document the artist has just saved or discarded
             self.discard_recovery()

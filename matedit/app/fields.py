@@ -12,9 +12,11 @@ import math
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSize, Qt, Signal
+from PySide6.QtCore import QEvent, QObject, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap
 from PySide6.QtWidgets import (
+    QAbstractScrollArea,
+    QApplication,
     QColorDialog,
     QDoubleSpinBox,
     QFileDialog,
@@ -37,8 +39,31 @@ SPIN_LIMIT = 1e6
 IMAGE_FILTER = "Images (*.png *.jpg *.jpeg *.tga *.tif *.tiff *.exr *.hdr *.bmp);;All files (*)"
 
 
+class WheelGuard(QObject):
+    """Lets the wheel change a slider, spin box or combo box only while it has focus;
+    otherwise the wheel scrolls the panel around it."""
+
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
+        if event.type() == QEvent.Type.Wheel and isinstance(obj, QWidget) and not obj.hasFocus():
+            area = obj.parentWidget()
+            while area is not None and not isinstance(area, QAbstractScrollArea):
+                area = area.parentWidget()
+            if area is not None:
+                QApplication.sendEvent(area.verticalScrollBar(), event)
+            return True
+        return False
+
+
+def guard_wheel(widget: QWidget) -> QWidget:
+    """`widget` with a `WheelGuard`, and focus only by click or Tab (never by the wheel)."""
+    widget.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+    widget.installEventFilter(WheelGuard(widget))
+    return widget
+
+
 def _spin(decimals: int = 3) -> QDoubleSpinBox:
     s = QDoubleSpinBox()
+    guard_wheel(s)
     s.setRange(-SPIN_LIMIT, SPIN_LIMIT)
     s.setDecimals(decimals)
     s.setSingleStep(0.01)
@@ -74,7 +99,7 @@ class FloatField(QWidget):
         lay = QHBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(6)
-        self.slider = QSlider(Qt.Orientation.Horizontal)
+        self.slider = guard_wheel(QSlider(Qt.Orientation.Horizontal))
         self.slider.setRange(0, SLIDER_STEPS)
         self.slider.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         self.spin = _spin()

@@ -27,7 +27,14 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app.controller import DocumentController
-from matedit.app.fields import ColorField, FloatField, TextureField, VectorField, _spin
+from matedit.app.fields import (
+    ColorField,
+    FloatField,
+    TextureField,
+    VectorField,
+    _spin,
+    guard_wheel,
+)
 from matedit.app.paths import absolute_of, reference_for
 from matedit.graph import nodes
 from matedit.graph.commands import SetLabel, SetSetting, SetValue
@@ -59,6 +66,7 @@ class InspectorPanel(QScrollArea):
         self.node_id: str | None = None
         self._fields: dict[tuple[str, str], QWidget] = {}  # ("value"|"setting", name) -> field
         self._ports_key: object = None
+        self._shown: str | None = None  # the node the body was last built for
         self._rebuild_timer = QTimer(self)
         self._rebuild_timer.setSingleShot(True)
         self._rebuild_timer.setInterval(0)
@@ -137,7 +145,18 @@ class InspectorPanel(QScrollArea):
 
     # --- building --------------------------------------------------------------------------
     def rebuild(self) -> None:
+        # The same node rebuilt (an edit changed its ports): stay where the artist was.
+        bar = self.verticalScrollBar()
+        keep = bar.value() if self.node_id is not None and self.node_id == self._shown else 0
+        self._shown = self.node_id
         self._fields.clear()
+        self._build_body()
+        if keep:
+            self.widget().adjustSize()
+            bar.setValue(keep)
+            QTimer.singleShot(0, self, lambda: bar.setValue(keep))
+
+    def _build_body(self) -> None:
         body = QWidget()
         lay = QVBoxLayout(body)
         lay.setContentsMargins(10, 8, 10, 8)
@@ -228,7 +247,7 @@ class InspectorPanel(QScrollArea):
     def _setting_editor(self, node: Node, s: SettingDef) -> QWidget | None:
         cur = node.settings.get(s.name, s.default)
         if s.kind == "type" and s.choices:
-            combo = QComboBox()
+            combo = guard_wheel(QComboBox())
             combo.addItems(list(s.choices))
             combo.setCurrentText(str(cur))
             combo.setToolTip(s.doc)

@@ -27,7 +27,7 @@ from matedit.app.code_view import CodeView
 from matedit.app.compile_service import MaterialCompiler
 from matedit.app.controller import DocumentController
 from matedit.app.diagnostics import DiagnosticsPanel, Problem
-from matedit.app.document_actions import DocumentActions, document_title
+from matedit.app.document_actions import DocumentActions, document_title, new_material
 from matedit.app.export_dialog import ExportDialog
 from matedit.app.inspector import InspectorPanel
 from matedit.app.layers_panel import LayersPanel
@@ -36,7 +36,6 @@ from matedit.app.lights_panel import LightsPanel
 from matedit.app.node_preview import PreviewTarget
 from matedit.app.theme import icon
 from matedit.app.viewport import EnvironmentPanel, ViewportPanel
-from matedit.graph.model import MaterialDocument
 from matedit.resources import graphs_dir
 
 SAMPLE = "materials/rusty_painted_metal.json"
@@ -55,7 +54,7 @@ class MainWindow(QMainWindow):
         self.setObjectName("MainWindow")
         self.resize(1480, 900)
         self.setDockNestingEnabled(True)
-        self.controller = DocumentController(MaterialDocument(name="Untitled"), self)
+        self.controller = DocumentController(new_material(), self)
         self.actions = DocumentActions(self, self.controller)
         self.compiler = MaterialCompiler(self.controller, self)
         self.undo_group = QUndoGroup(self)
@@ -78,6 +77,7 @@ class MainWindow(QMainWindow):
         self.actions.open_recovered_function = lambda e, doc: self.tabs.open_function(
             e.document, self.tabs.material, recovered=doc)
         self.actions.open_recovered_material = self._open_recovered_material
+        self.actions.open_function = lambda p: self.tabs.open_function(p, self.tabs.material)
         if start:
             self.actions.start(path, sample_path() if sample else None)
             self.compiler.recompile()
@@ -91,8 +91,9 @@ class MainWindow(QMainWindow):
                          | QDockWidget.DockWidgetFeature.DockWidgetFloatable
                          | QDockWidget.DockWidgetFeature.DockWidgetClosable)
         self.addDockWidget(area, dock)
-        if icon_name:
-            dock.toggleViewAction().setIcon(icon(icon_name))
+        # No icon on the View menu's entry: styles draw an icon instead of the check mark.
+        dock.toggleViewAction().setCheckable(True)
+        dock.setProperty("iconName", icon_name)
         return dock
 
     def _build_docks(self) -> None:

@@ -19,6 +19,7 @@ from PySide6.QtOpenGLWidgets import QOpenGLWidget
 from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
+    QDoubleSpinBox,
     QFileDialog,
     QHBoxLayout,
     QLabel,
@@ -361,11 +362,19 @@ class ViewportPanel(QWidget):
         self.env_combo.addItems([*ENVIRONMENTS, OPEN_ENV])
         self.env_combo.setToolTip("Environment lighting")
         self.exposure = QSlider(Qt.Orientation.Horizontal)
-        self.exposure.setRange(-60, 60)  # tenths of EV
-        self.exposure.setFixedWidth(90)
-        self.exposure.setToolTip("Exposure (EV)")
-        self.exposure_label = QLabel("0.0 EV")
-        self.exposure_label.setMinimumWidth(44)
+        self.exposure.setRange(-60, 60)  # tenths of EV: the arrow keys step 0.1 EV
+        self.exposure.setSingleStep(1)
+        self.exposure.setPageStep(10)
+        self.exposure.setMinimumWidth(140)
+        self.exposure.setToolTip("Exposure (EV); arrow keys step 0.1 EV, Page Up/Down 1 EV")
+        self.exposure_spin = QDoubleSpinBox()
+        self.exposure_spin.setRange(-6.0, 6.0)
+        self.exposure_spin.setDecimals(1)
+        self.exposure_spin.setSingleStep(0.1)
+        self.exposure_spin.setSuffix(" EV")
+        self.exposure_spin.setKeyboardTracking(False)
+        self.exposure_spin.setToolTip("Exposure in EV (type a value; arrow keys step 0.1)")
+        self.exposure_label = self.exposure_spin  # the number shown beside the slider
         self.diff_label = QLabel("")
         self.diff_label.setObjectName("diffMean")
         self.save_button = QToolButton()
@@ -377,8 +386,8 @@ class ViewportPanel(QWidget):
         reset.setToolTip("Reset the camera (or double-click the view)")
         for w in (self.mesh_combo, self.mode_combo, self.env_combo):
             bl.addWidget(w)
-        bl.addWidget(self.exposure)
-        bl.addWidget(self.exposure_label)
+        bl.addWidget(self.exposure, 1)
+        bl.addWidget(self.exposure_spin)
         bl.addWidget(self.diff_label)
         bl.addStretch(1)
         bl.addWidget(self.save_button)
@@ -408,6 +417,8 @@ class ViewportPanel(QWidget):
         self.mesh_combo.currentTextChanged.connect(self.view.set_mesh)
         self.mode_combo.currentTextChanged.connect(self._mode_changed)
         self.exposure.valueChanged.connect(self._exposure_changed)
+        self.exposure_spin.valueChanged.connect(
+            lambda ev: self.exposure.setValue(int(round(ev * 10))))
         self.env_combo.activated.connect(self._env_activated)
         reset.clicked.connect(lambda: self.view.renderer and (self.view.renderer.camera.reset(),
                                                               self.view.update()))
@@ -532,7 +543,9 @@ class ViewportPanel(QWidget):
 
     def _exposure_changed(self, tenths: int) -> None:
         ev = tenths / 10.0
-        self.exposure_label.setText(f"{ev:+.1f} EV")
+        self.exposure_spin.blockSignals(True)
+        self.exposure_spin.setValue(ev)
+        self.exposure_spin.blockSignals(False)
         self.view.set_exposure(ev)
 
     def _frame_drawn(self) -> None:

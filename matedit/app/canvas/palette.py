@@ -124,6 +124,7 @@ class NodePalette(QFrame):
         lay.addWidget(self.about)
         self.resize(300, 400)
         self._entries = catalogue()
+        self.out_of_place: frozenset[str] = frozenset()  # kinds ranked last in this document
         self._filter: Callable[[str], bool] | None = None
         self.search.textChanged.connect(self._refill)
         self.search.installEventFilter(self)
@@ -162,13 +163,18 @@ class NodePalette(QFrame):
     def _refill(self) -> None:
         query = self.search.text().strip()
         entries = [e for e in self._entries if self._filter is None or self._filter(e.kind)]
+        # Kinds that belong to the other kind of document go last (stable: rank kept).
+        entries.sort(key=lambda e: e.kind in self.out_of_place)
         self.list.clear()
         if query:
-            for e in search(query, entries):
+            found = search(query, entries)
+            found.sort(key=lambda e: e.kind in self.out_of_place)
+            for e in found:
                 self._add_entry(e, show_category=True)
         else:
             category = None
-            for e in entries:
+            order = {c: i for i, c in enumerate(dict.fromkeys(e.category for e in entries))}
+            for e in sorted(entries, key=lambda e: order[e.category]):
                 if e.category != category:
                     category = e.category
                     self._add_header(category)

@@ -302,6 +302,9 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
 
     def _show_palette(self, scene_pos: QPointF, accept, hint: str) -> None:
         self._palette_pos = QPointF(scene_pos)
+        self.node_palette.out_of_place = frozenset(
+            {"material_output"} if self.controller.document.is_function
+            else {"function_input", "function_output"})
         at = self.viewport().mapTo(self, self.mapFromScene(scene_pos))
         self.node_palette.popup(at, accept, hint)
 
@@ -499,8 +502,24 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
                 lambda kind: compatible_port(kind, a_type, anchor.is_output) is not None,
                 f"Connect to {anchor.node_id}.{anchor.name} ({a_type} {side})")
 
+    def insert_reroute(self, link: Link, scene_pos: QPointF) -> str:
+        """A reroute on `link` at `scene_pos`, as one undo step; its id ('' if refused)."""
+        node = self._new_node("reroute", scene_pos - QPointF(C.REROUTE_RADIUS,
+                                                             C.REROUTE_RADIUS), None)
+        if node is None or link not in self.controller.document.graph.links:
+            return ""
+        ok = self.controller.push_all(
+            [Disconnect(link), AddNode(node), Connect(Link(link.src, link.src_port, node.id,
+                                                           "value")),
+             Connect(Link(node.id, "value", link.dst, link.dst_port))], "insert reroute")
+        return node.id if ok else ""
+
     def mouseDoubleClickEvent(self, event) -> None:
         item = self.itemAt(event.position().toPoint())
+        if isinstance(item, WireItem):  # a reroute where the wire was double-clicked
+            self.insert_reroute(item.link, self.mapToScene(event.position().toPoint()))
+            event.accept()
+            return
         while item is not None and not isinstance(item, (NodeItem, CommentItem)):
             item = item.parentItem()
         if isinstance(item, NodeItem) and item.kind == "function_call":
@@ -520,9 +539,11 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         item = self.itemAt(pos)
         while item is not None and not isinstance(item, (NodeItem, CommentItem, WireItem)):
             item = item.parentItem()
+        wire = None
         if isinstance(item, WireItem):
             self._scene.clearSelection()
             self._scene.select_wire(item.link)
+            wire = item.link
         elif item is not None and not item.isSelected() and isinstance(
                 item, (NodeItem, CommentItem)):
             self._scene.clearSelection()
@@ -530,6 +551,9 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             item.setSelected(True)
         menu = QMenu(self)
         menu.addAction("Add node…\tTab", lambda: self.open_palette(sp))
+        if wire is not None:
+            menu.addAction("Insert reroute\tdouble-click",
+                           lambda: self.insert_reroute(wire, sp))
         if isinstance(item, NodeItem) and not self.controller.document.is_function:
             port = port_at(self._scene, sp, self._hit_radius(), want_output=True)
             name = port.name if port is not None and port.node_id == item.node_id else ""

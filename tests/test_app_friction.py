@@ -1,0 +1,131 @@
+"""What got in an artist's way (issue 18, "Friction"), through the real widgets."""
+
+from __future__ import annotations
+
+import pytest
+from PySide6.QtCore import QPoint, QPointF, Qt
+from test_app_support import app_env, make_window, settle  # noqa: F401 - fixture
+
+from matedit.resources import graphs_dir
+
+pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
+
+SAMPLE = graphs_dir() / "materials" / "rusty_painted_metal.json"
+
+
+def test_a_new_material_starts_with_an_output_and_the_palette_ranks_it_first(qtbot):
+    w = make_window(qtbot, SAMPLE)
+    assert w.actions.new()
+    kinds = [n.kind for n in w.controller.document.graph.nodes.values()]
+    assert kinds == ["material_output"] and not w.controller.dirty
+    pal = w.tabs.material.canvas.node_palette
+    w.tabs.material.canvas.open_palette(QPointF(0, 0))
+    pal.search.setText("output")
+    found = pal.visible_kinds()
+    assert found.index("material_output") < found.index("function_output")
+    pal.close_palette()
+    tab = w.tabs.open_function(graphs_dir() / "functions" / "rotate_uv.json")
+    tab.canvas.open_palette(QPointF(0, 0))
+    tab.canvas.node_palette.search.setText("output")
+    found = tab.canvas.node_palette.visible_kinds()
+    assert found.index("function_output") < found.index("material_output")  # in a function
+
+
+def test_file_open_on_a_function_opens_it_in_a_tab(qtbot):
+    w = make_window(qtbot, SAMPLE)
+    fn = graphs_dir() / "functions" / "rotate_uv.json"
+    w.actions.ask_open_path = lambda: str(fn)
+    assert w.actions.open_dialog()
+    assert w.tabs.active.is_function and w.tabs.active.controller.document.path == fn
+    assert w.controller.document.path == SAMPLE  # the material stays
+    assert not w.shown_errors
+
+
+def test_view_menu_shows_dock_check_states(qtbot):
+    w = make_window(qtbot, SAMPLE, show=True)
+    view_menu = next(a.menu() for a in w.menuBar().actions() if a.text() == "&View")
+    docks = {a.text(): a for a in view_menu.actions() if a.isCheckable()}
+    assert "Inspector" in docks and "Lights && Environment" in docks
+    for a in docks.values():
+        assert a.icon().isNull()  # an icon would be drawn instead of the check mark
+    assert docks["Inspector"].isChecked()
+    w.inspector_dock.close()
+    assert not docks["Inspector"].isChecked()
+
+
+def test_the_wheel_never_changes_an_unfocused_slider_it_scrolls_the_panel(qtbot):
+    from PySide6.QtGui import QWheelEvent
+    from PySide6.QtWidgets import QApplication
+
+    from matedit.app.fields import FloatField
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    w.inspector.show_node("stack")
+    qtbot.wait(10)
+    field = next(f for f in w.inspector._fields.values() if isinstance(f, FloatField))
+    bar = w.inspector.verticalScrollBar()
+    assert bar.maximum() > 0
+    before, scroll = field.slider.value(), bar.value()
+    for target in (field.slider, field.spin):
+        pos = QPointF(target.rect().center())
+        ev = QWheelEvent(pos, QPointF(target.mapToGlobal(pos.toPoint())), QPoint(0, 0),
+                         QPoint(0, -120), Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier,
+                         Qt.ScrollPhase.NoScrollPhase, False)
+        QApplication.sendEvent(target, ev)
+    assert field.slider.value() == before and field.value() == pytest.approx(
+        field._from_steps(before), abs=1e-3)
+    assert bar.value() > scroll  # the panel scrolled instead
+
+
+def test_the_inspector_keeps_its_scroll_position_across_edits(qtbot):
+    from matedit.graph.commands import SetSetting
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    w.inspector.show_node("stack")
+    qtbot.wait(10)
+    bar = w.inspector.verticalScrollBar()
+    assert bar.maximum() > 40
+    bar.setValue(40)
+    layers = w.controller.document.graph.nodes["stack"].settings["layers"]
+    renamed = [dict(e) for e in layers]
+    renamed[1]["name"] = "Old rust"
+    assert w.controller.push(SetSetting("stack", "layers", renamed))  # rebuilds the body
+    settle(qtbot, w, 20)
+    assert w.inspector._fields  # rebuilt
+    assert bar.value() == 40
+    w.inspector.show_node("mask_noise")  # another node starts at the top
+    assert bar.value() == 0
+
+
+def test_exposure_has_a_numeric_entry_and_steps_a_tenth_of_an_ev(qtbot):
+    w = make_window(qtbot, SAMPLE, show=True)
+    vp = w.viewport
+    vp.exposure_spin.setValue(1.5)
+    assert vp.view._exposure == pytest.approx(1.5) and vp.exposure.value() == 15
+    vp.exposure.setFocus()
+    qtbot.keyClick(vp.exposure, Qt.Key.Key_Right)
+    assert vp.view._exposure == pytest.approx(1.6)
+    assert vp.exposure_spin.value() == pytest.approx(1.6)
+    assert vp.exposure.width() >= 140
+
+
+def test_double_clicking_a_wire_inserts_a_reroute_as_one_step(qtbot):
+    w = make_window(qtbot, SAMPLE, show=True)
+    canvas = w.tabs.material.canvas
+    g = w.controller.document.graph
+    link = g.incoming("mask", "value")
+    wire = canvas.scene().wire_items[link]
+    canvas.centerOn(wire)
+    qtbot.wait(5)
+    path = wire.path()
+    mid = path.pointAtPercent(0.5)
+    steps = w.controller.undo_stack.count()
+    qtbot.mouseDClick(canvas.viewport(), Qt.MouseButton.LeftButton,
+                      pos=canvas.mapFromScene(wire.mapToScene(mid)))
+    settle(qtbot, w)
+    (reroute,) = [n for n in g.nodes.values() if n.kind == "reroute"]
+    assert g.incoming(reroute.id, "value").src == link.src
+    assert g.incoming("mask", "value").src == reroute.id
+    assert link not in g.links and w.controller.undo_stack.count() == steps + 1
+    w.controller.undo_stack.undo()
+    assert link in g.links and reroute.id not in g.nodes
