@@ -129,3 +129,91 @@ def test_double_clicking_a_wire_inserts_a_reroute_as_one_step(qtbot):
     assert link not in g.links and w.controller.undo_stack.count() == steps + 1
     w.controller.undo_stack.undo()
     assert link in g.links and reroute.id not in g.nodes
+
+
+def test_tab_opens_the_palette_when_the_pointer_is_over_the_canvas_wherever_focus_is(qtbot):
+    from PySide6.QtGui import QCursor
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    w.activateWindow()
+    canvas = w.tabs.material.canvas
+    w.inspector.show_node("mask_noise")
+    focus = w.viewport.mesh_combo
+    focus.setFocus()
+    qtbot.waitUntil(focus.hasFocus, timeout=3000)
+    QCursor.setPos(canvas.viewport().mapToGlobal(canvas.viewport().rect().center()))
+    qtbot.keyClick(focus, Qt.Key.Key_Tab)
+    assert canvas.node_palette.isVisible()
+    canvas.node_palette.close_palette()
+    QCursor.setPos(w.viewport.mapToGlobal(w.viewport.rect().center()))  # elsewhere: focus moves
+    focus.setFocus()
+    qtbot.keyClick(focus, Qt.Key.Key_Tab)
+    assert not canvas.node_palette.isVisible()
+
+
+def test_f2_renames_a_node_inline_as_one_undo_step(qtbot):
+    w = make_window(qtbot, SAMPLE, show=True)
+    canvas = w.tabs.material.canvas
+    canvas.select_nodes(["mask_noise"])
+    canvas.setFocus()
+    steps = w.controller.undo_stack.count()
+    qtbot.keyClick(canvas, Qt.Key.Key_F2)
+    edit = canvas._rename_edit
+    assert edit is not None and edit.isVisible() and edit.text() == "Value Noise"
+    edit.setText("Rust mask noise")
+    qtbot.keyClick(edit, Qt.Key.Key_Return)
+    assert w.controller.document.graph.nodes["mask_noise"].label == "Rust mask noise"
+    assert w.controller.undo_stack.count() == steps + 1
+    assert canvas.scene().node_items["mask_noise"].title == "Rust mask noise"
+
+
+def test_help_keyboard_reference_is_searchable(qtbot):
+    w = make_window(qtbot, SAMPLE)
+    ref = w.show_shortcuts()
+    assert len(ref.shown_rows()) > 20
+    ref.search.setText("reroute")
+    rows = ref.shown_rows()
+    assert rows and all("reroute" in " ".join(r).lower() for r in rows)
+    assert any(r[0] == "Double-click a wire" for r in rows)
+    help_menu = next(a.menu() for a in w.menuBar().actions() if a.text() == "&Help")
+    assert w.act_shortcuts in help_menu.actions() and w.act_about in help_menu.actions()
+
+
+def test_node_docs_open_from_f1_the_palette_and_the_inspector(qtbot):
+    from matedit.graph import nodes
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    canvas = w.tabs.material.canvas
+    canvas.select_nodes(["mask_noise"])
+    canvas.setFocus()
+    qtbot.keyClick(canvas, Qt.Key.Key_F1)
+    docs = w._docs
+    assert docs is not None and docs.isVisible() and docs.kind == "value_noise"
+    text = docs.browser.toPlainText()
+    d = nodes.REGISTRY["value_noise"]
+    assert d.description in text
+    for i in d.inputs:  # every port, with its range where it has one
+        assert i.name in text
+        if i.range:
+            assert f"{i.range[0]:g} … {i.range[1]:g}" in text
+    canvas.open_palette(QPointF(0, 0))
+    canvas.node_palette.search.setText("checker")
+    qtbot.keyClick(canvas.node_palette.search, Qt.Key.Key_F1)
+    assert w._docs.kind == "checker"
+    canvas.node_palette.close_palette()
+    w.inspector.show_node("stack")
+    w.inspector.docs_button.click()
+    assert w._docs.kind == "layer_stack"
+
+
+def test_about_names_the_versions_and_the_gl_renderer(qtbot):
+    from test_app_support import wait_for_renderer
+
+    from matedit.app.help import about_text
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    wait_for_renderer(qtbot, w)
+    gl = w.viewport.view.gl_renderer()
+    assert gl and "?" not in gl
+    text = about_text(gl)
+    assert gl in text and "PySide6" in text and "matedit" in text

@@ -45,6 +45,7 @@ class CanvasTabs(QWidget):
     functionSaved = Signal(object)  # Path
     previewRequested = Signal(str, str)  # a node's output to show in the viewport
     materialOpenRequested = Signal(str)  # a material file dropped on a canvas
+    docsRequested = Signal(str)  # a node kind's documentation (F1)
 
     def __init__(self, material: DocumentController, material_actions: DocumentActions,
                  undo_group: QUndoGroup, parent=None) -> None:
@@ -90,6 +91,7 @@ class CanvasTabs(QWidget):
         canvas.functionOpenRequested.connect(lambda p, t=tab: self.open_function(p, t))
         canvas.message.connect(self.message)
         canvas.materialOpenRequested.connect(self.materialOpenRequested)
+        canvas.docsRequested.connect(self.docsRequested)
         controller.undo_stack.cleanChanged.connect(self._clean_changed)
         actions.saved.connect(lambda p, t=tab: self._saved(t, p))
         self.tabs.addTab(canvas, icon("function" if controller.document.is_function

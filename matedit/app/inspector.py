@@ -57,6 +57,7 @@ class InspectorPanel(QScrollArea):
 
     message = Signal(str)
     functionOpenRequested = Signal(str)
+    docsRequested = Signal(str)  # a node kind's documentation
 
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
@@ -177,7 +178,13 @@ class InspectorPanel(QScrollArea):
         title.setObjectName("inspectorTitle")
         title.setToolTip("Node label (shown on the canvas)")
         title.editingFinished.connect(lambda: self._rename(title.text()))
-        lay.addWidget(title)
+        head = QHBoxLayout()
+        head.addWidget(title, 1)
+        self.docs_button = QPushButton("Docs")
+        self.docs_button.setToolTip("This node kind's documentation: ports, types, ranges (F1)")
+        self.docs_button.clicked.connect(lambda _=False, k=node.kind: self.docsRequested.emit(k))
+        head.addWidget(self.docs_button)
+        lay.addLayout(head)
         kind = QLabel(f"{d.title if d else node.kind}  ·  {d.category if d else '?'}  ·  "
                       f"id {node.id}")
         kind.setObjectName("inspectorKind")
@@ -306,9 +313,8 @@ class InspectorPanel(QScrollArea):
         edit.setToolTip(s.doc)
         edit.editingFinished.connect(lambda: edit.text() != ref and
                                      self._set_setting(s.name, edit.text().strip()))
-        browse = QPushButton("…")
-        browse.setFixedWidth(28)
-        browse.setToolTip("Choose a file")
+        browse = QPushButton("Browse…")
+        browse.setToolTip("Choose a material function file")
 
         def pick() -> None:
             path, _ = QFileDialog.getOpenFileName(self, "Choose a material function", "",

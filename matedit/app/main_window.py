@@ -9,9 +9,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence, QUndoGroup
+from PySide6.QtCore import QByteArray, QEvent, QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QCursor, QKeySequence, QUndoGroup
 from PySide6.QtWidgets import (
+    QApplication,
     QDockWidget,
     QLabel,
     QMainWindow,
@@ -29,6 +30,7 @@ from matedit.app.controller import DocumentController
 from matedit.app.diagnostics import DiagnosticsPanel, Problem
 from matedit.app.document_actions import DocumentActions, document_title, new_material
 from matedit.app.export_dialog import ExportDialog
+from matedit.app.help import NodeDocs, ShortcutReference, show_about
 from matedit.app.inspector import InspectorPanel
 from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
@@ -74,6 +76,9 @@ class MainWindow(QMainWindow):
         self._on_active(self.tabs.active)
         self._retitle()
         self.extra_windows: list[MainWindow] = []  # recovered materials opened at start-up
+        self._shortcuts: ShortcutReference | None = None
+        self._docs: NodeDocs | None = None
+        QApplication.instance().installEventFilter(self)
         self.actions.open_recovered_function = lambda e, doc: self.tabs.open_function(
             e.document, self.tabs.material, recovered=doc)
         self.actions.open_recovered_material = self._open_recovered_material
@@ -196,6 +201,11 @@ class MainWindow(QMainWindow):
             self.canvas_actions.append(self._action(text, lambda _=False, m=method:
                                                     self._canvas_call(m)))
         self.act_reset_layout = self._action("Reset &Layout", self.reset_layout)
+        self.act_shortcuts = self._action("&Keyboard Reference…", self.show_shortcuts,
+                                          "Ctrl+/", tip="Every shortcut, searchable")
+        self.act_node_docs = self._action("&Node Reference", self.show_selected_docs, None,
+                                          tip="Documentation of the selected node kind (F1)")
+        self.act_about = self._action("&About matedit", self.show_about)
 
     def _build_menus(self) -> None:
         mb = self.menuBar()
@@ -231,6 +241,12 @@ class MainWindow(QMainWindow):
             v.addAction(dock.toggleViewAction())
         v.addSeparator()
         v.addAction(self.act_reset_layout)
+        h = mb.addMenu("&Help")
+        for a in (self.act_shortcuts, self.act_node_docs, None, self.act_about):
+            if a is None:
+                h.addSeparator()
+            else:
+                h.addAction(a)
         tb = self.addToolBar("Main")
         tb.setObjectName("mainToolBar")
         tb.setMovable(False)
@@ -265,6 +281,8 @@ class MainWindow(QMainWindow):
         self.viewport.statusMessage.connect(self.status)
         self.viewport.environmentChanged.connect(lambda s: self.status(f"environment: {s}"))
         self.tabs.materialOpenRequested.connect(self.open_material)
+        self.tabs.docsRequested.connect(self.show_docs)
+        self.inspector.docsRequested.connect(self.show_docs)
         self.tabs.previewRequested.connect(
             lambda nid, port: self.compiler.set_preview(PreviewTarget(nid, port)))
         self.tabs.activeChanged.connect(self._on_active)
@@ -297,6 +315,45 @@ class MainWindow(QMainWindow):
         if not self.tabs.close_functions():
             return False
         return self.actions.open(path)
+
+    # --- help ------------------------------------------------------------------------------
+    def show_shortcuts(self) -> ShortcutReference:
+        if self._shortcuts is None:
+            self._shortcuts = ShortcutReference(self)
+        self._shortcuts.show()
+        self._shortcuts.raise_()
+        return self._shortcuts
+
+    def show_docs(self, kind: str) -> NodeDocs:
+        if self._docs is None:
+            self._docs = NodeDocs(kind, self)
+        self._docs.show_kind(kind)
+        self._docs.show()
+        self._docs.raise_()
+        return self._docs
+
+    def show_selected_docs(self) -> None:
+        ids = self.tabs.active.canvas.selected_ids()
+        node = self.tabs.active.controller.document.graph.nodes.get(ids[0]) if ids else None
+        self.show_docs(node.kind if node is not None else "material_output")
+
+    def show_about(self) -> None:
+        show_about(self, self.viewport.view.gl_renderer())
+
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
+        """Tab opens the palette whenever the pointer is over the active canvas, wherever
+        the keyboard focus is in this window."""
+        if event.type() == QEvent.Type.KeyPress and event.key() == Qt.Key.Key_Tab and \
+                event.modifiers() == Qt.KeyboardModifier.NoModifier and \
+                isinstance(obj, QWidget) and obj.window() is self:
+            canvas = self.tabs.active.canvas
+            vp = canvas.viewport()
+            inside = vp.rect().contains(vp.mapFromGlobal(QCursor.pos()))
+            if inside and canvas.isVisible() and not canvas.node_palette.isAncestorOf(obj) \
+                    and obj is not canvas.node_palette:
+                canvas.open_palette()
+                return True
+        return super().eventFilter(obj, event)
 
     def _open_recovered_material(self, entry, doc) -> None:
         """A second recovered material gets a window of its own."""

@@ -273,6 +273,16 @@ class ViewportWidget(QOpenGLWidget):
     def _set_environment_now(self, spec: str, progress) -> None:
         self.renderer.set_environment(spec, progress=progress)
 
+    def gl_renderer(self) -> str:
+        """The OpenGL renderer string ("" before GL is up)."""
+        if self.ctx is None:
+            return ""
+        try:
+            info = self.ctx.info
+            return f"{info.get('GL_RENDERER', '?')} ({info.get('GL_VERSION', '?')})"
+        except Exception:  # a context that cannot answer says nothing
+            return ""
+
     def read_hdr(self):
         """(H, W, 3) scene-linear radiance of the last frame (before exposure and display
         transform), or None without a renderer."""

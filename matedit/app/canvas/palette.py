@@ -91,6 +91,7 @@ class NodePalette(QFrame):
 
     chosen = Signal(str)
     cancelled = Signal()
+    docsRequested = Signal(str)  # F1 on an entry: that kind's documentation
 
     def __init__(self, parent: QWidget) -> None:
         super().__init__(parent)
@@ -240,5 +241,10 @@ class NodePalette(QFrame):
                 return True
             if key in (Qt.Key.Key_PageDown, Qt.Key.Key_PageUp):
                 self._step(8 if key == Qt.Key.Key_PageDown else -8)
+                return True
+            if key == Qt.Key.Key_F1:
+                item = self.list.currentItem()
+                if item is not None and item.data(KIND_ROLE):
+                    self.docsRequested.emit(item.data(KIND_ROLE))
                 return True
         return super().eventFilter(obj, event)

@@ -15,11 +15,12 @@ from __future__ import annotations
 import re
 
 from PySide6.QtCore import QEvent, QPoint, QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QImage, QKeySequence, QPainter, QPixmapCache, QTransform
+from PySide6.QtGui import QAction, QImage, QKeySequence, QPainter, QPixmapCache, QTransform
 from PySide6.QtWidgets import (
     QApplication,
     QGraphicsView,
     QInputDialog,
+    QLineEdit,
     QMenu,
     QWidget,
 )
@@ -37,7 +38,15 @@ from matedit.app.canvas.toast import Toast
 from matedit.app.canvas.wire_item import WireItem
 from matedit.app.controller import DocumentController
 from matedit.graph import nodes
-from matedit.graph.commands import AddNode, Command, Connect, Disconnect, PutComment, RemoveNode
+from matedit.graph.commands import (
+    AddNode,
+    Command,
+    Connect,
+    Disconnect,
+    PutComment,
+    RemoveNode,
+    SetLabel,
+)
 from matedit.graph.model import Comment, Link, MaterialDocument, Node
 from matedit.graph.types import PortType
 from matedit.graph.validate import check_connect
@@ -59,6 +68,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
     message = Signal(str)
     previewRequested = Signal(str, str)  # node id, output port: show it in the viewport
     materialOpenRequested = Signal(str)  # a material file dropped on the canvas
+    docsRequested = Signal(str)  # a node kind whose documentation to show (F1)
 
     def __init__(self, controller: DocumentController, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -91,6 +101,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self.node_palette = NodePalette(self)
         self.node_palette.chosen.connect(self._palette_chosen)
         self.node_palette.cancelled.connect(self._palette_cancelled)
+        self.node_palette.docsRequested.connect(self.docsRequested)
         self.toast = Toast(self.viewport())
         self.minimap = MiniMap(self)
 
@@ -103,6 +114,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self._palette_anchor: tuple[str, str, bool, str] | None = None
         self._selecting = False
         self._last_ids: list[str] = []
+        self._rename_edit: QLineEdit | None = None
 
         self._scene.selectionChanged.connect(self._selection_changed)
         self._scene.commentTextRequested.connect(self._edit_comment_text)
@@ -502,6 +514,52 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
                 lambda kind: compatible_port(kind, a_type, anchor.is_output) is not None,
                 f"Connect to {anchor.node_id}.{anchor.name} ({a_type} {side})")
 
+    def start_rename(self, node_id: str) -> QLineEdit | None:
+        """An editor over the node's title: Enter renames (one undo step), Esc cancels."""
+        item = self._scene.node_items.get(node_id)
+        node = self.controller.document.graph.nodes.get(node_id)
+        if item is None or node is None:
+            return None
+        if self._rename_edit is not None:
+            self._rename_edit.deleteLater()
+        top_left = self.mapFromScene(item.mapToScene(QPointF(0, 0)))
+        width = int(item.layout.width * self.zoom())
+        edit = QLineEdit(item.title, self.viewport())
+        edit.setObjectName("renameNode")
+        edit.setGeometry(top_left.x(), top_left.y(), max(width, 120),
+                         max(22, int(C.HEADER_HEIGHT * self.zoom())))
+        edit.selectAll()
+        done = {"ok": False}
+
+        def commit() -> None:
+            if done["ok"]:
+                return
+            done["ok"] = True
+            text = edit.text().strip()
+            d = nodes.REGISTRY.get(node.kind)
+            label = "" if d is not None and text == d.title else text
+            current = self.controller.document.graph.nodes.get(node_id)
+            if current is not None and label != current.label and text:
+                self.controller.push(SetLabel(node_id, label))
+            edit.deleteLater()
+            self._rename_edit = None
+            self.setFocus()
+
+        def cancel() -> None:
+            done["ok"] = True
+            edit.deleteLater()
+            self._rename_edit = None
+            self.setFocus()
+
+        edit.returnPressed.connect(commit)
+        edit.editingFinished.connect(commit)
+        edit.addAction(QAction(edit, shortcut=QKeySequence(Qt.Key.Key_Escape),
+                               triggered=cancel))
+        edit.show()
+        edit.setFocus()
+        self._rename_edit = edit
+        return edit
+
     def insert_reroute(self, link: Link, scene_pos: QPointF) -> str:
         """A reroute on `link` at `scene_pos`, as one undo step; its id ('' if refused)."""
         node = self._new_node("reroute", scene_pos - QPointF(C.REROUTE_RADIUS,
@@ -522,6 +580,12 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             return
         while item is not None and not isinstance(item, (NodeItem, CommentItem)):
             item = item.parentItem()
+        if isinstance(item, NodeItem) and item.kind != "function_call" and \
+                item.mapFromScene(self.mapToScene(event.position().toPoint())).y() \
+                < C.HEADER_HEIGHT:  # double-click on the title: rename
+            self.start_rename(item.node_id)
+            event.accept()
+            return
         if isinstance(item, NodeItem) and item.kind == "function_call":
             node = self.controller.document.graph.nodes.get(item.node_id)
             ref = node.settings.get("function") if node else None
@@ -589,7 +653,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         return mods == Qt.KeyboardModifier.NoModifier and key in (
             Qt.Key.Key_Tab, Qt.Key.Key_Delete, Qt.Key.Key_Backspace, Qt.Key.Key_F,
             Qt.Key.Key_A, Qt.Key.Key_Home, Qt.Key.Key_C, Qt.Key.Key_M, Qt.Key.Key_Space,
-            Qt.Key.Key_Escape)
+            Qt.Key.Key_Escape, Qt.Key.Key_F1, Qt.Key.Key_F2)
 
     def event(self, event) -> bool:
         t = event.type()
@@ -624,6 +688,15 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             self.frame_all()
         elif plain and key == Qt.Key.Key_C:
             self.comment_selection()
+        elif plain and key == Qt.Key.Key_F2:
+            ids = self.selected_ids()
+            if len(ids) == 1:
+                self.start_rename(ids[0])
+        elif plain and key == Qt.Key.Key_F1:
+            ids = self.selected_ids()
+            node = self.controller.document.graph.nodes.get(ids[0]) if ids else None
+            if node is not None:
+                self.docsRequested.emit(node.kind)
         elif plain and key == Qt.Key.Key_M:
             self.minimap.setVisible(not self.minimap.isVisible())
         elif plain and key == Qt.Key.Key_Space:
