@@ -132,8 +132,9 @@ class MainWindow(QMainWindow):
         lights_scroll.setWidget(lights_host)
         self.lights_dock = self._dock("Lights & Environment", "lightsDock", lights_scroll, R,
                                       "light")
-        # The title bar shows the text as it is; the View menu's action reads '&' as a mnemonic.
-        self.lights_dock.toggleViewAction().setText("Lights && Environment")
+        for sig in (self.lights_dock.topLevelChanged, self.lights_dock.dockLocationChanged,
+                    self.lights_dock.visibilityChanged):
+            sig.connect(lambda *_: QTimer.singleShot(0, self, self._retitle_lights))
         self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
                                            B, "warning")
         self.code_dock = self._dock("GLSL", "codeDock", self.code, B)
@@ -145,6 +146,7 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(self.diagnostics_dock, self.code_dock)
         self.tabifyDockWidget(self.code_dock, self.history_dock)
         self.diagnostics_dock.raise_()
+        self._retitle_lights()
         self.resizeDocks([self.library_dock, self.viewport_dock], [270, 430],
                          Qt.Orientation.Horizontal)
         self.resizeDocks([self.viewport_dock, self.inspector_dock], [400, 420],
@@ -152,6 +154,14 @@ class MainWindow(QMainWindow):
         self.resizeDocks([self.library_dock, self.layers_dock], [330, 420],
                          Qt.Orientation.Vertical)
         self.resizeDocks([self.diagnostics_dock], [170], Qt.Orientation.Vertical)
+
+    def _retitle_lights(self) -> None:
+        """'&' shown as itself everywhere: a dock's title bar draws its title as it is, but
+        the tab of tabified docks and the View menu read '&' as a mnemonic marker."""
+        d = self.lights_dock
+        tabbed = not d.isFloating() and bool(self.tabifiedDockWidgets(d))
+        d.setWindowTitle("Lights && Environment" if tabbed else "Lights & Environment")
+        d.toggleViewAction().setText("Lights && Environment")
 
     def _action(self, text: str, slot, shortcut=None, icon_name: str = "",
                 tip: str = "") -> QAction:
