@@ -217,3 +217,72 @@ def test_about_names_the_versions_and_the_gl_renderer(qtbot):
     assert gl and "?" not in gl
     text = about_text(gl)
     assert gl in text and "PySide6" in text and "matedit" in text
+
+
+def test_snap_to_grid_lands_moved_nodes_on_the_grid(qtbot):
+    from matedit.app.canvas import constants as C
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    assert not w.act_snap.isChecked()
+    w.act_snap.trigger()
+    canvas = w.tabs.material.canvas
+    canvas.select_nodes(["mask_noise"])
+    item = canvas.scene().node_items["mask_noise"]
+    item.setPos(item.pos() + QPointF(13.0, 27.0))  # what a drag does
+    canvas.scene().commit_moves()
+    x, y = w.controller.document.graph.nodes["mask_noise"].position
+    assert x % C.GRID_MINOR == 0 and y % C.GRID_MINOR == 0
+    assert (item.pos().x(), item.pos().y()) == (x, y)
+
+
+def test_viewport_view_light_rig_snap_and_export_targets_are_remembered(qtbot):
+    from matedit.app.export_dialog import ExportDialog
+
+    w = make_window(qtbot, SAMPLE)
+    w.viewport.mesh_combo.setCurrentText("cube")
+    w.viewport.mode_combo.setCurrentText("Reference")
+    w.viewport.exposure_spin.setValue(-1.3)
+    rig = w.lights.lights[:1] if w.lights.lights else []
+    from matedit.shading.lights import Light
+
+    rig = [Light(kind="point", position=(1.0, 2.0, 3.0), intensity=7.0)]
+    w.lights.set_lights(rig, emit=True)
+    w.act_snap.setChecked(True)
+    w.save_layout()
+    dlg = ExportDialog(w.controller.document, w.controller.resolver, w)
+    dlg.boxes["glsl450"].setChecked(True)
+    dlg.close()
+
+    w2 = make_window(qtbot, SAMPLE)
+    w2.restore_layout()
+    settle(qtbot, w2, 20)
+    assert w2.viewport.mesh_combo.currentText() == "cube"
+    assert w2.viewport.mode_combo.currentText() == "Reference"
+    assert w2.viewport.view._exposure == pytest.approx(-1.3)
+    assert w2.lights.lights == rig
+    assert w2.act_snap.isChecked()
+    dlg2 = ExportDialog(w2.controller.document, w2.controller.resolver, w2)
+    assert set(dlg2.targets()) == {"glsl330", "glsl450"}
+    dlg2.close()
+
+
+def test_reference_mode_shows_its_progress_and_the_label_never_shifts_the_bar(qtbot):
+    from test_app_support import wait_for_renderer
+    from test_app_viewport import frame
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    r = wait_for_renderer(qtbot, w)
+    bar_x = w.viewport.save_button.x()
+    r.reference_frames = 4  # converge fast: the count is what is checked
+    w.viewport.mode_combo.setCurrentText("Reference")
+    frame(qtbot, w.viewport.view)
+    text = w.viewport.diff_label.text()
+    assert "samples" in text
+    qtbot.waitUntil(lambda: r.converged, timeout=20000)
+    frame(qtbot, w.viewport.view)
+    assert w.viewport.diff_label.text() == f"{4 * r.reference_samples} samples"
+    w.viewport.mode_combo.setCurrentText("Difference")
+    qtbot.waitUntil(lambda: r.converged, timeout=20000)
+    frame(qtbot, w.viewport.view)
+    assert "mean |Δ|" in w.viewport.diff_label.text()
+    assert w.viewport.save_button.x() == bar_x  # nothing moved along the bar

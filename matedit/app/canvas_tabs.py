@@ -68,6 +68,7 @@ class CanvasTabs(QWidget):
         self.tabs.currentChanged.connect(self._current_changed)
         lay.addWidget(self.tabs, 1)
         self._tabs: list[CanvasTab] = []
+        self.snap_to_grid = False
         self.material = self._add(material, material_actions, None)
         bar = self.tabs.tabBar()
         bar.setTabButton(0, bar.ButtonPosition.RightSide, None)
@@ -79,6 +80,7 @@ class CanvasTabs(QWidget):
     def _add(self, controller: DocumentController, actions: DocumentActions,
              parent: CanvasTab | None) -> CanvasTab:
         canvas = NodeCanvasView(controller, self)
+        canvas.scene().snap_to_grid = self.snap_to_grid
         tab = CanvasTab(controller, canvas, actions, parent)
         if not controller.document.is_function:
             tab.previews = NodePreviews(controller, canvas, self)
@@ -99,6 +101,11 @@ class CanvasTabs(QWidget):
         self._retitle(tab)
         QTimer.singleShot(0, canvas, canvas.frame_all)
         return tab
+
+    def set_snap_to_grid(self, on: bool) -> None:
+        self.snap_to_grid = bool(on)
+        for tab in self._tabs:
+            tab.canvas.scene().snap_to_grid = self.snap_to_grid
 
     def all_tabs(self) -> list[CanvasTab]:
         return list(self._tabs)

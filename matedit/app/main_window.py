@@ -7,6 +7,8 @@ are kept in QSettings and restored at the next start.
 
 from __future__ import annotations
 
+import json
+from dataclasses import asdict
 from pathlib import Path
 
 from PySide6.QtCore import QByteArray, QEvent, QSettings, Qt, QTimer
@@ -39,9 +41,11 @@ from matedit.app.node_preview import PreviewTarget
 from matedit.app.theme import icon
 from matedit.app.viewport import EnvironmentPanel, ViewportPanel
 from matedit.resources import graphs_dir
+from matedit.shading.lights import Light
 
 SAMPLE = "materials/rusty_painted_metal.json"
 GEOMETRY_KEY, STATE_KEY = "window/geometry", "window/state"
+VIEW_KEY, LIGHTS_KEY, SNAP_KEY = "viewport/state", "viewport/lights", "canvas/snap"
 STATE_VERSION = 1
 
 
@@ -211,6 +215,9 @@ class MainWindow(QMainWindow):
             self.canvas_actions.append(self._action(text, lambda _=False, m=method:
                                                     self._canvas_call(m)))
         self.act_reset_layout = self._action("Reset &Layout", self.reset_layout)
+        self.act_snap = self._action("&Snap to Grid", self.tabs.set_snap_to_grid, None,
+                                     tip="Moved nodes land on the canvas grid")
+        self.act_snap.setCheckable(True)
         self.act_shortcuts = self._action("&Keyboard Reference…", self.show_shortcuts,
                                           "Ctrl+/", tip="Every shortcut, searchable")
         self.act_node_docs = self._action("&Node Reference", self.show_selected_docs, None,
@@ -249,6 +256,7 @@ class MainWindow(QMainWindow):
                      self.library_dock, self.lights_dock, self.code_dock,
                      self.diagnostics_dock, self.history_dock):
             v.addAction(dock.toggleViewAction())
+        v.addAction(self.act_snap)
         v.addSeparator()
         v.addAction(self.act_reset_layout)
         h = mb.addMenu("&Help")
@@ -500,7 +508,24 @@ class MainWindow(QMainWindow):
 
     # --- layout ----------------------------------------------------------------------------
     def restore_layout(self) -> None:
+        """Window geometry, docks, the viewport's view, the light rig and grid snapping."""
         s = QSettings()
+        self.act_snap.setChecked(s.value(SNAP_KEY, False, type=bool))
+        try:
+            view = json.loads(str(s.value(VIEW_KEY, "") or "{}"))
+            rig = json.loads(str(s.value(LIGHTS_KEY, "") or "null"))
+        except ValueError:
+            view, rig = {}, None
+        if isinstance(view, dict) and view:
+            QTimer.singleShot(0, self, lambda: self.viewport.restore_view_state(view))
+        if isinstance(rig, list):
+            try:
+                lights = [Light(**{k: tuple(v) if isinstance(v, list) else v
+                                   for k, v in d.items()}) for d in rig]
+            except TypeError:
+                lights = None
+            if lights is not None:
+                self.lights.set_lights(lights, emit=True)
         geo = s.value(GEOMETRY_KEY)
         state = s.value(STATE_KEY)
         if isinstance(geo, QByteArray) and not geo.isEmpty():
@@ -510,6 +535,10 @@ class MainWindow(QMainWindow):
 
     def save_layout(self) -> None:
         s = QSettings()
+        s.setValue(SNAP_KEY, self.act_snap.isChecked())
+        s.setValue(VIEW_KEY, json.dumps(self.viewport.view_state()))
+        if self.lights.lights:
+            s.setValue(LIGHTS_KEY, json.dumps([asdict(light) for light in self.lights.lights]))
         s.setValue(GEOMETRY_KEY, self.saveGeometry())
         s.setValue(STATE_KEY, self.saveState(STATE_VERSION))
 

@@ -387,6 +387,11 @@ class ViewportPanel(QWidget):
         self.exposure_label = self.exposure_spin  # the number shown beside the slider
         self.diff_label = QLabel("")
         self.diff_label.setObjectName("diffMean")
+        # Room for the longest text it shows, so that its appearing shifts nothing.
+        self.diff_label.setFixedWidth(self.diff_label.fontMetrics().horizontalAdvance(
+            "2048/2048 samples · mean |Δ| 0.0000") + 8)
+        self.diff_label.setToolTip("Reference and difference modes: samples a pixel so far, "
+                                   "and the mean difference from the split-sum image")
         self.save_button = QToolButton()
         self.save_button.setIcon(icon("save"))
         self.save_button.setToolTip("Save the viewport image (PNG as shown, or linear EXR)")
@@ -560,10 +565,36 @@ class ViewportPanel(QWidget):
 
     def _frame_drawn(self) -> None:
         r = self.view.renderer
-        if r is not None and getattr(r, "mode", "") == "difference":
-            mean = getattr(r, "difference_mean", None)
+        if r is None or r.mode == "splitsum":
+            return
+        total = r.reference_frames * r.reference_samples
+        done = min(r.accumulated_frames, r.reference_frames) * r.reference_samples
+        text = f"{done}/{total} samples" if not r.converged else f"{total} samples"
+        if r.mode == "difference" and r.converged:
+            mean = r.difference_mean
             if mean is not None:
-                self.diff_label.setText(f"mean |Δ| {float(mean):.4f}")
+                text += f" · mean |Δ| {float(mean):.4f}"
+        self.diff_label.setText(text)
+
+    def view_state(self) -> dict:
+        """Mesh, mode, exposure and environment, as remembered across restarts."""
+        return {"mesh": self.mesh_combo.currentText(), "mode": self.mode_combo.currentText(),
+                "exposure": self.exposure.value() / 10.0,
+                "environment": self.view._environment}
+
+    def restore_view_state(self, state: dict) -> None:
+        mesh, mode = state.get("mesh"), state.get("mode")
+        if isinstance(mesh, str) and mesh in MESHES:
+            self.mesh_combo.setCurrentText(mesh)
+        if isinstance(mode, str) and mode in MODES:
+            self.mode_combo.setCurrentText(mode)
+        ev = state.get("exposure")
+        if isinstance(ev, (int, float)):
+            self.exposure.setValue(int(round(float(ev) * 10)))
+        env = state.get("environment")
+        if isinstance(env, str) and env and env != self.view._environment and (
+                env in ENVIRONMENTS.values() or Path(env).is_file()):
+            self.choose_environment(env)
 
     def set_preview(self, preview: dict) -> None:
         """Mesh and environment stored with a document."""
