@@ -286,3 +286,27 @@ def test_reference_mode_shows_its_progress_and_the_label_never_shifts_the_bar(qt
     frame(qtbot, w.viewport.view)
     assert "mean |Δ|" in w.viewport.diff_label.text()
     assert w.viewport.save_button.x() == bar_x  # nothing moved along the bar
+
+
+def test_the_colour_picker_is_not_modal_and_edits_live_as_one_undo_step(qtbot):
+    from PySide6.QtGui import QColor
+
+    from matedit.app.fields import ColorField
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    w.inspector.show_node("stack")
+    field = w.inspector._fields[("value", "paint_color")]
+    assert isinstance(field, ColorField)
+    field.intensity.setValue(3.0)  # HDR through the intensity
+    steps = w.controller.undo_stack.count()
+    dlg = field.pick()
+    assert dlg is not None and dlg.isVisible() and not dlg.isModal()
+    node = w.controller.document.graph.nodes["stack"]
+    for c in (QColor(255, 0, 0), QColor(0, 255, 0)):  # what dragging in the picker does
+        dlg.setCurrentColor(c)
+        assert node.values["paint_color"] == pytest.approx(
+            [0.0, 3.0, 0.0] if c.green() else [3.0, 0.0, 0.0])
+    assert w.controller.undo_stack.count() == steps + 1  # the whole pick: one step
+    dlg.accept()
+    w.controller.undo_stack.undo()
+    assert node.values["paint_color"][1] != pytest.approx(3.0)

@@ -233,7 +233,8 @@ class ColorField(QWidget):
         lay.addWidget(self.intensity)
         self._base: list[float] = []  # the first value is split afresh
         self.set_value(value)
-        self.dialog_factory = QColorDialog.getColor  # tests replace it
+        self.dialog_factory = QColorDialog.getColor  # replaced: a modal dialog (tests)
+        self.live_dialog: QColorDialog | None = None
 
     def value(self) -> list[float]:
         k = float(self.intensity.value())
@@ -268,8 +269,13 @@ class ColorField(QWidget):
         v = self.value()
         self.swatch.setToolTip("linear RGB " + ", ".join(f"{c:.3f}" for c in v))
 
-    def pick(self) -> None:
+    def pick(self) -> QColorDialog | None:
+        """A colour picker that stays open beside the canvas and edits live (one undo step
+        for the whole pick); the intensity field beside it makes the colour HDR. A replaced
+        `dialog_factory` (the stock modal dialog) is the fallback."""
         r, g, b = (int(round(linear_to_srgb(c) * 255)) for c in self._base)
+        if self.dialog_factory is QColorDialog.getColor:
+            return self._pick_live(QColor(r, g, b))
         chosen = self.dialog_factory(QColor(r, g, b), self, "Colour")
         if chosen is None or not chosen.isValid():
             return
@@ -277,6 +283,35 @@ class ColorField(QWidget):
                       (chosen.redF(), chosen.greenF(), chosen.blueF())]
         self._paint()
         self.edited.emit(self.value(), None)
+
+    def _pick_live(self, start: QColor) -> QColorDialog:
+        if self.live_dialog is not None:
+            self.live_dialog.raise_()
+            return self.live_dialog
+        dlg = QColorDialog(start, self)
+        dlg.setWindowTitle("Colour (× intensity for HDR)")
+        dlg.setModal(False)
+        merge = new_merge_id()
+        before = self.value()
+
+        def changed(c: QColor) -> None:
+            if not c.isValid():
+                return
+            self._base = [round(srgb_to_linear(x), 6) for x in (c.redF(), c.greenF(),
+                                                                 c.blueF())]
+            self._paint()
+            self.edited.emit(self.value(), merge)
+
+        def cancelled() -> None:  # back to the colour before the pick, in the same step
+            self.set_value(before)
+            self.edited.emit(self.value(), merge)
+
+        dlg.currentColorChanged.connect(changed)
+        dlg.rejected.connect(cancelled)
+        dlg.finished.connect(lambda _r: setattr(self, "live_dialog", None))
+        dlg.show()
+        self.live_dialog = dlg
+        return dlg
 
     def _intensity_typed(self, _v: float) -> None:
         self._paint()
