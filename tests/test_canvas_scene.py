@@ -256,32 +256,3 @@ def test_disconnect_event_removes_only_that_wire(view):
     assert len(view.scene().wire_items) == 3
     assert_mirrors(view)
 
-
-def test_zoomed_out_nodes_draw_a_larger_title_and_no_port_labels(view):
-    """Below the text level of detail a node still shows its title, drawn larger (it used to
-    draw none): count bright (text) pixels with and without a title at zoom 0.25."""
-    from PySide6.QtGui import QImage, QPainter
-    from PySide6.QtWidgets import QStyleOptionGraphicsItem
-
-    from matedit.app.canvas import constants as C
-
-    nid = next(iter(view.scene().node_items))
-    item = view.scene().node_items[nid]
-
-    def bright_pixels(title: str, zoom: float) -> int:
-        item.title = title
-        img = QImage(400, 300, QImage.Format.Format_RGB32)
-        img.fill(0)
-        p = QPainter(img)
-        p.scale(zoom, zoom)
-        item.paint(p, QStyleOptionGraphicsItem())
-        p.end()
-        import numpy as np
-
-        a = np.frombuffer(img.constBits(), np.uint8, img.sizeInBytes()).reshape(300, 400, 4)
-        return int((a[..., :3].min(axis=2) > 120).sum())
-
-    title = item.title or "Node"
-    zoom = C.LOD_TEXT * 0.6
-    assert bright_pixels(title, zoom) > bright_pixels("", zoom) + 20
-    item.title = title

@@ -29,7 +29,7 @@ from matedit.app.canvas_tabs import CanvasTab, CanvasTabs
 from matedit.app.code_view import CodeView
 from matedit.app.compile_service import MaterialCompiler
 from matedit.app.controller import DocumentController
-from matedit.app.diagnostics import DiagnosticsPanel, Problem
+from matedit.app.diagnostics import DiagnosticsPanel
 from matedit.app.document_actions import DocumentActions, document_title, new_material
 from matedit.app.export_dialog import ExportDialog
 from matedit.app.help import NodeDocs, ShortcutReference, show_about
@@ -38,6 +38,7 @@ from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
 from matedit.app.node_preview import PreviewTarget
+from matedit.app.problems import ProblemsModel
 from matedit.app.theme import icon
 from matedit.app.viewport import EnvironmentPanel, ViewportPanel
 from matedit.resources import graphs_dir
@@ -64,11 +65,11 @@ class MainWindow(QMainWindow):
         self.actions = DocumentActions(self, self.controller)
         self.compiler = MaterialCompiler(self.controller, self)
         self.undo_group = QUndoGroup(self)
-        self._problems = {"compile": [], "gl": []}
 
         self.tabs = CanvasTabs(self.controller, self.actions, self.undo_group, self)
         self.setCentralWidget(self.tabs)
         self._build_docks()
+        self.problems = ProblemsModel(self.compiler, self.viewport.view, self)
         self._build_actions()
         self._build_menus()
         self._build_status()
@@ -292,10 +293,7 @@ class MainWindow(QMainWindow):
         self.actions.opened.connect(lambda _p: self._retitle())
         self.actions.saved.connect(lambda p: self.status(f"saved {p}"))
         self.actions.message.connect(self.status)
-        self.compiler.compiled.connect(self._compiled)
-        self.compiler.failed.connect(self._compile_failed)
-        self.viewport.view.glErrors.connect(self._gl_errors)
-        self.viewport.view.materialApplied.connect(self._material_applied)
+        self.problems.changed.connect(self._refresh_problems)
         self.viewport.statusMessage.connect(self.status)
         self.viewport.environmentChanged.connect(lambda s: self.status(f"environment: {s}"))
         self.tabs.materialOpenRequested.connect(self.open_material)
@@ -453,54 +451,18 @@ class MainWindow(QMainWindow):
         fn = getattr(self.tabs.active.canvas, method, None)
         return fn() if fn is not None else None
 
-    # --- compile results and problems ------------------------------------------------------
-    def _compiled(self, cm) -> None:
-        self._problems["compile"] = []
-        self.compile_label.setText(f"compiled in {self.compiler.last_compile_ms:.0f} ms")
-        self._refresh_problems()
-
-    def _compile_failed(self, diagnostics) -> None:
-        self._problems["compile"] = [
-            Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "compiler")
-            for d in diagnostics]
-        self.compile_label.setText("does not compile: the viewport shows the last good "
-                                   "material")
-        self._refresh_problems()
-
-    def _gl_errors(self, errors) -> None:
-        self._problems["gl"] = [Problem("error", str(msg), nid or "", "", "GL")
-                                for nid, msg in errors]
-        self.compile_label.setText("GLSL failed to build: the viewport keeps the last good "
-                                   "program")
-        self._refresh_problems()
-
-    def _material_applied(self, ok: bool) -> None:
-        if ok:
-            self._problems["gl"] = []
-            self._refresh_problems()
-
+    # --- problems --------------------------------------------------------------------------
     def _refresh_problems(self) -> None:
         tab = self.tabs.active
-        problems: list[Problem] = []
-        a = tab.controller.analysis
-        if a is not None:
-            problems += [Problem(d.severity.value, d.message, d.node_id or "", d.port or "",
-                                 "graph") for d in a.diagnostics]
-        if tab is self.tabs.material:
-            problems += self._problems["compile"] + self._problems["gl"]
-        self.diagnostics.set_problems(problems)
-        errors = self.diagnostics.errors_by_node()
-        tab.canvas.set_node_errors(errors)
-        if tab is not self.tabs.material:
-            m = self.tabs.material
-            merr: dict[str, str] = {}
-            for p in self._problems["compile"] + self._problems["gl"]:
-                if p.node_id and p.severity == "error":
-                    merr[p.node_id] = p.message
-            m.canvas.set_node_errors(merr)
+        m = self.tabs.material
+        self.compile_label.setText(self.problems.status)
+        self.diagnostics.set_problems(self.problems.for_tab(tab.controller.analysis,
+                                                            tab is m))
+        tab.canvas.set_node_errors(self.diagnostics.errors_by_node())
+        if tab is not m:
+            m.canvas.set_node_errors(self.problems.material_errors())
         n = sum(1 for p in self.diagnostics.problems if p.severity == "error")  # the rows
-        title = "Diagnostics" + (f" ({n})" if n else "")
-        self.diagnostics_dock.setWindowTitle(title)
+        self.diagnostics_dock.setWindowTitle("Diagnostics" + (f" ({n})" if n else ""))
         self._retitle()
 
     def status(self, text: str) -> None:

@@ -34,7 +34,11 @@ RECOVER, DISCARD, KEEP = "recover", "discard", "keep"
 
 
 def recovery_dir() -> Path:
-    """The folder of recovery files (the one place that says where it is)."""
+    """The folder of recovery files (the one place that says where it is);
+    `MATEDIT_RECOVERY_DIR` overrides it (tests, several editors side by side)."""
+    override = os.environ.get("MATEDIT_RECOVERY_DIR")
+    if override:
+        return Path(override)
     base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
     return Path(base or Path.home() / ".matedit") / "recovery"
 

@@ -325,16 +325,7 @@ class NodeItem(QGraphicsRectItem):
         painter.setBrush(Qt.BrushStyle.NoBrush)
         painter.drawPath(body)
         if lod < C.LOD_TEXT:
-            # Zoomed out: no port labels, and the title drawn larger across the body, so
-            # that it stays readable on screen (its size grows as the zoom shrinks).
             self._paint_ports(painter, labels=False)
-            if self.title and lod > 0.04:
-                font = C.title_font()
-                font.setPixelSize(round(font.pixelSize() * min(C.LOD_TEXT / lod, 4.0)))
-                painter.setFont(font)
-                painter.setPen(C.NODE_TEXT)
-                painter.drawText(rect.adjusted(4, 2, -4, -2), Qt.AlignmentFlag.AlignCenter
-                                 | Qt.TextFlag.TextWordWrap, self.title)
             return
         # Title, elided when the node is at its widest.
         painter.setFont(C.title_font())
