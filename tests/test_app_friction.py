@@ -310,3 +310,35 @@ def test_the_colour_picker_is_not_modal_and_edits_live_as_one_undo_step(qtbot):
     dlg.accept()
     w.controller.undo_stack.undo()
     assert node.values["paint_color"][1] != pytest.approx(3.0)
+
+
+def test_a_document_saves_its_preview_with_a_user_hdr_relative_to_it(qtbot, tmp_path,
+                                                                       monkeypatch):
+    import json
+
+    from matedit.io.images import write_image
+
+    (tmp_path / "env").mkdir()
+    (tmp_path / "mat").mkdir()
+    hdr = tmp_path / "env" / "sky.exr"
+    write_image(hdr, np_ones())
+    w = make_window(qtbot, SAMPLE)
+    w.viewport.mesh_combo.setCurrentText("cylinder")
+    w.viewport.view._environment = str(hdr)  # what choosing it did (the bake is skipped)
+    w.actions.ask_save_path = lambda _s: str(tmp_path / "mat" / "m.json")
+    assert w.actions.save_as()
+    saved = json.loads((tmp_path / "mat" / "m.json").read_text())
+    assert saved["preview"] == {"mesh": "cylinder", "environment": "../env/sky.exr"}
+
+    w2 = make_window(qtbot)
+    chosen = []
+    monkeypatch.setattr(w2.viewport, "choose_environment", chosen.append)
+    assert w2.actions.open(tmp_path / "mat" / "m.json")
+    assert w2.viewport.mesh_combo.currentText() == "cylinder"
+    assert chosen == [str(hdr.resolve())]
+
+
+def np_ones():
+    import numpy as np
+
+    return np.ones((8, 16, 3), np.float32)

@@ -106,6 +106,8 @@ class DocumentActions(QObject):
         self.open_recovered_material: Callable[[RecoveryEntry, MaterialDocument], None] | \
             None = None
         self.open_function: Callable[[Path], None] | None = None  # File > Open on a function
+        # The preview settings saved with a material, for the file it is saved as.
+        self.preview_settings: Callable[[Path], dict] | None = None
         self.ask_open_path: Callable[[], str] = self._ask_open_path
         self.ask_save_path: Callable[[str], str] = self._ask_save_path
         self.show_error: Callable[[str, str], None] = self._show_error
@@ -293,6 +295,8 @@ class DocumentActions(QObject):
         try:
             if old_path is None:
                 relativise_references(self.document, path)
+            if self.preview_settings is not None:  # the viewport's mesh and environment
+                self.document.preview.update(self.preview_settings(path))
             save(self.document, path)
         except (OSError, ValueError) as exc:
             self.show_error("Cannot save", f"{path} could not be saved:\n{exc}")

@@ -88,6 +88,7 @@ class MainWindow(QMainWindow):
             e.document, self.tabs.material, recovered=doc)
         self.actions.open_recovered_material = self._open_recovered_material
         self.actions.open_function = lambda p: self.tabs.open_function(p, self.tabs.material)
+        self.actions.preview_settings = self.viewport.document_preview
         if start:
             self.actions.start(path, sample_path() if sample else None)
             self.compiler.recompile()
@@ -396,7 +397,8 @@ class MainWindow(QMainWindow):
 
     def _document_replaced(self) -> None:
         self._retitle()
-        self.viewport.set_preview(self.controller.document.preview)
+        self.viewport.set_preview(self.controller.document.preview,
+                                  self.controller.document.path)
         self.inspector.show_node(None)
 
     def _clean_changed(self, _clean: bool) -> None:

@@ -596,14 +596,37 @@ class ViewportPanel(QWidget):
                 env in ENVIRONMENTS.values() or Path(env).is_file()):
             self.choose_environment(env)
 
-    def set_preview(self, preview: dict) -> None:
-        """Mesh and environment stored with a document."""
+    def document_preview(self, saved_as: Path) -> dict:
+        """The mesh and environment to store in a document saved as `saved_as`: a user HDR
+        as a path relative to the document, like every reference it holds."""
+        import os
+
+        env = self.view._environment
+        if env not in ENVIRONMENTS.values():
+            try:
+                env = Path(os.path.relpath(Path(env).resolve(),
+                                           Path(saved_as).resolve().parent)).as_posix()
+            except ValueError:  # another drive
+                env = Path(env).resolve().as_posix()
+        return {"mesh": self.mesh_combo.currentText(), "environment": env}
+
+    def set_preview(self, preview: dict, doc_path: Path | None = None) -> None:
+        """Mesh and environment stored with a document (a file relative to `doc_path`)."""
         mesh = preview.get("mesh")
         if isinstance(mesh, str) and mesh in MESHES:
             self.mesh_combo.setCurrentText(mesh)
         env = preview.get("environment")
-        if isinstance(env, str) and env in ENVIRONMENTS.values() and \
-                env != self.view._environment:
+        if not isinstance(env, str) or not env:
+            return
+        if env not in ENVIRONMENTS.values():
+            p = Path(env)
+            if not p.is_absolute() and doc_path is not None:
+                p = Path(doc_path).resolve().parent / p
+            if not p.is_file():
+                self.statusMessage.emit(f"the document's environment {env} is missing")
+                return
+            env = str(p.resolve())
+        if env != self.view._environment:
             self.choose_environment(env)
 
     def _env_activated(self, index: int) -> None:
