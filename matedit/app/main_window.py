@@ -25,6 +25,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app.canvas import NodeCanvasView
 from matedit.app.canvas_tabs import CanvasTab, CanvasTabs
 from matedit.app.code_view import CodeView
 from matedit.app.compile_service import MaterialCompiler
@@ -69,7 +70,7 @@ class MainWindow(QMainWindow):
         self.tabs = CanvasTabs(self.controller, self.actions, self.undo_group, self)
         self.setCentralWidget(self.tabs)
         self._build_docks()
-        self.problems = ProblemsModel(self.compiler, self.viewport.view, self)
+        self.problems = ProblemsModel(self.compiler, self.viewport, self)
         self._build_actions()
         self._build_menus()
         self._build_status()
@@ -203,19 +204,20 @@ class MainWindow(QMainWindow):
         # The canvas owns its keys (Tab, F, Home, Delete, Ctrl+C/X/V/D): menus only show them.
         self.act_add_node = self._action("Add &Node…\tTab", self.open_palette, None, "add",
                                          "Add a node (palette)")
-        self.act_frame_all = self._action("Frame &All\tHome", lambda: self._canvas_call(
-            "frame_all"), None, "frame", "Frame the whole graph")
-        self.act_frame_sel = self._action("Frame &Selection\tF", lambda: self._canvas_call(
-            "frame_selection"))
+        self.act_frame_all = self._action("Frame &All\tHome", lambda: self.canvas.frame_all(),
+                                          None, "frame", "Frame the whole graph")
+        self.act_frame_sel = self._action("Frame &Selection\tF",
+                                          lambda: self.canvas.frame_selection())
         self.canvas_actions = []
-        for text, method in (("&Delete\tDel", "delete_selection"),
-                             ("Cu&t\tCtrl+X", "cut_selection"),
-                             ("&Copy\tCtrl+C", "copy_selection"),
-                             ("&Paste\tCtrl+V", "paste"),
-                             ("D&uplicate\tCtrl+D", "duplicate_selection"),
-                             ("Co&mment Selection\tC", "comment_selection")):
+        V = NodeCanvasView
+        for text, method in (("&Delete\tDel", V.delete_selection),
+                             ("Cu&t\tCtrl+X", V.cut_selection),
+                             ("&Copy\tCtrl+C", V.copy_selection),
+                             ("&Paste\tCtrl+V", V.paste),
+                             ("D&uplicate\tCtrl+D", V.duplicate_selection),
+                             ("Co&mment Selection\tC", V.comment_selection)):
             self.canvas_actions.append(self._action(text, lambda _=False, m=method:
-                                                    self._canvas_call(m)))
+                                                    m(self.canvas)))
         self.act_reset_layout = self._action("Reset &Layout", self.reset_layout)
         self.act_snap = self._action("&Snap to Grid", self.tabs.set_snap_to_grid, None,
                                      tip="Moved nodes land on the canvas grid")
@@ -317,15 +319,16 @@ class MainWindow(QMainWindow):
         self.library.layerAddRequested.connect(
             lambda p: self.layers.add_layer_file(Path(p)))
         self.diagnostics.nodeActivated.connect(self.select_node)
-        self.lights.lightsChanged.connect(self.viewport.view.set_lights)
+        self.lights.lightsChanged.connect(self.viewport.set_lights)
         QTimer.singleShot(0, self, self._sync_lights)
 
     def _sync_lights(self) -> None:
         """The lights panel starts with the renderer's default lights once GL is up."""
-        if self.viewport.view.renderer is not None and not self.lights.lights:
-            self.lights.set_lights(self.viewport.view.lights)
-        elif self.viewport.view.renderer is None and not self.viewport.view.problem:
+        lights = self.viewport.renderer_lights()
+        if lights is None:
             QTimer.singleShot(200, self, self._sync_lights)
+        elif lights and not self.lights.lights:
+            self.lights.set_lights(lights)
 
     # --- documents -------------------------------------------------------------------------
     def open_material(self, path: str | Path) -> bool:
@@ -355,7 +358,7 @@ class MainWindow(QMainWindow):
         self.show_docs(node.kind if node is not None else "material_output")
 
     def show_about(self) -> None:
-        show_about(self, self.viewport.view.gl_renderer())
+        show_about(self, self.viewport.gl_renderer())
 
     def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
         """Tab opens the palette whenever the pointer is over the active canvas, wherever
@@ -375,8 +378,9 @@ class MainWindow(QMainWindow):
     def _open_recovered_material(self, entry, doc) -> None:
         """A second recovered material gets a window of its own."""
         w = MainWindow(restore_layout=False, start=False)
-        for name in ("ask_save_changes", "ask_recover", "show_error"):
-            setattr(w.actions, name, getattr(self.actions, name))
+        w.actions.ask_save_changes = self.actions.ask_save_changes
+        w.actions.ask_recover = self.actions.ask_recover
+        w.actions.show_error = self.actions.show_error
         w.actions._adopt(entry, doc)
         w.compiler.recompile()
         w.show()
@@ -445,13 +449,13 @@ class MainWindow(QMainWindow):
         self.tabs.material.canvas.select_nodes([stack_id])
         self.inspector.show_node(stack_id)
 
-    def open_palette(self) -> None:
-        self._canvas_call("open_palette")
+    @property
+    def canvas(self) -> NodeCanvasView:
+        """The active tab's canvas."""
+        return self.tabs.active.canvas
 
-    def _canvas_call(self, method: str):
-        """Calls a canvas method on the active tab's canvas."""
-        fn = getattr(self.tabs.active.canvas, method, None)
-        return fn() if fn is not None else None
+    def open_palette(self) -> None:
+        self.canvas.open_palette()
 
     # --- problems --------------------------------------------------------------------------
     def _refresh_problems(self) -> None:

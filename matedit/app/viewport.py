@@ -10,6 +10,7 @@ out through `glErrors`. A value edit only sets uniforms and redraws.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +41,16 @@ ENVIRONMENTS = {"Studio": "studio", "Sky": "sky"}
 OPEN_ENV = "Open HDR/EXR…"
 ENV_FILTER = "HDR environments (*.hdr *.exr);;All files (*)"
 SAVE_FILTER = "PNG image, as shown (*.png);;OpenEXR, linear radiance (*.exr)"
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """How the viewport draws, apart from the material: renderer attributes that need no GL
+    work to change (a typed record, not option names)."""
+
+    environment_intensity: float = 1.0
+    show_background: bool = True
+    background_blur: float = 0.0
 
 
 def _load_renderer_class():
@@ -80,7 +91,7 @@ class ViewportWidget(QOpenGLWidget):
         self.last_frame_time = 0.0
         self._fbo = None
         self._fbo_glo = -1
-        self._options: dict[str, Any] = {}
+        self.settings = RenderSettings()
 
     # --- GL lifecycle ----------------------------------------------------------------------
     def initializeGL(self) -> None:  # noqa: N802 - Qt's name
@@ -120,13 +131,11 @@ class ViewportWidget(QOpenGLWidget):
         r.set_mesh(self._mesh)
         r.mode = self._mode
         r.exposure = self._exposure
-        for name, value in self._options.items():
-            if hasattr(r, name):
-                setattr(r, name, value)
+        self._apply_settings(r)
         if self._lights is not None:
             r.set_lights(list(self._lights))
         else:
-            self._lights = list(getattr(r, "lights", []) or [])
+            self._lights = list(r.lights)
         if set_environment:
             self._set_environment_now(self._environment, None)
 
@@ -154,7 +163,7 @@ class ViewportWidget(QOpenGLWidget):
         self.frames += 1
         self.last_frame_time = time.perf_counter() - t0
         self.frameDrawn.emit()
-        if getattr(self.renderer, "needs_redraw", False):
+        if self.renderer.needs_redraw:
             QTimer.singleShot(0, self, self.update)  # reference mode accumulates until converged
 
     def _paint_message(self, text: str) -> None:
@@ -183,9 +192,9 @@ class ViewportWidget(QOpenGLWidget):
             self.materialApplied.emit(False)
             return False
         self.doneCurrent()
-        ok = bool(getattr(status, "ok", True))
+        ok = bool(status.ok)
         if not ok:
-            self.glErrors.emit(list(getattr(status, "errors", []) or []))
+            self.glErrors.emit(list(status.errors or []))
         self.materialApplied.emit(ok)
         self.update()
         return ok
@@ -236,14 +245,22 @@ class ViewportWidget(QOpenGLWidget):
             self.renderer.exposure = float(ev)
             self.update()
 
-    def set_render_option(self, name: str, value) -> None:
-        """A renderer attribute that needs no GL work (background, blur, IBL intensity)."""
-        self._options[name] = value
-        if self.renderer is not None and hasattr(self.renderer, name):
-            setattr(self.renderer, name, value)
-            if hasattr(self.renderer, "reset_accumulation"):
-                self.renderer.reset_accumulation()
+    def set_settings(self, settings: RenderSettings) -> None:
+        """New render settings (background, blur, IBL intensity): no GL work, a redraw."""
+        self.settings = settings
+        if self.renderer is not None:
+            self._apply_settings(self.renderer)
+            self.renderer.reset_accumulation()
             self.update()
+
+    def change_settings(self, **changes) -> None:
+        self.set_settings(replace(self.settings, **changes))
+
+    def _apply_settings(self, r) -> None:
+        s = self.settings
+        r.environment_intensity = s.environment_intensity
+        r.show_background = s.show_background
+        r.background_blur = s.background_blur
 
     @property
     def lights(self) -> list:
@@ -348,6 +365,8 @@ class ViewportPanel(QWidget):
 
     environmentChanged = Signal(str)
     statusMessage = Signal(str)
+    glErrors = Signal(list)  # the view's: [(node id, message)] when a program fails to build
+    materialApplied = Signal(bool)
 
     def __init__(self, compiler: MaterialCompiler, parent=None) -> None:
         super().__init__(parent)
@@ -439,6 +458,8 @@ class ViewportPanel(QWidget):
                                                               self.view.update()))
         self.view.frameDrawn.connect(self._frame_drawn)
         self.view.statusMessage.connect(self.statusMessage)
+        self.view.glErrors.connect(self.glErrors)
+        self.view.materialApplied.connect(self.materialApplied)
         compiler.compiled.connect(self.on_compiled)
         compiler.previewChanged.connect(self._preview_changed)
         self.controller.valuesChanged.connect(self.push_values)
@@ -454,6 +475,19 @@ class ViewportPanel(QWidget):
             return
         doc = self.controller.document
         self.view.set_values(uniform_values(cm, doc), texture_paths(cm, doc))
+
+    # --- the typed interface the window uses ------------------------------------------------
+    def set_lights(self, lights: list) -> None:
+        self.view.set_lights(lights)
+
+    def renderer_lights(self) -> list | None:
+        """The renderer's light rig once it runs; None while it starts; [] if it cannot."""
+        if self.view.renderer is not None:
+            return self.view.lights
+        return [] if self.view.problem else None
+
+    def gl_renderer(self) -> str:
+        return self.view.gl_renderer()
 
     # --- saving the picture; dropped environments -------------------------------------------
     def save_image_dialog(self) -> bool:
@@ -704,17 +738,17 @@ class EnvironmentPanel(QWidget):
         self.intensity = FloatField(1.0, (0.0, 4.0))
         self.intensity.setToolTip("Multiplies the environment's light")
         self.intensity.edited.connect(
-            lambda v, _m: viewport.view.set_render_option("environment_intensity", float(v)))
+            lambda v, _m: viewport.view.change_settings(environment_intensity=float(v)))
         form.addRow("intensity", self.intensity)
         self.background = QCheckBox("show behind the mesh")
         self.background.setChecked(True)
         self.background.toggled.connect(
-            lambda on: viewport.view.set_render_option("show_background", bool(on)))
+            lambda on: viewport.view.change_settings(show_background=bool(on)))
         form.addRow("background", self.background)
         self.blur = FloatField(0.0, (0.0, 1.0))
         self.blur.setToolTip("Blurs the background only (lighting is unchanged)")
         self.blur.edited.connect(
-            lambda v, _m: viewport.view.set_render_option("background_blur", float(v)))
+            lambda v, _m: viewport.view.change_settings(background_blur=float(v)))
         form.addRow("blur", self.blur)
         lay.addLayout(form)
 
