@@ -138,5 +138,8 @@ def test_render_settings_are_a_typed_record_applied_to_the_renderer(window, qtbo
     assert (r.show_background, r.environment_intensity) == (False, 0.5)
     after = frame(qtbot, view)
     assert np.abs(after - before).mean() > 0.01  # the background went, the light halved
-    window.environment.background.setChecked(True)  # the panel goes through the same record
+    box = window.environment.background  # the panel goes through the same record
+    box.setChecked(False)
+    box.setChecked(True)
     assert view.settings.show_background and r.show_background
+    assert view.settings.environment_intensity == 0.5  # the other fields kept
