@@ -11,6 +11,7 @@ import json
 from dataclasses import asdict
 from pathlib import Path
 
+import shiboken6
 from PySide6.QtCore import QByteArray, QEvent, QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QCloseEvent, QCursor, QKeySequence, QUndoGroup
 from PySide6.QtWidgets import (
@@ -141,7 +142,8 @@ class MainWindow(QMainWindow):
                                       "light")
         for sig in (self.lights_dock.topLevelChanged, self.lights_dock.dockLocationChanged,
                     self.lights_dock.visibilityChanged):
-            sig.connect(lambda *_: QTimer.singleShot(0, self, self._retitle_lights))
+            sig.connect(lambda *_: shiboken6.isValid(self)  # also fires while closing down
+                        and QTimer.singleShot(0, self, self._retitle_lights))
         self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
                                            B, "warning")
         self.code_dock = self._dock("GLSL", "codeDock", self.code, B)

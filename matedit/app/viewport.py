@@ -404,11 +404,13 @@ class ViewportPanel(QWidget):
         self.exposure_spin.setKeyboardTracking(False)
         self.exposure_spin.setToolTip("Exposure in EV (type a value; arrow keys step 0.1)")
         self.exposure_label = self.exposure_spin  # the number shown beside the slider
-        self.diff_label = QLabel("")
+        # Laid over the view's bottom edge (placed with the banner): its text never moves
+        # anything, and it takes no room from the bar.
+        self.diff_label = QLabel("", self)
         self.diff_label.setObjectName("diffMean")
-        # Room for the longest text it shows, so that its appearing shifts nothing.
-        self.diff_label.setFixedWidth(self.diff_label.fontMetrics().horizontalAdvance(
-            "2048/2048 samples · mean |Δ| 0.0000") + 8)
+        self.diff_label.setStyleSheet("background: rgba(20, 22, 27, 170); color: #d5d9e0;"
+                                      " padding: 1px 6px;")
+        self.diff_label.hide()
         self.diff_label.setToolTip("Reference and difference modes: samples a pixel so far, "
                                    "and the mean difference from the split-sum image")
         self.save_button = QToolButton()
@@ -422,7 +424,6 @@ class ViewportPanel(QWidget):
             bl.addWidget(w)
         bl.addWidget(self.exposure, 1)
         bl.addWidget(self.exposure_spin)
-        bl.addWidget(self.diff_label)
         bl.addStretch(1)
         bl.addWidget(self.save_button)
         bl.addWidget(reset)
@@ -580,6 +581,8 @@ class ViewportPanel(QWidget):
     def _place_banner(self) -> None:
         g = self.view.geometry()
         self.banner.setGeometry(g.x(), g.y(), g.width(), self.banner.sizeHint().height())
+        self.diff_label.adjustSize()
+        self.diff_label.move(g.x() + 4, g.y() + g.height() - self.diff_label.height() - 4)
 
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().resizeEvent(event)
@@ -589,6 +592,7 @@ class ViewportPanel(QWidget):
     def _mode_changed(self, text: str) -> None:
         self.view.set_mode(MODES[text])
         self.diff_label.setText("")
+        self.diff_label.setVisible(MODES[text] != "splitsum")
 
     def _exposure_changed(self, tenths: int) -> None:
         ev = tenths / 10.0
@@ -609,6 +613,8 @@ class ViewportPanel(QWidget):
             if mean is not None:
                 text += f" · mean |Δ| {float(mean):.4f}"
         self.diff_label.setText(text)
+        self._place_banner()
+        self.diff_label.raise_()
 
     def view_state(self) -> dict:
         """Mesh, mode, exposure and environment, as remembered across restarts."""
