@@ -28,16 +28,19 @@ def test_two_layer_material_built_from_empty_saves_reopens_and_undoes_to_empty(q
     from PySide6.QtCore import QPointF
     from PySide6.QtGui import QColor
 
+    from matedit.app.document_actions import new_material
     from matedit.app.fields import ColorField, FloatField
 
     w = make_window(qtbot)
-    empty = MaterialDocument(name="Untitled").graph.snapshot()
+    empty = new_material().graph.snapshot()  # a new material holds its Material Output
     assert w.controller.document.graph.snapshot() == empty
+    assert MaterialDocument(name="Untitled").graph.snapshot() != empty
     canvas = w.tabs.material.canvas
 
-    # The output node through the canvas API, the layers through the layer panel.
-    out = canvas.add_node_at("material_output", QPointF(400, 0))
-    assert out
+    # The output node is there; the layers come through the layer panel.
+    (out,) = [n.id for n in w.controller.document.graph.nodes.values()
+              if n.kind == "material_output"]
+    assert canvas.add_node_at("noise", QPointF(400, 0)) == ""  # unknown kinds: refused
     base = w.layers.add_layer_file(LAYERS / "painted_metal.json")
     top = w.layers.add_layer_file(LAYERS / "rust.json")
     assert base and top

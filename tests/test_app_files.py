@@ -109,7 +109,9 @@ def test_recent_files_and_new_document(qtbot, sample_copy):
     w._fill_recent()
     assert any(a.text() == sample_copy.name for a in w.recent_menu.actions())
     assert w.actions.new()
-    assert w.controller.document.graph.nodes == {} and w.controller.document.path is None
+    nodes = w.controller.document.graph.nodes  # a new material starts with its output
+    assert [n.kind for n in nodes.values()] == ["material_output"]
+    assert w.controller.document.path is None and not w.controller.dirty
     assert w.windowTitle().startswith("Untitled")
 
 

@@ -7,8 +7,10 @@ autosave folder in Qt's test locations, emptied for each test.
 
 from __future__ import annotations
 
+import atexit
 import os
 import shutil
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -26,6 +28,10 @@ configure_gl()
 QCoreApplication.setAttribute(Qt.ApplicationAttribute.AA_ShareOpenGLContexts)
 configure_application_names()
 QStandardPaths.setTestModeEnabled(True)
+# Recovery files of this test run only: other runs on the machine clear theirs.
+if "MATEDIT_RECOVERY_DIR" not in os.environ:
+    os.environ["MATEDIT_RECOVERY_DIR"] = tempfile.mkdtemp(prefix="matedit-recovery-")
+    atexit.register(shutil.rmtree, os.environ["MATEDIT_RECOVERY_DIR"], True)
 
 
 @pytest.fixture

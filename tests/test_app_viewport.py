@@ -125,3 +125,21 @@ def test_a_bad_environment_file_is_reported_and_the_old_one_kept(window, qtbot, 
     assert not window.viewport.choose_environment(str(bad))
     assert shown and "broken.hdr" in shown[0]
     assert window.viewport.env_combo.currentText() == "Studio"
+
+
+def test_render_settings_are_a_typed_record_applied_to_the_renderer(window, qtbot):
+    from matedit.app.viewport import RenderSettings
+
+    view = window.viewport.view
+    before = frame(qtbot, view)
+    view.change_settings(show_background=False, environment_intensity=0.5)
+    assert view.settings == RenderSettings(0.5, False, 0.0)
+    r = view.renderer
+    assert (r.show_background, r.environment_intensity) == (False, 0.5)
+    after = frame(qtbot, view)
+    assert np.abs(after - before).mean() > 0.01  # the background went, the light halved
+    box = window.environment.background  # the panel goes through the same record
+    box.setChecked(False)
+    box.setChecked(True)
+    assert view.settings.show_background and r.show_background
+    assert view.settings.environment_intensity == 0.5  # the other fields kept

@@ -255,3 +255,4 @@ def test_disconnect_event_removes_only_that_wire(view):
     assert Link("p", "value", "mul", "a") not in view.scene().wire_items
     assert len(view.scene().wire_items) == 3
     assert_mirrors(view)
+

@@ -43,6 +43,9 @@ class CanvasTabs(QWidget):
     selectionChanged = Signal(list)
     message = Signal(str)
     functionSaved = Signal(object)  # Path
+    previewRequested = Signal(str, str)  # a node's output to show in the viewport
+    materialOpenRequested = Signal(str)  # a material file dropped on a canvas
+    docsRequested = Signal(str)  # a node kind's documentation (F1)
 
     def __init__(self, material: DocumentController, material_actions: DocumentActions,
                  undo_group: QUndoGroup, parent=None) -> None:
@@ -65,6 +68,7 @@ class CanvasTabs(QWidget):
         self.tabs.currentChanged.connect(self._current_changed)
         lay.addWidget(self.tabs, 1)
         self._tabs: list[CanvasTab] = []
+        self.snap_to_grid = False
         self.material = self._add(material, material_actions, None)
         bar = self.tabs.tabBar()
         bar.setTabButton(0, bar.ButtonPosition.RightSide, None)
@@ -76,9 +80,11 @@ class CanvasTabs(QWidget):
     def _add(self, controller: DocumentController, actions: DocumentActions,
              parent: CanvasTab | None) -> CanvasTab:
         canvas = NodeCanvasView(controller, self)
+        canvas.scene().snap_to_grid = self.snap_to_grid
         tab = CanvasTab(controller, canvas, actions, parent)
         if not controller.document.is_function:
             tab.previews = NodePreviews(controller, canvas, self)
+            canvas.previewRequested.connect(self.previewRequested)
         if parent is not None:
             parent.children.append(tab)
         self._tabs.append(tab)
@@ -86,6 +92,8 @@ class CanvasTabs(QWidget):
         canvas.selectionChangedIds.connect(self._selection)
         canvas.functionOpenRequested.connect(lambda p, t=tab: self.open_function(p, t))
         canvas.message.connect(self.message)
+        canvas.materialOpenRequested.connect(self.materialOpenRequested)
+        canvas.docsRequested.connect(self.docsRequested)
         controller.undo_stack.cleanChanged.connect(self._clean_changed)
         actions.saved.connect(lambda p, t=tab: self._saved(t, p))
         self.tabs.addTab(canvas, icon("function" if controller.document.is_function
@@ -93,6 +101,11 @@ class CanvasTabs(QWidget):
         self._retitle(tab)
         QTimer.singleShot(0, canvas, canvas.frame_all)
         return tab
+
+    def set_snap_to_grid(self, on: bool) -> None:
+        self.snap_to_grid = bool(on)
+        for tab in self._tabs:
+            tab.canvas.scene().snap_to_grid = self.snap_to_grid
 
     def all_tabs(self) -> list[CanvasTab]:
         return list(self._tabs)

@@ -16,6 +16,7 @@ from typing import Any
 from PySide6.QtCore import QObject, Signal
 
 from matedit.app.controller import DocumentController
+from matedit.app.node_preview import PreviewTarget, preview_document
 from matedit.app.paths import absolute_of
 from matedit.compiler import CompiledMaterial, CompileError, compile_document
 from matedit.graph.model import MaterialDocument
@@ -53,6 +54,7 @@ class MaterialCompiler(QObject):
 
     compiled = Signal(object)  # CompiledMaterial
     failed = Signal(list)  # list[Diagnostic]
+    previewChanged = Signal(object)  # PreviewTarget | None: the viewport shows that socket
 
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
@@ -62,7 +64,42 @@ class MaterialCompiler(QObject):
         self.diagnostics: list[Diagnostic] = []
         self.last_compile_ms = 0.0
         self._cache: dict[str, CompiledMaterial] = {}
+        self.preview: PreviewTarget | None = None
         controller.structureChanged.connect(self.recompile)
+        controller.documentReplaced.connect(lambda: self.set_preview(None, recompile=False))
+
+    # --- preview any node ------------------------------------------------------------------
+    def set_preview(self, target: PreviewTarget | None, recompile: bool = True) -> bool:
+        """Show `target` in the viewport instead of the material (None: the material again).
+        A structural change for the viewport; the document is not touched."""
+        if target is not None and self._preview_type(target) is None:
+            return False
+        if target == self.preview:
+            return True
+        self.preview = target
+        self.previewChanged.emit(target)
+        if recompile:
+            self.recompile()
+        return True
+
+    def _preview_type(self, target: PreviewTarget) -> PortType | None:
+        a = self.controller.analysis
+        t = a.out_types.get(target.node_id, {}).get(target.port) if a is not None else None
+        if t is None or not (t.is_numeric or t == PortType.MATERIAL):
+            return None
+        return t
+
+    def _viewport_document(self) -> MaterialDocument:
+        """The document the viewport compiles: the material, or a copy showing the preview."""
+        doc = self.controller.document
+        if self.preview is None:
+            return doc
+        t = self._preview_type(self.preview)
+        if t is None:  # the node went away or changed type: back to the material
+            self.preview = None
+            self.previewChanged.emit(None)
+            return doc
+        return preview_document(doc, self.preview, t)
 
     def recompile(self) -> CompiledMaterial | None:
         doc = self.controller.document
@@ -72,8 +109,9 @@ class MaterialCompiler(QObject):
             self.diagnostics = []
             return None
         t0 = time.perf_counter()
+        shown = self._viewport_document()
         try:
-            cm = compile_document(doc, self.controller.resolver, VIEWPORT_TARGET)
+            cm = compile_document(shown, self.controller.resolver, VIEWPORT_TARGET)
         except CompileError as exc:
             self.diagnostics = list(exc.diagnostics)
             self.last_compile_ms = (time.perf_counter() - t0) * 1e3
@@ -87,7 +125,8 @@ class MaterialCompiler(QObject):
         self.last_compile_ms = (time.perf_counter() - t0) * 1e3
         self.diagnostics = []
         self.current = self.last_good = cm
-        self._cache[VIEWPORT_TARGET] = cm
+        if shown is doc:  # exports and the code view want the material, never a preview
+            self._cache[VIEWPORT_TARGET] = cm
         self.compiled.emit(cm)
         return cm
 

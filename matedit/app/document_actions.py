@@ -35,7 +35,7 @@ from matedit.app.recovery import (
     remove_recovery,
     write_meta_text,
 )
-from matedit.graph.model import MaterialDocument
+from matedit.graph.model import MaterialDocument, Node
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import FormatError, dumps, load, loads, save
 
@@ -45,6 +45,13 @@ RECENT_KEY = "files/recent"
 FILE_FILTER = "matedit graphs (*.json);;All files (*)"
 
 SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
+
+
+def new_material() -> MaterialDocument:
+    """What File > New makes: an untitled material with its Material Output in place."""
+    doc = MaterialDocument(name="Untitled")
+    doc.graph.nodes["out"] = Node("out", "material_output", (300.0, 0.0))
+    return doc
 
 
 def document_title(doc: MaterialDocument) -> str:
@@ -98,6 +105,9 @@ class DocumentActions(QObject):
             None = None
         self.open_recovered_material: Callable[[RecoveryEntry, MaterialDocument], None] | \
             None = None
+        self.open_function: Callable[[Path], None] | None = None  # File > Open on a function
+        # The preview settings saved with a material, for the file it is saved as.
+        self.preview_settings: Callable[[Path], dict] | None = None
         self.ask_open_path: Callable[[], str] = self._ask_open_path
         self.ask_save_path: Callable[[str], str] = self._ask_save_path
         self.show_error: Callable[[str, str], None] = self._show_error
@@ -175,7 +185,7 @@ class DocumentActions(QObject):
             return False
         self.discard_recovery()
         self.untitled_key = new_untitled_key()
-        self.controller.replace(MaterialDocument(name="Untitled"))
+        self.controller.replace(new_material())
         self.opened.emit(None)
         return True
 
@@ -200,14 +210,18 @@ class DocumentActions(QObject):
 
         if is_instance_file(path) and hasattr(self.parent(), "open_instance"):
             return self.parent().open_instance(str(path)) is not None
-        if ask and not self.maybe_save():
-            return False
         doc = self.read(path)
         if doc is None:
             return False
-        if doc.is_function:
+        if doc.is_function:  # a function opens in a canvas tab; the material stays
+            if self.open_function is not None:
+                self.open_function(Path(path))
+                self.add_recent(Path(path))
+                return True
             self.show_error("Not a material", f"{Path(path).name} is a material function; "
                             "open it from the Library to edit it in a tab.")
+            return False
+        if ask and not self.maybe_save():
             return False
         if ask:  # leaving a document the artist has just saved or discarded
             self.discard_recovery()
@@ -285,6 +299,8 @@ class DocumentActions(QObject):
         try:
             if old_path is None:
                 relativise_references(self.document, path)
+            if self.preview_settings is not None:  # the viewport's mesh and environment
+                self.document.preview.update(self.preview_settings(path))
             save(self.document, path)
         except (OSError, ValueError) as exc:
             self.show_error("Cannot save", f"{path} could not be saved:\n{exc}")

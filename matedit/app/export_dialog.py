@@ -27,6 +27,7 @@ from matedit.io.document import FileResolver
 from matedit.io.inputs import OverwriteError
 
 FOLDER_KEY = "export/folder"
+TARGETS_KEY = "export/targets"
 
 
 class ExportDialog(QDialog):
@@ -38,9 +39,12 @@ class ExportDialog(QDialog):
         lay = QVBoxLayout(self)
         lay.addWidget(QLabel("Targets"))
         self.boxes = {}
+        remembered = QSettings().value(TARGETS_KEY, ["glsl330"])
+        remembered = [remembered] if isinstance(remembered, str) else list(remembered or [])
         for t in TARGETS:
             box = QCheckBox(t)
-            box.setChecked(t == "glsl330")
+            box.setChecked(t in remembered)
+            box.toggled.connect(self._remember_targets)
             lay.addWidget(box)
             self.boxes[t] = box
         lay.addWidget(QLabel("Folder"))
@@ -59,6 +63,10 @@ class ExportDialog(QDialog):
         buttons.rejected.connect(self.reject)
         lay.addWidget(buttons)
         self.resize(420, self.sizeHint().height())
+
+    def _remember_targets(self, _on: bool = False) -> None:
+        """The targets chosen are the next export's default (across restarts)."""
+        QSettings().setValue(TARGETS_KEY, self.targets())
 
     def targets(self) -> list[str]:
         return [t for t, b in self.boxes.items() if b.isChecked()]

@@ -12,9 +12,11 @@ import math
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSize, Qt, Signal
+from PySide6.QtCore import QEvent, QObject, QSize, Qt, Signal
 from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap
 from PySide6.QtWidgets import (
+    QAbstractScrollArea,
+    QApplication,
     QColorDialog,
     QDoubleSpinBox,
     QFileDialog,
@@ -37,8 +39,31 @@ SPIN_LIMIT = 1e6
 IMAGE_FILTER = "Images (*.png *.jpg *.jpeg *.tga *.tif *.tiff *.exr *.hdr *.bmp);;All files (*)"
 
 
+class WheelGuard(QObject):
+    """Lets the wheel change a slider, spin box or combo box only while it has focus;
+    otherwise the wheel scrolls the panel around it."""
+
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
+        if event.type() == QEvent.Type.Wheel and isinstance(obj, QWidget) and not obj.hasFocus():
+            area = obj.parentWidget()
+            while area is not None and not isinstance(area, QAbstractScrollArea):
+                area = area.parentWidget()
+            if area is not None:
+                QApplication.sendEvent(area.verticalScrollBar(), event)
+            return True
+        return False
+
+
+def guard_wheel(widget: QWidget) -> QWidget:
+    """`widget` with a `WheelGuard`, and focus only by click or Tab (never by the wheel)."""
+    widget.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+    widget.installEventFilter(WheelGuard(widget))
+    return widget
+
+
 def _spin(decimals: int = 3) -> QDoubleSpinBox:
     s = QDoubleSpinBox()
+    guard_wheel(s)
     s.setRange(-SPIN_LIMIT, SPIN_LIMIT)
     s.setDecimals(decimals)
     s.setSingleStep(0.01)
@@ -74,7 +99,7 @@ class FloatField(QWidget):
         lay = QHBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(6)
-        self.slider = QSlider(Qt.Orientation.Horizontal)
+        self.slider = guard_wheel(QSlider(Qt.Orientation.Horizontal))
         self.slider.setRange(0, SLIDER_STEPS)
         self.slider.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         self.spin = _spin()
@@ -208,7 +233,8 @@ class ColorField(QWidget):
         lay.addWidget(self.intensity)
         self._base: list[float] = []  # the first value is split afresh
         self.set_value(value)
-        self.dialog_factory = QColorDialog.getColor  # tests replace it
+        self.dialog_factory = QColorDialog.getColor  # replaced: a modal dialog (tests)
+        self.live_dialog: QColorDialog | None = None
 
     def value(self) -> list[float]:
         k = float(self.intensity.value())
@@ -243,8 +269,13 @@ class ColorField(QWidget):
         v = self.value()
         self.swatch.setToolTip("linear RGB " + ", ".join(f"{c:.3f}" for c in v))
 
-    def pick(self) -> None:
+    def pick(self) -> QColorDialog | None:
+        """A colour picker that stays open beside the canvas and edits live (one undo step
+        for the whole pick); the intensity field beside it makes the colour HDR. A replaced
+        `dialog_factory` (the stock modal dialog) is the fallback."""
         r, g, b = (int(round(linear_to_srgb(c) * 255)) for c in self._base)
+        if self.dialog_factory is QColorDialog.getColor:
+            return self._pick_live(QColor(r, g, b))
         chosen = self.dialog_factory(QColor(r, g, b), self, "Colour")
         if chosen is None or not chosen.isValid():
             return
@@ -252,6 +283,35 @@ class ColorField(QWidget):
                       (chosen.redF(), chosen.greenF(), chosen.blueF())]
         self._paint()
         self.edited.emit(self.value(), None)
+
+    def _pick_live(self, start: QColor) -> QColorDialog:
+        if self.live_dialog is not None:
+            self.live_dialog.raise_()
+            return self.live_dialog
+        dlg = QColorDialog(start, self)
+        dlg.setWindowTitle("Colour (× intensity for HDR)")
+        dlg.setModal(False)
+        merge = new_merge_id()
+        before = self.value()
+
+        def changed(c: QColor) -> None:
+            if not c.isValid():
+                return
+            self._base = [round(srgb_to_linear(x), 6) for x in (c.redF(), c.greenF(),
+                                                                 c.blueF())]
+            self._paint()
+            self.edited.emit(self.value(), merge)
+
+        def cancelled() -> None:  # back to the colour before the pick, in the same step
+            self.set_value(before)
+            self.edited.emit(self.value(), merge)
+
+        dlg.currentColorChanged.connect(changed)
+        dlg.rejected.connect(cancelled)
+        dlg.finished.connect(lambda _r: setattr(self, "live_dialog", None))
+        dlg.show()
+        self.live_dialog = dlg
+        return dlg
 
     def _intensity_typed(self, _v: float) -> None:
         self._paint()

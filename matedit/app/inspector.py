@@ -27,7 +27,14 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app.controller import DocumentController
-from matedit.app.fields import ColorField, FloatField, TextureField, VectorField, _spin
+from matedit.app.fields import (
+    ColorField,
+    FloatField,
+    TextureField,
+    VectorField,
+    _spin,
+    guard_wheel,
+)
 from matedit.app.paths import absolute_of, reference_for
 from matedit.graph import nodes
 from matedit.graph.commands import SetLabel, SetSetting, SetValue
@@ -50,6 +57,7 @@ class InspectorPanel(QScrollArea):
 
     message = Signal(str)
     functionOpenRequested = Signal(str)
+    docsRequested = Signal(str)  # a node kind's documentation
 
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
@@ -59,6 +67,7 @@ class InspectorPanel(QScrollArea):
         self.node_id: str | None = None
         self._fields: dict[tuple[str, str], QWidget] = {}  # ("value"|"setting", name) -> field
         self._ports_key: object = None
+        self._shown: str | None = None  # the node the body was last built for
         self._rebuild_timer = QTimer(self)
         self._rebuild_timer.setSingleShot(True)
         self._rebuild_timer.setInterval(0)
@@ -137,7 +146,18 @@ class InspectorPanel(QScrollArea):
 
     # --- building --------------------------------------------------------------------------
     def rebuild(self) -> None:
+        # The same node rebuilt (an edit changed its ports): stay where the artist was.
+        bar = self.verticalScrollBar()
+        keep = bar.value() if self.node_id is not None and self.node_id == self._shown else 0
+        self._shown = self.node_id
         self._fields.clear()
+        self._build_body()
+        if keep:
+            self.widget().adjustSize()
+            bar.setValue(keep)
+            QTimer.singleShot(0, self, lambda: bar.setValue(keep))
+
+    def _build_body(self) -> None:
         body = QWidget()
         lay = QVBoxLayout(body)
         lay.setContentsMargins(10, 8, 10, 8)
@@ -158,7 +178,13 @@ class InspectorPanel(QScrollArea):
         title.setObjectName("inspectorTitle")
         title.setToolTip("Node label (shown on the canvas)")
         title.editingFinished.connect(lambda: self._rename(title.text()))
-        lay.addWidget(title)
+        head = QHBoxLayout()
+        head.addWidget(title, 1)
+        self.docs_button = QPushButton("Docs")
+        self.docs_button.setToolTip("This node kind's documentation: ports, types, ranges (F1)")
+        self.docs_button.clicked.connect(lambda _=False, k=node.kind: self.docsRequested.emit(k))
+        head.addWidget(self.docs_button)
+        lay.addLayout(head)
         kind = QLabel(f"{d.title if d else node.kind}  ·  {d.category if d else '?'}  ·  "
                       f"id {node.id}")
         kind.setObjectName("inspectorKind")
@@ -231,7 +257,7 @@ class InspectorPanel(QScrollArea):
     def _setting_editor(self, node: Node, s: SettingDef) -> QWidget | None:
         cur = node.settings.get(s.name, s.default)
         if s.kind == "type" and s.choices:
-            combo = QComboBox()
+            combo = guard_wheel(QComboBox())
             combo.addItems(list(s.choices))
             combo.setCurrentText(str(cur))
             combo.setToolTip(s.doc)
@@ -290,9 +316,8 @@ class InspectorPanel(QScrollArea):
         edit.setToolTip(s.doc)
         edit.editingFinished.connect(lambda: edit.text() != ref and
                                      self._set_setting(s.name, edit.text().strip()))
-        browse = QPushButton("…")
-        browse.setFixedWidth(28)
-        browse.setToolTip("Choose a file")
+        browse = QPushButton("Browse…")
+        browse.setToolTip("Choose a material function file")
 
         def pick() -> None:
             path, _ = QFileDialog.getOpenFileName(self, "Choose a material function", "",

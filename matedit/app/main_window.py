@@ -7,11 +7,15 @@ are kept in QSettings and restored at the next start.
 
 from __future__ import annotations
 
+import json
+from dataclasses import asdict
 from pathlib import Path
 
-from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence, QUndoGroup
+import shiboken6
+from PySide6.QtCore import QByteArray, QEvent, QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QCloseEvent, QCursor, QKeySequence, QUndoGroup
 from PySide6.QtWidgets import (
+    QApplication,
     QDockWidget,
     QLabel,
     QMainWindow,
@@ -22,25 +26,30 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app.canvas import NodeCanvasView
 from matedit.app.canvas_tabs import CanvasTab, CanvasTabs
 from matedit.app.code_view import CodeView
 from matedit.app.compile_service import MaterialCompiler
 from matedit.app.controller import DocumentController
-from matedit.app.diagnostics import DiagnosticsPanel, Problem
-from matedit.app.document_actions import DocumentActions, document_title
+from matedit.app.diagnostics import DiagnosticsPanel
+from matedit.app.document_actions import DocumentActions, document_title, new_material
 from matedit.app.export_dialog import ExportDialog
+from matedit.app.help import NodeDocs, ShortcutReference, show_about
 from matedit.app.inspector import InspectorPanel
 from matedit.app.instance_editor import install as install_instances
 from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
+from matedit.app.node_preview import PreviewTarget
+from matedit.app.problems import ProblemsModel
 from matedit.app.theme import icon
 from matedit.app.viewport import EnvironmentPanel, ViewportPanel
-from matedit.graph.model import MaterialDocument
 from matedit.resources import graphs_dir
+from matedit.shading.lights import Light
 
 SAMPLE = "materials/rusty_painted_metal.json"
 GEOMETRY_KEY, STATE_KEY = "window/geometry", "window/state"
+VIEW_KEY, LIGHTS_KEY, SNAP_KEY = "viewport/state", "viewport/lights", "canvas/snap"
 STATE_VERSION = 1
 
 
@@ -55,15 +64,15 @@ class MainWindow(QMainWindow):
         self.setObjectName("MainWindow")
         self.resize(1480, 900)
         self.setDockNestingEnabled(True)
-        self.controller = DocumentController(MaterialDocument(name="Untitled"), self)
+        self.controller = DocumentController(new_material(), self)
         self.actions = DocumentActions(self, self.controller)
         self.compiler = MaterialCompiler(self.controller, self)
         self.undo_group = QUndoGroup(self)
-        self._problems = {"compile": [], "gl": []}
 
         self.tabs = CanvasTabs(self.controller, self.actions, self.undo_group, self)
         self.setCentralWidget(self.tabs)
         self._build_docks()
+        self.problems = ProblemsModel(self.compiler, self.viewport, self)
         self._build_actions()
         self._build_menus()
         self._build_status()
@@ -76,9 +85,14 @@ class MainWindow(QMainWindow):
         self._on_active(self.tabs.active)
         self._retitle()
         self.extra_windows: list[MainWindow] = []  # recovered materials opened at start-up
+        self._shortcuts: ShortcutReference | None = None
+        self._docs: NodeDocs | None = None
+        QApplication.instance().installEventFilter(self)
         self.actions.open_recovered_function = lambda e, doc: self.tabs.open_function(
             e.document, self.tabs.material, recovered=doc)
         self.actions.open_recovered_material = self._open_recovered_material
+        self.actions.open_function = lambda p: self.tabs.open_function(p, self.tabs.material)
+        self.actions.preview_settings = self.viewport.document_preview
         if start:
             self.actions.start(path, sample_path() if sample else None)
             self.compiler.recompile()
@@ -92,8 +106,9 @@ class MainWindow(QMainWindow):
                          | QDockWidget.DockWidgetFeature.DockWidgetFloatable
                          | QDockWidget.DockWidgetFeature.DockWidgetClosable)
         self.addDockWidget(area, dock)
-        if icon_name:
-            dock.toggleViewAction().setIcon(icon(icon_name))
+        # No icon on the View menu's entry: styles draw an icon instead of the check mark.
+        dock.toggleViewAction().setCheckable(True)
+        dock.setProperty("iconName", icon_name)
         return dock
 
     def _build_docks(self) -> None:
@@ -127,8 +142,10 @@ class MainWindow(QMainWindow):
         lights_scroll.setWidget(lights_host)
         self.lights_dock = self._dock("Lights & Environment", "lightsDock", lights_scroll, R,
                                       "light")
-        # The title bar shows the text as it is; the View menu's action reads '&' as a mnemonic.
-        self.lights_dock.toggleViewAction().setText("Lights && Environment")
+        for sig in (self.lights_dock.topLevelChanged, self.lights_dock.dockLocationChanged,
+                    self.lights_dock.visibilityChanged):
+            sig.connect(lambda *_: shiboken6.isValid(self)  # also fires while closing down
+                        and QTimer.singleShot(0, self, self._retitle_lights))
         self.diagnostics_dock = self._dock("Diagnostics", "diagnosticsDock", self.diagnostics,
                                            B, "warning")
         self.code_dock = self._dock("GLSL", "codeDock", self.code, B)
@@ -140,6 +157,7 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(self.diagnostics_dock, self.code_dock)
         self.tabifyDockWidget(self.code_dock, self.history_dock)
         self.diagnostics_dock.raise_()
+        self._retitle_lights()
         self.resizeDocks([self.library_dock, self.viewport_dock], [270, 430],
                          Qt.Orientation.Horizontal)
         self.resizeDocks([self.viewport_dock, self.inspector_dock], [400, 420],
@@ -147,6 +165,14 @@ class MainWindow(QMainWindow):
         self.resizeDocks([self.library_dock, self.layers_dock], [330, 420],
                          Qt.Orientation.Vertical)
         self.resizeDocks([self.diagnostics_dock], [170], Qt.Orientation.Vertical)
+
+    def _retitle_lights(self) -> None:
+        """'&' shown as itself everywhere: a dock's title bar draws its title as it is, but
+        the tab of tabified docks and the View menu read '&' as a mnemonic marker."""
+        d = self.lights_dock
+        tabbed = not d.isFloating() and bool(self.tabifiedDockWidgets(d))
+        d.setWindowTitle("Lights && Environment" if tabbed else "Lights & Environment")
+        d.toggleViewAction().setText("Lights && Environment")
 
     def _action(self, text: str, slot, shortcut=None, icon_name: str = "",
                 tip: str = "") -> QAction:
@@ -169,6 +195,9 @@ class MainWindow(QMainWindow):
         self.act_save_as = self._action("Save &As…", self.save_active_as, K.SaveAs, "save-as")
         self.act_export = self._action("&Export Shaders…", self.export_shaders, "Ctrl+E",
                                        "export", "Write GLSL for chosen targets to a folder")
+        self.act_save_image = self._action("Save &Viewport Image…",
+                                           lambda: self.viewport.save_image_dialog(), None,
+                                           "save", "The viewport's frame as PNG or linear EXR")
         self.act_quit = self._action("&Quit", self.close, K.Quit)
         self.act_undo = self.undo_group.createUndoAction(self, "&Undo")
         self.act_undo.setShortcut(K.Undo)
@@ -179,20 +208,29 @@ class MainWindow(QMainWindow):
         # The canvas owns its keys (Tab, F, Home, Delete, Ctrl+C/X/V/D): menus only show them.
         self.act_add_node = self._action("Add &Node…\tTab", self.open_palette, None, "add",
                                          "Add a node (palette)")
-        self.act_frame_all = self._action("Frame &All\tHome", lambda: self._canvas_call(
-            "frame_all"), None, "frame", "Frame the whole graph")
-        self.act_frame_sel = self._action("Frame &Selection\tF", lambda: self._canvas_call(
-            "frame_selection"))
+        self.act_frame_all = self._action("Frame &All\tHome", lambda: self.canvas.frame_all(),
+                                          None, "frame", "Frame the whole graph")
+        self.act_frame_sel = self._action("Frame &Selection\tF",
+                                          lambda: self.canvas.frame_selection())
         self.canvas_actions = []
-        for text, method in (("&Delete\tDel", "delete_selection"),
-                             ("Cu&t\tCtrl+X", "cut_selection"),
-                             ("&Copy\tCtrl+C", "copy_selection"),
-                             ("&Paste\tCtrl+V", "paste"),
-                             ("D&uplicate\tCtrl+D", "duplicate_selection"),
-                             ("Co&mment Selection\tC", "comment_selection")):
+        V = NodeCanvasView
+        for text, method in (("&Delete\tDel", V.delete_selection),
+                             ("Cu&t\tCtrl+X", V.cut_selection),
+                             ("&Copy\tCtrl+C", V.copy_selection),
+                             ("&Paste\tCtrl+V", V.paste),
+                             ("D&uplicate\tCtrl+D", V.duplicate_selection),
+                             ("Co&mment Selection\tC", V.comment_selection)):
             self.canvas_actions.append(self._action(text, lambda _=False, m=method:
-                                                    self._canvas_call(m)))
+                                                    m(self.canvas)))
         self.act_reset_layout = self._action("Reset &Layout", self.reset_layout)
+        self.act_snap = self._action("&Snap to Grid", self.tabs.set_snap_to_grid, None,
+                                     tip="Moved nodes land on the canvas grid")
+        self.act_snap.setCheckable(True)
+        self.act_shortcuts = self._action("&Keyboard Reference…", self.show_shortcuts,
+                                          "Ctrl+/", tip="Every shortcut, searchable")
+        self.act_node_docs = self._action("&Node Reference", self.show_selected_docs, None,
+                                          tip="Documentation of the selected node kind (F1)")
+        self.act_about = self._action("&About matedit", self.show_about)
 
     def _build_menus(self) -> None:
         mb = self.menuBar()
@@ -207,6 +245,7 @@ class MainWindow(QMainWindow):
             f.addAction(a)
         f.addSeparator()
         f.addAction(self.act_export)
+        f.addAction(self.act_save_image)
         f.addSeparator()
         f.addAction(self.act_quit)
         e = mb.addMenu("&Edit")
@@ -225,8 +264,15 @@ class MainWindow(QMainWindow):
                      self.library_dock, self.lights_dock, self.code_dock,
                      self.diagnostics_dock, self.history_dock):
             v.addAction(dock.toggleViewAction())
+        v.addAction(self.act_snap)
         v.addSeparator()
         v.addAction(self.act_reset_layout)
+        h = mb.addMenu("&Help")
+        for a in (self.act_shortcuts, self.act_node_docs, None, self.act_about):
+            if a is None:
+                h.addSeparator()
+            else:
+                h.addAction(a)
         tb = self.addToolBar("Main")
         tb.setObjectName("mainToolBar")
         tb.setMovable(False)
@@ -254,12 +300,14 @@ class MainWindow(QMainWindow):
         self.actions.opened.connect(lambda _p: self._retitle())
         self.actions.saved.connect(lambda p: self.status(f"saved {p}"))
         self.actions.message.connect(self.status)
-        self.compiler.compiled.connect(self._compiled)
-        self.compiler.failed.connect(self._compile_failed)
-        self.viewport.view.glErrors.connect(self._gl_errors)
-        self.viewport.view.materialApplied.connect(self._material_applied)
+        self.problems.changed.connect(self._refresh_problems)
         self.viewport.statusMessage.connect(self.status)
         self.viewport.environmentChanged.connect(lambda s: self.status(f"environment: {s}"))
+        self.tabs.materialOpenRequested.connect(self.open_material)
+        self.tabs.docsRequested.connect(self.show_docs)
+        self.inspector.docsRequested.connect(self.show_docs)
+        self.tabs.previewRequested.connect(
+            lambda nid, port: self.compiler.set_preview(PreviewTarget(nid, port)))
         self.tabs.activeChanged.connect(self._on_active)
         self.tabs.selectionChanged.connect(self.inspector.set_selection)
         self.tabs.message.connect(self.status)
@@ -275,15 +323,16 @@ class MainWindow(QMainWindow):
         self.library.layerAddRequested.connect(
             lambda p: self.layers.add_layer_file(Path(p)))
         self.diagnostics.nodeActivated.connect(self.select_node)
-        self.lights.lightsChanged.connect(self.viewport.view.set_lights)
+        self.lights.lightsChanged.connect(self.viewport.set_lights)
         QTimer.singleShot(0, self, self._sync_lights)
 
     def _sync_lights(self) -> None:
         """The lights panel starts with the renderer's default lights once GL is up."""
-        if self.viewport.view.renderer is not None and not self.lights.lights:
-            self.lights.set_lights(self.viewport.view.lights)
-        elif self.viewport.view.renderer is None and not self.viewport.view.problem:
+        lights = self.viewport.renderer_lights()
+        if lights is None:
             QTimer.singleShot(200, self, self._sync_lights)
+        elif lights and not self.lights.lights:
+            self.lights.set_lights(lights)
 
     # --- documents -------------------------------------------------------------------------
     def open_material(self, path: str | Path) -> bool:
@@ -291,11 +340,51 @@ class MainWindow(QMainWindow):
             return False
         return self.actions.open(path)
 
+    # --- help ------------------------------------------------------------------------------
+    def show_shortcuts(self) -> ShortcutReference:
+        if self._shortcuts is None:
+            self._shortcuts = ShortcutReference(self)
+        self._shortcuts.show()
+        self._shortcuts.raise_()
+        return self._shortcuts
+
+    def show_docs(self, kind: str) -> NodeDocs:
+        if self._docs is None:
+            self._docs = NodeDocs(kind, self)
+        self._docs.show_kind(kind)
+        self._docs.show()
+        self._docs.raise_()
+        return self._docs
+
+    def show_selected_docs(self) -> None:
+        ids = self.tabs.active.canvas.selected_ids()
+        node = self.tabs.active.controller.document.graph.nodes.get(ids[0]) if ids else None
+        self.show_docs(node.kind if node is not None else "material_output")
+
+    def show_about(self) -> None:
+        show_about(self, self.viewport.gl_renderer())
+
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
+        """Tab opens the palette whenever the pointer is over the active canvas, wherever
+        the keyboard focus is in this window."""
+        if event.type() == QEvent.Type.KeyPress and event.key() == Qt.Key.Key_Tab and \
+                event.modifiers() == Qt.KeyboardModifier.NoModifier and \
+                isinstance(obj, QWidget) and obj.window() is self:
+            canvas = self.tabs.active.canvas
+            vp = canvas.viewport()
+            inside = vp.rect().contains(vp.mapFromGlobal(QCursor.pos()))
+            if inside and canvas.isVisible() and not canvas.node_palette.isAncestorOf(obj) \
+                    and obj is not canvas.node_palette:
+                canvas.open_palette()
+                return True
+        return super().eventFilter(obj, event)
+
     def _open_recovered_material(self, entry, doc) -> None:
         """A second recovered material gets a window of its own."""
         w = MainWindow(restore_layout=False, start=False)
-        for name in ("ask_save_changes", "ask_recover", "show_error"):
-            setattr(w.actions, name, getattr(self.actions, name))
+        w.actions.ask_save_changes = self.actions.ask_save_changes
+        w.actions.ask_recover = self.actions.ask_recover
+        w.actions.show_error = self.actions.show_error
         w.actions._adopt(entry, doc)
         w.compiler.recompile()
         w.show()
@@ -316,7 +405,8 @@ class MainWindow(QMainWindow):
 
     def _document_replaced(self) -> None:
         self._retitle()
-        self.viewport.set_preview(self.controller.document.preview)
+        self.viewport.set_preview(self.controller.document.preview,
+                                  self.controller.document.path)
         self.inspector.show_node(None)
 
     def _clean_changed(self, _clean: bool) -> None:
@@ -363,62 +453,26 @@ class MainWindow(QMainWindow):
         self.tabs.material.canvas.select_nodes([stack_id])
         self.inspector.show_node(stack_id)
 
+    @property
+    def canvas(self) -> NodeCanvasView:
+        """The active tab's canvas."""
+        return self.tabs.active.canvas
+
     def open_palette(self) -> None:
-        self._canvas_call("open_palette")
+        self.canvas.open_palette()
 
-    def _canvas_call(self, method: str):
-        """Calls a canvas method on the active tab's canvas."""
-        fn = getattr(self.tabs.active.canvas, method, None)
-        return fn() if fn is not None else None
-
-    # --- compile results and problems ------------------------------------------------------
-    def _compiled(self, cm) -> None:
-        self._problems["compile"] = []
-        self.compile_label.setText(f"compiled in {self.compiler.last_compile_ms:.0f} ms")
-        self._refresh_problems()
-
-    def _compile_failed(self, diagnostics) -> None:
-        self._problems["compile"] = [
-            Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "compiler")
-            for d in diagnostics]
-        self.compile_label.setText("does not compile: the viewport shows the last good "
-                                   "material")
-        self._refresh_problems()
-
-    def _gl_errors(self, errors) -> None:
-        self._problems["gl"] = [Problem("error", str(msg), nid or "", "", "GL")
-                                for nid, msg in errors]
-        self.compile_label.setText("GLSL failed to build: the viewport keeps the last good "
-                                   "program")
-        self._refresh_problems()
-
-    def _material_applied(self, ok: bool) -> None:
-        if ok:
-            self._problems["gl"] = []
-            self._refresh_problems()
-
+    # --- problems --------------------------------------------------------------------------
     def _refresh_problems(self) -> None:
         tab = self.tabs.active
-        problems: list[Problem] = []
-        a = tab.controller.analysis
-        if a is not None:
-            problems += [Problem(d.severity.value, d.message, d.node_id or "", d.port or "",
-                                 "graph") for d in a.diagnostics]
-        if tab is self.tabs.material:
-            problems += self._problems["compile"] + self._problems["gl"]
-        self.diagnostics.set_problems(problems)
-        errors = self.diagnostics.errors_by_node()
-        tab.canvas.set_node_errors(errors)
-        if tab is not self.tabs.material:
-            m = self.tabs.material
-            merr: dict[str, str] = {}
-            for p in self._problems["compile"] + self._problems["gl"]:
-                if p.node_id and p.severity == "error":
-                    merr[p.node_id] = p.message
-            m.canvas.set_node_errors(merr)
+        m = self.tabs.material
+        self.compile_label.setText(self.problems.status)
+        self.diagnostics.set_problems(self.problems.for_tab(tab.controller.analysis,
+                                                            tab is m))
+        tab.canvas.set_node_errors(self.diagnostics.errors_by_node())
+        if tab is not m:
+            m.canvas.set_node_errors(self.problems.material_errors())
         n = sum(1 for p in self.diagnostics.problems if p.severity == "error")  # the rows
-        title = "Diagnostics" + (f" ({n})" if n else "")
-        self.diagnostics_dock.setWindowTitle(title)
+        self.diagnostics_dock.setWindowTitle("Diagnostics" + (f" ({n})" if n else ""))
         self._retitle()
 
     def status(self, text: str) -> None:
@@ -426,7 +480,24 @@ class MainWindow(QMainWindow):
 
     # --- layout ----------------------------------------------------------------------------
     def restore_layout(self) -> None:
+        """Window geometry, docks, the viewport's view, the light rig and grid snapping."""
         s = QSettings()
+        self.act_snap.setChecked(s.value(SNAP_KEY, False, type=bool))
+        try:
+            view = json.loads(str(s.value(VIEW_KEY, "") or "{}"))
+            rig = json.loads(str(s.value(LIGHTS_KEY, "") or "null"))
+        except ValueError:
+            view, rig = {}, None
+        if isinstance(view, dict) and view:
+            QTimer.singleShot(0, self, lambda: self.viewport.restore_view_state(view))
+        if isinstance(rig, list):
+            try:
+                lights = [Light(**{k: tuple(v) if isinstance(v, list) else v
+                                   for k, v in d.items()}) for d in rig]
+            except TypeError:
+                lights = None
+            if lights is not None:
+                self.lights.set_lights(lights, emit=True)
         geo = s.value(GEOMETRY_KEY)
         state = s.value(STATE_KEY)
         if isinstance(geo, QByteArray) and not geo.isEmpty():
@@ -436,6 +507,10 @@ class MainWindow(QMainWindow):
 
     def save_layout(self) -> None:
         s = QSettings()
+        s.setValue(SNAP_KEY, self.act_snap.isChecked())
+        s.setValue(VIEW_KEY, json.dumps(self.viewport.view_state()))
+        if self.lights.lights:
+            s.setValue(LIGHTS_KEY, json.dumps([asdict(light) for light in self.lights.lights]))
         s.setValue(GEOMETRY_KEY, self.saveGeometry())
         s.setValue(STATE_KEY, self.saveState(STATE_VERSION))
 

@@ -34,8 +34,12 @@ RECOVER, DISCARD, KEEP = "recover", "discard", "keep"
 
 
 def recovery_dir() -> Path:
-    """The folder of recovery files: `matedit.dirs.recovery_dir()` (platformdirs: on Linux
-    `$XDG_DATA_HOME/matedit/recovery`), the one place that says where it is."""
+    """The folder of recovery files, the one place that says where it is:
+    `MATEDIT_RECOVERY_DIR` if set (tests, several editors side by side), else
+    `matedit.dirs.recovery_dir()` (platformdirs: on Linux `$XDG_DATA_HOME/matedit/recovery`)."""
+    override = os.environ.get("MATEDIT_RECOVERY_DIR")
+    if override:
+        return Path(override)
     from matedit import dirs
 
     return dirs.recovery_dir()

@@ -10,6 +10,7 @@ out through `glErrors`. A value edit only sets uniforms and redraws.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +20,7 @@ from PySide6.QtOpenGLWidgets import QOpenGLWidget
 from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
+    QDoubleSpinBox,
     QFileDialog,
     QHBoxLayout,
     QLabel,
@@ -38,6 +40,17 @@ MODES = {"Split-sum": "splitsum", "Reference": "reference", "Difference": "diffe
 ENVIRONMENTS = {"Studio": "studio", "Sky": "sky"}
 OPEN_ENV = "Open HDR/EXR…"
 ENV_FILTER = "HDR environments (*.hdr *.exr);;All files (*)"
+SAVE_FILTER = "PNG image, as shown (*.png);;OpenEXR, linear radiance (*.exr)"
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """How the viewport draws, apart from the material: renderer attributes that need no GL
+    work to change (a typed record, not option names)."""
+
+    environment_intensity: float = 1.0
+    show_background: bool = True
+    background_blur: float = 0.0
 
 
 def _load_renderer_class():
@@ -78,7 +91,7 @@ class ViewportWidget(QOpenGLWidget):
         self.last_frame_time = 0.0
         self._fbo = None
         self._fbo_glo = -1
-        self._options: dict[str, Any] = {}
+        self.settings = RenderSettings()
 
     # --- GL lifecycle ----------------------------------------------------------------------
     def initializeGL(self) -> None:  # noqa: N802 - Qt's name
@@ -118,13 +131,11 @@ class ViewportWidget(QOpenGLWidget):
         r.set_mesh(self._mesh)
         r.mode = self._mode
         r.exposure = self._exposure
-        for name, value in self._options.items():
-            if hasattr(r, name):
-                setattr(r, name, value)
+        self._apply_settings(r)
         if self._lights is not None:
             r.set_lights(list(self._lights))
         else:
-            self._lights = list(getattr(r, "lights", []) or [])
+            self._lights = list(r.lights)
         if set_environment:
             self._set_environment_now(self._environment, None)
 
@@ -152,7 +163,7 @@ class ViewportWidget(QOpenGLWidget):
         self.frames += 1
         self.last_frame_time = time.perf_counter() - t0
         self.frameDrawn.emit()
-        if getattr(self.renderer, "needs_redraw", False):
+        if self.renderer.needs_redraw:
             QTimer.singleShot(0, self, self.update)  # reference mode accumulates until converged
 
     def _paint_message(self, text: str) -> None:
@@ -181,9 +192,9 @@ class ViewportWidget(QOpenGLWidget):
             self.materialApplied.emit(False)
             return False
         self.doneCurrent()
-        ok = bool(getattr(status, "ok", True))
+        ok = bool(status.ok)
         if not ok:
-            self.glErrors.emit(list(getattr(status, "errors", []) or []))
+            self.glErrors.emit(list(status.errors or []))
         self.materialApplied.emit(ok)
         self.update()
         return ok
@@ -234,14 +245,22 @@ class ViewportWidget(QOpenGLWidget):
             self.renderer.exposure = float(ev)
             self.update()
 
-    def set_render_option(self, name: str, value) -> None:
-        """A renderer attribute that needs no GL work (background, blur, IBL intensity)."""
-        self._options[name] = value
-        if self.renderer is not None and hasattr(self.renderer, name):
-            setattr(self.renderer, name, value)
-            if hasattr(self.renderer, "reset_accumulation"):
-                self.renderer.reset_accumulation()
+    def set_settings(self, settings: RenderSettings) -> None:
+        """New render settings (background, blur, IBL intensity): no GL work, a redraw."""
+        self.settings = settings
+        if self.renderer is not None:
+            self._apply_settings(self.renderer)
+            self.renderer.reset_accumulation()
             self.update()
+
+    def change_settings(self, **changes) -> None:
+        self.set_settings(replace(self.settings, **changes))
+
+    def _apply_settings(self, r) -> None:
+        s = self.settings
+        r.environment_intensity = s.environment_intensity
+        r.show_background = s.show_background
+        r.background_blur = s.background_blur
 
     @property
     def lights(self) -> list:
@@ -270,6 +289,27 @@ class ViewportWidget(QOpenGLWidget):
 
     def _set_environment_now(self, spec: str, progress) -> None:
         self.renderer.set_environment(spec, progress=progress)
+
+    def gl_renderer(self) -> str:
+        """The OpenGL renderer string ("" before GL is up)."""
+        if self.ctx is None:
+            return ""
+        try:
+            info = self.ctx.info
+            return f"{info.get('GL_RENDERER', '?')} ({info.get('GL_VERSION', '?')})"
+        except Exception:  # a context that cannot answer says nothing
+            return ""
+
+    def read_hdr(self):
+        """(H, W, 3) scene-linear radiance of the last frame (before exposure and display
+        transform), or None without a renderer."""
+        if self.renderer is None:
+            return None
+        self.makeCurrent()
+        try:
+            return self.renderer.read_hdr()
+        finally:
+            self.doneCurrent()
 
     def read_image(self):
         """(H, W, 3) sRGB floats of the last frame, through the renderer."""
@@ -325,6 +365,8 @@ class ViewportPanel(QWidget):
 
     environmentChanged = Signal(str)
     statusMessage = Signal(str)
+    glErrors = Signal(list)  # the view's: [(node id, message)] when a program fails to build
+    materialApplied = Signal(bool)
 
     def __init__(self, compiler: MaterialCompiler, parent=None) -> None:
         super().__init__(parent)
@@ -349,38 +391,78 @@ class ViewportPanel(QWidget):
         self.env_combo.addItems([*ENVIRONMENTS, OPEN_ENV])
         self.env_combo.setToolTip("Environment lighting")
         self.exposure = QSlider(Qt.Orientation.Horizontal)
-        self.exposure.setRange(-60, 60)  # tenths of EV
-        self.exposure.setFixedWidth(90)
-        self.exposure.setToolTip("Exposure (EV)")
-        self.exposure_label = QLabel("0.0 EV")
-        self.exposure_label.setMinimumWidth(44)
-        self.diff_label = QLabel("")
+        self.exposure.setRange(-60, 60)  # tenths of EV: the arrow keys step 0.1 EV
+        self.exposure.setSingleStep(1)
+        self.exposure.setPageStep(10)
+        self.exposure.setMinimumWidth(140)
+        self.exposure.setToolTip("Exposure (EV); arrow keys step 0.1 EV, Page Up/Down 1 EV")
+        self.exposure_spin = QDoubleSpinBox()
+        self.exposure_spin.setRange(-6.0, 6.0)
+        self.exposure_spin.setDecimals(1)
+        self.exposure_spin.setSingleStep(0.1)
+        self.exposure_spin.setSuffix(" EV")
+        self.exposure_spin.setKeyboardTracking(False)
+        self.exposure_spin.setToolTip("Exposure in EV (type a value; arrow keys step 0.1)")
+        self.exposure_label = self.exposure_spin  # the number shown beside the slider
+        # Laid over the view's bottom edge (placed with the banner): its text never moves
+        # anything, and it takes no room from the bar.
+        self.diff_label = QLabel("", self)
         self.diff_label.setObjectName("diffMean")
+        self.diff_label.setStyleSheet("background: rgba(20, 22, 27, 170); color: #d5d9e0;"
+                                      " padding: 1px 6px;")
+        self.diff_label.hide()
+        self.diff_label.setToolTip("Reference and difference modes: samples a pixel so far, "
+                                   "and the mean difference from the split-sum image")
+        self.save_button = QToolButton()
+        self.save_button.setIcon(icon("save"))
+        self.save_button.setToolTip("Save the viewport image (PNG as shown, or linear EXR)")
+        self.save_button.clicked.connect(self.save_image_dialog)
         reset = QToolButton()
         reset.setIcon(icon("reset"))
         reset.setToolTip("Reset the camera (or double-click the view)")
         for w in (self.mesh_combo, self.mode_combo, self.env_combo):
             bl.addWidget(w)
-        bl.addWidget(self.exposure)
-        bl.addWidget(self.exposure_label)
-        bl.addWidget(self.diff_label)
+        bl.addWidget(self.exposure, 1)
+        bl.addWidget(self.exposure_spin)
         bl.addStretch(1)
+        bl.addWidget(self.save_button)
         bl.addWidget(reset)
         lay.addWidget(bar)
+        self.banner = QWidget(self)  # laid over the view's top edge: the view keeps its size
+        self.banner.setObjectName("previewBanner")
+        self.banner.setStyleSheet("#previewBanner { background: #6b4f12; }")
+        bn = QHBoxLayout(self.banner)
+        bn.setContentsMargins(8, 2, 4, 2)
+        self.banner_label = QLabel("")
+        self.banner_label.setStyleSheet("color: #ffe7a8; font-weight: bold;")
+        self.banner_clear = QToolButton()
+        self.banner_clear.setText("Show material")
+        self.banner_clear.setToolTip("Stop previewing the node: show the whole material again")
+        self.banner_clear.clicked.connect(lambda: compiler.set_preview(None))
+        bn.addWidget(self.banner_label, 1)
+        bn.addWidget(self.banner_clear)
+        self.banner.hide()
         self.view = ViewportWidget()
         lay.addWidget(self.view, 1)
         self._env_index = 0
         self._custom_envs: list[str] = []
         self.env_dialog = QFileDialog.getOpenFileName  # tests replace it
+        self.save_dialog = QFileDialog.getSaveFileName  # tests replace it
+        self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment
         self.mesh_combo.currentTextChanged.connect(self.view.set_mesh)
         self.mode_combo.currentTextChanged.connect(self._mode_changed)
         self.exposure.valueChanged.connect(self._exposure_changed)
+        self.exposure_spin.valueChanged.connect(
+            lambda ev: self.exposure.setValue(int(round(ev * 10))))
         self.env_combo.activated.connect(self._env_activated)
         reset.clicked.connect(lambda: self.view.renderer and (self.view.renderer.camera.reset(),
                                                               self.view.update()))
         self.view.frameDrawn.connect(self._frame_drawn)
         self.view.statusMessage.connect(self.statusMessage)
+        self.view.glErrors.connect(self.glErrors)
+        self.view.materialApplied.connect(self.materialApplied)
         compiler.compiled.connect(self.on_compiled)
+        compiler.previewChanged.connect(self._preview_changed)
         self.controller.valuesChanged.connect(self.push_values)
 
     # --- material --------------------------------------------------------------------------
@@ -395,31 +477,196 @@ class ViewportPanel(QWidget):
         doc = self.controller.document
         self.view.set_values(uniform_values(cm, doc), texture_paths(cm, doc))
 
+    # --- the typed interface the window uses ------------------------------------------------
+    def set_lights(self, lights: list) -> None:
+        self.view.set_lights(lights)
+
+    def renderer_lights(self) -> list | None:
+        """The renderer's light rig once it runs; None while it starts; [] if it cannot."""
+        if self.view.renderer is not None:
+            return self.view.lights
+        return [] if self.view.problem else None
+
+    def gl_renderer(self) -> str:
+        return self.view.gl_renderer()
+
+    # --- saving the picture; dropped environments -------------------------------------------
+    def save_image_dialog(self) -> bool:
+        path, _ = self.save_dialog(self, "Save the viewport image", "viewport.png",
+                                   SAVE_FILTER)
+        return bool(path) and self.save_image(path)
+
+    def _inputs(self) -> set[Path]:
+        """Files the document reads: an image saved over one of them is refused."""
+        doc = self.controller.document
+        out = {Path(doc.path).resolve()} if doc.path else set()
+        cm = self.compiler.current or self.compiler.last_good
+        if cm is not None:
+            out |= {Path(p).resolve() for p in texture_paths(cm, doc).values() if p}
+        if Path(self.view._environment).suffix:
+            out.add(Path(self.view._environment).resolve())
+        return out
+
+    def save_image(self, path: str | Path) -> bool:
+        """The current frame as PNG (display-referred, as shown) or as EXR (scene-linear
+        radiance, before exposure and display transform)."""
+        path = Path(path)
+        if path.suffix.lower() not in (".png", ".exr"):
+            path = path.with_suffix(path.suffix + ".png") if path.suffix else \
+                path.with_suffix(".png")
+        if path.resolve() in self._inputs():
+            self.statusMessage.emit(f"{path.name} is a file the material reads: not "
+                                    "overwritten")
+            return False
+        if self.view.renderer is None:
+            self.statusMessage.emit("no image to save: the renderer is not running")
+            return False
+        try:
+            if path.suffix.lower() == ".exr":
+                from matedit.io.images import write_image
+
+                write_image(path, self.view.read_hdr())
+            else:
+                from PySide6.QtCore import QBuffer, QByteArray, QIODevice
+
+                from matedit.io.atomic import atomic_write_bytes
+
+                data = QByteArray()
+                buf = QBuffer(data)
+                buf.open(QIODevice.OpenModeFlag.WriteOnly)
+                if not self.view.grabFramebuffer().save(buf, "PNG"):
+                    raise OSError("PNG encoding failed")
+                buf.close()
+                atomic_write_bytes(path, bytes(data.data()))
+        except (OSError, ValueError) as exc:
+            self.statusMessage.emit(f"cannot save {path.name}: {exc}")
+            return False
+        self.statusMessage.emit(f"saved the viewport image to {path}")
+        return True
+
+    @staticmethod
+    def _dropped_environment(mime) -> str:
+        for url in mime.urls() if mime.hasUrls() else []:
+            p = url.toLocalFile()
+            if p and Path(p).suffix.lower() in (".hdr", ".exr"):
+                return p
+        return ""
+
+    def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._dropped_environment(event.mimeData()):
+            event.acceptProposedAction()
+        else:
+            event.ignore()
+
+    def dragMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        self.dragEnterEvent(event)
+
+    def dropEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        path = self._dropped_environment(event.mimeData())
+        if not path:
+            event.ignore()
+            return
+        event.acceptProposedAction()
+        self.choose_environment(path)
+
+    def _preview_changed(self, target) -> None:
+        if target is None:
+            self.banner.hide()
+            return
+        self.banner_label.setText(f"Previewing {target.label()}, not the material")
+        self._place_banner()
+        self.banner.show()
+        self.banner.raise_()
+
+    def _place_banner(self) -> None:
+        g = self.view.geometry()
+        self.banner.setGeometry(g.x(), g.y(), g.width(), self.banner.sizeHint().height())
+        self.diff_label.adjustSize()
+        self.diff_label.move(g.x() + 4, g.y() + g.height() - self.diff_label.height() - 4)
+
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        self._place_banner()
+
     # --- bar -------------------------------------------------------------------------------
     def _mode_changed(self, text: str) -> None:
         self.view.set_mode(MODES[text])
         self.diff_label.setText("")
+        self.diff_label.setVisible(MODES[text] != "splitsum")
 
     def _exposure_changed(self, tenths: int) -> None:
         ev = tenths / 10.0
-        self.exposure_label.setText(f"{ev:+.1f} EV")
+        self.exposure_spin.blockSignals(True)
+        self.exposure_spin.setValue(ev)
+        self.exposure_spin.blockSignals(False)
         self.view.set_exposure(ev)
 
     def _frame_drawn(self) -> None:
         r = self.view.renderer
-        if r is not None and getattr(r, "mode", "") == "difference":
-            mean = getattr(r, "difference_mean", None)
+        if r is None or r.mode == "splitsum":
+            return
+        total = r.reference_frames * r.reference_samples
+        done = min(r.accumulated_frames, r.reference_frames) * r.reference_samples
+        text = f"{done}/{total} samples" if not r.converged else f"{total} samples"
+        if r.mode == "difference" and r.converged:
+            mean = r.difference_mean
             if mean is not None:
-                self.diff_label.setText(f"mean |Δ| {float(mean):.4f}")
+                text += f" · mean |Δ| {float(mean):.4f}"
+        self.diff_label.setText(text)
+        self._place_banner()
+        self.diff_label.raise_()
 
-    def set_preview(self, preview: dict) -> None:
-        """Mesh and environment stored with a document."""
+    def view_state(self) -> dict:
+        """Mesh, mode, exposure and environment, as remembered across restarts."""
+        return {"mesh": self.mesh_combo.currentText(), "mode": self.mode_combo.currentText(),
+                "exposure": self.exposure.value() / 10.0,
+                "environment": self.view._environment}
+
+    def restore_view_state(self, state: dict) -> None:
+        mesh, mode = state.get("mesh"), state.get("mode")
+        if isinstance(mesh, str) and mesh in MESHES:
+            self.mesh_combo.setCurrentText(mesh)
+        if isinstance(mode, str) and mode in MODES:
+            self.mode_combo.setCurrentText(mode)
+        ev = state.get("exposure")
+        if isinstance(ev, (int, float)):
+            self.exposure.setValue(int(round(float(ev) * 10)))
+        env = state.get("environment")
+        if isinstance(env, str) and env and env != self.view._environment and (
+                env in ENVIRONMENTS.values() or Path(env).is_file()):
+            self.choose_environment(env)
+
+    def document_preview(self, saved_as: Path) -> dict:
+        """The mesh and environment to store in a document saved as `saved_as`: a user HDR
+        as a path relative to the document, like every reference it holds."""
+        import os
+
+        env = self.view._environment
+        if env not in ENVIRONMENTS.values():
+            try:
+                env = Path(os.path.relpath(Path(env).resolve(),
+                                           Path(saved_as).resolve().parent)).as_posix()
+            except ValueError:  # another drive
+                env = Path(env).resolve().as_posix()
+        return {"mesh": self.mesh_combo.currentText(), "environment": env}
+
+    def set_preview(self, preview: dict, doc_path: Path | None = None) -> None:
+        """Mesh and environment stored with a document (a file relative to `doc_path`)."""
         mesh = preview.get("mesh")
         if isinstance(mesh, str) and mesh in MESHES:
             self.mesh_combo.setCurrentText(mesh)
         env = preview.get("environment")
-        if isinstance(env, str) and env in ENVIRONMENTS.values() and \
-                env != self.view._environment:
+        if not isinstance(env, str) or not env:
+            return
+        if env not in ENVIRONMENTS.values():
+            p = Path(env)
+            if not p.is_absolute() and doc_path is not None:
+                p = Path(doc_path).resolve().parent / p
+            if not p.is_file():
+                self.statusMessage.emit(f"the document's environment {env} is missing")
+                return
+            env = str(p.resolve())
+        if env != self.view._environment:
             self.choose_environment(env)
 
     def _env_activated(self, index: int) -> None:
@@ -497,17 +744,17 @@ class EnvironmentPanel(QWidget):
         self.intensity = FloatField(1.0, (0.0, 4.0))
         self.intensity.setToolTip("Multiplies the environment's light")
         self.intensity.edited.connect(
-            lambda v, _m: viewport.view.set_render_option("environment_intensity", float(v)))
+            lambda v, _m: viewport.view.change_settings(environment_intensity=float(v)))
         form.addRow("intensity", self.intensity)
         self.background = QCheckBox("show behind the mesh")
         self.background.setChecked(True)
         self.background.toggled.connect(
-            lambda on: viewport.view.set_render_option("show_background", bool(on)))
+            lambda on: viewport.view.change_settings(show_background=bool(on)))
         form.addRow("background", self.background)
         self.blur = FloatField(0.0, (0.0, 1.0))
         self.blur.setToolTip("Blurs the background only (lighting is unchanged)")
         self.blur.edited.connect(
-            lambda v, _m: viewport.view.set_render_option("background_blur", float(v)))
+            lambda v, _m: viewport.view.change_settings(background_blur=float(v)))
         form.addRow("blur", self.blur)
         lay.addLayout(form)
 

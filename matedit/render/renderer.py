@@ -393,6 +393,11 @@ class Renderer:
     def converged(self) -> bool:
         return self.mode == "splitsum" or self._accum_frames >= self.reference_frames
 
+    @property
+    def accumulated_frames(self) -> int:
+        """Reference frames averaged so far (converged at `reference_frames`)."""
+        return self._accum_frames
+
     def _write_frame_block(self) -> np.ndarray:
         w, h = self._size
         view = self.camera.view_matrix()

@@ -91,6 +91,7 @@ class NodePalette(QFrame):
 
     chosen = Signal(str)
     cancelled = Signal()
+    docsRequested = Signal(str)  # F1 on an entry: that kind's documentation
 
     def __init__(self, parent: QWidget) -> None:
         super().__init__(parent)
@@ -124,6 +125,7 @@ class NodePalette(QFrame):
         lay.addWidget(self.about)
         self.resize(300, 400)
         self._entries = catalogue()
+        self.out_of_place: frozenset[str] = frozenset()  # kinds ranked last in this document
         self._filter: Callable[[str], bool] | None = None
         self.search.textChanged.connect(self._refill)
         self.search.installEventFilter(self)
@@ -162,13 +164,18 @@ class NodePalette(QFrame):
     def _refill(self) -> None:
         query = self.search.text().strip()
         entries = [e for e in self._entries if self._filter is None or self._filter(e.kind)]
+        # Kinds that belong to the other kind of document go last (stable: rank kept).
+        entries.sort(key=lambda e: e.kind in self.out_of_place)
         self.list.clear()
         if query:
-            for e in search(query, entries):
+            found = search(query, entries)
+            found.sort(key=lambda e: e.kind in self.out_of_place)
+            for e in found:
                 self._add_entry(e, show_category=True)
         else:
             category = None
-            for e in entries:
+            order = {c: i for i, c in enumerate(dict.fromkeys(e.category for e in entries))}
+            for e in sorted(entries, key=lambda e: order[e.category]):
                 if e.category != category:
                     category = e.category
                     self._add_header(category)
@@ -234,5 +241,10 @@ class NodePalette(QFrame):
                 return True
             if key in (Qt.Key.Key_PageDown, Qt.Key.Key_PageUp):
                 self._step(8 if key == Qt.Key.Key_PageDown else -8)
+                return True
+            if key == Qt.Key.Key_F1:
+                item = self.list.currentItem()
+                if item is not None and item.data(KIND_ROLE):
+                    self.docsRequested.emit(item.data(KIND_ROLE))
                 return True
         return super().eventFilter(obj, event)

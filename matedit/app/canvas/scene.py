@@ -90,6 +90,7 @@ class NodeScene(QGraphicsScene):
         self.comment_items: dict[str, CommentItem] = {}
         self._wires_of: dict[str, set[Link]] = {}
         self._node_errors: dict[str, str] = {}  # GLSL errors mapped to nodes, from the window
+        self.snap_to_grid = False  # moves end on the minor grid
         self._previews: dict[str, QImage] = {}
         self.selected_wires: set[Link] = set()  # wires keep their own selection (see WireItem)
         self.hairline = False  # wires draw as hairlines when zoomed far out
@@ -396,9 +397,13 @@ class NodeScene(QGraphicsScene):
         """After a drag: one MoveNodes for every node whose item left its model position."""
         graph = self.graph
         moved = {}
+        g = C.GRID_MINOR
         for it in self.selectedItems():
             if isinstance(it, NodeItem) and it.node_id in graph.nodes:
                 p = (it.pos().x(), it.pos().y())
+                if self.snap_to_grid:  # the top-left corner lands on the minor grid
+                    p = (round(p[0] / g) * g, round(p[1] / g) * g)
+                    it.setPos(*p)
                 if p != graph.nodes[it.node_id].position:
                     moved[it.node_id] = p
         if moved and not self.controller.push(MoveNodes(moved)):

@@ -16,11 +16,12 @@ import dataclasses
 import re
 
 from PySide6.QtCore import QEvent, QPoint, QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QImage, QKeySequence, QPainter, QPixmapCache, QTransform
+from PySide6.QtGui import QAction, QImage, QKeySequence, QPainter, QPixmapCache, QTransform
 from PySide6.QtWidgets import (
     QApplication,
     QGraphicsView,
     QInputDialog,
+    QLineEdit,
     QMenu,
     QWidget,
 )
@@ -28,6 +29,7 @@ from PySide6.QtWidgets import (
 from matedit.app.canvas import clipboard
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.comment_item import CommentItem
+from matedit.app.canvas.drops import CanvasDrops
 from matedit.app.canvas.interaction import WireDrag, compatible_port, kind_ports, port_at
 from matedit.app.canvas.minimap import MiniMap
 from matedit.app.canvas.node_item import NodeItem, PortRow, measure
@@ -37,8 +39,17 @@ from matedit.app.canvas.toast import Toast
 from matedit.app.canvas.wire_item import WireItem
 from matedit.app.controller import DocumentController
 from matedit.graph import nodes
-from matedit.graph.commands import AddNode, Command, Connect, Disconnect, PutComment, RemoveNode
+from matedit.graph.commands import (
+    AddNode,
+    Command,
+    Connect,
+    Disconnect,
+    PutComment,
+    RemoveNode,
+    SetLabel,
+)
 from matedit.graph.model import Comment, Link, MaterialDocument, Node
+from matedit.graph.types import PortType
 from matedit.graph.validate import check_connect
 
 _DRAG_START = 4  # pixels the mouse must travel before a press on a port becomes a drag
@@ -50,12 +61,15 @@ def _id_stem(kind: str) -> str:
     return (parts[0] + "".join(p[:1].upper() + p[1:] for p in parts[1:])) if parts else "n"
 
 
-class NodeCanvasView(QGraphicsView):
+class NodeCanvasView(CanvasDrops, QGraphicsView):
     """The node canvas over one DocumentController (see `matedit.app.canvas` for the API)."""
 
     selectionChangedIds = Signal(list)
     functionOpenRequested = Signal(str)
     message = Signal(str)
+    previewRequested = Signal(str, str)  # node id, output port: show it in the viewport
+    materialOpenRequested = Signal(str)  # a material file dropped on the canvas
+    docsRequested = Signal(str)  # a node kind whose documentation to show (F1)
 
     def __init__(self, controller: DocumentController, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -82,10 +96,13 @@ class NodeCanvasView(QGraphicsView):
         self.setMouseTracking(True)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setStyleSheet("QGraphicsView { background: #1b1e24; border: none; }")
+        self.setAcceptDrops(True)
+        self.run_menu = lambda menu, at: menu.exec(at)  # tests read the menu instead
 
         self.node_palette = NodePalette(self)
         self.node_palette.chosen.connect(self._palette_chosen)
         self.node_palette.cancelled.connect(self._palette_cancelled)
+        self.node_palette.docsRequested.connect(self.docsRequested)
         self.toast = Toast(self.viewport())
         self.minimap = MiniMap(self)
 
@@ -98,6 +115,7 @@ class NodeCanvasView(QGraphicsView):
         self._palette_anchor: tuple[str, str, bool, str] | None = None
         self._selecting = False
         self._last_ids: list[str] = []
+        self._rename_edit: QLineEdit | None = None
 
         self._scene.selectionChanged.connect(self._selection_changed)
         self._scene.commentTextRequested.connect(self._edit_comment_text)
@@ -161,6 +179,25 @@ class NodeCanvasView(QGraphicsView):
         """The node palette at `scene_pos` (default: the cursor, else the middle of the view)."""
         self._palette_anchor = None
         self._show_palette(self._resolve_pos(scene_pos), None, "Add node")
+
+    def previewable_output(self, node_id: str, port: str = "") -> str:
+        """`port` if the node has that output with a value to show, else its first such
+        output ("" if none: a texture object, say)."""
+        a = self.controller.analysis
+        outs = a.out_types.get(node_id, {}) if a is not None else {}
+        ok = [p for p, t in outs.items() if t.is_numeric or t == PortType.MATERIAL]
+        if port in ok:
+            return port
+        return ok[0] if ok else ""
+
+    def preview_node(self, node_id: str, port: str = "") -> bool:
+        """Asks the viewport to show one of the node's outputs (see `previewRequested`)."""
+        port = self.previewable_output(node_id, port)
+        if not port:
+            self.refuse(f"{node_id} has no output the viewport can show")
+            return False
+        self.previewRequested.emit(node_id, port)
+        return True
 
     def set_minimap_visible(self, visible: bool) -> None:
         self.minimap.setVisible(visible)
@@ -278,6 +315,9 @@ class NodeCanvasView(QGraphicsView):
 
     def _show_palette(self, scene_pos: QPointF, accept, hint: str) -> None:
         self._palette_pos = QPointF(scene_pos)
+        self.node_palette.out_of_place = frozenset(
+            {"material_output"} if self.controller.document.is_function
+            else {"function_input", "function_output"})
         at = self.viewport().mapTo(self, self.mapFromScene(scene_pos))
         self.node_palette.popup(at, accept, hint)
 
@@ -475,10 +515,78 @@ class NodeCanvasView(QGraphicsView):
                 lambda kind: compatible_port(kind, a_type, anchor.is_output) is not None,
                 f"Connect to {anchor.node_id}.{anchor.name} ({a_type} {side})")
 
+    def start_rename(self, node_id: str) -> QLineEdit | None:
+        """An editor over the node's title: Enter renames (one undo step), Esc cancels."""
+        item = self._scene.node_items.get(node_id)
+        node = self.controller.document.graph.nodes.get(node_id)
+        if item is None or node is None:
+            return None
+        if self._rename_edit is not None:
+            self._rename_edit.deleteLater()
+        top_left = self.mapFromScene(item.mapToScene(QPointF(0, 0)))
+        width = int(item.layout.width * self.zoom())
+        edit = QLineEdit(item.title, self.viewport())
+        edit.setObjectName("renameNode")
+        edit.setGeometry(top_left.x(), top_left.y(), max(width, 120),
+                         max(22, int(C.HEADER_HEIGHT * self.zoom())))
+        edit.selectAll()
+        done = {"ok": False}
+
+        def commit() -> None:
+            if done["ok"]:
+                return
+            done["ok"] = True
+            text = edit.text().strip()
+            d = nodes.REGISTRY.get(node.kind)
+            label = "" if d is not None and text == d.title else text
+            current = self.controller.document.graph.nodes.get(node_id)
+            if current is not None and label != current.label and text:
+                self.controller.push(SetLabel(node_id, label))
+            edit.deleteLater()
+            self._rename_edit = None
+            self.setFocus()
+
+        def cancel() -> None:
+            done["ok"] = True
+            edit.deleteLater()
+            self._rename_edit = None
+            self.setFocus()
+
+        edit.returnPressed.connect(commit)
+        edit.editingFinished.connect(commit)
+        edit.addAction(QAction(edit, shortcut=QKeySequence(Qt.Key.Key_Escape),
+                               triggered=cancel))
+        edit.show()
+        edit.setFocus()
+        self._rename_edit = edit
+        return edit
+
+    def insert_reroute(self, link: Link, scene_pos: QPointF) -> str:
+        """A reroute on `link` at `scene_pos`, as one undo step; its id ('' if refused)."""
+        node = self._new_node("reroute", scene_pos - QPointF(C.REROUTE_RADIUS,
+                                                             C.REROUTE_RADIUS), None)
+        if node is None or link not in self.controller.document.graph.links:
+            return ""
+        ok = self.controller.push_all(
+            [Disconnect(link), AddNode(node), Connect(Link(link.src, link.src_port, node.id,
+                                                           "value")),
+             Connect(Link(node.id, "value", link.dst, link.dst_port))], "insert reroute")
+        return node.id if ok else ""
+
     def mouseDoubleClickEvent(self, event) -> None:
         item = self.itemAt(event.position().toPoint())
+        if isinstance(item, WireItem):  # a reroute where the wire was double-clicked
+            self.insert_reroute(item.link, self.mapToScene(event.position().toPoint()))
+            event.accept()
+            return
         while item is not None and not isinstance(item, (NodeItem, CommentItem)):
             item = item.parentItem()
+        if isinstance(item, NodeItem) and item.kind != "function_call" and \
+                item.mapFromScene(self.mapToScene(event.position().toPoint())).y() \
+                < C.HEADER_HEIGHT:  # double-click on the title: rename
+            self.start_rename(item.node_id)
+            event.accept()
+            return
         if isinstance(item, NodeItem) and item.kind == "function_call":
             node = self.controller.document.graph.nodes.get(item.node_id)
             ref = node.settings.get("function") if node else None
@@ -496,9 +604,11 @@ class NodeCanvasView(QGraphicsView):
         item = self.itemAt(pos)
         while item is not None and not isinstance(item, (NodeItem, CommentItem, WireItem)):
             item = item.parentItem()
+        wire = None
         if isinstance(item, WireItem):
             self._scene.clearSelection()
             self._scene.select_wire(item.link)
+            wire = item.link
         elif item is not None and not item.isSelected() and isinstance(
                 item, (NodeItem, CommentItem)):
             self._scene.clearSelection()
@@ -506,6 +616,18 @@ class NodeCanvasView(QGraphicsView):
             item.setSelected(True)
         menu = QMenu(self)
         menu.addAction("Add node…\tTab", lambda: self.open_palette(sp))
+        if wire is not None:
+            menu.addAction("Insert reroute\tdouble-click",
+                           lambda: self.insert_reroute(wire, sp))
+        if isinstance(item, NodeItem) and not self.controller.document.is_function:
+            port = port_at(self._scene, sp, self._hit_radius(), want_output=True)
+            name = port.name if port is not None and port.node_id == item.node_id else ""
+            name = self.previewable_output(item.node_id, name)
+            act = menu.addAction(f"Preview in viewport ({name})" if name else
+                                 "Preview in viewport",
+                                 lambda n=item.node_id, p=name: self.preview_node(n, p))
+            act.setEnabled(bool(name))
+            menu.addSeparator()
         has_sel = bool(self._scene.selectedItems() or self._scene.selected_wires)
         for text, slot, key, enabled in (
                 ("Copy", self.copy_selection, "Ctrl+C", has_sel),
@@ -517,7 +639,7 @@ class NodeCanvasView(QGraphicsView):
                 ("Frame all", self.frame_all, "Home", True)):
             action = menu.addAction(f"{text}\t{key}", slot)
             action.setEnabled(enabled)
-        menu.exec(event.globalPos())
+        self.run_menu(menu, event.globalPos())
 
     # --- keys --------------------------------------------------------------------------------
     _OWN_KEYS = (QKeySequence.StandardKey.Copy, QKeySequence.StandardKey.Paste,
@@ -532,7 +654,7 @@ class NodeCanvasView(QGraphicsView):
         return mods == Qt.KeyboardModifier.NoModifier and key in (
             Qt.Key.Key_Tab, Qt.Key.Key_Delete, Qt.Key.Key_Backspace, Qt.Key.Key_F,
             Qt.Key.Key_A, Qt.Key.Key_Home, Qt.Key.Key_C, Qt.Key.Key_M, Qt.Key.Key_Space,
-            Qt.Key.Key_Escape)
+            Qt.Key.Key_Escape, Qt.Key.Key_F1, Qt.Key.Key_F2)
 
     def event(self, event) -> bool:
         t = event.type()
@@ -567,6 +689,15 @@ class NodeCanvasView(QGraphicsView):
             self.frame_all()
         elif plain and key == Qt.Key.Key_C:
             self.comment_selection()
+        elif plain and key == Qt.Key.Key_F2:
+            ids = self.selected_ids()
+            if len(ids) == 1:
+                self.start_rename(ids[0])
+        elif plain and key == Qt.Key.Key_F1:
+            ids = self.selected_ids()
+            node = self.controller.document.graph.nodes.get(ids[0]) if ids else None
+            if node is not None:
+                self.docsRequested.emit(node.kind)
         elif plain and key == Qt.Key.Key_M:
             self.minimap.setVisible(not self.minimap.isVisible())
         elif plain and key == Qt.Key.Key_Space:

@@ -1,0 +1,201 @@
+"""The Help menu's pages: a searchable keyboard reference, per-node documentation from the
+node catalogue (ports, types, defaults and ranges), and the About box."""
+
+from __future__ import annotations
+
+import platform
+from html import escape
+
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (
+    QDialog,
+    QDialogButtonBox,
+    QHeaderView,
+    QLineEdit,
+    QMessageBox,
+    QTableWidget,
+    QTableWidgetItem,
+    QTextBrowser,
+    QVBoxLayout,
+    QWidget,
+)
+
+from matedit.graph import nodes
+
+# (keys, what it does, where): the one list the reference shows.
+SHORTCUTS: tuple[tuple[str, str, str], ...] = (
+    ("Tab", "Add a node (the palette), wherever the pointer is over the canvas", "Canvas"),
+    ("Right-click", "Node, wire and canvas menu: preview in viewport, insert reroute, …",
+     "Canvas"),
+    ("Drag from a port", "Connect; drop on nothing to add a connected node", "Canvas"),
+    ("Double-click a wire", "Insert a reroute", "Canvas"),
+    ("Double-click a function call", "Open the function in a tab", "Canvas"),
+    ("F2", "Rename the selected node", "Canvas"),
+    ("F1", "Documentation of the selected node", "Canvas, palette"),
+    ("Delete / Backspace", "Delete the selection", "Canvas"),
+    ("Ctrl+C / Ctrl+X / Ctrl+V", "Copy, cut, paste nodes", "Canvas"),
+    ("Ctrl+D", "Duplicate the selection", "Canvas"),
+    ("C", "Frame the selection in a comment", "Canvas"),
+    ("F", "Frame the selection", "Canvas"),
+    ("Home / A", "Frame the whole graph", "Canvas"),
+    ("M", "Show or hide the minimap", "Canvas"),
+    ("Middle drag, Alt+drag, Space+drag", "Pan", "Canvas"),
+    ("Wheel", "Zoom about the pointer", "Canvas"),
+    ("Esc", "Cancel a wire, clear the selection", "Canvas"),
+    ("Left drag", "Orbit the camera", "Viewport"),
+    ("Shift+drag, middle drag", "Pan the camera", "Viewport"),
+    ("Wheel", "Dolly the camera", "Viewport"),
+    ("Double-click", "Reset the camera", "Viewport"),
+    ("← / → on exposure", "Exposure −/+ 0.1 EV (Page Up/Down: 1 EV)", "Viewport"),
+    ("Ctrl+N", "New material", "File"),
+    ("Ctrl+O", "Open a material or a function", "File"),
+    ("Ctrl+S / Ctrl+Shift+S", "Save, save as (the active tab)", "File"),
+    ("Ctrl+E", "Export shaders", "File"),
+    ("Ctrl+Z / Ctrl+Shift+Z", "Undo, redo (the active tab)", "Edit"),
+    ("Ctrl+/", "This reference", "Help"),
+)
+
+
+class ShortcutReference(QDialog):
+    """Every shortcut in one table, filtered as you type."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("shortcutReference")
+        self.setWindowTitle("Keyboard and mouse reference")
+        lay = QVBoxLayout(self)
+        self.search = QLineEdit()
+        self.search.setPlaceholderText("Search shortcuts…")
+        self.search.setClearButtonEnabled(True)
+        self.table = QTableWidget(0, 3)
+        self.table.setHorizontalHeaderLabels(["Keys", "Does", "Where"])
+        self.table.verticalHeader().hide()
+        self.table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
+        self.table.setSelectionBehavior(QTableWidget.SelectionBehavior.SelectRows)
+        head = self.table.horizontalHeader()
+        head.setSectionResizeMode(0, QHeaderView.ResizeMode.ResizeToContents)
+        head.setSectionResizeMode(1, QHeaderView.ResizeMode.Stretch)
+        head.setSectionResizeMode(2, QHeaderView.ResizeMode.ResizeToContents)
+        lay.addWidget(self.search)
+        lay.addWidget(self.table, 1)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Close)
+        buttons.rejected.connect(self.close)
+        lay.addWidget(buttons)
+        self.search.textChanged.connect(self.fill)
+        self.fill("")
+        self.resize(680, 560)
+
+    def fill(self, query: str) -> None:
+        words = query.lower().split()
+        rows = [r for r in SHORTCUTS if all(w in " ".join(r).lower() for w in words)]
+        self.table.setRowCount(len(rows))
+        for i, row in enumerate(rows):
+            for j, text in enumerate(row):
+                self.table.setItem(i, j, QTableWidgetItem(text))
+
+    def shown_rows(self) -> list[tuple[str, str, str]]:
+        return [tuple(self.table.item(i, j).text() for j in range(3))
+                for i in range(self.table.rowCount())]
+
+
+def _fmt(value) -> str:
+    if value is None:
+        return "—"
+    if value == nodes.MESH_UV:
+        return "mesh UVs"
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, (list, tuple)):
+        return "(" + ", ".join(_fmt(v) for v in value) + ")"
+    return str(value)
+
+
+def node_doc_html(kind: str) -> str:
+    """A node kind's page, from its catalogue entry: what it does, its ports with types,
+    defaults and ranges, and its settings."""
+    d = nodes.REGISTRY.get(kind)
+    if d is None:
+        return f"<h2>{escape(kind)}</h2><p>Unknown node kind.</p>"
+    out = [f"<h2>{escape(d.title)}</h2>",
+           f"<p><i>{escape(d.category)}</i> · <code>{escape(d.kind)}</code></p>",
+           f"<p>{escape(d.description)}</p>"]
+
+    def table(title: str, rows: list[list[str]], head: list[str]) -> None:
+        if not rows:
+            return
+        out.append(f"<h3>{escape(title)}</h3><table cellspacing='0' cellpadding='3' "
+                   "border='1' style='border-collapse: collapse'>")
+        out.append("<tr>" + "".join(f"<th align='left'>{escape(h)}</th>" for h in head) +
+                   "</tr>")
+        for r in rows:
+            out.append("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>")
+        out.append("</table>")
+
+    generic = "T (any numeric type, resolved from the wires)"
+    ins = [[i.name, generic if i.type == "T" else i.type, _fmt(i.default),
+            f"{_fmt(i.range[0])} … {_fmt(i.range[1])}" if i.range else "",
+            ("required. " if i.required else "") + i.doc] for i in d.inputs]
+    table("Inputs", ins, ["name", "type", "default", "range", "about"])
+    outs = [[o.name, generic if o.type == "T" else o.type, o.doc] for o in d.outputs]
+    table("Outputs", outs, ["name", "type", "about"])
+    vals = [[v.name, v.type, _fmt(v.default),
+             f"{_fmt(v.range[0])} … {_fmt(v.range[1])}" if v.range else "", v.doc]
+            for v in d.values]
+    table("Values", vals, ["name", "type", "default", "range", "about"])
+    sets = [[s.name, s.kind, _fmt(s.default), ", ".join(s.choices), s.doc] for s in d.settings]
+    table("Settings", sets, ["name", "kind", "default", "choices", "about"])
+    if d.ports_rule:
+        out.append(f"<p>Its ports depend on its settings ({escape(d.ports_rule)}).</p>")
+    return "\n".join(out)
+
+
+class NodeDocs(QDialog):
+    """A node kind's documentation; not modal, so it can stay open beside the canvas."""
+
+    def __init__(self, kind: str, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("nodeDocs")
+        self.setWindowFlag(Qt.WindowType.Tool, True)
+        self.browser = QTextBrowser()
+        lay = QVBoxLayout(self)
+        lay.addWidget(self.browser)
+        self.resize(620, 520)
+        self.show_kind(kind)
+
+    def show_kind(self, kind: str) -> None:
+        self.kind = kind
+        d = nodes.REGISTRY.get(kind)
+        self.setWindowTitle(f"{d.title if d else kind} — node reference")
+        self.browser.setHtml(node_doc_html(kind))
+
+
+def _version(dist: str) -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(dist)
+    except PackageNotFoundError:
+        return "not installed"
+
+
+def about_text(gl_renderer: str = "") -> str:
+    """Versions of matedit and what it stands on, and the OpenGL renderer in use."""
+    from PySide6 import __version__ as pyside_version
+    from PySide6.QtCore import qVersion
+
+    rows = [("matedit", _version("matedit")),
+            ("Python", platform.python_version()),
+            ("Qt / PySide6", f"{qVersion()} / {pyside_version}"),
+            ("moderngl", _version("moderngl")),
+            ("numpy", _version("numpy")),
+            ("OpenImageIO", _version("OpenImageIO")),
+            ("networkx", _version("networkx")),
+            ("OpenGL renderer", gl_renderer or "not started")]
+    body = "".join(f"<tr><td><b>{escape(k)}</b></td><td>{escape(v)}</td></tr>" for k, v in rows)
+    return ("<h3>matedit</h3><p>A node-based material editor after Karis, "
+            "“Real Shading in Unreal Engine 4”.</p>"
+            f"<table cellpadding='2'>{body}</table>")
+
+
+def show_about(parent: QWidget | None, gl_renderer: str = "") -> None:
+    QMessageBox.about(parent, "About matedit", about_text(gl_renderer))

@@ -1,0 +1,78 @@
+"""The problems model: one place that merges what is wrong with the open documents.
+
+Validation (per tab, from its controller's analysis), the compiler and the GL
+driver each report; the model keeps the compiler's and the driver's latest word,
+merges them with a tab's validation without duplicates (validation and the
+compiler often say the same thing), and says what the status bar should show.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QObject, Signal
+
+from matedit.app.diagnostics import Problem
+
+
+def unique(problems: list[Problem]) -> list[Problem]:
+    seen: set[tuple] = set()
+    out = []
+    for p in problems:
+        key = (p.severity, p.message, p.node_id, p.field)
+        if key not in seen:
+            seen.add(key)
+            out.append(p)
+    return out
+
+
+class ProblemsModel(QObject):
+    """Follows a `MaterialCompiler` and a viewport widget; `changed` after each report."""
+
+    changed = Signal()
+
+    def __init__(self, compiler, view, parent=None) -> None:
+        super().__init__(parent)
+        self.compiler = compiler
+        self.compile: list[Problem] = []
+        self.gl: list[Problem] = []
+        self.status = ""
+        compiler.compiled.connect(self._compiled)
+        compiler.failed.connect(self._failed)
+        view.glErrors.connect(self._gl_errors)
+        view.materialApplied.connect(self._applied)
+
+    def _compiled(self, _cm) -> None:
+        self.compile = []
+        self.status = f"compiled in {self.compiler.last_compile_ms:.0f} ms"
+        self.changed.emit()
+
+    def _failed(self, diagnostics) -> None:
+        self.compile = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "",
+                                "compiler") for d in diagnostics]
+        self.status = "does not compile: the viewport shows the last good material"
+        self.changed.emit()
+
+    def _gl_errors(self, errors) -> None:
+        self.gl = [Problem("error", str(msg), nid or "", "", "GL") for nid, msg in errors]
+        self.status = "GLSL failed to build: the viewport keeps the last good program"
+        self.changed.emit()
+
+    def _applied(self, ok: bool) -> None:
+        if ok and self.gl:
+            self.gl = []
+            self.changed.emit()
+
+    def for_tab(self, analysis, is_material: bool) -> list[Problem]:
+        """A tab's problems: its validation, and for the material the compiler's and GL's."""
+        out = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "graph")
+               for d in (analysis.diagnostics if analysis is not None else [])]
+        if is_material:
+            out += self.compile + self.gl
+        return unique(out)
+
+    def material_errors(self) -> dict[str, str]:
+        """The compiler's and GL's errors by node (badges on the material's canvas)."""
+        out: dict[str, str] = {}
+        for p in self.compile + self.gl:
+            if p.node_id and p.severity == "error":
+                out[p.node_id] = p.message
+        return out
