@@ -14,6 +14,7 @@ APT_PACKAGES=(
   libxcb-render-util0 libxcb-shape0 libxcb-xinerama0 libxcb-xkb1 libxkbcommon-x11-0
   libxkbcommon0 libfontconfig1 libdbus-1-3
   glslang-tools
+  spirv-cross spirv-tools
 )
 
 setup_system() {
