@@ -5,8 +5,10 @@ Each module exposes `register(subparsers)`, which adds its parser and sets
 Bad input raises `matedit.cli.UsageError` (one line, exit 2).
 """
 
+from matedit.commands import bake as bake_cmd
 from matedit.commands import bake_ibl, brdf_lut, render, validate
 from matedit.commands import compile as compile_cmd
+from matedit.commands import export as export_cmd
 
 REGISTRY = [
     validate.register,
@@ -14,4 +16,6 @@ REGISTRY = [
     render.register,
     bake_ibl.register,
     brdf_lut.register,
+    bake_cmd.register,
+    export_cmd.register,
 ]
