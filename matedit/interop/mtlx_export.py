@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV, Uni, Var
+from matedit.graph import nodes
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES
 from matedit.graph.types import PortType
 from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
@@ -243,9 +244,11 @@ class _Exporter:
             return [self.bake(hint, port, num, t, geo, op.kind)
                     for (port, t), num in zip(op.outs, nums)]
         if isinstance(entry, MxNode):
-            def make(entry=entry, args=args, t=outs_t[0], op=op):
-                ins = [(mxname, args[i].ref(), MX_TYPE[args[i].type])
-                       for i, (_, mxname) in enumerate(entry.ports)]
+            order = [i.name for i in nodes.REGISTRY[kind].inputs]
+
+            def make(entry=entry, args=args, t=outs_t[0], order=order):
+                ins = [(mxname, args[order.index(ours)].ref(),
+                        MX_TYPE[args[order.index(ours)].type]) for ours, mxname in entry.ports]
                 ins += [(name, _const(v, t), MX_TYPE[t]) for name, v in entry.fixed]
                 strings = [("space", "world")] if entry.category in ("position", "normal") \
                     else []
