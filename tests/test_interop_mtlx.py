@@ -113,3 +113,180 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
         drawer.release()
     print(path.stem, "checked", checked)
     assert "base_color" in checked, checked
+
+
+# --- import ---------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_round_trip_import_compile_evaluate_equals_original(exported, path):
+    """export -> import -> compile -> CPU evaluation equals the original at the texel centres
+    of the bake (baked nodes come back as float EXR textures read there): within 1e-6."""
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    folder, _ = exported
+    out = folder / f"{path.stem}_imported.json"
+    r = cli("import", str(folder / f"{path.stem}.mtlx"), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    r = cli("validate", str(out))
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert str(folder) not in out.read_text()
+    a = bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), SIZE)
+    b = bake.attributes_cpu(lower_and_optimise(load(out), FileResolver()), SIZE)
+    for k in a:
+        np.testing.assert_allclose(b[k], a[k], atol=1e-6, err_msg=f"{path.stem} {k}")
+
+
+def _doc(body: str) -> str:
+    return f'<?xml version="1.0"?>\n<materialx version="1.39">\n{body}\n</materialx>\n'
+
+
+def _import(tmp_path, text: str, name="in.mtlx"):
+    src = tmp_path / name
+    src.write_text(text)
+    out = tmp_path / "out.json"
+    return cli("import", str(src), "-o", str(out)), out
+
+
+def _eval(path: Path):
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    return bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), 4)
+
+
+def test_import_unsupported_nodes_are_named_each(tmp_path):
+    text = _doc('''
+  <nodegraph name="NG">
+    <texcoord name="uv" type="vector2" />
+    <noise2d name="bumpy" type="float"><input name="texcoord" type="vector2" nodename="uv"/>
+    </noise2d>
+    <cellnoise2d name="cells" type="float" />
+    <output name="r" type="float" nodename="bumpy" />
+    <output name="m" type="float" nodename="cells" />
+  </nodegraph>
+  <standard_surface name="S" type="surfaceshader">
+    <input name="specular_roughness" type="float" nodegraph="NG" output="r" />
+    <input name="metalness" type="float" nodegraph="NG" output="m" />
+  </standard_surface>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S" />
+  </surfacematerial>''')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert all(ln.startswith("error: ") for ln in lines) and len(lines) == 2
+    assert any("NG/bumpy" in ln and "noise2d" in ln for ln in lines)
+    assert any("NG/cells" in ln and "cellnoise2d" in ln for ln in lines)
+    assert not out.exists()
+
+
+def test_import_foreign_standard_surface_with_defaults_and_hostile_names(tmp_path):
+    text = _doc('''
+  <nodegraph name="NG">
+    <input name="gl_tint" type="color3" value="0.2, 0.4, 0.6" />
+    <multiply name="9 bad name__x" type="color3">
+      <input name="in1" type="color3" interfacename="gl_tint" />
+      <input name="in2" type="float" value="0.5" />
+    </multiply>
+    <output name="c" type="color3" nodename="9 bad name__x" />
+  </nodegraph>
+  <standard_surface name="S" type="surfaceshader">
+    <input name="base_color" type="color3" nodegraph="NG" output="c" />
+    <input name="emission" type="float" value="2" />
+    <input name="emission_color" type="color3" value="0.5, 0.25, 0" />
+  </standard_surface>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S" />
+  </surfacematerial>''')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 0, r.stderr
+    import json
+
+    data = json.loads(out.read_text())
+    from matedit.graph.model import valid_id
+    from matedit.graph.names import identifier_problem
+
+    assert all(valid_id(n["id"]) for n in data["nodes"])
+    assert "n_9_bad_name_x" in {n["id"] for n in data["nodes"]}
+    params = [n["settings"]["name"] for n in data["nodes"] if n["kind"].endswith("_parameter")]
+    assert params == ["p_gl_tint"] and identifier_problem(params[0]) is None
+    a = _eval(out)
+    np.testing.assert_allclose(a["baseColor"][0, 0], [0.1, 0.2, 0.3], atol=1e-9)
+    np.testing.assert_allclose(a["emissive"][0, 0], [1.0, 0.5, 0.0], atol=1e-9)
+    # Unset inputs take standard_surface's defaults: roughness 0.2, base 1 -> cavity 1.
+    assert a["roughness"][0, 0, 0] == pytest.approx(0.2)
+    assert a["cavity"][0, 0, 0] == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("surface, inputs, expect", [
+    ("gltf_pbr", '<input name="base_color" type="color3" value="0.1, 0.2, 0.3" />'
+                 '<input name="roughness" type="float" value="0.7" />'
+                 '<input name="occlusion" type="float" value="0.9" />',
+     {"baseColor": [0.1, 0.2, 0.3], "roughness": [0.7], "cavity": [0.9]}),
+    ("UsdPreviewSurface", '<input name="diffuseColor" type="color3" value="0.3, 0.2, 0.1" />'
+                          '<input name="metallic" type="float" value="1" />'
+                          '<input name="opacity" type="float" value="0.5" />',
+     {"baseColor": [0.3, 0.2, 0.1], "metallic": [1.0], "opacity": [0.5]}),
+    ("open_pbr_surface", '<input name="base_color" type="color3" value="0.5, 0.5, 0.1" />'
+                         '<input name="base_metalness" type="float" value="0.25" />',
+     {"baseColor": [0.5, 0.5, 0.1], "metallic": [0.25]}),
+])
+def test_import_other_surfaces(tmp_path, surface, inputs, expect):
+    text = _doc(f'''
+  <{surface} name="S" type="surfaceshader">{inputs}</{surface}>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S" />
+  </surfacematerial>''')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 0, r.stderr
+    a = _eval(out)
+    for k, v in expect.items():
+        np.testing.assert_allclose(a[k][0, 0], v, atol=1e-9, err_msg=k)
+
+
+@pytest.mark.parametrize("text, needle", [
+    ("<materialx version='1.39'><bad", "not a MaterialX document"),
+    (_doc('<disney_brdf_2012 name="S" type="surfaceshader"/><surfacematerial name="M" '
+          'type="material"><input name="surfaceshader" type="surfaceshader" nodename="S"/>'
+          '</surfacematerial>'), "unsupported surface"),
+    (_doc('<nodegraph name="NG"><image name="img" type="float"><input name="file" '
+          'type="filename" value="/etc/passwd"/></image><output name="o" type="float" '
+          'nodename="img"/></nodegraph><standard_surface name="S" type="surfaceshader">'
+          '<input name="metalness" type="float" nodegraph="NG" output="o"/>'
+          '</standard_surface><surfacematerial name="M" type="material"><input '
+          'name="surfaceshader" type="surfaceshader" nodename="S"/></surfacematerial>'),
+     "relative path"),
+    (_doc('<standard_surface name="S" type="surfaceshader"><input name="metalness" '
+          'type="float" value="nan"/></standard_surface><surfacematerial name="M" '
+          'type="material"><input name="surfaceshader" type="surfaceshader" nodename="S"/>'
+          '</surfacematerial>'), "not finite"),
+    (_doc(''), "no surfacematerial"),
+])
+def test_import_bad_input_is_one_error_line(tmp_path, text, needle):
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith("error: ") and needle in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr and not out.exists()
+
+
+def test_import_does_not_follow_xinclude(tmp_path):
+    (tmp_path / "other.mtlx").write_text(_doc('<standard_surface name="S" '
+                                              'type="surfaceshader"/><surfacematerial name="M" '
+                                              'type="material"><input name="surfaceshader" '
+                                              'type="surfaceshader" nodename="S"/>'
+                                              '</surfacematerial>'))
+    text = ('<?xml version="1.0"?>\n<materialx version="1.39" '
+            'xmlns:xi="http://www.w3.org/2001/XInclude">\n'
+            '<xi:include href="other.mtlx" />\n</materialx>\n')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 2 and "no surfacematerial" in r.stderr
+
+
+def test_import_refuses_to_overwrite_its_source(tmp_path):
+    src = tmp_path / "a.json"
+    src.write_text(_doc(""))
+    r = cli("import", str(src), "-o", str(src))
+    assert r.returncode == 2 and "refusing to write over" in r.stderr

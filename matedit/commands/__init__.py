@@ -9,6 +9,7 @@ from matedit.commands import bake as bake_cmd
 from matedit.commands import bake_ibl, brdf_lut, render, validate
 from matedit.commands import compile as compile_cmd
 from matedit.commands import export as export_cmd
+from matedit.commands import import_ as import_cmd
 
 REGISTRY = [
     validate.register,
@@ -18,4 +19,5 @@ REGISTRY = [
     brdf_lut.register,
     bake_cmd.register,
     export_cmd.register,
+    import_cmd.register,
 ]
