@@ -25,6 +25,7 @@ Textures are referenced relative to the document's folder. matedit reads texels 
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -521,15 +522,23 @@ class _Exporter:
         inp.setOutputString(out.getName())
 
 
+@functools.lru_cache(maxsize=1)
+def stdlib():
+    """MaterialX's standard libraries, loaded once (read only)."""
+    import MaterialX as mx
+
+    lib = mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
+    return lib
+
+
 def validate(text: str) -> tuple[bool, str]:
     """MaterialX's own validate() on a document text, with the stdlib loaded."""
     import MaterialX as mx
 
     doc = mx.createDocument()
     mx.readFromXmlString(doc, text)
-    lib = mx.createDocument()
-    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
-    doc.importLibrary(lib)
+    doc.importLibrary(stdlib())
     ok, msg = doc.validate()
     return bool(ok), msg
 
