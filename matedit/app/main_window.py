@@ -199,6 +199,8 @@ class MainWindow(QMainWindow):
             f.addAction(a)
         f.addSeparator()
         f.addAction(self.act_export)
+        from matedit.app.interop_actions import install as install_interop
+        self.interop = install_interop(self, f, self.act_export)
         f.addSeparator()
         f.addAction(self.act_quit)
         e = mb.addMenu("&Edit")
