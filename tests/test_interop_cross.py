@@ -103,3 +103,20 @@ def test_missing_tool_names_the_debian_package(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("error: ")
     assert "spirv-cross" in lines[0] and "Debian package spirv-cross" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_textured_material_bindings_in_hlsl_and_msl(tmp_path):
+    from tests.test_interop_mtlx import _all_kinds_material
+
+    src = _all_kinds_material(tmp_path)
+    out = compile_targets(load(src), FileResolver(), ["hlsl", "msl"])
+    hlsl, msl = out["hlsl"], out["msl"]
+    cross.check_hlsl(hlsl)
+    (tex,) = hlsl.reflection()["textures"]
+    assert tex["binding"] == FIRST_TEXTURE_BINDING
+    regs = {b["name"]: b["register"] for b in hlsl.bindings["fragment"]}
+    assert regs[tex["name"]] == f"t{FIRST_TEXTURE_BINDING}"
+    assert regs["MaterialParams"] == f"b{MATERIAL_BINDING}"
+    frag = {(b["kind"], b["index"]) for b in msl.bindings["fragment"]}
+    assert {("texture", FIRST_TEXTURE_BINDING), ("sampler", FIRST_TEXTURE_BINDING),
+            ("buffer", MATERIAL_BINDING)} <= frag

@@ -440,3 +440,18 @@ def test_every_mapped_kind_matches_materialx_glsl_and_round_trips(ctx, tmp_path)
     again = bake.attributes_cpu(lower_and_optimise(load(back), FileResolver()), SIZE)
     for k in cpu:
         np.testing.assert_allclose(again[k], cpu[k], atol=1e-6, err_msg=k)
+
+
+def test_mtlx_export_refuses_a_link_to_the_document(tmp_path):
+    import shutil
+
+    folder = tmp_path / "g"
+    shutil.copytree(graphs_dir(), folder)
+    doc = folder / "materials" / "car_paint.json"
+    before = doc.read_bytes()
+    trap = tmp_path / "car.mtlx"
+    trap.symlink_to(doc)
+    r = cli("export", str(doc), "-o", str(trap), "--size", "8")
+    assert r.returncode == 2 and "refusing to write over the document" in r.stderr
+    assert doc.read_bytes() == before
+    assert not list(tmp_path.glob("*.exr"))
