@@ -455,3 +455,25 @@ def test_mtlx_export_refuses_a_link_to_the_document(tmp_path):
     assert r.returncode == 2 and "refusing to write over the document" in r.stderr
     assert doc.read_bytes() == before
     assert not list(tmp_path.glob("*.exr"))
+
+
+def test_import_of_a_very_deep_chain_is_one_error_or_a_material(tmp_path):
+    n = 3000
+    nodes = ['<add name="a0" type="float"><input name="in1" type="float" value="0.001"/></add>']
+    for i in range(1, n):
+        nodes.append(f'<add name="a{i}" type="float"><input name="in1" type="float" '
+                     f'nodename="a{i - 1}"/><input name="in2" type="float" value="0.0001"/>'
+                     '</add>')
+    text = _doc('<nodegraph name="NG">' + "".join(nodes) +
+                f'<output name="o" type="float" nodename="a{n - 1}"/></nodegraph>'
+                '<standard_surface name="S" type="surfaceshader"><input name="metalness" '
+                'type="float" nodegraph="NG" output="o"/></standard_surface>'
+                '<surfacematerial name="M" type="material"><input name="surfaceshader" '
+                'type="surfaceshader" nodename="S"/></surfacematerial>')
+    r, out = _import(tmp_path, text)
+    assert "Traceback" not in r.stderr
+    if r.returncode == 2:
+        assert r.stderr.startswith("error: ") and "too deep" in r.stderr
+        assert not out.exists()
+    else:
+        assert r.returncode == 0 and out.is_file()

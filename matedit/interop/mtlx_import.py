@@ -594,7 +594,11 @@ def import_mtlx(path: Path, out: Path) -> MaterialDocument:
                                f"{shader.getCategory()!r} (expected "
                                f"{', '.join(SURFACES)})"])
     imp = _Importer(path, out, doc, lib)
-    result = imp.build(shader)
+    try:
+        result = imp.build(shader)
+    except RecursionError:
+        raise MtlxImportError([f"{path}: node {shader.getName()}: its graph is too deep to "
+                               "import"]) from None
     if imp.errors:
         raise MtlxImportError(imp.errors)
     name = mat.getName()
