@@ -67,8 +67,10 @@ class InteropActions:
         acts = file_menu.actions()
         i = acts.index(after) + 1 if after in acts else len(acts)
         before = acts[i] if i < len(acts) else None
-        for a in [*self.actions, self.act_import]:
+        for a in self.actions:
             file_menu.insertAction(before, a)
+        file_menu.insertSeparator(before)
+        file_menu.insertAction(before, self.act_import)
 
     # --- helpers ---------------------------------------------------------------------------
     @property
@@ -139,10 +141,13 @@ class InteropActions:
             out = out.with_suffix(".glb")
         from matedit.interop import gltf
         from matedit.interop.bake import bake_attributes, maps_from
-        from matedit.io.inputs import refuse_overwrite
-        from matedit.render.mesh import builtin_mesh
+        from matedit.io.inputs import BUILTIN_MESHES, preview_file, refuse_overwrite
+        from matedit.render.mesh import mesh_from_spec
 
         try:
+            named = self.doc.preview.get("mesh") if isinstance(self.doc.preview, dict) else None
+            mesh_spec = preview_file(self.doc, "mesh") or (
+                named if named in BUILTIN_MESHES else "sphere")
             outs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
             refuse_overwrite(outs, self._inputs())
             attrs, ir = _in_worker(lambda: bake_attributes(self.doc, self.resolver, size))
@@ -150,8 +155,8 @@ class InteropActions:
 
             emax = float(max(1.0, np.max(attrs["emissive"])))
             attrs["emissive"] = attrs["emissive"] / emax
-            files = gltf.files_for(out, maps_from(attrs, ir.attributes), builtin_mesh("sphere"),
-                                   self._stem(), emax)
+            files = gltf.files_for(out, maps_from(attrs, ir.attributes),
+                                   mesh_from_spec(mesh_spec), self._stem(), emax)
             gltf.write(files)
         except Exception as exc:
             return self._fail(title, exc)
