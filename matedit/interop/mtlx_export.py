@@ -26,6 +26,7 @@ Textures are referenced relative to the document's folder. matedit reads texels 
 from __future__ import annotations
 
 import functools
+import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -371,6 +372,9 @@ class _Exporter:
         if name == "vector_parameter":
             return [V(nums[0], outs_t[0], args[0].ref, geo),
                     V(nums[1], outs_t[1], lambda: self._to3(args[0].ref(), hint), geo)]
+        if name in ("checker", "gradient", "unpack_normal", "blend_normals",
+                    "flatten_normal"):
+            return self.procedural(name, op, args, nums, outs_t, hint, geo)
         if name == "texture_sample":
             return self.texture_sample(op, args, nums, outs_t, hint, geo)
         if name == "attributes":
@@ -378,6 +382,84 @@ class _Exporter:
         if name == "blend":
             return [self.blend(op, args, nums[0], hint)]
         raise MtlxExportError(f"node {hint}: no MaterialX recipe {name!r}")
+
+    def procedural(self, name, op, args, nums, outs_t, hint, geo) -> list[V]:
+        """Our procedural and normal nodes as small stdlib subgraphs (shaders/nodes/*.glsl
+        written out node by node)."""
+        order = [i.name for i in nodes.REGISTRY[op.kind].inputs]
+
+        def a(port):
+            v = args[order.index(port)]
+            return (v.ref(), MX_TYPE[v.type])
+
+        def n(cat, t, suffix, *ins):
+            names = {"mix": ("bg", "fg", "mix"), "clamp": ("in", "low", "high")}.get(
+                cat, ("in1", "in2") if len(ins) == 2 else ("in",))
+            return (self.node(cat, t, f"{hint}_{suffix}" if suffix else hint,
+                              [(k, r, rt) for k, (r, rt) in zip(names, ins)]), t)
+
+        def val(v, t="float"):
+            return (("value", v), t)
+
+        shared: dict[str, tuple] = {}
+        if name == "gradient":
+            def make():
+                ang = n("multiply", "float", "rad", a("angle"), val(math.pi / 180.0))
+                c = n("cos", "float", "cos", ang)
+                s = n("sin", "float", "sin", ang)
+                d = (self.node("combine2", "vector2", f"{hint}_dir",
+                               [("in1", c[0], "float"), ("in2", s[0], "float")]), "vector2")
+                ext = n("add", "float", "extent", n("absval", "float", "abs_x", c),
+                        n("absval", "float", "abs_y", s))
+                p = n("subtract", "vector2", "centred", a("uv"), val((0.5, 0.5), "vector2"))
+                proj = n("dotproduct", "float", "proj", p, d)
+                v = n("add", "float", "ramp", n("divide", "float", "norm", proj, ext),
+                      val(0.5))
+                return n("clamp", "float", "", v, val(0.0), val(1.0))[0]
+            return [V(nums[0], outs_t[0], make, geo)]
+        if name == "checker":
+            def mask():
+                if "mask" not in shared:
+                    cell = n("floor", "vector2", "cell",
+                             n("multiply", "vector2", "scaled", a("uv"), a("scale")))
+                    s = (self.node("add", "float", f"{hint}_parity_sum", [
+                        ("in1", self._extract(cell[0], PortType.VEC2, 0, hint), "float"),
+                        ("in2", self._extract(cell[0], PortType.VEC2, 1, hint), "float")]),
+                         "float")
+                    shared["mask"] = n("modulo", "float", "mask", s, val(2.0))[0]
+                return shared["mask"]
+
+            def color():
+                return n("mix", "vector3", "", a("color_a"), a("color_b"),
+                         (mask(), "float"))[0]
+            return [V(nums[0], outs_t[0], color, geo), V(nums[1], outs_t[1], mask, geo)]
+        if name == "unpack_normal":
+            def make():
+                x = n("subtract", "vector3", "signed",
+                      n("multiply", "vector3", "twice", a("packed"), val(2.0)), val(1.0))
+                st = a("strength")
+                k = (self.node("combine3", "vector3", f"{hint}_strength",
+                               [("in1", st[0], "float"), ("in2", st[0], "float"),
+                                ("in3", ("value", 1.0), "float")]), "vector3")
+                return n("normalize", "vector3", "", n("multiply", "vector3", "scaled", x, k))[0]
+            return [V(nums[0], outs_t[0], make, geo)]
+        if name == "flatten_normal":
+            def make():
+                m = n("mix", "vector3", "towards_z", a("normal"),
+                      val((0.0, 0.0, 1.0), "vector3"), a("flatness"))
+                return n("normalize", "vector3", "", m)[0]
+            return [V(nums[0], outs_t[0], make, geo)]
+        # blend_normals: Barre-Brisebois & Hill 2012, reoriented normal mapping
+        def make_rnm():
+            t = n("add", "vector3", "t", a("base"), val((0.0, 0.0, 1.0), "vector3"))
+            u = n("multiply", "vector3", "u", a("detail"), val((-1.0, -1.0, 1.0), "vector3"))
+            tu = n("dotproduct", "float", "tu", t, u)
+            tz = (self._extract(t[0], PortType.VEC3, 2, hint), "float")
+            r = n("subtract", "vector3", "r",
+                  n("divide", "vector3", "scaled", n("multiply", "vector3", "tdot", t, tu), tz),
+                  u)
+            return n("normalize", "vector3", "", r)[0]
+        return [V(nums[0], outs_t[0], make_rnm, geo)]
 
     def _extract(self, r: tuple, t: PortType, i: int, hint: str) -> tuple:
         n = self.ng.addNode("extract", self.name(f"{hint}_{'xyzw'[i]}"), "float")

@@ -89,12 +89,12 @@ MTLX: dict[str, MxNode | MxRecipe | str] = {
     "set_attributes": MxRecipe("attributes"),
     "layer_blend": MxRecipe("blend"),  # a mix per field, the normal normalised
     "height_blend": MxRecipe("blend"),  # smoothstep(-c, c, dh) as the blend factor
-    "value_noise": BAKE,  # our hash lattice noise has no stdlib equal
-    "checker": BAKE,
-    "gradient": BAKE,
-    "unpack_normal": BAKE,
-    "blend_normals": BAKE,
-    "flatten_normal": BAKE,
+    "value_noise": BAKE,  # our PCG-hash lattice noise: the stdlib has no integer hash
+    "checker": MxRecipe("checker"),  # modulo(floor(u s) + floor(v s), 2) into a mix
+    "gradient": MxRecipe("gradient"),  # clamp(dot(uv - 0.5, d) / (|dx| + |dy|) + 0.5)
+    "unpack_normal": MxRecipe("unpack_normal"),  # normalize((2 p - 1) * (s, s, 1))
+    "blend_normals": MxRecipe("blend_normals"),  # reoriented normal mapping
+    "flatten_normal": MxRecipe("flatten_normal"),  # normalize(mix(n, +Z, flatness))
 }
 
 LOWERED = ("constant", "scalar_parameter", "color_parameter", "texture_parameter", "reroute",
