@@ -66,12 +66,11 @@ def compile_targets(doc: MaterialDocument, resolver, targets: list[str]) -> dict
     glsl = [t for t in targets if t not in CROSS_TARGETS]
     if not cross:
         return compile_all(doc, resolver, glsl)
-    from matedit.interop.cross import cross_compile, tool
+    from matedit.interop.cross import cross_compile_many, tool
 
     for name in ("glslangValidator", "spirv-val", "spirv-cross"):
         tool(name)
     base = compile_all(doc, resolver, sorted(set(glsl) | {"glsl450"}))
     out = {t: base[t] for t in glsl}
-    for t in cross:
-        out[t] = cross_compile(base["glsl450"], t)
+    out.update(cross_compile_many(base["glsl450"], cross))
     return {t: out[t] for t in targets}

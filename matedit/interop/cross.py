@@ -111,19 +111,48 @@ class CrossCompiled:
         return r
 
 
-def cross_compile(base, target: str) -> CrossCompiled:
-    """`base` is a glsl450 CompiledMaterial; returns its HLSL or MSL translation."""
-    if target not in _ARGS:
-        raise ValueError(f"unknown cross target {target!r} (expected hlsl or msl)")
-    if base.target != "glsl450":
-        raise ValueError("cross compilation starts from the glsl450 target")
-    parse = hlsl_bindings if target == "hlsl" else msl_bindings
+_VERTEX_CACHE: dict[tuple[str, str], str] = {}  # (glsl450 vertex text, target) -> source
+
+
+def _translate(text: str, stage: str, targets: list[str]) -> dict[str, str]:
+    """One stage to every target: SPIR-V once, then spirv-cross per target in parallel."""
+    from concurrent.futures import ThreadPoolExecutor
+
     with tempfile.TemporaryDirectory(prefix="matedit-cross-") as tmp:
         folder = Path(tmp)
-        vert = spirv_to(to_spirv(base.vertex_text, "vert", folder), target, folder)
-        frag = spirv_to(to_spirv(base.fragment_text, "frag", folder), target, folder)
-    return CrossCompiled(target, vert, frag, base,
-                         {"vertex": parse(vert), "fragment": parse(frag)})
+        spv = to_spirv(text, stage, folder)
+        if len(targets) == 1:
+            return {targets[0]: spirv_to(spv, targets[0], folder)}
+        with ThreadPoolExecutor(len(targets)) as pool:
+            futures = {t: pool.submit(spirv_to, spv, t, folder) for t in targets}
+            return {t: f.result() for t, f in futures.items()}
+
+
+def cross_compile_many(base, targets: list[str]) -> dict[str, CrossCompiled]:
+    """`base` is a glsl450 CompiledMaterial; returns its HLSL and/or MSL translations. The
+    vertex stage is the same for every material, so its translation is kept per process."""
+    for target in targets:
+        if target not in _ARGS:
+            raise ValueError(f"unknown cross target {target!r} (expected hlsl or msl)")
+    if base.target != "glsl450":
+        raise ValueError("cross compilation starts from the glsl450 target")
+    missing = [t for t in targets if (base.vertex_text, t) not in _VERTEX_CACHE]
+    if missing:
+        for t, text in _translate(base.vertex_text, "vert", missing).items():
+            _VERTEX_CACHE[(base.vertex_text, t)] = text
+    frags = _translate(base.fragment_text, "frag", list(targets))
+    out = {}
+    for t in targets:
+        parse = hlsl_bindings if t == "hlsl" else msl_bindings
+        vert = _VERTEX_CACHE[(base.vertex_text, t)]
+        out[t] = CrossCompiled(t, vert, frags[t], base,
+                               {"vertex": parse(vert), "fragment": parse(frags[t])})
+    return out
+
+
+def cross_compile(base, target: str) -> CrossCompiled:
+    """`base` is a glsl450 CompiledMaterial; returns its HLSL or MSL translation."""
+    return cross_compile_many(base, [target])[target]
 
 
 def check_hlsl(cc: CrossCompiled) -> None:

@@ -159,9 +159,6 @@ class _Exporter:
             self._uv = self.node("texcoord", "vector2", "uv0")
         return self._uv
 
-    def lazy(self, num, t: PortType, make, geo=False) -> V:
-        return V(num, t, make, geo)
-
     # --- values ----------------------------------------------------------------------------
     def expr(self, e, table: dict[str, V]) -> V:
         if isinstance(e, (Var, Param)):
