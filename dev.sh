@@ -15,6 +15,7 @@ APT_PACKAGES=(
   libxkbcommon0 libfontconfig1 libdbus-1-3
   glslang-tools
   desktop-file-utils appstream shared-mime-info dpkg-dev binutils libglib2.0-bin
+  spirv-cross spirv-tools
 )
 
 setup_system() {

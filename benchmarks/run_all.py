@@ -36,6 +36,7 @@ OPTIONAL_BENCHES = (
     ("bench_canvas.py", "Node canvas with 1,000 nodes"),
     ("bench_editor.py", "Editor responsiveness"),
     ("bench_instances.py", "Material instances and static switches"),
+    ("bench_interop.py", "Interop: bake, glTF and MaterialX export"),
 )
 OPTIONAL_TIMEOUT_S = 240
 IMPORT_ROWS = ("matedit.commands", "matedit.commands.validate", "matedit.graph.validate",

@@ -246,6 +246,8 @@ class MainWindow(QMainWindow):
         f.addSeparator()
         f.addAction(self.act_export)
         f.addAction(self.act_save_image)
+        from matedit.app.interop_actions import install as install_interop
+        self.interop = install_interop(self, f, self.act_export)
         f.addSeparator()
         f.addAction(self.act_quit)
         e = mb.addMenu("&Edit")

@@ -5,8 +5,11 @@ Each module exposes `register(subparsers)`, which adds its parser and sets
 Bad input raises `matedit.cli.UsageError` (one line, exit 2).
 """
 
+from matedit.commands import bake as bake_cmd
 from matedit.commands import bake_ibl, brdf_lut, contact_sheet, nodes, render, validate
 from matedit.commands import compile as compile_cmd
+from matedit.commands import export as export_cmd
+from matedit.commands import import_ as import_cmd
 
 REGISTRY = [
     validate.register,
@@ -16,4 +19,7 @@ REGISTRY = [
     brdf_lut.register,
     nodes.register,
     contact_sheet.register,
+    bake_cmd.register,
+    export_cmd.register,
+    import_cmd.register,
 ]

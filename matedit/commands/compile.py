@@ -1,4 +1,4 @@
-"""`matedit compile FILE -o DIR [--target glsl330|glsl450|essl300|all]`.
+"""`matedit compile FILE -o DIR [--target glsl330|glsl450|essl300|hlsl|msl|all]`.
 
 Writes DIR/STEM.TARGET.vert, DIR/STEM.TARGET.frag and DIR/STEM.reflection.json; refuses an
 output that is, or resolves to, the document or a file it references."""
@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli import UsageError, report
-from matedit.compiler.targets import TARGETS
+from matedit.compiler.targets import CROSS_TARGETS, TARGETS
 
 
 def register(sub) -> None:
@@ -18,14 +18,17 @@ def register(sub) -> None:
                        "reflection JSON (uniforms, textures, targets).")
     p.add_argument("file", metavar="FILE")
     p.add_argument("-o", "--output", required=True, metavar="DIR")
-    p.add_argument("--target", default="glsl330", choices=[*TARGETS, "all"])
+    p.add_argument("--target", default="glsl330", choices=[*TARGETS, *CROSS_TARGETS, "all"],
+                   help="GLSL dialect, HLSL/MSL (via SPIR-V and spirv-cross), or all (HLSL and "
+                   "MSL only when spirv-cross is installed)")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
     # Imported here, not at the top, so that other subcommands start without the compiler.
-    from matedit.compiler import CompileError, compile_all
-    from matedit.compiler.export import export_shaders
+    from matedit.compiler import CompileError
+    from matedit.compiler.export import compile_targets, export_shaders
+    from matedit.interop.cross import CrossCompileError, available
     from matedit.io.document import FileResolver, FormatError
     from matedit.io.inputs import OverwriteError
     from matedit.io.instance import InstanceError, load_effective
@@ -40,9 +43,12 @@ def run(args) -> int:
     if doc.is_function:
         raise UsageError(f"{path}: is a material function; compile a material that calls it")
     resolver = FileResolver()
-    targets = list(TARGETS) if args.target == "all" else [args.target]
+    targets = [*TARGETS, *(CROSS_TARGETS if available() else ())] if args.target == "all" \
+        else [args.target]
     try:
-        compiled = compile_all(doc, resolver, targets)
+        compiled = compile_targets(doc, resolver, targets)
+    except CrossCompileError as exc:
+        raise UsageError(f"{path}: {exc}") from None
     except CompileError as exc:
         for d in exc.diagnostics[1:]:
             report("error", f"{d.file or path}: {d.format()}")

@@ -51,9 +51,28 @@ def export_shaders(doc: MaterialDocument, resolver, targets: list[str], folder: 
     if folder.exists() and not folder.is_dir():
         raise NotADirectoryError(f"{folder}: exists and is not a folder")
     if compiled is None:
-        compiled = compile_all(doc, resolver, targets)
+        compiled = compile_targets(doc, resolver, targets)
     files = shader_files(doc, compiled, folder)
     refuse_overwrite(files, document_inputs(doc, resolver))
     for path, text in files.items():
         atomic_write_text(path, text)
     return list(files)
+
+
+def compile_targets(doc: MaterialDocument, resolver, targets: list[str]) -> dict:
+    """`compile_all`, plus the HLSL/MSL targets (translated from glsl450 by
+    `matedit.interop.cross`; raises its CrossCompileError when a tool is missing)."""
+    from matedit.compiler.targets import CROSS_TARGETS
+
+    cross = [t for t in targets if t in CROSS_TARGETS]
+    glsl = [t for t in targets if t not in CROSS_TARGETS]
+    if not cross:
+        return compile_all(doc, resolver, glsl)
+    from matedit.interop.cross import cross_compile_many, tool
+
+    for name in ("glslangValidator", "spirv-val", "spirv-cross"):
+        tool(name)
+    base = compile_all(doc, resolver, sorted(set(glsl) | {"glsl450"}))
+    out = {t: base[t] for t in glsl}
+    out.update(cross_compile_many(base["glsl450"], cross))
+    return {t: out[t] for t in targets}

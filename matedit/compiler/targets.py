@@ -47,3 +47,7 @@ TARGETS = {
     "glsl450": Target("glsl450", "450", vulkan=True),
     "essl300": Target("essl300", "300 es", es=True),
 }
+
+# HLSL (shader model 5.0) and MSL (2.0), translated from glsl450 through SPIR-V by
+# matedit.interop.cross (needs glslang-tools, spirv-tools and spirv-cross).
+CROSS_TARGETS = ("hlsl", "msl")

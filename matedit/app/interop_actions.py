@@ -1,0 +1,255 @@
+"""File › Export and File › Import entries for the interchange formats: glTF 2.0 (.gltf/.glb),
+MaterialX (.mtlx), baked texture maps, HLSL/MSL, and importing a .mtlx.
+
+The work is the command line's (matedit.interop, matedit.compiler.export), on the document in
+the editor, with its outputs checked against its inputs the same way. Baking needs a GL
+context: it runs on a worker thread with its own headless EGL context, so the GUI thread's
+GLX context is never disturbed (GLVND refuses GLX on a thread with EGL current).
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+from PySide6.QtCore import QSettings, Qt
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
+
+FOLDER_KEY = "interop/folder"
+
+
+def _in_worker(fn):
+    """Run `fn` on a worker thread and wait (the GUI shows a busy cursor); re-raise its
+    exception here."""
+    box: dict = {}
+
+    def run():
+        try:
+            box["value"] = fn()
+        except BaseException as exc:  # handed back to the GUI thread
+            box["error"] = exc
+
+    QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
+    try:
+        t = threading.Thread(target=run, name="matedit-interop", daemon=True)
+        t.start()
+        while t.is_alive():
+            t.join(0.05)
+            QApplication.processEvents()
+    finally:
+        QApplication.restoreOverrideCursor()
+    if "error" in box:
+        raise box["error"]
+    return box.get("value")
+
+
+class InteropActions:
+    """The actions, installed into a File menu; `window` is the MainWindow."""
+
+    def __init__(self, window) -> None:
+        self.window = window
+        self.last_message = ""
+        w = window
+        self.act_gltf = QAction("Export &glTF…", w)
+        self.act_gltf.triggered.connect(lambda: self.export_gltf())
+        self.act_mtlx = QAction("Export &MaterialX…", w)
+        self.act_mtlx.triggered.connect(lambda: self.export_mtlx())
+        self.act_bake = QAction("Export &Baked Textures…", w)
+        self.act_bake.triggered.connect(lambda: self.export_baked())
+        self.act_cross = QAction("Export &HLSL and MSL…", w)
+        self.act_cross.triggered.connect(lambda: self.export_cross())
+        self.act_import = QAction("&Import MaterialX…", w)
+        self.act_import.triggered.connect(lambda: self.import_mtlx())
+        self.actions = [self.act_gltf, self.act_mtlx, self.act_bake, self.act_cross]
+
+    def install(self, file_menu, after: QAction) -> None:
+        acts = file_menu.actions()
+        i = acts.index(after) + 1 if after in acts else len(acts)
+        before = acts[i] if i < len(acts) else None
+        for a in self.actions:
+            file_menu.insertAction(before, a)
+        file_menu.insertSeparator(before)
+        file_menu.insertAction(before, self.act_import)
+
+    # --- helpers ---------------------------------------------------------------------------
+    @property
+    def doc(self):
+        return self.window.controller.document
+
+    @property
+    def resolver(self):
+        return self.window.controller.resolver
+
+    def _stem(self) -> str:
+        from matedit.compiler.export import stem_of
+
+        return stem_of(self.doc)
+
+    def _start_dir(self) -> str:
+        saved = QSettings().value(FOLDER_KEY, "")
+        if saved:
+            return str(saved)
+        return str(Path(self.doc.path).parent) if self.doc.path else ""
+
+    def _ask_save(self, title: str, suffix_filter: str, default_name: str) -> Path | None:
+        path, _ = QFileDialog.getSaveFileName(self.window, title,
+                                              str(Path(self._start_dir()) / default_name),
+                                              suffix_filter)
+        if not path:
+            return None
+        QSettings().setValue(FOLDER_KEY, str(Path(path).parent))
+        return Path(path)
+
+    def _ask_folder(self, title: str) -> Path | None:
+        folder = QFileDialog.getExistingDirectory(self.window, title, self._start_dir())
+        if not folder:
+            return None
+        QSettings().setValue(FOLDER_KEY, folder)
+        return Path(folder)
+
+    def _fail(self, title: str, exc: Exception) -> bool:
+        from matedit.compiler import CompileError
+
+        if isinstance(exc, CompileError):
+            text = "The material does not compile:\n" + "\n".join(
+                d.format() for d in exc.diagnostics[:10])
+        else:
+            text = f"Nothing more was written: {exc}"
+        QMessageBox.critical(self.window, title, text)
+        self.last_message = text
+        return False
+
+    def _done(self, text: str) -> bool:
+        self.last_message = text
+        self.window.status(text)
+        return True
+
+    def _inputs(self):
+        from matedit.io.inputs import document_inputs
+
+        return document_inputs(self.doc, self.resolver)
+
+    # --- actions ---------------------------------------------------------------------------
+    def export_gltf(self, out: Path | None = None, size: int = 1024) -> bool:
+        title = "Export glTF"
+        out = out or self._ask_save(title, "glTF binary (*.glb);;glTF (*.gltf)",
+                                    f"{self._stem()}.glb")
+        if out is None:
+            return False
+        if out.suffix.lower() not in (".glb", ".gltf"):
+            out = out.with_suffix(".glb")
+        from matedit.interop import gltf
+        from matedit.interop.bake import bake_attributes, maps_from
+        from matedit.io.inputs import BUILTIN_MESHES, preview_file, refuse_overwrite
+        from matedit.render.mesh import mesh_from_spec
+
+        try:
+            named = self.doc.preview.get("mesh") if isinstance(self.doc.preview, dict) else None
+            mesh_spec = preview_file(self.doc, "mesh") or (
+                named if named in BUILTIN_MESHES else "sphere")
+            outs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
+            refuse_overwrite(outs, self._inputs())
+            attrs, ir = _in_worker(lambda: bake_attributes(self.doc, self.resolver, size))
+            import numpy as np
+
+            emax = float(max(1.0, np.max(attrs["emissive"])))
+            attrs["emissive"] = attrs["emissive"] / emax
+            files = gltf.files_for(out, maps_from(attrs, ir.attributes),
+                                   mesh_from_spec(mesh_spec), self._stem(), emax)
+            gltf.write(files)
+        except Exception as exc:
+            return self._fail(title, exc)
+        return self._done(f"exported {', '.join(p.name for p in files)}")
+
+    def export_mtlx(self, out: Path | None = None, size: int = 512) -> bool:
+        title = "Export MaterialX"
+        out = out or self._ask_save(title, "MaterialX (*.mtlx)", f"{self._stem()}.mtlx")
+        if out is None:
+            return False
+        out = out.with_suffix(".mtlx")
+        from matedit.interop import mtlx_export
+        from matedit.io.inputs import refuse_overwrite
+
+        try:
+            result = mtlx_export.export(self.doc, self.resolver, out, size)
+            refuse_overwrite(result.files, self._inputs())
+            mtlx_export.write(result)
+        except Exception as exc:
+            return self._fail(title, exc)
+        baked = f"; baked {', '.join(n for n, _ in result.baked)}" if result.baked else ""
+        return self._done(f"exported {out.name}{baked}")
+
+    def export_baked(self, folder: Path | None = None, size: int = 1024) -> bool:
+        title = "Export baked textures"
+        folder = folder or self._ask_folder(title)
+        if folder is None:
+            return False
+        from matedit.interop.bake import MAP_NAMES, bake_document, encode_file, map_paths
+        from matedit.io.inputs import refuse_overwrite
+
+        try:
+            refuse_overwrite(map_paths(folder, self._stem(), MAP_NAMES, "png").values(),
+                             self._inputs())
+            maps, _ = _in_worker(lambda: bake_document(self.doc, self.resolver, size))
+            paths = map_paths(folder, self._stem(), [m.name for m in maps], "png")
+            for m in maps:
+                encode_file(paths[m.name], m)
+        except Exception as exc:
+            return self._fail(title, exc)
+        return self._done(f"baked {len(paths)} maps into {folder}")
+
+    def export_cross(self, folder: Path | None = None) -> bool:
+        title = "Export HLSL and MSL"
+        folder = folder or self._ask_folder(title)
+        if folder is None:
+            return False
+        from matedit.compiler.export import export_shaders
+
+        try:
+            written = export_shaders(self.doc, self.resolver, ["hlsl", "msl"], folder)
+        except Exception as exc:
+            return self._fail(title, exc)
+        return self._done(f"exported {len(written)} files to {folder}")
+
+    def import_mtlx(self, src: Path | None = None, out: Path | None = None) -> bool:
+        title = "Import MaterialX"
+        if src is None:
+            path, _ = QFileDialog.getOpenFileName(self.window, title, self._start_dir(),
+                                                  "MaterialX (*.mtlx)")
+            if not path:
+                return False
+            src = Path(path)
+        out = out or self._ask_save("Save the imported material as", "Material (*.json)",
+                                    f"{src.stem}.json")
+        if out is None:
+            return False
+        out = out.with_suffix(".json")
+        import os
+
+        from matedit.interop.mtlx_import import MtlxImportError, import_mtlx
+        from matedit.io.atomic import atomic_write_text
+        from matedit.io.document import dumps
+        from matedit.io.inputs import refuse_overwrite
+
+        try:
+            refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
+            doc = import_mtlx(src, out)
+            if not self.window.actions.maybe_save():
+                return False
+            atomic_write_text(out, dumps(doc))
+        except MtlxImportError as exc:
+            text = "\n".join(exc.messages[:20])
+            QMessageBox.critical(self.window, title, f"Cannot import {src.name}:\n{text}")
+            self.last_message = text
+            return False
+        except Exception as exc:
+            return self._fail(title, exc)
+        return self.window.actions.open(out, ask=False) and self._done(f"imported {src.name}")
+
+
+def install(window, file_menu, after: QAction) -> InteropActions:
+    """Add the interop entries to `file_menu` after `after` (File › Export Shaders…)."""
+    acts = InteropActions(window)
+    acts.install(file_menu, after)
+    return acts

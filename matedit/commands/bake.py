@@ -1,0 +1,102 @@
+"""`matedit bake FILE -o DIR [--size N] [--format png|exr]`: the material's attributes baked
+over UV space into DIR/STEM_base_color, _normal, _orm and, where written, _emissive and
+_opacity (see matedit.interop.bake for the encodings)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from matedit.cli import UsageError
+
+MAX_SIZE = 8192
+
+
+def register(sub) -> None:
+    p = sub.add_parser("bake", help="bake a material's attributes to texture maps",
+                       description="Bake base colour (sRGB), tangent-space normal (+Y up), "
+                       "ORM (occlusion from cavity, roughness, metallic) and, where the "
+                       "material writes them, emissive and opacity maps over UV space.")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("-o", "--output", required=True, metavar="DIR")
+    p.add_argument("--size", type=str, default="1024", metavar="N",
+                   help=f"map width and height in texels, 1..{MAX_SIZE} (default 1024)")
+    p.add_argument("--format", default="png", choices=["png", "exr"],
+                   help="8-bit PNG or float EXR (default png)")
+    p.set_defaults(run=run)
+
+
+def parse_size(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if not 1 <= n <= MAX_SIZE:
+        raise UsageError(f"--size must be a whole number in 1..{MAX_SIZE}, got {text!r}")
+    return n
+
+
+def load_material(path: Path):
+    from matedit.io.document import FormatError, load
+
+    try:
+        doc = load(path)
+    except FormatError as exc:
+        raise UsageError(str(exc)) from None
+    if doc.is_function:
+        raise UsageError(f"{path}: is a material function; use a material that calls it")
+    return doc
+
+
+def progress_printer(label: str):
+    if not sys.stderr.isatty():
+        return None
+    return lambda f: print(f"\r{label} {f * 100:5.1f}%", end="" if f < 1 else "\n",
+                           file=sys.stderr)
+
+
+def compile_error(exc, path: Path) -> UsageError:
+    d = exc.diagnostics[0] if exc.diagnostics else None
+    return UsageError(f"{d.file or path}: {d.format()}" if d else f"{path}: {exc}")
+
+
+def run(args) -> int:
+    from matedit.compiler import CompileError
+    from matedit.compiler.export import stem_of
+    from matedit.interop.bake import bake_document, encode_file, map_paths
+    from matedit.io.document import FileResolver
+    from matedit.io.images import ImageError
+    from matedit.io.inputs import OverwriteError, document_inputs, refuse_overwrite
+
+    size = parse_size(args.size)
+    path = Path(args.file)
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"{out}: exists and is not a folder")
+    doc = load_material(path)
+    resolver = FileResolver()
+    stem = stem_of(doc)
+    inputs = document_inputs(doc, resolver)
+    try:
+        from matedit.interop.bake import MAP_NAMES
+
+        refuse_overwrite(map_paths(out, stem, MAP_NAMES, args.format).values(), inputs)
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    try:
+        maps, _ = bake_document(doc, resolver, size, progress_printer("baking"), args.format)
+    except CompileError as exc:
+        raise compile_error(exc, path) from None
+    paths = map_paths(out, stem, [m.name for m in maps], args.format)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        for m in maps:
+            encode_file(paths[m.name], m)
+    except ImageError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    if sys.stderr.isatty():
+        print(f"baked {', '.join(p.name for p in paths.values())} into {out}",
+              file=sys.stderr)
+    return 0

@@ -1,0 +1,128 @@
+"""`matedit export FILE -o OUT.gltf|OUT.glb|OUT.mtlx [--size N] [--mesh ...]`.
+
+glTF 2.0: the preview mesh with tangents and a metallic-roughness material on maps baked
+over UV space (matedit.interop.gltf). MaterialX: a nodegraph reproducing the attribute graph
+feeding one standard_surface (matedit.interop.mtlx_export); subgraphs MaterialX cannot
+express are baked to EXR images beside the document, and reported."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from matedit.cli import UsageError, report
+from matedit.commands.bake import compile_error, load_material, parse_size, progress_printer
+
+
+def register(sub) -> None:
+    p = sub.add_parser("export", help="export a material to glTF 2.0 or MaterialX",
+                       description="Export a material as a glTF 2.0 asset (.gltf or .glb: "
+                       "preview mesh, baked maps, metallic-roughness material) or as a "
+                       "MaterialX document (.mtlx: nodegraph and standard_surface).")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.gltf|OUT.glb|OUT.mtlx")
+    p.add_argument("--size", default=None, metavar="N",
+                   help="baked map size in texels (default 1024 for glTF, 512 for the "
+                   "MaterialX bakes)")
+    p.add_argument("--mesh", default=None,
+                   help="glTF only: sphere, cube, plane, cylinder or an OBJ file (default: "
+                   "the file's preview mesh, else sphere)")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    out = Path(args.output)
+    kind = out.suffix.lower()
+    if kind not in (".gltf", ".glb", ".mtlx"):
+        raise UsageError(f"{out}: the output must end in .gltf, .glb or .mtlx")
+    if not out.parent.is_dir():
+        raise UsageError(f"{out}: folder {out.parent} does not exist")
+    if kind == ".mtlx":
+        if args.mesh:
+            raise UsageError("--mesh applies to glTF exports only")
+        return _mtlx(args, out)
+    return _gltf(args, out)
+
+
+def _inputs(doc, resolver, extra=()):
+    from matedit.io.inputs import document_inputs
+
+    inputs = document_inputs(doc, resolver)
+    for given in extra:
+        inputs.setdefault(Path(os.path.realpath(given)), "an input file")
+    return inputs
+
+
+def _gltf(args, out: Path) -> int:
+    import numpy as np
+
+    from matedit.compiler import CompileError
+    from matedit.compiler.export import stem_of
+    from matedit.interop import gltf
+    from matedit.interop.bake import bake_attributes, maps_from
+    from matedit.io.document import FileResolver
+    from matedit.io.inputs import BUILTIN_MESHES, OverwriteError, preview_file, refuse_overwrite
+    from matedit.render.mesh import MeshError, mesh_from_spec
+
+    size = parse_size(args.size or "1024")
+    path = Path(args.file)
+    doc = load_material(path)
+    resolver = FileResolver()
+    mesh_spec = args.mesh or preview_file(doc, "mesh") or "sphere"
+    extra = [] if str(mesh_spec) in BUILTIN_MESHES else [mesh_spec]
+    inputs = _inputs(doc, resolver, extra)
+    outputs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
+    try:
+        refuse_overwrite(outputs, inputs)
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    try:
+        mesh = mesh_from_spec(mesh_spec)
+    except MeshError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"{mesh_spec}: cannot read mesh: {exc.strerror or exc}") from None
+    try:
+        attrs, ir = bake_attributes(doc, resolver, size, progress_printer("baking"))
+    except CompileError as exc:
+        raise compile_error(exc, path) from None
+    emax = float(max(1.0, np.max(attrs["emissive"])))
+    attrs["emissive"] = attrs["emissive"] / emax
+    maps = maps_from(attrs, ir.attributes, "png")
+    files = gltf.files_for(out, maps, mesh, stem_of(doc), emax)
+    try:
+        gltf.write(files)
+    except OSError as exc:
+        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    if sys.stderr.isatty():
+        print(f"exported {path} to {', '.join(str(p) for p in files)}", file=sys.stderr)
+    return 0
+
+
+def _mtlx(args, out: Path) -> int:
+    from matedit.compiler import CompileError
+    from matedit.interop import mtlx_export
+    from matedit.io.document import FileResolver
+    from matedit.io.inputs import OverwriteError, refuse_overwrite
+
+    size = parse_size(args.size or "512")
+    path = Path(args.file)
+    doc = load_material(path)
+    resolver = FileResolver()
+    inputs = _inputs(doc, resolver)
+    try:
+        result = mtlx_export.export(doc, resolver, out, size)
+        refuse_overwrite(result.files, inputs)
+        mtlx_export.write(result)
+    except CompileError as exc:
+        raise compile_error(exc, path) from None
+    except mtlx_export.MtlxExportError as exc:
+        raise UsageError(str(exc)) from None
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    for node, why in result.baked:
+        report("note", f"{path}: node {node}: baked to an image ({why})")
+    return 0

@@ -1,0 +1,5 @@
+"""Interchange with other tools: HLSL and MSL through SPIR-V, baked texture maps, glTF 2.0
+and MaterialX documents (export and import).
+
+Nothing here imports Qt; only `bake` creates a GL context (headless, EGL).
+"""

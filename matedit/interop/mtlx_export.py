@@ -1,0 +1,657 @@
+"""A material as a MaterialX 1.39 document: one nodegraph reproducing the attribute graph,
+feeding one `standard_surface` through a `surfacematerial`.
+
+Why standard_surface: it is the surface every MaterialX 1.39 code generator and renderer
+(GLSL, OSL, MDL, MSL; USD Hydra, Arnold, the MaterialX viewer) implements, and our model,
+Karis' metallic-roughness one, maps onto its inputs without approximation: base_color and
+metalness; specular_roughness (both square it into the GGX alpha); its default specular IOR
+1.5 is our 0.04 dielectric F0. Our cavity "multiplies all lighting": it becomes `base` (which
+scales the diffuse and, through base_color, the metal's reflectance) and `specular` (which
+scales the dielectric reflection). open_pbr_surface would do as well, but is newer and less
+widely implemented; the importer reads both.
+
+The graph comes from the lowered IR (matedit.compiler.lower), before optimisation, so the
+nodes are ours, one for one where matedit.interop.mtlx_map has a mapping: material function
+calls are inlined (their nodes named CALL_NODE), layer stacks are their blends, parameters are
+the nodegraph's interface inputs, other unconnected inputs are values. What cannot be
+expressed (`BAKE` in the map) is evaluated by the CPU evaluator over UV space (the bake plane
+of matedit.interop.bake) into a float EXR beside the document, read by an `image` node on
+texture coordinate 0, and reported; a baked node that reads the position, normal, view or
+time is exact on the bake plane only, and the report says so.
+
+Textures are referenced relative to the document's folder. matedit reads texels as stored
+(the texture's sRGB flag is informational), so images carry no colour space.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV, Uni, Var
+from matedit.graph import nodes
+from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES
+from matedit.graph.types import PortType
+from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
+
+MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "vector3",
+           PortType.VEC4: "vector4"}
+GEOMETRY = {"world_position", "world_normal", "view_direction", "time"}
+MTLX_VERSION = "1.39"
+
+
+class MtlxExportError(ValueError):
+    """The material cannot be written as MaterialX (the message names the node)."""
+
+
+@dataclass
+class V:
+    """A value both ways: numbers on the bake surface and a MaterialX reference (lazily)."""
+
+    num: Any
+    type: PortType
+    make: Callable[[], tuple] | None = None  # -> ("value", v) | ("node", node, out) | ...
+    geo: bool = False  # depends on position, normal, view or time
+    fields: dict[str, V] | None = None
+    _ref: tuple | None = None
+
+    def ref(self) -> tuple:
+        if self._ref is None:
+            self._ref = self.make()
+        return self._ref
+
+
+@dataclass
+class MtlxExport:
+    out: Path
+    text: str
+    images: dict[Path, np.ndarray] = field(default_factory=dict)
+    baked: list[tuple[str, str]] = field(default_factory=list)
+
+    @property
+    def files(self) -> list[Path]:
+        return [self.out, *self.images]
+
+
+def _fmt(value, mxtype: str) -> str:
+    if mxtype in ("float",):
+        v = np.asarray(value, dtype=np.float64).reshape(-1)
+        return repr(float(v[0]))
+    return ", ".join(repr(float(x)) for x in np.asarray(value, dtype=np.float64).reshape(-1))
+
+
+def _const(value, t: PortType) -> tuple:
+    if t == PortType.FLOAT:
+        return ("value", float(np.asarray(value, dtype=np.float64).reshape(-1)[0]))
+    v = np.asarray(value, dtype=np.float64).reshape(-1)
+    if v.size == 1:
+        v = np.repeat(v, t.components)
+    return ("value", tuple(float(x) for x in v[: t.components]))
+
+
+class _Exporter:
+    def __init__(self, ir: MaterialIR, size: int, folder: Path, stem: str) -> None:
+        import MaterialX as mx
+
+        from matedit.compiler.cpu_eval import Env
+        from matedit.interop.bake import load_textures, surface
+
+        self.mx = mx
+        self.ir = ir
+        self.size = size
+        self.folder = folder
+        self.stem = stem
+        self.doc = mx.createDocument()
+        self.doc.setVersionString(MTLX_VERSION)
+        self.ng = self.doc.addNodeGraph(mx.createValidName(f"NG_{stem}"))
+        n = size * size
+        uniforms = {u.name: u.default for u in ir.uniforms}
+        self.env = Env(surface(size), n, uniforms, load_textures(ir),
+                       {f.name: f for f in ir.functions})
+        self.functions = {f.name: f for f in ir.functions}
+        self.uniforms = {u.name: u for u in ir.uniforms}
+        self.textures = {t.name: t for t in ir.textures}
+        self.names: set[str] = set()
+        self.images: dict[Path, np.ndarray] = {}
+        self.baked: list[tuple[str, str]] = []
+        self._uv = None
+        self._iface: dict[str, str] = {}
+
+    # --- MaterialX building blocks ---------------------------------------------------------
+    def name(self, hint: str) -> str:
+        base = self.mx.createValidName(hint) or "n"
+        name, k = base, 1
+        while name in self.names:
+            k += 1
+            name = f"{base}_{k}"
+        self.names.add(name)
+        return name
+
+    def set_input(self, node, name: str, ref: tuple, mxtype: str) -> None:
+        inp = node.addInput(name, mxtype)
+        if ref[0] == "value":
+            inp.setValueString(_fmt(ref[1], mxtype))
+        elif ref[0] == "node":
+            inp.setConnectedNode(ref[1])
+            if ref[2]:
+                inp.setOutputString(ref[2])
+        elif ref[0] == "iface":
+            inp.setInterfaceName(ref[1])
+
+    def node(self, category: str, mxtype: str, hint: str,
+             inputs: list[tuple[str, tuple, str]] = (), strings=()) -> tuple:
+        n = self.ng.addNode(category, self.name(hint), mxtype)
+        for name, ref, t in inputs:
+            self.set_input(n, name, ref, t)
+        for name, value in strings:
+            n.setInputValue(name, value, "string")
+        return ("node", n, None)
+
+    def uv0(self) -> tuple:
+        if self._uv is None:
+            self._uv = self.node("texcoord", "vector2", "uv0")
+        return self._uv
+
+    # --- values ----------------------------------------------------------------------------
+    def expr(self, e, table: dict[str, V]) -> V:
+        if isinstance(e, (Var, Param)):
+            return table[e.name]
+        if isinstance(e, Lit):
+            from matedit.compiler.cpu_eval import eval_expr
+
+            num = eval_expr(e, {}, self.env)
+            if e.type == PortType.MATERIAL:
+                return self.attributes_const(num)
+            return V(num, e.type, lambda: _const(e.value, e.type))
+        if isinstance(e, Uni):
+            return self.uniform(e)
+        if isinstance(e, SurfaceUV):
+            return V(np.asarray(self.env.surface.uv, dtype=np.float64), PortType.VEC2, self.uv0)
+        if isinstance(e, Splat):
+            inner = self.expr(e.expr, table)
+            num = np.repeat(np.asarray(inner.num).reshape(-1, 1), e.type.components, axis=1)
+
+            def make(inner=inner, t=e.type):
+                r = inner.ref()
+                if r[0] == "value":
+                    return _const(r[1], t)
+                return self.node("convert", MX_TYPE[t], "convert",
+                                 [("in", r, MX_TYPE[inner.type])])
+            return V(num, e.type, make, inner.geo)
+        raise MtlxExportError(f"cannot express {e!r} in MaterialX")
+
+    def attributes_const(self, num) -> V:
+        fields = {}
+        for f in ATTRIBUTE_FIELDS:
+            t = PortType(f.type)
+            fields[f.name] = V(num[f.name], t, lambda d=f.default, t=t: _const(d, t))
+        return V(num, PortType.MATERIAL, None, False, fields)
+
+    def uniform(self, e: Uni) -> V:
+        if e.type == PortType.TEXTURE:
+            return V(self.env.textures.get(e.name), e.type, lambda: ("texture", e.name))
+        u = self.uniforms[e.name]
+        from matedit.compiler.cpu_eval import _broadcast
+
+        num = _broadcast(self.env.uniforms[e.name], e.type, self.env.n)
+        if not u.parameter:
+            return V(num, e.type, lambda: _const(u.default, e.type))
+
+        def make():
+            if e.name not in self._iface:
+                name = self.name(u.parameter)
+                inp = self.ng.addInput(name, MX_TYPE[e.type])
+                inp.setValueString(_fmt(u.default, MX_TYPE[e.type]))
+                self._iface[e.name] = name
+            return ("iface", self._iface[e.name])
+        return V(num, e.type, make)
+
+    # --- scopes ----------------------------------------------------------------------------
+    def scope(self, scope: Scope, params: dict[str, V], prefix: str) -> list[V]:
+        table = dict(params)
+        for op in scope.ops:
+            args = [self.expr(a, table) for a in op.args]
+            outs = self.op(op, args, prefix)
+            for (port, _), v in zip(op.outs, outs):
+                table[op.out(port).name] = v
+        return [self.expr(e, table) for _, _, e in scope.outputs]
+
+    def op(self, op, args: list[V], prefix: str) -> list[V]:
+        from matedit.compiler.cpu_eval import eval_op
+
+        hint = f"{prefix}{op.node}"
+        if op.kind == "call":
+            scope = self.functions[op.data["function"]]
+            return self.scope(scope, dict(zip((p for p, _ in scope.params), args)),
+                              f"{hint}_")
+        nums = eval_op(op, [a.num for a in args], self.env)
+        geo = op.kind in GEOMETRY or any(a.geo for a in args)
+        kind = {"blend": "layer_blend", "weight": "weight", "mask": "component_mask"}.get(
+            op.kind, op.kind)
+        entry = mapping(kind) if kind not in ("weight",) else MxRecipe("weight")
+        if kind == "normalize" and args[0].type == PortType.FLOAT:
+            entry = BAKE
+        outs_t = [t for _, t in op.outs]
+        if entry == BAKE:
+            return [self.bake(hint, port, num, t, geo, op.kind)
+                    for (port, t), num in zip(op.outs, nums)]
+        if isinstance(entry, MxNode):
+            order = [i.name for i in nodes.REGISTRY[kind].inputs]
+
+            def make(entry=entry, args=args, t=outs_t[0], order=order):
+                ins = [(mxname, args[order.index(ours)].ref(),
+                        MX_TYPE[args[order.index(ours)].type]) for ours, mxname in entry.ports]
+                ins += [(name, _const(v, t), MX_TYPE[t]) for name, v in entry.fixed]
+                strings = [("space", "world")] if entry.category in ("position", "normal") \
+                    else []
+                return self.node(entry.category, MX_TYPE[t], hint, ins, strings)
+            return [V(nums[0], outs_t[0], make, geo)]
+        return self.recipe(entry.name, op, args, nums, outs_t, hint, geo)
+
+    # --- baking ----------------------------------------------------------------------------
+    def bake(self, hint: str, port: str, num, t: PortType, geo: bool, kind: str) -> V:
+        def make():
+            name = self.name(f"{hint}_{port}_baked")
+            file = f"{self.stem}_{name}.exr"
+            arr = np.asarray(num, dtype=np.float32).reshape(self.size, self.size, -1)
+            self.images[self.folder / file] = arr
+            why = f"{kind} has no MaterialX stdlib equivalent"
+            if geo:
+                why += "; it reads position, normal, view or time, so the bake is exact on " \
+                       "the flat bake plane only"
+            self.baked.append((hint, why))
+            n = self.ng.addNode("image", name, MX_TYPE[t])
+            n.setInputValue("file", file, "filename")
+            self.set_input(n, "texcoord", self.uv0(), "vector2")
+            return ("node", n, None)
+        return V(num, t, make, geo)
+
+    # --- recipes ---------------------------------------------------------------------------
+    def recipe(self, name: str, op, args, nums, outs_t, hint, geo) -> list[V]:
+        mt = MX_TYPE.get(outs_t[0]) if outs_t else None
+
+        def one(make):
+            return [V(nums[0], outs_t[0], make, geo)]
+
+        def arg(i):
+            return (args[i].ref(), MX_TYPE[args[i].type])
+
+        def extract(v: V, i: int) -> tuple:
+            if v.type == PortType.FLOAT:
+                return v.ref()
+            if v.type.components <= i:
+                return ("value", 0.0)
+            r = v.ref()
+            if r[0] == "value":
+                return ("value", float(r[1][i]))
+            return self._extract(r, v.type, i, hint)
+
+        def combine(parts: list[tuple], t: PortType) -> tuple:
+            if len(parts) == 1:
+                return parts[0]
+            if all(p[0] == "value" for p in parts):
+                return ("value", tuple(p[1] for p in parts))
+            return self.node(f"combine{len(parts)}", MX_TYPE[t], hint,
+                             [(f"in{i + 1}", p, "float") for i, p in enumerate(parts)])
+
+        if name == "one_minus":
+            return one(lambda: self.node("subtract", mt, hint, [
+                ("in1", _const(1.0, outs_t[0]), mt), ("in2", *arg(0))]))
+        if name == "power":
+            return one(lambda: self.node("power", mt, hint, [
+                ("in1", self.node("max", mt, f"{hint}_max", [
+                    ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt),
+                ("in2", *arg(1))]))
+        if name == "sqrt":
+            return one(lambda: self.node("sqrt", mt, hint, [
+                ("in", self.node("max", mt, f"{hint}_max", [
+                    ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt)]))
+        if name == "step":
+            def make_step():
+                d = self.node("subtract", mt, f"{hint}_d", [("in1", *arg(1)), ("in2", *arg(0))])
+                f = self.node("floor", mt, f"{hint}_floor", [("in", d, mt)])
+                a = self.node("add", mt, f"{hint}_add", [("in1", f, mt),
+                                                         ("in2", _const(1.0, outs_t[0]), mt)])
+                return self.node("clamp", mt, hint, [("in", a, mt),
+                                                     ("low", _const(0.0, outs_t[0]), mt),
+                                                     ("high", _const(1.0, outs_t[0]), mt)])
+            return one(make_step)
+        if name == "dot":
+            if args[0].type == PortType.FLOAT:
+                return one(lambda: self.node("multiply", "float", hint,
+                                             [("in1", *arg(0)), ("in2", *arg(1))]))
+            return one(lambda: self.node("dotproduct", "float", hint,
+                                         [("in1", *arg(0)), ("in2", *arg(1))]))
+        if name == "length":
+            cat = "absval" if args[0].type == PortType.FLOAT else "magnitude"
+            return one(lambda: self.node(cat, "float", hint, [("in", *arg(0))]))
+        if name == "normalize":
+            return one(lambda: self.node("normalize", mt, hint, [("in", *arg(0))]))
+        if name == "weight":
+            return one(lambda: self.node("clamp", "float", hint, [
+                ("in", self.node("multiply", "float", f"{hint}_mul",
+                                 [("in1", *arg(0)), ("in2", *arg(1))]), "float"),
+                ("low", ("value", 0.0), "float"), ("high", ("value", 1.0), "float")]))
+        if name == "mask":
+            idx = ["xyzw".index(c) for c in op.data["channels"]]
+            return one(lambda: combine([extract(args[0], i) for i in idx], outs_t[0]))
+        if name == "append":
+            def make_append():
+                parts = []
+                for a in args:
+                    parts += [extract(a, i) for i in range(a.type.components)]
+                return combine(parts, outs_t[0])
+            return one(make_append)
+        if name == "split":
+            return [V(n, t, (lambda i=i: extract(args[0], i)), geo)
+                    for i, (n, t) in enumerate(zip(nums, outs_t))]
+        if name == "combine":
+            sizes = (2, 3, 4)
+            return [V(n, t, (lambda k=k, t=t: combine([a.ref() for a in args[:k]], t)), geo)
+                    for k, n, t in zip(sizes, nums, outs_t)]
+        if name == "texcoord":
+            return one(lambda: self.node("add", "vector2", hint, [
+                ("in1", self.node("multiply", "vector2", f"{hint}_tile", [
+                    ("in1", self.uv0(), "vector2"), ("in2", *arg(0))]), "vector2"),
+                ("in2", *arg(1))]))
+        if name == "view_direction":
+            return one(lambda: self.node("multiply", "vector3", hint, [
+                ("in1", self.node("viewdirection", "vector3", f"{hint}_eye", [],
+                                  [("space", "world")]), "vector3"),
+                ("in2", ("value", -1.0), "float")]))
+        if name == "vector_parameter":
+            return [V(nums[0], outs_t[0], args[0].ref, geo),
+                    V(nums[1], outs_t[1], lambda: self._to3(args[0].ref(), hint), geo)]
+        if name in ("checker", "gradient", "unpack_normal", "blend_normals",
+                    "flatten_normal"):
+            return self.procedural(name, op, args, nums, outs_t, hint, geo)
+        if name == "texture_sample":
+            return self.texture_sample(op, args, nums, outs_t, hint, geo)
+        if name == "attributes":
+            return self.attributes(op, args, nums)
+        if name == "blend":
+            return [self.blend(op, args, nums[0], hint)]
+        raise MtlxExportError(f"node {hint}: no MaterialX recipe {name!r}")
+
+    def procedural(self, name, op, args, nums, outs_t, hint, geo) -> list[V]:
+        """Our procedural and normal nodes as small stdlib subgraphs (shaders/nodes/*.glsl
+        written out node by node)."""
+        order = [i.name for i in nodes.REGISTRY[op.kind].inputs]
+
+        def a(port):
+            v = args[order.index(port)]
+            return (v.ref(), MX_TYPE[v.type])
+
+        def n(cat, t, suffix, *ins):
+            names = {"mix": ("bg", "fg", "mix"), "clamp": ("in", "low", "high")}.get(
+                cat, ("in1", "in2") if len(ins) == 2 else ("in",))
+            return (self.node(cat, t, f"{hint}_{suffix}" if suffix else hint,
+                              [(k, r, rt) for k, (r, rt) in zip(names, ins)]), t)
+
+        def val(v, t="float"):
+            return (("value", v), t)
+
+        shared: dict[str, tuple] = {}
+        if name == "gradient":
+            def make():
+                ang = n("multiply", "float", "rad", a("angle"), val(math.pi / 180.0))
+                c = n("cos", "float", "cos", ang)
+                s = n("sin", "float", "sin", ang)
+                d = (self.node("combine2", "vector2", f"{hint}_dir",
+                               [("in1", c[0], "float"), ("in2", s[0], "float")]), "vector2")
+                ext = n("add", "float", "extent", n("absval", "float", "abs_x", c),
+                        n("absval", "float", "abs_y", s))
+                p = n("subtract", "vector2", "centred", a("uv"), val((0.5, 0.5), "vector2"))
+                proj = n("dotproduct", "float", "proj", p, d)
+                v = n("add", "float", "ramp", n("divide", "float", "norm", proj, ext),
+                      val(0.5))
+                return n("clamp", "float", "", v, val(0.0), val(1.0))[0]
+            return [V(nums[0], outs_t[0], make, geo)]
+        if name == "checker":
+            def mask():
+                if "mask" not in shared:
+                    cell = n("floor", "vector2", "cell",
+                             n("multiply", "vector2", "scaled", a("uv"), a("scale")))
+                    s = (self.node("add", "float", f"{hint}_parity_sum", [
+                        ("in1", self._extract(cell[0], PortType.VEC2, 0, hint), "float"),
+                        ("in2", self._extract(cell[0], PortType.VEC2, 1, hint), "float")]),
+                         "float")
+                    shared["mask"] = n("modulo", "float", "mask", s, val(2.0))[0]
+                return shared["mask"]
+
+            def color():
+                return n("mix", "vector3", "", a("color_a"), a("color_b"),
+                         (mask(), "float"))[0]
+            return [V(nums[0], outs_t[0], color, geo), V(nums[1], outs_t[1], mask, geo)]
+        if name == "unpack_normal":
+            def make():
+                x = n("subtract", "vector3", "signed",
+                      n("multiply", "vector3", "twice", a("packed"), val(2.0)), val(1.0))
+                st = a("strength")
+                k = (self.node("combine3", "vector3", f"{hint}_strength",
+                               [("in1", st[0], "float"), ("in2", st[0], "float"),
+                                ("in3", ("value", 1.0), "float")]), "vector3")
+                return n("normalize", "vector3", "", n("multiply", "vector3", "scaled", x, k))[0]
+            return [V(nums[0], outs_t[0], make, geo)]
+        if name == "flatten_normal":
+            def make():
+                m = n("mix", "vector3", "towards_z", a("normal"),
+                      val((0.0, 0.0, 1.0), "vector3"), a("flatness"))
+                return n("normalize", "vector3", "", m)[0]
+            return [V(nums[0], outs_t[0], make, geo)]
+        # blend_normals: Barre-Brisebois & Hill 2012, reoriented normal mapping
+        def make_rnm():
+            t = n("add", "vector3", "t", a("base"), val((0.0, 0.0, 1.0), "vector3"))
+            u = n("multiply", "vector3", "u", a("detail"), val((-1.0, -1.0, 1.0), "vector3"))
+            tu = n("dotproduct", "float", "tu", t, u)
+            tz = (self._extract(t[0], PortType.VEC3, 2, hint), "float")
+            r = n("subtract", "vector3", "r",
+                  n("divide", "vector3", "scaled", n("multiply", "vector3", "tdot", t, tu), tz),
+                  u)
+            return n("normalize", "vector3", "", r)[0]
+        return [V(nums[0], outs_t[0], make_rnm, geo)]
+
+    def _extract(self, r: tuple, t: PortType, i: int, hint: str) -> tuple:
+        n = self.ng.addNode("extract", self.name(f"{hint}_{'xyzw'[i]}"), "float")
+        self.set_input(n, "in", r, MX_TYPE[t])
+        n.setInputValue("index", i, "integer")
+        return ("node", n, None)
+
+    def _to3(self, r: tuple, hint: str) -> tuple:
+        if r[0] == "value":
+            return ("value", tuple(r[1][:3]))
+        return self.node("convert", "vector3", f"{hint}_xyz", [("in", r, "vector4")])
+
+    def texture_sample(self, op, args, nums, outs_t, hint, geo) -> list[V]:
+        shared: dict[str, tuple] = {}
+
+        def image() -> tuple:
+            if "n" not in shared:
+                tex = args[0].ref()
+                info = self.textures.get(tex[1]) if tex[0] == "texture" else None
+                if info is None:
+                    raise MtlxExportError(f"node {hint}: texture input is not a texture "
+                                          "parameter")
+                n = self.ng.addNode("image", self.name(hint), "vector4")
+                if info.path:
+                    rel = os.path.relpath(info.path, self.folder)
+                    n.setInputValue("file", Path(rel).as_posix(), "filename")
+                self.set_input(n, "texcoord", args[1].ref(), "vector2")
+                shared["n"] = ("node", n, None)
+            return shared["n"]
+
+        makers = [image, lambda: self._to3(image(), hint)] + [
+            (lambda i=i: self._extract(image(), PortType.VEC4, i, hint)) for i in range(4)]
+        return [V(n, t, m, geo) for n, t, m in zip(nums, outs_t, makers)]
+
+    def attributes(self, op, args, nums) -> list[V]:
+        if op.kind == "make_attributes":
+            return [V(nums[0], PortType.MATERIAL, None, any(a.geo for a in args),
+                      dict(zip(ATTRIBUTE_NAMES, args)))]
+        if op.kind == "break_attributes":
+            return [args[0].fields[n] for n in ATTRIBUTE_NAMES]
+        fields = dict(args[0].fields)  # set_attributes
+        for name, v in zip(op.data["fields"], args[1:]):
+            fields[name] = v
+        return [V(nums[0], PortType.MATERIAL, None, any(a.geo for a in args), fields)]
+
+    def blend(self, op, args, num, hint) -> V:
+        a, b = args[0], args[1]
+        if op.kind == "height_blend":
+            bh, lh, c = args[2], args[3], args[4]
+
+            def make_t():
+                cm = self.node("max", "float", f"{hint}_c",
+                               [("in1", c.ref(), "float"), ("in2", ("value", 1e-5), "float")])
+                neg = self.node("multiply", "float", f"{hint}_negc",
+                                [("in1", cm, "float"), ("in2", ("value", -1.0), "float")])
+                dh = self.node("subtract", "float", f"{hint}_dh",
+                               [("in1", lh.ref(), "float"), ("in2", bh.ref(), "float")])
+                return self.node("smoothstep", "float", f"{hint}_t",
+                                 [("in", dh, "float"), ("low", neg, "float"),
+                                  ("high", cm, "float")])
+            t = V(None, PortType.FLOAT, make_t)
+        else:
+            t = args[2]
+        fields = {}
+        for f in ATTRIBUTE_FIELDS:
+            x, y = a.fields[f.name], b.fields[f.name]
+            ft = PortType(f.type)
+
+            def make(x=x, y=y, ft=ft, name=f.name):
+                m = self.node("mix", MX_TYPE[ft], f"{hint}_{name}",
+                              [("fg", y.ref(), MX_TYPE[ft]), ("bg", x.ref(), MX_TYPE[ft]),
+                               ("mix", t.ref(), "float")])
+                if name == "normal":
+                    return self.node("normalize", "vector3", f"{hint}_nrm",
+                                     [("in", m, "vector3")])
+                return m
+            fields[f.name] = V(num[f.name], ft, make, a.geo or b.geo or t.geo)
+        return V(num, PortType.MATERIAL, None, False, fields)
+
+    # --- the surface -----------------------------------------------------------------------
+    def surface(self, attrs: V) -> None:
+        mx = self.mx
+        f = attrs.fields
+        shader = self.doc.addNode("standard_surface", mx.createValidName(f"SR_{self.stem}"),
+                                  "surfaceshader")
+        outputs: list[tuple[str, str, tuple]] = []
+
+        def color(v: V) -> tuple:
+            r = v.ref()
+            if r[0] == "value":
+                return r
+            return self.node("convert", "color3", "to_color3", [("in", r, MX_TYPE[v.type])])
+
+        outputs.append(("base", "float", f["cavity"].ref()))
+        outputs.append(("base_color", "color3", color(f["baseColor"])))
+        outputs.append(("metalness", "float", f["metallic"].ref()))
+        outputs.append(("specular", "float", f["cavity"].ref()))
+        outputs.append(("specular_roughness", "float", f["roughness"].ref()))
+        written = set(self.ir.attributes)
+        if "normal" in written:
+            n = f["normal"].ref()
+            if not (n[0] == "value" and tuple(n[1]) == (0.0, 0.0, 1.0)):
+                enc = self.node("add", "vector3", "normal_encode", [
+                    ("in1", self.node("multiply", "vector3", "normal_half",
+                                      [("in1", n, "vector3"), ("in2", ("value", 0.5), "float")]),
+                     "vector3"), ("in2", ("value", 0.5), "float")])
+                outputs.append(("normal", "vector3", self.node("normalmap", "vector3",
+                                                               "normal_map",
+                                                               [("in", enc, "vector3")])))
+        if "emissive" in written:
+            e = f["emissive"].ref()
+            if not (e[0] == "value" and not any(e[1])):
+                shader.setInputValue("emission", 1.0, "float")
+                outputs.append(("emission_color", "color3", color(f["emissive"])))
+        if "opacity" in written:
+            o = f["opacity"].ref()
+            if not (o[0] == "value" and o[1] == 1.0):
+                c = o if o[0] == "value" else self.node("convert", "color3", "to_opacity",
+                                                        [("in", o, "float")])
+                if c[0] == "value":
+                    c = ("value", (c[1],) * 3)
+                outputs.append(("opacity", "color3", c))
+        for name, t, r in outputs:
+            inp = shader.addInput(name, t)
+            if r[0] == "value":
+                inp.setValueString(_fmt(r[1], t))
+            elif r[0] == "iface":
+                # A parameter straight into the surface: route it through a dot node.
+                d = self.node("dot", t, f"{name}_param", [("in", r, t)])
+                self._output(inp, name, t, d)
+            else:
+                self._output(inp, name, t, r)
+        mat = self.doc.addMaterialNode(mx.createValidName(f"M_{self.stem}"), shader)
+        del mat
+
+    def _output(self, inp, name: str, t: str, r: tuple) -> None:
+        out = self.ng.addOutput(self.name(f"out_{name}"), t)
+        out.setConnectedNode(r[1])
+        if r[2]:
+            out.setOutputString(r[2])
+        inp.setNodeGraphString(self.ng.getName())
+        inp.setOutputString(out.getName())
+
+
+@functools.lru_cache(maxsize=1)
+def stdlib():
+    """MaterialX's standard libraries, loaded once (read only)."""
+    import MaterialX as mx
+
+    lib = mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
+    return lib
+
+
+def validate(text: str) -> tuple[bool, str]:
+    """MaterialX's own validate() on a document text, with the stdlib loaded."""
+    import MaterialX as mx
+
+    doc = mx.createDocument()
+    mx.readFromXmlString(doc, text)
+    doc.importLibrary(stdlib())
+    ok, msg = doc.validate()
+    return bool(ok), msg
+
+
+def export_ir(ir: MaterialIR, out: Path, size: int, stem: str) -> MtlxExport:
+    ex = _Exporter(ir, size, Path(out).parent, stem)
+    try:
+        (attrs,) = ex.scope(ir.main, {}, "")
+        ex.surface(attrs)
+    except RecursionError:
+        raise MtlxExportError(f"{stem}: the graph is too deep to export to MaterialX") from None
+    import MaterialX as mx
+
+    text = mx.writeToXmlString(ex.doc)
+    ok, msg = validate(text)
+    if not ok:
+        raise MtlxExportError(f"{out}: the MaterialX document does not validate: "
+                              f"{' '.join(msg.split())[:300]}")
+    return MtlxExport(Path(out), text, ex.images, ex.baked)
+
+
+def export(doc, resolver, out: Path, size: int = 512) -> MtlxExport:
+    """The MaterialX export of a material document (raises CompileError, MtlxExportError)."""
+    from matedit.compiler.export import stem_of
+    from matedit.compiler.lower import lower_document
+
+    ir = lower_document(doc, resolver)
+    return export_ir(ir, Path(out), size, stem_of(doc))
+
+
+def write(result: MtlxExport) -> None:
+    from matedit.interop.bake import BakedMap, encode_file
+    from matedit.io.atomic import atomic_write_text
+
+    for path, arr in result.images.items():
+        encode_file(path, BakedMap(path.stem, arr, False))
+    atomic_write_text(result.out, result.text)

@@ -1,0 +1,619 @@
+"""A MaterialX document as a matedit material: `matedit import FILE.mtlx -o OUT.json`.
+
+The first `surfacematerial` is read; its surface must be a standard_surface,
+open_pbr_surface, gltf_pbr or UsdPreviewSurface (SURFACES maps each one's inputs to our
+attributes). Its inputs may be values or connections into nodegraphs (or top-level nodes) of
+the stdlib nodes that matedit.interop.mtlx_map maps from our catalogue, read back here; any
+other node is an error naming it, never a silent drop. Every error is collected, so one run
+names every unsupported node.
+
+The file is untrusted: it is read bounded (`read_bounded`), without XIncludes; MaterialX
+names become matedit node ids and parameter names only through the identifier rule
+(`mangle`, then `valid_id` / `identifier_problem`); numbers must be finite; image file names
+must be relative and stay text in the document (they are never read here).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node, valid_id
+from matedit.graph.names import identifier_problem, mangle
+from matedit.io.atomic import read_bounded
+
+MAX_MTLX_BYTES = 16 << 20
+MAX_NODES = 20000
+
+# Surface category -> attribute -> (input, scale input or None, scale factor).
+SURFACES: dict[str, dict[str, tuple[str, str | None, float]]] = {
+    "standard_surface": {
+        "baseColor": ("base_color", None, 1.0), "metallic": ("metalness", None, 1.0),
+        "roughness": ("specular_roughness", None, 1.0), "cavity": ("base", None, 1.0),
+        "normal": ("normal", None, 1.0), "emissive": ("emission_color", "emission", 1.0),
+        "opacity": ("opacity", None, 1.0)},
+    "open_pbr_surface": {
+        "baseColor": ("base_color", None, 1.0), "metallic": ("base_metalness", None, 1.0),
+        "roughness": ("specular_roughness", None, 1.0), "cavity": ("base_weight", None, 1.0),
+        "normal": ("geometry_normal", None, 1.0),
+        # emission_luminance is in nits; 1000 nits is our emissive 1.0
+        "emissive": ("emission_color", "emission_luminance", 1e-3),
+        "opacity": ("geometry_opacity", None, 1.0)},
+    "gltf_pbr": {
+        "baseColor": ("base_color", None, 1.0), "metallic": ("metallic", None, 1.0),
+        "roughness": ("roughness", None, 1.0), "cavity": ("occlusion", None, 1.0),
+        "normal": ("normal", None, 1.0), "emissive": ("emissive", "emissive_strength", 1.0),
+        "opacity": ("alpha", None, 1.0)},
+    "UsdPreviewSurface": {
+        "baseColor": ("diffuseColor", None, 1.0), "metallic": ("metallic", None, 1.0),
+        "roughness": ("roughness", None, 1.0), "cavity": ("occlusion", None, 1.0),
+        "normal": ("normal", None, 1.0), "emissive": ("emissiveColor", None, 1.0),
+        "opacity": ("opacity", None, 1.0)},
+}
+# Surfaces whose normal input is world space (a normalmap node is expected there); the
+# UsdPreviewSurface normal is tangent space already.
+WORLD_NORMAL = {"standard_surface", "open_pbr_surface", "gltf_pbr"}
+
+# MaterialX category -> (our kind, {MaterialX input: our input}) for one-to-one nodes.
+DIRECT: dict[str, tuple[str, dict[str, str]]] = {
+    "add": ("add", {"in1": "a", "in2": "b"}),
+    "subtract": ("subtract", {"in1": "a", "in2": "b"}),
+    "multiply": ("multiply", {"in1": "a", "in2": "b"}),
+    "divide": ("divide", {"in1": "a", "in2": "b"}),
+    "min": ("min", {"in1": "a", "in2": "b"}),
+    "max": ("max", {"in1": "a", "in2": "b"}),
+    "crossproduct": ("cross", {"in1": "a", "in2": "b"}),
+    "dotproduct": ("dot", {"in1": "a", "in2": "b"}),
+    "mix": ("lerp", {"bg": "a", "fg": "b", "mix": "alpha"}),
+    "clamp": ("clamp", {"in": "value", "low": "min", "high": "max"}),
+    "smoothstep": ("smoothstep", {"in": "value", "low": "edge0", "high": "edge1"}),
+    "remap": ("remap", {"in": "value", "inlow": "in_min", "inhigh": "in_max",
+                        "outlow": "out_min", "outhigh": "out_max"}),
+    "absval": ("abs", {"in": "value"}),
+    "sin": ("sin", {"in": "value"}),
+    "cos": ("cos", {"in": "value"}),
+    "floor": ("floor", {"in": "value"}),
+    "sqrt": ("sqrt", {"in": "value"}),
+    "power": ("power", {"in1": "base", "in2": "exponent"}),
+    "normalize": ("normalize", {"in": "value"}),
+    "magnitude": ("length", {"in": "value"}),
+}
+_WIDTH = {"float": 1, "integer": 1, "vector2": 2, "vector3": 3, "color3": 3, "vector4": 4,
+          "color4": 4}
+
+
+class MtlxImportError(ValueError):
+    """Errors of one import, one line each (the first is the exception's message)."""
+
+    def __init__(self, messages: list[str]) -> None:
+        self.messages = messages
+        super().__init__(messages[0])
+
+
+@dataclass
+class Src:
+    """Where a value comes from in the matedit graph: a node's output, or a constant."""
+
+    node: str | None = None
+    port: str | None = None
+    value: Any = None
+    width: int = 1
+
+
+def _floats(text: str, where: str) -> list[float]:
+    try:
+        vals = [float(x) for x in text.split(",")] if text.strip() else []
+    except ValueError:
+        raise ValueError(f"{where}: value {text[:40]!r} is not a number list") from None
+    if not all(math.isfinite(v) for v in vals):
+        raise ValueError(f"{where}: value {text[:40]!r} is not finite")
+    return vals
+
+
+class _Importer:
+    def __init__(self, source: Path, out: Path, doc, lib) -> None:
+        self.source = source
+        self.out = out
+        self.mxdoc = doc
+        self.lib = lib
+        self.errors: list[str] = []
+        self.mat = MaterialDocument(kind=DocumentKind.MATERIAL, path=out)
+        self.ids: set[str] = set()
+        self.done: dict[tuple[int, str], Src] = {}
+        self.params: dict[str, Src] = {}
+        self.count = 0
+
+    # --- helpers ---------------------------------------------------------------------------
+    def err(self, what: str) -> None:
+        msg = f"{self.source.name}: {what}"
+        if msg not in self.errors:
+            self.errors.append(msg)
+
+    def new_id(self, hint: str) -> str:
+        base = mangle(hint, 56)
+        if not valid_id(base):
+            base = f"n_{base}"[:56].strip("_")
+        if not valid_id(base):
+            base = "node"
+        nid, k = base, 1
+        while nid in self.ids:
+            k += 1
+            nid = f"{base}_{k}"
+        self.ids.add(nid)
+        return nid
+
+    def add(self, hint: str, kind: str, settings=None, values=None, depth=0) -> str:
+        self.count += 1
+        if self.count > MAX_NODES:
+            raise MtlxImportError([f"{self.source.name}: more than {MAX_NODES} nodes"])
+        nid = self.new_id(hint)
+        pos = (-260.0 * (depth + 1), 110.0 * (self.count % 40))
+        self.mat.graph.nodes[nid] = Node(nid, kind, pos, dict(settings or {}),
+                                         dict(values or {}))
+        return nid
+
+    def connect(self, src: Src, nid: str, port: str) -> None:
+        if src is None:
+            return
+        if src.node is None:
+            v = src.value
+            self.mat.graph.nodes[nid].values[port] = v[0] if len(v) == 1 else list(v)
+        else:
+            self.mat.graph.links.add(Link(src.node, src.port, nid, port))
+
+    def name_of(self, el) -> str:
+        return el.getNamePath() if el is not None else "?"
+
+    # --- inputs ----------------------------------------------------------------------------
+    def input_src(self, node, name: str, depth: int) -> Src | None:
+        """The source of input `name` of MaterialX `node`: None when unset (our default)."""
+        inp = node.getInput(name)
+        if inp is None:
+            return None
+        return self.input_el(inp, depth, f"node {self.name_of(node)}: input {name}")
+
+    def input_el(self, inp, depth: int, where: str) -> Src | None:
+        width = _WIDTH.get(inp.getType(), 0)
+        iface = inp.getInterfaceName()
+        if iface:
+            graph = inp.getParent().getParent()
+            gin = graph.getInput(iface) if graph is not None else None
+            if gin is None:
+                self.err(f"{where}: interface input {iface!r} not found")
+                return None
+            return self.parameter(gin, where)
+        graph_name, out_name = inp.getNodeGraphString(), inp.getOutputString()
+        node_name = inp.getNodeName()
+        if graph_name:
+            ng = self.mxdoc.getNodeGraph(graph_name)
+            out = ng.getOutput(out_name) if ng is not None else None
+            if out is None:
+                self.err(f"{where}: nodegraph output {graph_name}.{out_name} not found")
+                return None
+            return self.output_el(out, depth)
+        if node_name:
+            scope = inp.getParent().getParent()
+            up = scope.getNode(node_name) if scope is not None else None
+            if up is None:
+                self.err(f"{where}: node {node_name!r} not found")
+                return None
+            return self.node_src(up, out_name or "out", depth + 1)
+        if not inp.getValueString():
+            return None
+        if width == 0:
+            self.err(f"{where}: unsupported input type {inp.getType()!r}")
+            return None
+        try:
+            vals = _floats(inp.getValueString(), where)
+        except ValueError as exc:
+            self.err(str(exc))
+            return None
+        if len(vals) != width:
+            self.err(f"{where}: expected {width} numbers, got {len(vals)}")
+            return None
+        return Src(value=vals, width=width)
+
+    def output_el(self, out, depth: int) -> Src | None:
+        graph = out.getParent()
+        up = graph.getNode(out.getNodeName()) if out.getNodeName() else None
+        if up is None:
+            if out.getInterfaceName() and graph.getInput(out.getInterfaceName()) is not None:
+                return self.parameter(graph.getInput(out.getInterfaceName()),
+                                      f"output {self.name_of(out)}")
+            self.err(f"output {self.name_of(out)}: not connected to a node")
+            return None
+        return self.node_src(up, out.getOutputString() or "out", depth + 1)
+
+    def parameter(self, gin, where: str) -> Src | None:
+        key = gin.getNamePath()
+        if key in self.params:
+            return self.params[key]
+        t = gin.getType()
+        if gin.getNodeName() or gin.getNodeGraphString():
+            self.err(f"{where}: interface input {gin.getName()!r} is connected upstream; only "
+                     "values are supported")
+            return None
+        try:
+            vals = _floats(gin.getValueString(), f"interface input {gin.getName()}")
+        except ValueError as exc:
+            self.err(str(exc))
+            return None
+        name = gin.getName()
+        if identifier_problem(name):
+            name = mangle(name)
+        if identifier_problem(name):
+            name = f"p_{name}"
+        if identifier_problem(name):
+            self.err(f"interface input {gin.getName()!r}: not usable as a parameter name "
+                     f"({identifier_problem(name)})")
+            return None
+        width = _WIDTH.get(t, 0)
+        if len(vals) != width:
+            self.err(f"interface input {gin.getName()}: {t} needs {width} numbers")
+            return None
+        if width == 1:
+            nid = self.add(name, "scalar_parameter", {"name": name, "ui_min": min(0.0, vals[0]),
+                                                      "ui_max": max(1.0, vals[0])},
+                           {"value": vals[0]})
+            src = Src(nid, "value", width=1)
+        elif width == 3:
+            nid = self.add(name, "color_parameter", {"name": name}, {"value": vals})
+            src = Src(nid, "color", width=3)
+        elif width == 4:
+            nid = self.add(name, "vector_parameter", {"name": name}, {"value": vals})
+            src = Src(nid, "value", width=4)
+        else:  # vector2: a vec4 parameter, masked
+            nid = self.add(name, "vector_parameter", {"name": name},
+                           {"value": vals + [0.0, 0.0]})
+            m = self.add(f"{name}_xy", "component_mask", {"channels": "xy"})
+            self.connect(Src(nid, "value", width=4), m, "value")
+            src = Src(m, "result", width=2)
+        self.params[key] = src
+        return src
+
+    # --- nodes -----------------------------------------------------------------------------
+    def node_src(self, node, output: str, depth: int) -> Src | None:
+        key = (id(node), node.getNamePath(), output)
+        if key in self.done:
+            return self.done[key]
+        if depth > 2000:
+            self.err(f"node {self.name_of(node)}: the graph is too deep")
+            return None
+        src = self.convert(node, output, depth)
+        self.done[key] = src
+        return src
+
+    def convert(self, node, output: str, depth: int) -> Src | None:
+        cat = node.getCategory()
+        name = node.getName()
+        t = node.getType()
+        width = _WIDTH.get(t, 0)
+        where = f"node {self.name_of(node)}"
+        if cat in DIRECT:
+            kind, ports = DIRECT[cat]
+            nid = self.add(name, kind, depth=depth)
+            for mxin, ours in ports.items():
+                self.connect(self.input_src(node, mxin, depth), nid, ours)
+            self._defaults(node, nid, ports)
+            return Src(nid, "result", width=width)
+        if cat == "modulo":
+            in1 = self.input_src(node, "in1", depth) or Src(value=[0.0] * max(width, 1))
+            in2 = self.input_src(node, "in2", depth)
+            if in2 is None or (in2.node is None and all(v == 1.0 for v in in2.value)):
+                nid = self.add(name, "frac", depth=depth)
+                self.connect(in1, nid, "value")
+                return Src(nid, "result", width=width)
+            # MaterialX's modulo is GLSL mod: a - b floor(a / b)
+            q = self.add(f"{name}_q", "divide", depth=depth)
+            self.connect(in1, q, "a")
+            self.connect(in2, q, "b")
+            f = self.add(f"{name}_floor", "floor", depth=depth)
+            self.connect(Src(q, "result"), f, "value")
+            m = self.add(f"{name}_m", "multiply", depth=depth)
+            self.connect(Src(f, "result"), m, "a")
+            self.connect(in2, m, "b")
+            nid = self.add(name, "subtract", depth=depth)
+            self.connect(in1, nid, "a")
+            self.connect(Src(m, "result"), nid, "b")
+            return Src(nid, "result", width=width)
+        if cat == "extract":
+            idx_in = node.getInput("index")
+            idx = int(_floats(idx_in.getValueString(), where)[0]) if idx_in is not None else 0
+            if not 0 <= idx <= 3:
+                self.err(f"{where}: extract index {idx} out of range")
+                return None
+            nid = self.add(name, "component_mask", {"channels": "xyzw"[idx]}, depth=depth)
+            self.connect(self.input_src(node, "in", depth), nid, "value")
+            return Src(nid, "result", width=1)
+        if cat in ("separate2", "separate3", "separate4"):
+            port = {"outx": "x", "outy": "y", "outz": "z", "outw": "w", "outr": "x",
+                    "outg": "y", "outb": "z", "outa": "w"}.get(output)
+            if port is None:
+                self.err(f"{where}: unknown output {output!r}")
+                return None
+            nid = self.add(name, "split", depth=depth)
+            self.connect(self.input_src(node, "in", depth), nid, "value")
+            return Src(nid, port, width=1)
+        if cat in ("combine2", "combine3", "combine4"):
+            k = int(cat[-1])
+            nid = self.add(name, "combine", depth=depth)
+            for i, port in enumerate("xyzw"[:k]):
+                s = self.input_src(node, f"in{i + 1}", depth)
+                self.connect(s if s is not None else Src(value=[0.0]), nid, port)
+            return Src(nid, {2: "xy", 3: "xyz", 4: "xyzw"}[k], width=k)
+        if cat == "convert":
+            inp = node.getInput("in")
+            w_in = _WIDTH.get(inp.getType(), 0) if inp is not None else 1
+            s = self.input_src(node, "in", depth)
+            if s is None:
+                s = Src(value=[0.0] * max(w_in, 1), width=max(w_in, 1))
+            if w_in == width:  # vector3 <-> color3
+                nid = self.add(name, "reroute", depth=depth)
+                self.connect(s, nid, "value")
+                return Src(nid, "value", width=width)
+            if w_in == 1 and width in (2, 3, 4):
+                nid = self.add(name, "combine", depth=depth)
+                for port in "xyzw"[:width]:
+                    self.connect(s, nid, port)
+                return Src(nid, {2: "xy", 3: "xyz", 4: "xyzw"}[width], width=width)
+            if w_in > width >= 1:
+                nid = self.add(name, "component_mask", {"channels": "xyzw"[:width]},
+                               depth=depth)
+                self.connect(s, nid, "value")
+                return Src(nid, "result", width=width)
+            self.err(f"{where}: convert {inp.getType()} to {t} is not supported")
+            return None
+        if cat == "texcoord":
+            idx_in = node.getInput("index")
+            if idx_in is not None and idx_in.getValueString() not in ("", "0"):
+                self.err(f"{where}: only texture coordinate set 0 is supported")
+                return None
+            nid = self.add(name, "texcoord", depth=depth)
+            return Src(nid, "uv", width=2)
+        if cat in ("position", "normal"):
+            space = node.getInputValue("space") if node.getInput("space") else "object"
+            if space != "world":
+                self.err(f"{where}: {cat} in {space} space is not supported (world only)")
+                return None
+            nid = self.add(name, "world_position" if cat == "position" else "world_normal",
+                           depth=depth)
+            return Src(nid, "position" if cat == "position" else "normal", width=3)
+        if cat == "viewdirection":
+            v = self.add(f"{name}_eye", "view_direction", depth=depth)
+            nid = self.add(name, "multiply", values={"b": [-1.0, -1.0, -1.0]}, depth=depth)
+            self.connect(Src(v, "direction", width=3), nid, "a")
+            return Src(nid, "result", width=3)
+        if cat == "time":
+            nid = self.add(name, "time", depth=depth)
+            return Src(nid, "seconds", width=1)
+        if cat == "constant":
+            s = self.input_src(node, "value", depth)
+            return s if s is not None else Src(value=[0.0] * max(width, 1), width=max(width, 1))
+        if cat == "dot":
+            nid = self.add(name, "reroute", depth=depth)
+            self.connect(self.input_src(node, "in", depth), nid, "value")
+            return Src(nid, "value", width=width)
+        if cat == "image":
+            return self.image(node, depth, where, width)
+        self.err(f"{where}: unsupported MaterialX node {cat!r} (type {t})")
+        return None
+
+    def _defaults(self, node, nid: str, ports: dict[str, str]) -> None:
+        """Unset MaterialX inputs take the node definition's defaults, not ours."""
+        nd = node.getNodeDef()
+        if nd is None:
+            return
+        values = self.mat.graph.nodes[nid].values
+        linked = {lk.dst_port for lk in self.mat.graph.links if lk.dst == nid}
+        for mxin, ours in ports.items():
+            if ours in values or ours in linked or node.getInput(mxin) is not None:
+                continue
+            d = nd.getActiveInput(mxin)
+            if d is None or not d.getValueString():
+                continue
+            try:
+                vals = _floats(d.getValueString(), mxin)
+            except ValueError:
+                continue
+            values[ours] = vals[0] if len(vals) == 1 else vals
+
+    def image(self, node, depth: int, where: str, width: int) -> Src | None:
+        file_in = node.getInput("file")
+        file = file_in.getValueString() if file_in is not None else ""
+        if not file or Path(file).is_absolute() or "\0" in file or ":" in file:
+            self.err(f"{where}: image file must be a relative path, got {file[:60]!r}")
+            return None
+        for opt, ok in (("uaddressmode", ("", "periodic")), ("vaddressmode", ("", "periodic")),
+                        ("filtertype", ("", "linear"))):
+            v = node.getInput(opt)
+            if v is not None and v.getValueString() not in ok:
+                self.err(f"{where}: {opt} {v.getValueString()!r} is not supported (periodic "
+                         "addressing, linear filtering only)")
+                return None
+        target = (self.source.parent / file)
+        rel = Path(os.path.relpath(os.path.abspath(target),
+                                   os.path.abspath(self.out.parent))).as_posix()
+        pname = self.new_id(f"{node.getName()}_file")
+        self.ids.discard(pname)
+        tex = self.add(pname, "texture_parameter", {"name": pname, "path": rel, "srgb": False},
+                       depth=depth)
+        nid = self.add(node.getName(), "texture_sample", depth=depth)
+        self.connect(Src(tex, "texture"), nid, "texture")
+        uv = self.input_src(node, "texcoord", depth)
+        if uv is not None:
+            self.connect(uv, nid, "uv")
+        if width == 1:
+            return Src(nid, "r", width=1)
+        if width == 3:
+            return Src(nid, "rgb", width=3)
+        if width == 4:
+            return Src(nid, "rgba", width=4)
+        m = self.add(f"{node.getName()}_xy", "component_mask", {"channels": "xy"}, depth=depth)
+        self.connect(Src(nid, "rgba", width=4), m, "value")
+        return Src(m, "result", width=2)
+
+    # --- the surface -----------------------------------------------------------------------
+    def surface_input(self, shader, name: str) -> Src | None:
+        inp = shader.getInput(name)
+        if inp is not None:
+            return self.input_el(inp, 0, f"node {self.name_of(shader)}: input {name}")
+        nd = shader.getNodeDef()
+        d = nd.getActiveInput(name) if nd is not None else None
+        if d is None or not d.getValueString():
+            return None
+        try:
+            return Src(value=_floats(d.getValueString(), name),
+                       width=_WIDTH.get(d.getType(), 1))
+        except ValueError:
+            return None
+
+    def build(self, shader) -> MaterialDocument:
+        cat = shader.getCategory()
+        table = SURFACES[cat]
+        make = self.add("make", "make_attributes")
+        out = self.add("out", "material_output")
+        self.mat.graph.nodes[out].position = (260.0, 0.0)
+        self.mat.graph.nodes[make].position = (0.0, 0.0)
+        self.connect(Src(make, "attributes"), out, "attributes")
+        for attr, (inp, scale, factor) in table.items():
+            if attr == "normal":
+                self.normal(shader, inp, cat in WORLD_NORMAL, make)
+                continue
+            src = self.surface_input(shader, inp)
+            if src is None:
+                continue
+            if src.width == 3 and attr in ("metallic", "roughness", "cavity", "opacity"):
+                if src.node is None:
+                    src = Src(value=src.value[:1], width=1)
+                else:
+                    m = self.add(f"{attr}_x", "component_mask", {"channels": "x"})
+                    self.connect(src, m, "value")
+                    src = Src(m, "result", width=1)
+            if scale is not None:
+                w = self.surface_input(shader, scale)
+                if w is None:
+                    w = Src(value=[1.0], width=1)
+                if w.node is None and src.node is None:
+                    src = Src(value=[v * w.value[0] * factor for v in src.value],
+                              width=src.width)
+                elif not (w.node is None and w.value[0] * factor == 1.0):
+                    mul = self.add(f"{attr}_weight", "multiply")
+                    self.connect(src, mul, "a")
+                    if w.node is None:
+                        self.connect(Src(value=[w.value[0] * factor]), mul, "b")
+                    else:
+                        scaled = w
+                        if factor != 1.0:
+                            s = self.add(f"{attr}_units", "multiply", values={"b": factor})
+                            self.connect(w, s, "a")
+                            scaled = Src(s, "result")
+                        self.connect(scaled, mul, "b")
+                    src = Src(mul, "result", width=src.width)
+            self.connect(src, make, attr)
+        return self.mat
+
+    def normal(self, shader, name: str, world: bool, make: str) -> None:
+        inp = shader.getInput(name)
+        if inp is None:
+            return
+        if not world:
+            src = self.surface_input(shader, name)
+            if src is not None:
+                self.connect(src, make, "normal")
+            return
+        up = None
+        if inp.getNodeGraphString():
+            ng = self.mxdoc.getNodeGraph(inp.getNodeGraphString())
+            o = ng.getOutput(inp.getOutputString()) if ng is not None else None
+            up = ng.getNode(o.getNodeName()) if o is not None and o.getNodeName() else None
+        elif inp.getNodeName():
+            up = self.mxdoc.getNode(inp.getNodeName())
+        if up is None or up.getCategory() != "normalmap":
+            self.err(f"node {self.name_of(shader)}: input {name}: a world-space normal is "
+                     "supported only from a normalmap node (a tangent-space normal map)")
+            return
+        where = f"node {self.name_of(up)}"
+        for extra in ("normal", "tangent", "bitangent"):
+            if up.getInput(extra) is not None:
+                self.err(f"{where}: a normalmap with its own {extra} input is not supported")
+        sc = up.getInput("scale")
+        if sc is not None and (sc.getNodeName() or sc.getInterfaceName()
+                               or _floats(sc.getValueString() or "1", where) != [1.0]):
+            self.err(f"{where}: normalmap scale other than 1 is not supported")
+        enc = self.input_src(up, "in", 1)
+        if enc is None:
+            return
+        if enc.node is None:
+            self.connect(Src(value=[v * 2.0 - 1.0 for v in enc.value], width=3), make,
+                         "normal")
+            return
+        two = self.add(f"{up.getName()}_x2", "multiply", values={"b": [2.0, 2.0, 2.0]})
+        self.connect(enc, two, "a")
+        one = self.add(up.getName(), "subtract", values={"b": [1.0, 1.0, 1.0]})
+        self.connect(Src(two, "result", width=3), one, "a")
+        self.connect(Src(one, "result", width=3), make, "normal")
+
+
+def _load_mtlx(path: Path):
+    import MaterialX as mx
+
+    try:
+        raw = read_bounded(path, MAX_MTLX_BYTES)
+    except FileNotFoundError:
+        raise MtlxImportError([f"{path}: no such file"]) from None
+    except OSError as exc:
+        raise MtlxImportError([f"{path}: cannot read: {getattr(exc, 'strerror', None) or exc}"]
+                              ) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise MtlxImportError([f"{path}: not UTF-8 text"]) from None
+    doc = mx.createDocument()
+    opts = mx.XmlReadOptions()
+    opts.readXIncludeFunction = None  # never follow XIncludes to other files
+    try:
+        mx.readFromXmlString(doc, text, mx.FileSearchPath(), opts)
+    except Exception as exc:  # MaterialX raises its own parse errors
+        msg = " ".join(str(exc).split())[:200]
+        raise MtlxImportError([f"{path}: not a MaterialX document: {msg}"]) from None
+    lib = mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
+    doc.importLibrary(lib)
+    return doc, lib
+
+
+def import_mtlx(path: Path, out: Path) -> MaterialDocument:
+    """The material of `path` as a matedit document to be saved at `out`; raises
+    MtlxImportError with every problem found."""
+    path, out = Path(path), Path(out)
+    doc, lib = _load_mtlx(path)
+    materials = [m for m in doc.getMaterialNodes() if not m.hasSourceUri()]
+    if not materials:
+        raise MtlxImportError([f"{path}: no surfacematerial in the document"])
+    mat = materials[0]
+    sin = mat.getInput("surfaceshader")
+    shader = None
+    if sin is not None and sin.getNodeName():
+        shader = doc.getNode(sin.getNodeName())
+    if shader is None:
+        raise MtlxImportError([f"{path}: node {mat.getName()}: its surfaceshader input is not "
+                               "connected to a surface node"])
+    if shader.getCategory() not in SURFACES:
+        raise MtlxImportError([f"{path}: node {shader.getName()}: unsupported surface "
+                               f"{shader.getCategory()!r} (expected "
+                               f"{', '.join(SURFACES)})"])
+    imp = _Importer(path, out, doc, lib)
+    try:
+        result = imp.build(shader)
+    except RecursionError:
+        raise MtlxImportError([f"{path}: node {shader.getName()}: its graph is too deep to "
+                               "import"]) from None
+    if imp.errors:
+        raise MtlxImportError(imp.errors)
+    name = mat.getName()
+    result.name = name if not identifier_problem(mangle(name)) else "imported"
+    result.description = f"Imported from {path.name}"
+    return result

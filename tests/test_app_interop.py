@@ -1,0 +1,71 @@
+"""File › Export glTF / MaterialX / baked textures / HLSL and MSL, and File › Import MaterialX,
+in the editor: the same outputs as the command line, checked by the same references."""
+
+from __future__ import annotations
+
+import pytest
+from test_app_support import app_env, make_window  # noqa: F401 - fixture
+
+from matedit.resources import graphs_dir
+from tests.interop_tools import validate_gltf
+
+pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
+SAMPLE = graphs_dir() / "materials" / "mossy_stone.json"
+
+
+def test_file_menu_offers_the_interop_entries(qtbot):
+    w = make_window(qtbot, SAMPLE)
+    file_menu = w.menuBar().actions()[0].menu()
+    texts = [a.text() for a in file_menu.actions() if not a.isSeparator()]
+    i = texts.index("&Export Shaders…")
+    assert texts[i + 1:i + 6] == ["Export &glTF…", "Export &MaterialX…",
+                                  "Export &Baked Textures…", "Export &HLSL and MSL…",
+                                  "&Import MaterialX…"]
+
+
+def test_editor_exports_and_imports(qtbot, tmp_path):
+    from matedit.interop.cross import available
+    from matedit.interop.mtlx_export import validate
+
+    w = make_window(qtbot, SAMPLE)
+    ia = w.interop
+    assert ia.export_gltf(tmp_path / "m.glb", size=16), ia.last_message
+    issues = validate_gltf(tmp_path / "m.glb", tmp_path)
+    assert issues["numErrors"] == 0, issues["messages"][:5]
+    assert ia.export_mtlx(tmp_path / "m.mtlx", size=16), ia.last_message
+    ok, msg = validate((tmp_path / "m.mtlx").read_text())
+    assert ok, msg
+    assert "baked" in ia.last_message
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    assert ia.export_baked(maps, size=8), ia.last_message
+    assert sorted(p.name for p in maps.iterdir()) == [
+        "mossy_stone_base_color.png", "mossy_stone_normal.png", "mossy_stone_orm.png"]
+    if available():
+        out = tmp_path / "cross"
+        assert ia.export_cross(out), ia.last_message
+        assert (out / "mossy_stone.hlsl.frag").is_file()
+        assert (out / "mossy_stone.msl.vert").is_file()
+    assert ia.import_mtlx(tmp_path / "m.mtlx", tmp_path / "back.json"), ia.last_message
+    assert w.controller.document.path == tmp_path / "back.json"
+    assert any(n.kind == "texture_sample" for n in w.controller.document.graph.nodes.values())
+
+
+def test_editor_import_error_names_the_node(qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QMessageBox
+
+    src = tmp_path / "bad.mtlx"
+    src.write_text('<?xml version="1.0"?>\n<materialx version="1.39">'
+                   '<nodegraph name="NG"><noise3d name="lumpy" type="float"/>'
+                   '<output name="o" type="float" nodename="lumpy"/></nodegraph>'
+                   '<standard_surface name="S" type="surfaceshader"><input name="metalness"'
+                   ' type="float" nodegraph="NG" output="o"/></standard_surface>'
+                   '<surfacematerial name="M" type="material"><input name="surfaceshader" '
+                   'type="surfaceshader" nodename="S"/></surfacematerial></materialx>\n')
+    shown = []
+    monkeypatch.setattr(QMessageBox, "critical", lambda *a: shown.append(a[2]))
+    w = make_window(qtbot, SAMPLE)
+    assert not w.interop.import_mtlx(src, tmp_path / "x.json")
+    assert shown and "NG/lumpy" in shown[0] and "noise3d" in shown[0]
+    assert not (tmp_path / "x.json").exists()
+    assert w.controller.document.path == SAMPLE

@@ -1,0 +1,178 @@
+"""`matedit bake` and `matedit export OUT.gltf|glb`.
+
+References: the CPU evaluator for the baked maps (the GPU attribute pass must match it at
+texel centres within 1/255 after 8-bit encoding, 1e-4 in float EXR), and the Khronos
+glTF-Validator (npm `gltf-validator`) for the assets: 0 errors (warnings are reported too and
+must also be 0 for our files).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from matedit.compiler.api import compile_document, lower_and_optimise
+from matedit.interop import bake
+from matedit.io.document import FileResolver, load
+from matedit.io.images import read_image
+from matedit.resources import graphs_dir
+from tests.interop_tools import validate_gltf
+
+SAMPLES = sorted((graphs_dir() / "materials").glob("*.json"))
+SIZE = 32
+
+
+def cli(*args):
+    return subprocess.run([sys.executable, "-m", "matedit", *args], capture_output=True,
+                          text=True)
+
+
+def file_pixels(path: Path) -> np.ndarray:
+    """A map read back as the bake stores it, row 0 = v = 0."""
+    return read_image(path).pixels[::-1].astype(np.float64)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_gpu_attribute_bake_matches_cpu_evaluator(ctx, path):
+    doc = load(path)
+    r = FileResolver()
+    ir = lower_and_optimise(doc, r)
+    cm = compile_document(doc, r, "glsl330", mode="attributes", ir=ir)
+    gpu = bake.attributes_gpu(ctx, cm, 48)
+    cpu = bake.attributes_cpu(lower_and_optimise(doc, r), 48)
+    for k in cpu:
+        np.testing.assert_allclose(gpu[k], cpu[k], atol=1e-4, err_msg=f"{path.stem} {k}")
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_baked_png_maps_match_cpu_at_texel_centres(tmp_path, path):
+    r = cli("bake", str(path), "-o", str(tmp_path), "--size", str(SIZE))
+    assert r.returncode == 0, r.stderr
+    doc = load(path)
+    ir = lower_and_optimise(doc, FileResolver())
+    cpu = bake.attributes_cpu(ir, SIZE)
+    expect = {
+        "base_color": bake.linear_to_srgb(cpu["baseColor"]),
+        "normal": np.clip(cpu["normal"] * 0.5 + 0.5, 0, 1),
+        "orm": np.clip(np.concatenate([cpu["cavity"], cpu["roughness"], cpu["metallic"]], -1),
+                       0, 1),
+    }
+    if "emissive" in ir.attributes and np.any(cpu["emissive"] != 0):
+        expect["emissive"] = bake.linear_to_srgb(cpu["emissive"])
+    if "opacity" in ir.attributes and np.any(cpu["opacity"] != 1):
+        expect["opacity"] = np.clip(cpu["opacity"], 0, 1)
+    written = sorted(p.name for p in tmp_path.iterdir())
+    assert written == sorted(f"{path.stem}_{n}.png" for n in expect)
+    for name, want in expect.items():
+        got = file_pixels(tmp_path / f"{path.stem}_{name}.png")
+        assert got.shape == (SIZE, SIZE, want.shape[-1])
+        err = np.abs(got - want).max()
+        assert err <= 1.0 / 255.0 + 1e-9, f"{name}: max error {err * 255:.3f}/255"
+
+
+@pytest.mark.gl
+def test_baked_exr_keeps_linear_floats(tmp_path):
+    path = graphs_dir() / "materials" / "mossy_stone.json"
+    r = cli("bake", str(path), "-o", str(tmp_path), "--size", "16", "--format", "exr")
+    assert r.returncode == 0, r.stderr
+    cpu = bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), 16)
+    got = file_pixels(tmp_path / "mossy_stone_base_color.exr")
+    np.testing.assert_allclose(got, cpu["baseColor"], atol=1e-4)
+    orm = file_pixels(tmp_path / "mossy_stone_orm.exr")
+    np.testing.assert_allclose(orm[..., 1], cpu["roughness"][..., 0], atol=1e-4)
+
+
+def test_bake_rejects_bad_size(tmp_path):
+    r = cli("bake", str(SAMPLES[0]), "-o", str(tmp_path), "--size", "0")
+    assert r.returncode == 2 and r.stderr.startswith("error: --size")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_exported_glb_passes_khronos_validator(tmp_path, path):
+    out = tmp_path / f"{path.stem}.glb"
+    r = cli("export", str(path), "-o", str(out), "--size", str(SIZE))
+    assert r.returncode == 0, r.stderr
+    issues = validate_gltf(out, tmp_path)
+    assert issues["numErrors"] == 0, issues["messages"][:5]
+    assert issues["numWarnings"] == 0, issues["messages"][:5]
+
+
+@pytest.mark.gl
+def test_exported_gltf_with_bin_and_mesh(tmp_path):
+    out = tmp_path / "asset.gltf"
+    r = cli("export", str(SAMPLES[0]), "-o", str(out), "--size", "16", "--mesh", "cube")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["asset.bin", "asset.gltf"]
+    issues = validate_gltf(out, tmp_path)
+    assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"][:5]
+    doc = json.loads(out.read_text())
+    assert doc["buffers"][0]["uri"] == "asset.bin" and str(tmp_path) not in out.read_text()
+    prim = doc["meshes"][0]["primitives"][0]
+    assert {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0"} <= set(prim["attributes"])
+    mat = doc["materials"][0]
+    assert mat["normalTexture"]["index"] != mat["occlusionTexture"]["index"]
+    assert mat["occlusionTexture"]["index"] == \
+        mat["pbrMetallicRoughness"]["metallicRoughnessTexture"]["index"]
+    # The validator is live: a broken accessor is reported as an error.
+    doc["accessors"][0]["count"] += 1000
+    bad = tmp_path / "bad.gltf"
+    bad.write_text(json.dumps(doc))
+    assert validate_gltf(bad, tmp_path)["numErrors"] > 0
+
+
+def test_export_refuses_to_overwrite_its_mesh(tmp_path):
+    mesh = tmp_path / "out.bin"  # an OBJ under another name, read by --mesh
+    mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n")
+    before = mesh.read_bytes()
+    r = cli("export", str(SAMPLES[0]), "-o", str(tmp_path / "out.gltf"), "--size", "8",
+            "--mesh", str(mesh))
+    assert r.returncode == 2 and "refusing to write over" in r.stderr
+    assert mesh.read_bytes() == before and not (tmp_path / "out.gltf").exists()
+
+
+def test_export_rejects_unknown_suffix(tmp_path):
+    r = cli("export", str(SAMPLES[0]), "-o", str(tmp_path / "x.fbx"))
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and ".gltf, .glb or .mtlx" in r.stderr
+
+
+@pytest.mark.gl
+def test_emissive_hdr_and_opacity_bake_and_export(tmp_path):
+    from matedit.io.document import save
+    from tests.graphs_util import link, node, simple_material
+
+    d = simple_material()
+    node(d, "g", "gradient")
+    node(d, "e", "multiply", values={"b": [3.0, 1.5, 0.5]})
+    link(d, "g", "value", "e", "a")
+    link(d, "e", "result", "make", "emissive")
+    link(d, "g", "value", "make", "opacity")
+    src = save(d, tmp_path / "glow.json")
+    r = cli("bake", str(src), "-o", str(tmp_path / "maps"), "--size", "16")
+    assert r.returncode == 0, r.stderr
+    names = sorted(p.name for p in (tmp_path / "maps").iterdir())
+    assert names == [f"glow_{n}.png" for n in
+                     ("base_color", "emissive", "normal", "opacity", "orm")]
+    cpu = bake.attributes_cpu(lower_and_optimise(load(src), FileResolver()), 16)
+    got = file_pixels(tmp_path / "maps" / "glow_opacity.png")[..., 0]
+    assert np.abs(got - cpu["opacity"][..., 0]).max() <= 1 / 255 + 1e-9
+    out = tmp_path / "glow.glb"
+    r = cli("export", str(src), "-o", str(out), "--size", "16")
+    assert r.returncode == 0, r.stderr
+    issues = validate_gltf(out, tmp_path)
+    assert issues["numErrors"] == 0 and issues["numWarnings"] == 0, issues["messages"][:5]
+    import pygltflib
+
+    g = pygltflib.GLTF2().load(str(out))
+    mat = g.materials[0]
+    assert mat.alphaMode == "BLEND" and mat.emissiveTexture is not None
+    strength = mat.extensions["KHR_materials_emissive_strength"]["emissiveStrength"]
+    assert strength == pytest.approx(cpu["emissive"].max(), rel=1e-4)

@@ -1,0 +1,498 @@
+"""`matedit export OUT.mtlx` (and later `matedit import`): checked by MaterialX itself.
+
+- every sample's document passes MaterialX's own `validate()` with its stdlib loaded;
+- every nodegraph output, generated to GLSL by MaterialX's own GLSL generator and drawn
+  on the bake plane (UV square, z = 0, +Z normal, camera far above) on EGL, matches our CPU
+  evaluator of the same quantity at the texel centres within 2e-3 (float32 GPU maths
+  against float64, and baked EXR images read at their texel centres).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from matedit.resources import graphs_dir
+
+mx = pytest.importorskip("MaterialX")
+SAMPLES = sorted((graphs_dir() / "materials").glob("*.json"))
+SIZE = 24
+
+
+def cli(*args):
+    return subprocess.run([sys.executable, "-m", "matedit", *args], capture_output=True,
+                          text=True)
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("mtlx")
+    notes = {}
+    for path in SAMPLES:
+        r = cli("export", str(path), "-o", str(folder / f"{path.stem}.mtlx"), "--size",
+                str(SIZE))
+        assert r.returncode == 0, r.stderr
+        notes[path.stem] = r.stderr
+    return folder, notes
+
+
+def load_with_stdlib(path: Path):
+    doc = mx.createDocument()
+    mx.readFromXmlFile(doc, str(path))
+    lib = mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
+    doc.importLibrary(lib)
+    return doc
+
+
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_exported_mtlx_validates(exported, path):
+    folder, notes = exported
+    out = folder / f"{path.stem}.mtlx"
+    doc = load_with_stdlib(out)
+    ok, msg = doc.validate()
+    assert ok, msg
+    text = out.read_text()
+    assert str(folder) not in text and str(graphs_dir()) not in text
+    surfaces = [n for n in doc.getNodes() if n.getCategory() == "standard_surface"]
+    assert len(surfaces) == 1
+    assert [m.getName() for m in doc.getMaterialNodes()] == [f"M_{path.stem}"]
+    # Every image the document references was written beside it, and is reported.
+    images = doc.getNodeGraph(f"NG_{path.stem}").getNodes("image")
+    for img in images:
+        file = img.getInputValue("file")
+        assert "/" not in file and (folder / file).is_file()
+        assert f"node {img.getName().removesuffix('_baked').rsplit('_', 1)[0]}" in \
+            notes[path.stem]
+    for line in notes[path.stem].splitlines():
+        assert line.startswith("note: ") and "baked to an image" in line
+
+
+# standard_surface input -> (our attribute, how the surface input relates to it)
+SURFACE_INPUTS = {
+    "base_color": "baseColor", "base": "cavity", "specular": "cavity",
+    "metalness": "metallic", "specular_roughness": "roughness",
+    "normal": "normal", "emission_color": "emissive", "opacity": "opacity",
+}
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+    from tests.mtlx_gpu import MtlxDrawer
+
+    folder, _ = exported
+    doc = load_with_stdlib(folder / f"{path.stem}.mtlx")
+    cpu = bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), SIZE)
+    shader = next(n for n in doc.getNodes() if n.getCategory() == "standard_surface")
+    drawer = MtlxDrawer(ctx, SIZE)
+    checked = []
+    try:
+        for inp in shader.getInputs():
+            if not inp.getNodeGraphString():
+                continue
+            out = doc.getNodeGraph(inp.getNodeGraphString()).getOutput(inp.getOutputString())
+            got = drawer.draw(doc, out, folder)
+            want = cpu[SURFACE_INPUTS[inp.getName()]]
+            if inp.getName() == "normal":  # normalmap on T = +X, B = +Y, N = +Z
+                want = want / np.linalg.norm(want, axis=-1, keepdims=True)
+            k = want.shape[-1]
+            if inp.getName() == "opacity":
+                got, k = got[..., :1], 1
+            np.testing.assert_allclose(got[..., :k], want, atol=2e-3,
+                                       err_msg=f"{path.stem}: {inp.getName()}")
+            checked.append(inp.getName())
+    finally:
+        drawer.release()
+    print(path.stem, "checked", checked)
+    assert "base_color" in checked, checked
+
+
+# --- import ---------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_round_trip_import_compile_evaluate_equals_original(exported, path):
+    """export -> import -> compile -> CPU evaluation equals the original at the texel centres
+    of the bake (baked nodes come back as float EXR textures read there): within 1e-6."""
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    folder, _ = exported
+    out = folder / f"{path.stem}_imported.json"
+    r = cli("import", str(folder / f"{path.stem}.mtlx"), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    r = cli("validate", str(out))
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert str(folder) not in out.read_text()
+    a = bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), SIZE)
+    b = bake.attributes_cpu(lower_and_optimise(load(out), FileResolver()), SIZE)
+    for k in a:
+        np.testing.assert_allclose(b[k], a[k], atol=1e-6, err_msg=f"{path.stem} {k}")
+
+
+def _doc(body: str) -> str:
+    return f'<?xml version="1.0"?>\n<materialx version="1.39">\n{body}\n</materialx>\n'
+
+
+def _import(tmp_path, text: str, name="in.mtlx"):
+    src = tmp_path / name
+    src.write_text(text)
+    out = tmp_path / "out.json"
+    return cli("import", str(src), "-o", str(out)), out
+
+
+def _eval(path: Path):
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    return bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), 4)
+
+
+def test_import_unsupported_nodes_are_named_each(tmp_path):
+    text = _doc('''
+  <nodegraph name="NG">
+    <texcoord name="uv" type="vector2" />
+    <noise2d name="bumpy" type="float"><input name="texcoord" type="vector2" nodename="uv"/>
+    </noise2d>
+    <cellnoise2d name="cells" type="float" />
+    <output name="r" type="float" nodename="bumpy" />
+    <output name="m" type="float" nodename="cells" />
+  </nodegraph>
+  <standard_surface name="S" type="surfaceshader">
+    <input name="specular_roughness" type="float" nodegraph="NG" output="r" />
+    <input name="metalness" type="float" nodegraph="NG" output="m" />
+  </standard_surface>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S" />
+  </surfacematerial>''')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert all(ln.startswith("error: ") for ln in lines) and len(lines) == 2
+    assert any("NG/bumpy" in ln and "noise2d" in ln for ln in lines)
+    assert any("NG/cells" in ln and "cellnoise2d" in ln for ln in lines)
+    assert not out.exists()
+
+
+def test_import_foreign_standard_surface_with_defaults_and_hostile_names(tmp_path):
+    text = _doc('''
+  <nodegraph name="NG">
+    <input name="gl_tint" type="color3" value="0.2, 0.4, 0.6" />
+    <multiply name="9 bad name__x" type="color3">
+      <input name="in1" type="color3" interfacename="gl_tint" />
+      <input name="in2" type="float" value="0.5" />
+    </multiply>
+    <output name="c" type="color3" nodename="9 bad name__x" />
+  </nodegraph>
+  <standard_surface name="S" type="surfaceshader">
+    <input name="base_color" type="color3" nodegraph="NG" output="c" />
+    <input name="emission" type="float" value="2" />
+    <input name="emission_color" type="color3" value="0.5, 0.25, 0" />
+  </standard_surface>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S" />
+  </surfacematerial>''')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 0, r.stderr
+    import json
+
+    data = json.loads(out.read_text())
+    from matedit.graph.model import valid_id
+    from matedit.graph.names import identifier_problem
+
+    assert all(valid_id(n["id"]) for n in data["nodes"])
+    assert "n_9_bad_name_x" in {n["id"] for n in data["nodes"]}
+    params = [n["settings"]["name"] for n in data["nodes"] if n["kind"].endswith("_parameter")]
+    assert params == ["p_gl_tint"] and identifier_problem(params[0]) is None
+    a = _eval(out)
+    np.testing.assert_allclose(a["baseColor"][0, 0], [0.1, 0.2, 0.3], atol=1e-9)
+    np.testing.assert_allclose(a["emissive"][0, 0], [1.0, 0.5, 0.0], atol=1e-9)
+    # Unset inputs take standard_surface's defaults: roughness 0.2, base 1 -> cavity 1.
+    assert a["roughness"][0, 0, 0] == pytest.approx(0.2)
+    assert a["cavity"][0, 0, 0] == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("surface, inputs, expect", [
+    ("gltf_pbr", '<input name="base_color" type="color3" value="0.1, 0.2, 0.3" />'
+                 '<input name="roughness" type="float" value="0.7" />'
+                 '<input name="occlusion" type="float" value="0.9" />',
+     {"baseColor": [0.1, 0.2, 0.3], "roughness": [0.7], "cavity": [0.9]}),
+    ("UsdPreviewSurface", '<input name="diffuseColor" type="color3" value="0.3, 0.2, 0.1" />'
+                          '<input name="metallic" type="float" value="1" />'
+                          '<input name="opacity" type="float" value="0.5" />',
+     {"baseColor": [0.3, 0.2, 0.1], "metallic": [1.0], "opacity": [0.5]}),
+    ("open_pbr_surface", '<input name="base_color" type="color3" value="0.5, 0.5, 0.1" />'
+                         '<input name="base_metalness" type="float" value="0.25" />',
+     {"baseColor": [0.5, 0.5, 0.1], "metallic": [0.25]}),
+])
+def test_import_other_surfaces(tmp_path, surface, inputs, expect):
+    text = _doc(f'''
+  <{surface} name="S" type="surfaceshader">{inputs}</{surface}>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S" />
+  </surfacematerial>''')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 0, r.stderr
+    a = _eval(out)
+    for k, v in expect.items():
+        np.testing.assert_allclose(a[k][0, 0], v, atol=1e-9, err_msg=k)
+
+
+@pytest.mark.parametrize("text, needle", [
+    ("<materialx version='1.39'><bad", "not a MaterialX document"),
+    (_doc('<disney_brdf_2012 name="S" type="surfaceshader"/><surfacematerial name="M" '
+          'type="material"><input name="surfaceshader" type="surfaceshader" nodename="S"/>'
+          '</surfacematerial>'), "unsupported surface"),
+    (_doc('<nodegraph name="NG"><image name="img" type="float"><input name="file" '
+          'type="filename" value="/etc/passwd"/></image><output name="o" type="float" '
+          'nodename="img"/></nodegraph><standard_surface name="S" type="surfaceshader">'
+          '<input name="metalness" type="float" nodegraph="NG" output="o"/>'
+          '</standard_surface><surfacematerial name="M" type="material"><input '
+          'name="surfaceshader" type="surfaceshader" nodename="S"/></surfacematerial>'),
+     "relative path"),
+    (_doc('<standard_surface name="S" type="surfaceshader"><input name="metalness" '
+          'type="float" value="nan"/></standard_surface><surfacematerial name="M" '
+          'type="material"><input name="surfaceshader" type="surfaceshader" nodename="S"/>'
+          '</surfacematerial>'), "not finite"),
+    (_doc(''), "no surfacematerial"),
+])
+def test_import_bad_input_is_one_error_line(tmp_path, text, needle):
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith("error: ") and needle in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr and not out.exists()
+
+
+def test_import_does_not_follow_xinclude(tmp_path):
+    (tmp_path / "other.mtlx").write_text(_doc('<standard_surface name="S" '
+                                              'type="surfaceshader"/><surfacematerial name="M" '
+                                              'type="material"><input name="surfaceshader" '
+                                              'type="surfaceshader" nodename="S"/>'
+                                              '</surfacematerial>'))
+    text = ('<?xml version="1.0"?>\n<materialx version="1.39" '
+            'xmlns:xi="http://www.w3.org/2001/XInclude">\n'
+            '<xi:include href="other.mtlx" />\n</materialx>\n')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 2 and "no surfacematerial" in r.stderr
+
+
+def test_import_refuses_to_overwrite_its_source(tmp_path):
+    src = tmp_path / "a.json"
+    src.write_text(_doc(""))
+    r = cli("import", str(src), "-o", str(src))
+    assert r.returncode == 2 and "refusing to write over" in r.stderr
+
+
+# --- every mapped kind ----------------------------------------------------------------------
+
+def _all_kinds_material(folder: Path) -> Path:
+    """A material using every catalogue kind with a MaterialX mapping (and a texture)."""
+    from matedit.io.document import save
+    from matedit.io.images import write_image
+    from tests.graphs_util import link, material, node
+
+    ramp = np.stack(np.meshgrid(np.linspace(0, 1, 8), np.linspace(1, 0, 8)), -1)
+    write_image(folder / "ramp.exr", np.concatenate([ramp, ramp[..., :1] * 0.5], -1))
+    d = material()
+    node(d, "uv", "texcoord", values={"tiling": [2.0, 3.0], "offset": [0.1, 0.2]})
+    node(d, "sp", "split")
+    link(d, "uv", "uv", "sp", "value")
+    node(d, "sn", "sin")
+    link(d, "sp", "x", "sn", "value")
+    node(d, "cs", "cos")
+    link(d, "sp", "y", "cs", "value")
+    node(d, "cb", "combine")
+    link(d, "sn", "result", "cb", "x")
+    link(d, "cs", "result", "cb", "y")
+    link(d, "sp", "x", "cb", "z")
+    node(d, "mk", "component_mask", {"channels": "zy"})
+    link(d, "cb", "xyz", "mk", "value")
+    node(d, "ap", "append")
+    link(d, "mk", "result", "ap", "a")
+    link(d, "sn", "result", "ap", "b")
+    node(d, "cr", "cross")
+    link(d, "ap", "result", "cr", "a")
+    link(d, "cb", "xyz", "cr", "b")
+    node(d, "ln", "length")
+    link(d, "cr", "result", "ln", "value")
+    node(d, "nr", "normalize")
+    link(d, "cr", "result", "nr", "value")
+    node(d, "m3", "multiply", values={"b": 2.5})
+    link(d, "ap", "result", "m3", "a")
+    node(d, "fr", "frac")
+    link(d, "m3", "result", "fr", "value")
+    node(d, "fl", "floor")
+    link(d, "m3", "result", "fl", "value")
+    node(d, "st", "step", values={"edge": 0.3})
+    link(d, "sn", "result", "st", "value")
+    node(d, "sq", "sqrt")
+    link(d, "cs", "result", "sq", "value")
+    node(d, "ab", "abs")
+    link(d, "sn", "result", "ab", "value")
+    node(d, "mn", "min")
+    link(d, "ab", "result", "mn", "a")
+    link(d, "sq", "result", "mn", "b")
+    node(d, "mxn", "max", values={"b": 0.05})
+    link(d, "mn", "result", "mxn", "a")
+    node(d, "dv", "divide", values={"b": 2.0})
+    link(d, "mxn", "result", "dv", "a")
+    node(d, "cl", "clamp", values={"min": 0.1, "max": 0.9})
+    link(d, "ln", "result", "cl", "value")
+    node(d, "om", "one_minus")
+    link(d, "cl", "result", "om", "value")
+    node(d, "pw", "power", values={"exponent": 1.7})
+    link(d, "om", "result", "pw", "base")
+    node(d, "ss", "smoothstep", values={"edge0": 0.2, "edge1": 0.8})
+    link(d, "pw", "result", "ss", "value")
+    node(d, "rm", "remap", values={"in_min": -1.0, "in_max": 1.0, "out_min": 0.1,
+                                   "out_max": 0.6})
+    link(d, "sn", "result", "rm", "value")
+    node(d, "wp", "world_position")
+    node(d, "wn", "world_normal")
+    node(d, "vd", "view_direction")
+    node(d, "dt", "dot")
+    link(d, "wn", "normal", "dt", "a")
+    link(d, "vd", "direction", "dt", "b")
+    node(d, "wpm", "component_mask", {"channels": "x"})
+    link(d, "wp", "position", "wpm", "value")
+    node(d, "tm", "time")
+    node(d, "vp", "vector_parameter", {"name": "tint4"}, {"value": [0.3, 0.6, 0.9, 1.0]})
+    node(d, "sat", "saturate")
+    link(d, "dt", "result", "sat", "value")
+    node(d, "tex", "texture_parameter", {"name": "ramp", "path": "ramp.exr", "srgb": False})
+    node(d, "smp", "texture_sample")
+    link(d, "tex", "texture", "smp", "texture")
+    link(d, "uv", "uv", "smp", "uv")
+    node(d, "lp", "lerp")
+    link(d, "fr", "result", "lp", "a")
+    link(d, "vp", "xyz", "lp", "b")
+    link(d, "st", "result", "lp", "alpha")
+    node(d, "ad", "add")
+    link(d, "dv", "result", "ad", "a")
+    link(d, "wpm", "result", "ad", "b")
+    node(d, "sb", "subtract")
+    link(d, "ss", "result", "sb", "a")
+    link(d, "tm", "seconds", "sb", "b")
+    node(d, "em", "multiply")
+    link(d, "smp", "rgb", "em", "a")
+    link(d, "fl", "result", "em", "b")
+    node(d, "gr", "gradient", values={"angle": 30.0})
+    link(d, "uv", "uv", "gr", "uv")
+    node(d, "ck", "checker", values={"scale": 3.0, "color_a": [0.9, 0.2, 0.1],
+                                     "color_b": [0.1, 0.3, 0.8]})
+    link(d, "uv", "uv", "ck", "uv")
+    node(d, "un", "unpack_normal", values={"strength": 1.5})
+    link(d, "fr", "result", "un", "packed")
+    node(d, "bn", "blend_normals")
+    link(d, "nr", "result", "bn", "base")
+    link(d, "un", "normal", "bn", "detail")
+    node(d, "fn", "flatten_normal")
+    link(d, "bn", "normal", "fn", "normal")
+    link(d, "gr", "value", "fn", "flatness")
+    node(d, "ckm", "multiply")
+    link(d, "ck", "color", "ckm", "a")
+    link(d, "ck", "mask", "ckm", "b")
+    node(d, "bc", "add")
+    link(d, "lp", "result", "bc", "a")
+    link(d, "ckm", "result", "bc", "b")
+    node(d, "make", "make_attributes")
+    node(d, "out", "material_output")
+    link(d, "bc", "result", "make", "baseColor")
+    link(d, "ad", "result", "make", "metallic")
+    link(d, "sb", "result", "make", "roughness")
+    link(d, "rm", "result", "make", "cavity")
+    link(d, "fn", "normal", "make", "normal")
+    link(d, "em", "result", "make", "emissive")
+    link(d, "sat", "result", "make", "opacity")
+    link(d, "make", "attributes", "out", "attributes")
+    return save(d, folder / "all_kinds.json")
+
+
+@pytest.mark.gl
+def test_every_mapped_kind_matches_materialx_glsl_and_round_trips(ctx, tmp_path):
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+    from tests.mtlx_gpu import MtlxDrawer
+
+    src = _all_kinds_material(tmp_path)
+    assert cli("validate", str(src)).returncode == 0
+    out = tmp_path / "all_kinds.mtlx"
+    r = cli("export", str(src), "-o", str(out), "--size", str(SIZE))
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == ""  # nothing baked: every kind here maps
+    doc = load_with_stdlib(out)
+    ok, msg = doc.validate()
+    assert ok, msg
+    cpu = bake.attributes_cpu(lower_and_optimise(load(src), FileResolver()), SIZE)
+    shader = next(n for n in doc.getNodes() if n.getCategory() == "standard_surface")
+    drawer = MtlxDrawer(ctx, SIZE)
+    checked = []
+    try:
+        for inp in shader.getInputs():
+            if not inp.getNodeGraphString():
+                continue
+            o = doc.getNodeGraph(inp.getNodeGraphString()).getOutput(inp.getOutputString())
+            got = drawer.draw(doc, o, tmp_path)
+            want = cpu[SURFACE_INPUTS[inp.getName()]]
+            if inp.getName() == "normal":
+                want = want / np.linalg.norm(want, axis=-1, keepdims=True)
+            k = 1 if inp.getName() == "opacity" else want.shape[-1]
+            np.testing.assert_allclose(got[..., :k], want[..., :k], atol=2e-3,
+                                       err_msg=inp.getName())
+            checked.append(inp.getName())
+    finally:
+        drawer.release()
+    assert set(checked) == set(SURFACE_INPUTS), checked
+    back = tmp_path / "back.json"
+    r = cli("import", str(out), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    again = bake.attributes_cpu(lower_and_optimise(load(back), FileResolver()), SIZE)
+    for k in cpu:
+        np.testing.assert_allclose(again[k], cpu[k], atol=1e-6, err_msg=k)
+
+
+def test_mtlx_export_refuses_a_link_to_the_document(tmp_path):
+    import shutil
+
+    folder = tmp_path / "g"
+    shutil.copytree(graphs_dir(), folder)
+    doc = folder / "materials" / "car_paint.json"
+    before = doc.read_bytes()
+    trap = tmp_path / "car.mtlx"
+    trap.symlink_to(doc)
+    r = cli("export", str(doc), "-o", str(trap), "--size", "8")
+    assert r.returncode == 2 and "refusing to write over the document" in r.stderr
+    assert doc.read_bytes() == before
+    assert not list(tmp_path.glob("*.exr"))
+
+
+def test_import_of_a_very_deep_chain_is_one_error_or_a_material(tmp_path):
+    n = 3000
+    nodes = ['<add name="a0" type="float"><input name="in1" type="float" value="0.001"/></add>']
+    for i in range(1, n):
+        nodes.append(f'<add name="a{i}" type="float"><input name="in1" type="float" '
+                     f'nodename="a{i - 1}"/><input name="in2" type="float" value="0.0001"/>'
+                     '</add>')
+    text = _doc('<nodegraph name="NG">' + "".join(nodes) +
+                f'<output name="o" type="float" nodename="a{n - 1}"/></nodegraph>'
+                '<standard_surface name="S" type="surfaceshader"><input name="metalness" '
+                'type="float" nodegraph="NG" output="o"/></standard_surface>'
+                '<surfacematerial name="M" type="material"><input name="surfaceshader" '
+                'type="surfaceshader" nodename="S"/></surfacematerial>')
+    r, out = _import(tmp_path, text)
+    assert "Traceback" not in r.stderr
+    if r.returncode == 2:
+        assert r.stderr.startswith("error: ") and "too deep" in r.stderr
+        assert not out.exists()
+    else:
+        assert r.returncode == 0 and out.is_file()
