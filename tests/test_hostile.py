@@ -32,14 +32,14 @@ from hypothesis import strategies as st
 from matedit.graph.names import GLSL_KEYWORDS, identifier_problem
 from matedit.io.document import FormatError, load, loads
 
-pytestmark = pytest.mark.timeout(20)
+pytestmark = pytest.mark.timeout(20, method="signal")
 EXAMPLES = int(os.environ.get("HOSTILE_EXAMPLES", "60"))
 # Generated cases: each example within 20 s (hypothesis' deadline), the whole property
 # within the sum (pytest-timeout, which also ends a hang).
 HSET = settings(max_examples=EXAMPLES, deadline=timedelta(seconds=20), derandomize=True,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,
                                        HealthCheck.too_slow])
-HTIMEOUT = pytest.mark.timeout(20 * EXAMPLES + 60)
+HTIMEOUT = pytest.mark.timeout(20 * EXAMPLES + 60, method="signal")
 
 # --- every string field of a material, one payload at a time --------------------------------
 
