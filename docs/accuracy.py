@@ -122,17 +122,20 @@ def sphere_light_section() -> None:
         e_model = float((model * V[:, 2]).sum() * d_omega_v)
         e_brute = float((brute * V[:, 2]).sum() * d_omega_v)
         a = roughness * roughness
-        alt = (a / min(1.0, a + radius / (2 * d))) ** 2 / (a / min(1.0, a + radius / (3 * d))) ** 2
+        # the default widening is a' = a + r/(2d); the notes' reading r/(3d) for comparison
+        alt = (a / min(1.0, a + radius / (3 * d))) ** 2 / (a / min(1.0, a + radius / (2 * d))) ** 2
         rows.append([f"{roughness:.2f}", f"{e_model / e_brute:.2f}",
                      f"{e_model * alt / e_brute:.2f}"])
     print("### Sphere light, specular energy\n")
     print(f"Reflected specular energy (∫ Lo NoV dω over every view direction) of a white metal "
           f"(F0 = 1) under a sphere light of radius {radius} m at {d} m straight above, "
-          "`matedit.shading.lights.sphereLight` (representative point and the notes' "
-          "normalisation) divided by a brute-force integral of the same BRDF over the "
-          "sphere's solid angle at uniform radiance. 1.00 is exact; the second column is "
-          "what `sourceRadius / (2 d)` in the normalisation would give instead.\n")
-    table(["roughness", "ours, a' = a + r/(3d)", "if a' = a + r/(2d)"], rows)
+          "`matedit.shading.lights.sphereLight` (representative point and the default "
+          "normalisation, a' = a + r/(2d)) divided by a brute-force integral of the same BRDF "
+          "over the sphere's solid angle at uniform radiance. 1.00 is exact; the second "
+          "column is what `sourceRadius / (3 d)` would give instead. "
+          "`benchmarks/bench_lights.py` measures more sizes, tubes and tilted lights "
+          "(benchmarks/LIGHTS_ENERGY.md).\n")
+    table(["roughness", "ours, a' = a + r/(2d)", "if a' = a + r/(3d)"], rows)
 
 
 def ibl_section(ctx) -> None:
