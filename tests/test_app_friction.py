@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from graphs_util import EDITOR_SAMPLE
 from PySide6.QtCore import QPoint, QPointF, Qt
 from test_app_support import app_env, make_window, settle  # noqa: F401 - fixture
 
@@ -10,7 +11,7 @@ from matedit.resources import graphs_dir
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 
-SAMPLE = graphs_dir() / "materials" / "rusty_painted_metal.json"
+SAMPLE = EDITOR_SAMPLE
 
 
 def test_a_new_material_starts_with_an_output_and_the_palette_ranks_it_first(qtbot):

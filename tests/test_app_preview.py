@@ -3,10 +3,12 @@ viewport's picture: through the real window, its renderer under Xvfb."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 import pytest
+from graphs_util import EDITOR_SAMPLE
 from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
 from test_app_viewport import frame
 
@@ -14,7 +16,7 @@ from matedit.resources import graphs_dir
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 
-SAMPLE = graphs_dir() / "materials" / "rusty_painted_metal.json"
+SAMPLE = EDITOR_SAMPLE
 
 
 @pytest.fixture
@@ -146,7 +148,8 @@ def test_function_and_material_files_dropped_on_the_canvas(qtbot):
     assert _drop(qtbot, canvas.viewport(), [fn]) == (True, True)
     (call,) = set(g.nodes) - before
     assert g.nodes[call].kind == "function_call"
-    assert g.nodes[call].settings["function"] == "../functions/fresnel_rim.json"
+    assert g.nodes[call].settings["function"] == Path(os.path.relpath(fn, SAMPLE.parent)) \
+        .as_posix()
     other = graphs_dir() / "materials" / "brushed_gold.json"
     _drop(qtbot, canvas.viewport(), [other])  # a material: opened (the edit is discarded)
     assert w.controller.document.path == other

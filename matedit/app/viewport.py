@@ -9,6 +9,7 @@ out through `glErrors`. A value edit only sets uniforms and redraws.
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -496,15 +497,14 @@ class ViewportPanel(QWidget):
                                    SAVE_FILTER)
         return bool(path) and self.save_image(path)
 
-    def _inputs(self) -> set[Path]:
-        """Files the document reads: an image saved over one of them is refused."""
-        doc = self.controller.document
-        out = {Path(doc.path).resolve()} if doc.path else set()
-        cm = self.compiler.current or self.compiler.last_good
-        if cm is not None:
-            out |= {Path(p).resolve() for p in texture_paths(cm, doc).values() if p}
+    def _inputs(self) -> dict[Path, str]:
+        """Files the document reads (matedit.io.inputs: the document, its functions and
+        layers, every texture, live or not), and the viewport's environment file."""
+        from matedit.io.inputs import document_inputs
+
+        out = document_inputs(self.controller.document, self.controller.resolver)
         if Path(self.view._environment).suffix:
-            out.add(Path(self.view._environment).resolve())
+            out.setdefault(Path(os.path.realpath(self.view._environment)), "the environment")
         return out
 
     def save_image(self, path: str | Path) -> bool:
@@ -514,7 +514,11 @@ class ViewportPanel(QWidget):
         if path.suffix.lower() not in (".png", ".exr"):
             path = path.with_suffix(path.suffix + ".png") if path.suffix else \
                 path.with_suffix(".png")
-        if path.resolve() in self._inputs():
+        from matedit.io.inputs import OverwriteError, refuse_overwrite
+
+        try:
+            refuse_overwrite([path], self._inputs())
+        except OverwriteError:
             self.statusMessage.emit(f"{path.name} is a file the material reads: not "
                                     "overwritten")
             return False

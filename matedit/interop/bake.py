@@ -47,7 +47,9 @@ def surface(size: int, rows: tuple[int, int] | None = None) -> SurfaceArrays:
     nrm = np.tile([0.0, 0.0, 1.0], (len(uv), 1))
     view = np.asarray(CAMERA) - pos
     view /= np.linalg.norm(view, axis=1, keepdims=True)
-    return SurfaceArrays(uv, pos, nrm, view, 0.0)
+    # the texel grid as the GPU's pixel grid, so screen derivatives (bump from height,
+    # filtered patterns) are the same 2 x 2 quad differences on both
+    return SurfaceArrays(uv, pos, nrm, view, 0.0, grid=(j1 - j0, size))
 
 
 def load_textures(ir) -> dict[str, np.ndarray]:

@@ -243,6 +243,9 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> In
         dumps(doc)
     except (TypeError, ValueError) as exc:
         raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
+    from matedit.io.schema import check_document_shape
+
+    check_document_shape(raw, file)  # the published JSON Schema, after the rules above
     return doc
 
 

@@ -19,6 +19,7 @@ SCHEMA_DIR = Path(__file__).resolve().parent.parent / "schemas"
 SCHEMA_FILES = {
     "matedit.material": "material.schema.json",
     "matedit.function": "function.schema.json",
+    "matedit.instance": "instance.schema.json",
 }
 _SHARED = ("document.schema.json",)
 
