@@ -1,6 +1,7 @@
 """The deferred preview: the material's GBUFFER program fills multisampled float targets, and
 one lighting program (shaders/render/lighting.frag), linked once a variant for the renderer's
-lifetime, shades them in a full-screen pass (see that file for how edges are anti-aliased).
+lifetime, shades them in a full-screen pass over the background (drawn first into a one-sample
+texture), writing every sample; see that file for how edges are anti-aliased.
 
 G-buffer layout (GBUFFER entry, shaders/entry/gbuffer.frag.glsl), RGBA float32 each:
   0: baseColor.rgb, metallic      1: world-space shading normal, roughness
@@ -87,55 +88,52 @@ class GBuffer:
 
 
 class LightingPass:
-    """The lighting programs, keyed by (split sum only, energy compensation): each a pair,
-    per pixel and per sample, linked on first use and then kept."""
+    """The lighting programs, keyed by (split sum only, energy compensation), each linked on
+    first use and then kept for the renderer's lifetime."""
 
     def __init__(self, ctx: moderngl.Context, samples: int, bind) -> None:
         self.ctx = ctx
         self.samples = max(1, samples)
         self._bind = bind
         self._quad = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
-        self._pairs: dict[tuple[bool, bool], tuple] = {}
+        self._programs: dict[tuple[bool, bool], tuple] = {}
         self.link_count = 0
 
-    def _link(self, defines: list[str]) -> tuple[moderngl.Program, moderngl.VertexArray]:
-        lines = [f"#define {d} 1" for d in defines]
-        lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")
-        if "MATEDIT_PER_SAMPLE" in defines:
-            lines.insert(0, "#extension GL_ARB_sample_shading : require")
-        root = shaders_dir() / "render"
-        v = assemble((root / "fullscreen.vert").read_text(), "330 core", [], "<vertex>")
-        f = assemble((root / "lighting.frag").read_text(), "330 core", [], "<lighting>",
-                     roots=[root, shaders_dir()], prelude="\n".join(lines))
-        prog = self.ctx.program(vertex_shader=v.text, fragment_shader=f.text)
-        self._bind(prog)
-        for i in range(GBUFFER_TARGETS):
-            prog[f"uGBuffer{i}"].value = GBUFFER_FIRST_UNIT + i
-        self.link_count += 1
-        return prog, self.ctx.vertex_array(prog, [(self._quad, "2f", "a_pos")])
-
-    def pair(self, split_sum_only: bool, compensation: bool):
+    def program(self, split_sum_only: bool, compensation: bool):
         key = (bool(split_sum_only), bool(compensation))
-        hit = self._pairs.get(key)
+        hit = self._programs.get(key)
         if hit is None:
-            base = ([SPLIT_SUM_ONLY] if split_sum_only else []) + \
-                   ([ENERGY_COMPENSATION] if compensation else [])
-            hit = (self._link(base), self._link(base + ["MATEDIT_PER_SAMPLE"]))
-            self._pairs[key] = hit
+            defines = ([SPLIT_SUM_ONLY] if split_sum_only else []) + \
+                      ([ENERGY_COMPENSATION] if compensation else [])
+            lines = [f"#define {d} 1" for d in defines]
+            lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")
+            root = shaders_dir() / "render"
+            v = assemble((root / "fullscreen.vert").read_text(), "330 core", [], "<vertex>")
+            f = assemble((root / "lighting.frag").read_text(), "330 core", [], "<lighting>",
+                         roots=[root, shaders_dir()], prelude="\n".join(lines))
+            prog = self.ctx.program(vertex_shader=v.text, fragment_shader=f.text)
+            self._bind(prog)
+            for i in range(GBUFFER_TARGETS):
+                prog[f"uGBuffer{i}"].value = GBUFFER_FIRST_UNIT + i
+            prog["uBackground"].value = GBUFFER_FIRST_UNIT + GBUFFER_TARGETS
+            self.link_count += 1
+            hit = (prog, self.ctx.vertex_array(prog, [(self._quad, "2f", "a_pos")]))
+            self._programs[key] = hit
         return hit
 
-    def draw(self, gbuffer: GBuffer, eye, split_sum_only: bool, compensation: bool) -> None:
-        """Shades the G-buffer into the bound (multisampled) colour target."""
+    def draw(self, gbuffer: GBuffer, background: moderngl.Texture, eye,
+             split_sum_only: bool, compensation: bool) -> None:
+        """Shades the G-buffer over `background` into every sample of the bound target."""
         for i, t in enumerate(gbuffer.textures):
             t.use(location=GBUFFER_FIRST_UNIT + i)
-        for prog, vao in self.pair(split_sum_only, compensation):
-            prog["uCameraPosition"].value = tuple(float(x) for x in eye)
-            vao.render(vertices=3)
+        background.use(location=GBUFFER_FIRST_UNIT + GBUFFER_TARGETS)
+        prog, vao = self.program(split_sum_only, compensation)
+        prog["uCameraPosition"].value = tuple(float(x) for x in eye)
+        vao.render(vertices=3)
 
     def release(self) -> None:
-        for pair in self._pairs.values():
-            for prog, vao in pair:
-                vao.release()
-                prog.release()
-        self._pairs.clear()
+        for prog, vao in self._programs.values():
+            vao.release()
+            prog.release()
+        self._programs.clear()
         self._quad.release()

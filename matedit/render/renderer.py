@@ -146,7 +146,7 @@ class Renderer:
         self._gbuffer: GBuffer | None = None
         self.lighting = LightingPass(ctx, samples, self._bind_program)
         if self.deferred:
-            self.lighting.pair(True, False)  # linked once, at start-up
+            self.lighting.program(True, False)  # linked once, at start-up
         self.set_mesh("sphere")
         self.resize(*size)
         if environment is not None:
@@ -170,6 +170,7 @@ class Renderer:
             [ctx.renderbuffer((width, height), 4, samples=s, dtype="f4")], depth)
         if self.deferred:
             self._gbuffer = GBuffer(ctx, (width, height), s, depth)
+            self._background_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
         self._resolve_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
         self._accum_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
         self._split_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
@@ -194,7 +195,8 @@ class Renderer:
                 fbo.release()
                 setattr(self, name, None)
 
-    _TARGETS = ("_msaa_fbo", "_resolve_fbo", "_accum_fbo", "_split_fbo", "_out_fbo")
+    _TARGETS = ("_msaa_fbo", "_resolve_fbo", "_accum_fbo", "_split_fbo", "_out_fbo",
+                "_background_fbo")
 
     def reset_accumulation(self) -> None:
         self._accum_frames = 0
@@ -423,8 +425,13 @@ class Renderer:
         shades it into the target; forward: the mesh's FORWARD program draws into it."""
         ctx = self.ctx
         vp = self._write_frame_block()
-        self._msaa_fbo.use()
-        self._msaa_fbo.viewport = (0, 0, *self._size)
+        program = self._program_for(ibl_mode)
+        deferred = program is not None and self._mesh is not None and not self.is_forward
+        # the background: into the target itself (forward), or a one-sample texture that the
+        # lighting pass reads where the mesh is not (deferred)
+        backdrop = self._background_fbo if deferred else self._msaa_fbo
+        backdrop.use()
+        backdrop.viewport = (0, 0, *self._size)
         ctx.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
         if self.show_background and self._ibl is not None:
@@ -436,10 +443,9 @@ class Renderer:
             self._bg["uLod"].value = float(self.background_blur * (self._env_levels - 1))
             self._bg["uIntensity"].value = float(self.environment_intensity)
             self._fs_vaos[self._bg.glo].render(vertices=3)
-        program = self._program_for(ibl_mode)
         if program is not None and self._mesh is not None:
             self._bind_scene_inputs(program, ibl_mode, offset)
-            if self.is_forward:
+            if not deferred:
                 ctx.enable(moderngl.DEPTH_TEST | moderngl.BLEND)
                 ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
                 self._mesh.render(program)
@@ -451,10 +457,12 @@ class Renderer:
                 ctx.enable(moderngl.DEPTH_TEST)
                 self._mesh.render(program)
                 ctx.disable(moderngl.DEPTH_TEST)
-                self._msaa_fbo.use()
+                self._msaa_fbo.use()  # no clear: the pass writes every sample; depth is kept
+                self._msaa_fbo.viewport = (0, 0, *self._size)
                 compensation = self.energy_compensation or \
                     ENERGY_COMPENSATION in self._compiled.ir.defines
-                self.lighting.draw(self._gbuffer, np.array(self.camera.eye, "f4"),
+                self.lighting.draw(self._gbuffer, self._background_fbo.color_attachments[0],
+                                   np.array(self.camera.eye, "f4"),
                                    ibl_mode != IBL_MODE_REFERENCE, compensation)
         if self.show_gizmos:
             ctx.enable(moderngl.DEPTH_TEST)

@@ -2,13 +2,12 @@
 // applied to the G-buffer the material's GBUFFER entry wrote (shaders/entry/gbuffer.frag.glsl),
 // in a full-screen pass. Linked once per variant, whatever the material.
 //
-// Anti-aliasing: the G-buffer is multisampled like the forward target. A pixel whose samples
-// all hold the same values (the interior of a triangle) is shaded once and written to every
-// sample, as a forward fragment would be; a pixel whose samples differ (a silhouette, or two
-// triangles meeting) is left to the MATEDIT_PER_SAMPLE variant, which runs per sample
-// (ARB_sample_shading's gl_SampleID) and shades each covered sample from its own values. So
-// every sample receives the colour the forward pass gives it; uncovered samples keep the
-// background drawn before.
+// Anti-aliasing: the G-buffer is multisampled like the forward target, and the pass runs once a
+// pixel. A pixel whose samples all hold the same values (inside a triangle, or all background)
+// is shaded once; a pixel whose samples differ (a silhouette, or two triangles meeting) is
+// shaded per sample from each sample's own values, uncovered samples taking the background,
+// and the average is written. Every sample of the target gets the pixel's colour, so the
+// resolve gives what the forward pass's resolve gives: the average of the samples' colours.
 #include "surface.glsl"
 
 in vec2 v_ndc;
@@ -17,6 +16,7 @@ uniform sampler2DMS uGBuffer0;  // baseColor, metallic
 uniform sampler2DMS uGBuffer1;  // world-space shading normal, roughness
 uniform sampler2DMS uGBuffer2;  // emissive, cavity
 uniform sampler2DMS uGBuffer3;  // world position (m), coverage (1 where the mesh was drawn)
+uniform sampler2D uBackground;  // the environment behind the mesh, one sample a pixel
 uniform vec3 uCameraPosition;   // eye in world space (m), FrameBlock's cameraPosition.xyz
 
 #ifndef MATEDIT_GBUFFER_SAMPLES
@@ -57,12 +57,15 @@ vec3 shadeSample(ivec2 p, int s) {
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-#ifdef MATEDIT_PER_SAMPLE
-    int s = gl_SampleID;
-    if (!isEdge(p) || texelFetch(uGBuffer3, p, s).w < 0.5) discard;
-    fragColor = vec4(shadeSample(p, s), 1.0);
-#else
-    if (texelFetch(uGBuffer3, p, 0).w < 0.5 || isEdge(p)) discard;
-    fragColor = vec4(shadeSample(p, 0), 1.0);
-#endif
+    vec3 background = texelFetch(uBackground, p, 0).rgb;
+    if (!isEdge(p)) {
+        fragColor = vec4(texelFetch(uGBuffer3, p, 0).w < 0.5 ? background : shadeSample(p, 0),
+                         1.0);
+        return;
+    }
+    vec3 sum = vec3(0.0);
+    for (int s = 0; s < MATEDIT_GBUFFER_SAMPLES; s++) {
+        sum += texelFetch(uGBuffer3, p, s).w < 0.5 ? background : shadeSample(p, s);
+    }
+    fragColor = vec4(sum / float(MATEDIT_GBUFFER_SAMPLES), 1.0);
 }
