@@ -190,6 +190,14 @@ def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = 
     return CompiledMaterial(target, vert, frag, smap, ir, structure_hash(vert.text, frag.text))
 
 
+def compile_ir(ir: MaterialIR, target: str = "glsl330") -> CompiledMaterial:
+    """A CompiledMaterial of an IR built by hand (the renderer's warm-up, benchmarks' floor)."""
+    t = TARGETS[target]
+    vert = vertex_source(t)
+    frag, smap = fragment_source(ir, t)
+    return CompiledMaterial(target, vert, frag, smap, ir, structure_hash(vert.text, frag.text))
+
+
 def compile_all(doc: MaterialDocument, resolver: FunctionResolver | None = None,
                 targets: list[str] | None = None) -> dict[str, CompiledMaterial]:
     if resolver is None:

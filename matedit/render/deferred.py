@@ -96,15 +96,19 @@ class LightingPass:
         self.samples = max(1, samples)
         self._bind = bind
         self._quad = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
-        self._programs: dict[tuple[bool, bool], tuple] = {}
+        self._programs: dict[tuple[bool, bool, bool], tuple] = {}
         self.link_count = 0
+        self.edges_once = False  # benchmarks only (see program)
 
-    def program(self, split_sum_only: bool, compensation: bool):
-        key = (bool(split_sum_only), bool(compensation))
+    def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False):
+        """`edges_once` (benchmarks only) shades every pixel once, edges too: no anti-aliasing
+        of the lighting, to measure what lighting edges per sample costs."""
+        key = (bool(split_sum_only), bool(compensation), bool(edges_once))
         hit = self._programs.get(key)
         if hit is None:
             defines = ([SPLIT_SUM_ONLY] if split_sum_only else []) + \
-                      ([ENERGY_COMPENSATION] if compensation else [])
+                      ([ENERGY_COMPENSATION] if compensation else []) + \
+                      (["MATEDIT_EDGES_ONCE"] if edges_once else [])
             lines = [f"#define {d} 1" for d in defines]
             lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")
             root = shaders_dir() / "render"
@@ -127,7 +131,7 @@ class LightingPass:
         for i, t in enumerate(gbuffer.textures):
             t.use(location=GBUFFER_FIRST_UNIT + i)
         background.use(location=GBUFFER_FIRST_UNIT + GBUFFER_TARGETS)
-        prog, vao = self.program(split_sum_only, compensation)
+        prog, vao = self.program(split_sum_only, compensation, self.edges_once)
         prog["uCameraPosition"].value = tuple(float(x) for x in eye)
         vao.render(vertices=3)
 

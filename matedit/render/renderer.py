@@ -18,6 +18,7 @@ import numpy as np
 
 from matedit.compiler.api import CompiledMaterial
 from matedit.compiler.emit import Entry
+from matedit.compiler.ir import MaterialIR, Scope
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING
 from matedit.glsl.include import assemble
 from matedit.render.camera import OrbitCamera
@@ -151,6 +152,19 @@ class Renderer:
         self.resize(*size)
         if environment is not None:
             self.set_environment(environment)
+        if self.deferred:
+            self._warm_up()
+
+    def _warm_up(self) -> None:
+        """The driver compiles at a program's first draw (and builds its per-framebuffer state
+        the first time a target is used): one frame of a constant material now, at start-up,
+        so that the lighting pass and the G-buffer targets cost nothing at the first edit."""
+        from matedit.compiler.api import compile_ir
+
+        self.set_material(compile_ir(MaterialIR(Scope("evaluateMaterial"), [], [], [], set(),
+                                                [])))
+        self.render()
+        self._program = self._compiled = None
 
     # --- configuration --------------------------------------------------------------------
     @property

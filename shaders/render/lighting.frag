@@ -33,6 +33,9 @@ bool sameAsFirst(ivec2 p, int s) {
 
 bool isEdge(ivec2 p) {
     // matedit deferred pass: a pixel whose samples do not all agree
+#ifdef MATEDIT_EDGES_ONCE
+    return false;  // benchmarks/bench_render.py: the cost of lighting edges per sample
+#endif
     for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
         if (!sameAsFirst(p, s)) return true;
     }
