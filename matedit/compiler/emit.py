@@ -15,6 +15,7 @@ from functools import cache
 
 from matedit.compiler.ir import Expr, Lit, MaterialIR, Op, Param, Scope, Splat, SurfaceUV, Uni, Var
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING, Target
+from matedit.glsl import layout as _layout
 from matedit.glsl.include import Assembly, assemble
 from matedit.graph import nodes
 from matedit.graph.types import PortType
@@ -175,13 +176,9 @@ def std140_layout(ir: MaterialIR) -> tuple[dict[str, int], int]:
     return offsets, (off + 15) // 16 * 16
 
 
-FRAME_BLOCK = """MATEDIT_UBO({binding}) uniform FrameBlock {{
-    mat4 viewProjection;
-    mat4 model;
-    mat4 normalMatrix;
-    vec4 cameraPosition;  // xyz: eye in world space (m)
-    vec4 params;          // x: time (s), y: exposure (EV), zw: viewport size (px)
-}} uFrame;"""
+# The FrameBlock declaration, a str.format template of {binding} (matedit/glsl/layout.py)
+FRAME_BLOCK = (_layout.FRAME_BLOCK.declaration("@B@").replace("{", "{{").replace("}", "}}")
+               .replace("@B@", "{binding}"))
 
 
 def vertex_source(target: Target) -> Assembly:

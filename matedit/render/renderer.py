@@ -20,6 +20,7 @@ from matedit.compiler.api import CompiledMaterial
 from matedit.compiler.emit import Entry
 from matedit.compiler.ir import MaterialIR, Scope
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING
+from matedit.glsl import layout as _layout
 from matedit.glsl.include import assemble
 from matedit.render.camera import OrbitCamera
 from matedit.render.deferred import (
@@ -42,8 +43,11 @@ from matedit.shading.lights import Light
 from matedit.shading.lights_block import pack_lights
 
 MODES = ("splitsum", "reference", "difference")
-LIGHTS_BINDING, IBL_BINDING = 0, 1
-PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = 2, 3, 4
+# binding numbers and block sizes: matedit/glsl/layout.py, the one source
+LIGHTS_BINDING, IBL_BINDING = _layout.BINDINGS["LIGHTS"], _layout.BINDINGS["IBL"]
+PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = (
+    _layout.BINDINGS[k] for k in ("PREFILTERED_ENV", "BRDF_LUT", "ENVIRONMENT"))
+_FRAME_OFFSETS = _layout.FRAME_BLOCK.offsets()
 GL_SRGB8_ALPHA8 = 0x8C43
 # SH irradiance coefficients -> radiance coefficients: divide by the cosine lobe's A_l
 # (Ramamoorthi and Hanrahan 2001): pi, 2pi/3, pi/4 for bands 0, 1, 2.
@@ -140,9 +144,9 @@ class Renderer:
                                            self._gizmo_ibo)
         self._line_vbo = ctx.buffer(reserve=24)
         self._line_vao = ctx.vertex_array(self._gizmo, [(self._line_vbo, "3f", "a_position")])
-        self._frame_buf = ctx.buffer(reserve=224)
+        self._frame_buf = ctx.buffer(reserve=_layout.FRAME_BLOCK.size)
         self._lights_buf = ctx.buffer(pack_lights(self.lights))
-        self._ibl_buf = ctx.buffer(reserve=176)
+        self._ibl_buf = ctx.buffer(reserve=_layout.IBL_BLOCK.size)
         self._params_buf: moderngl.Buffer | None = None
         self._gbuffer: GBuffer | None = None
         self.lighting = LightingPass(ctx, samples, self._bind_program)
@@ -427,10 +431,14 @@ class Renderer:
         view = self.camera.view_matrix()
         proj = self.camera.projection(w / h)
         vp = proj @ view
-        data = b"".join([_mat_bytes(vp), _mat_bytes(np.eye(4)), _mat_bytes(np.eye(4)),
-                         np.array([*self.camera.eye, 1.0], "f4").tobytes(),
-                         np.array([self.time, self.exposure, w, h], "f4").tobytes()])
-        self._frame_buf.write(data)
+        data = bytearray(_layout.FRAME_BLOCK.size)
+        for name, value in (("viewProjection", _mat_bytes(vp)), ("model", _mat_bytes(np.eye(4))),
+                            ("normalMatrix", _mat_bytes(np.eye(4))),
+                            ("cameraPosition", np.array([*self.camera.eye, 1.0], "f4").tobytes()),
+                            ("params", np.array([self.time, self.exposure, w, h], "f4").tobytes())):
+            off = _FRAME_OFFSETS[name]
+            data[off:off + len(value)] = value
+        self._frame_buf.write(bytes(data))
         return vp
 
     def _scene(self, ibl_mode: int, offset=(0.0, 0.0)) -> None:
