@@ -33,6 +33,7 @@ from matedit.render.deferred import (
 from matedit.render.lights import default_rig
 from matedit.render.mesh import GpuMesh, mesh_from_spec, uv_sphere
 from matedit.render.programs import MaterialStatus, ProgramCache, failure
+from matedit.render.textures import file_stamp, texture_from
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
     IBL_MODE_REFERENCE,
@@ -48,7 +49,6 @@ LIGHTS_BINDING, IBL_BINDING = _layout.BINDINGS["LIGHTS"], _layout.BINDINGS["IBL"
 PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = (
     _layout.BINDINGS[k] for k in ("PREFILTERED_ENV", "BRDF_LUT", "ENVIRONMENT"))
 _FRAME_OFFSETS = _layout.FRAME_BLOCK.offsets()
-GL_SRGB8_ALPHA8 = 0x8C43
 # SH irradiance coefficients -> radiance coefficients: divide by the cosine lobe's A_l
 # (Ramamoorthi and Hanrahan 2001): pi, 2pi/3, pi/4 for bands 0, 1, 2.
 _SH_BAND_SCALE = np.array([math.pi] + [2 * math.pi / 3] * 3 + [math.pi / 4] * 5)
@@ -119,6 +119,7 @@ class Renderer:
         self._values: dict[str, Any] = {}
         self._textures: dict[str, moderngl.Texture] = {}
         self._texture_keys: dict[str, tuple[str | None, str]] = {}  # name: (path, space)
+        self._texture_stamps: dict[str, tuple] = {}  # name: textures.file_stamp
         self._accum_frames = 0
         self._frame_index = 0
         self._size = (0, 0)
@@ -347,12 +348,16 @@ class Renderer:
         """Loads a material texture (a value edit); a missing file shows a checker. The colour
         space defaults to the compiled material's setting for that texture (srgb, linear or an
         OpenColorIO space; matedit.shading.colorspace)."""
+        space = color_space or self._texture_space(name)
+        stamp = file_stamp(path, space)
+        if name in self._textures and self._texture_stamps.get(name) == stamp:
+            return  # the same unchanged file: nothing to read, upload or redraw
         old = self._textures.pop(name, None)
         if old is not None:
             old.release()
-        space = color_space or self._texture_space(name)
         self._textures[name] = self._texture_from(path, space)
         self._texture_keys[name] = (path, space)
+        self._texture_stamps[name] = stamp
         self.reset_accumulation()
 
     def _texture_space(self, name: str) -> str:
@@ -364,38 +369,7 @@ class Renderer:
         return "srgb"
 
     def _texture_from(self, path: str | None, space: str = "srgb") -> moderngl.Texture:
-        """sRGB 8-bit files go to an sRGB internal format (decoded before filtering), their
-        mips built in linear space and encoded back; everything else is linear float RGBA,
-        decoded on the CPU (matedit.shading.colorspace), mips in linear space."""
-        from matedit.compiler.cpu_eval import checker_texture
-        from matedit.shading.colorspace import linear_to_srgb, load_texture_cached, mip_chain
-
-        image = None
-        if path:
-            try:
-                image = load_texture_cached(path, space)
-            except (ValueError, OSError):
-                image = None
-        linear = image.linear if image is not None else checker_texture(8)
-        levels = mip_chain(linear)
-        size = (linear.shape[1], linear.shape[0])
-        if image is not None and image.srgb8 is not None:
-            tex = self.ctx.texture(size, 4, image.srgb8.tobytes(), dtype="f1",
-                                   internal_format=GL_SRGB8_ALPHA8)
-            tex.build_mipmaps()  # allocates the chain; every level is rewritten below
-            for i, lev in enumerate(levels[1:], start=1):
-                codes = np.concatenate([linear_to_srgb(lev[..., :3]), lev[..., 3:]], axis=2)
-                tex.write(np.rint(codes * 255.0).clip(0, 255).astype(np.uint8).tobytes(),
-                          level=i)
-        else:
-            tex = self.ctx.texture(size, 4, np.ascontiguousarray(linear, "f4").tobytes(),
-                                   dtype="f4")
-            tex.build_mipmaps()
-            for i, lev in enumerate(levels[1:], start=1):
-                tex.write(np.ascontiguousarray(lev, "f4").tobytes(), level=i)
-        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-        tex.repeat_x = tex.repeat_y = True
-        return tex
+        return texture_from(self.ctx, path, space)
 
     def _load_textures(self, compiled: CompiledMaterial) -> None:
         from matedit.shading.colorspace import effective_space
@@ -405,6 +379,7 @@ class Renderer:
             if name not in wanted:
                 self._textures.pop(name).release()
                 self._texture_keys.pop(name, None)
+                self._texture_stamps.pop(name, None)
         for name, info in wanted.items():
             key = (info.path, effective_space(getattr(info, "color_space", ""), info.srgb))
             if name not in self._textures or self._texture_keys.get(name, key)[1] != key[1]:
@@ -415,6 +390,7 @@ class Renderer:
                     else info.path
                 self._textures[name] = self._texture_from(path, key[1])
                 self._texture_keys[name] = (path, key[1])
+                self._texture_stamps[name] = file_stamp(path, key[1])
 
     # --- drawing --------------------------------------------------------------------------
     @property
