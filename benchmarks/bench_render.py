@@ -10,6 +10,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "true")
 
@@ -46,7 +48,10 @@ MaterialAttributes evaluateMaterial() {{
 
 
 def floor_material() -> CompiledMaterial:
-    """The same lighting with constant material inputs, written by hand: the cost floor."""
+    """The same lighting with constant material inputs: the cost floor. The renderer links the
+    entry variants of a material's IR (an empty IR: the default attributes, constants), so in
+    the deferred preview this floor is a GBUFFER program of constants and the same lighting
+    pass; in the forward preview, the FORWARD entry of constants."""
     t = TARGETS["glsl330"]
     frag = assemble(FLOOR_BODY, t.version, ["common.glsl", "material.glsl",
                                             "nodes/context.glsl", "surface.glsl"],
@@ -128,6 +133,90 @@ def parameter_edit(renderer, ctx, material: CompiledMaterial, repeat: int = 5,
     return times[len(times) // 2], renderer.link_count - links
 
 
+def structural_edit_paths(ctx, size: int = 512, repeat: int = 3,
+                          names: list[str] | None = None) -> list[dict]:
+    """Structural edit latency of each sample, forward and deferred previews side by side (two
+    renderers, alternating, so that load on the machine hits both), medians in seconds."""
+    from matedit.render import Renderer
+
+    paths = {"forward": Renderer(ctx, (size, size), deferred=False),
+             "deferred": Renderer(ctx, (size, size), deferred=True)}
+    for r in paths.values():
+        r.render()
+        ctx.finish()
+    rows = []
+    files = sorted((graphs_dir() / "materials").glob("*.json"))
+    for path in files:
+        if names and path.stem not in names:
+            continue
+        doc = load(path)
+        runs: dict[str, list] = {k: [] for k in paths}
+        for _ in range(repeat):
+            for k, r in paths.items():
+                runs[k].append(structural_edit(r, ctx, doc, repeat=1))
+        row = {"sample": path.stem}
+        for k in paths:
+            ordered = sorted(runs[k], key=lambda x: x[3])
+            c, li, f, tot = ordered[len(ordered) // 2]
+            row[k] = {"compile": c, "link": li, "first_frame": f, "total": tot}
+        row["deferred_path"] = not paths["deferred"].is_forward
+        rows.append(row)
+    for r in paths.values():
+        r.release()
+    return rows
+
+
+def frames_forward_deferred(ctx, material: CompiledMaterial, sizes=(512, 1024),
+                            frames: int = 5) -> list[dict]:
+    """Frame medians (s) of the material and the floor on both paths, and of the deferred path
+    with edges lit once (no anti-aliasing of the lighting): what per-sample edges cost."""
+    import statistics
+
+    from matedit.render import Renderer
+
+    rows = []
+    floor = floor_material()
+    for size in sizes:
+        rs = {"forward": Renderer(ctx, (size, size), deferred=False),
+              "deferred": Renderer(ctx, (size, size), deferred=True)}
+        times: dict[str, list[float]] = {}
+        for i in range(frames + 1):
+            for path, r in rs.items():
+                for name, m in (("material", material), ("floor", floor)):
+                    r.set_material(m)
+                    for edges_once in ((False, True) if path == "deferred" and
+                                       name == "material" else (False,)):
+                        r.lighting.edges_once = edges_once
+                        t = time.perf_counter()
+                        r.render()
+                        ctx.finish()
+                        key = f"{path} {name}" + (" edges once" if edges_once else "")
+                        if i:
+                            times.setdefault(key, []).append(time.perf_counter() - t)
+                    r.lighting.edges_once = False
+        row = {"size": size, **{k: statistics.median(v) for k, v in times.items()}}
+        g = rs["deferred"]._gbuffer
+        if g is not None:  # the share of edge pixels (samples that disagree), for the cost
+            t3 = np.frombuffer(_resolve_coverage(ctx, g, size), np.float32)
+            row["edge_pixel_share"] = float(((t3 > 0) & (t3 < 1)).mean())
+        for r in rs.values():
+            r.release()
+        rows.append(row)
+    return rows
+
+
+def _resolve_coverage(ctx, gbuffer, size: int) -> bytes:
+    """The G-buffer's coverage channel resolved (average of samples): 0 < c < 1 at a
+    silhouette pixel."""
+    tex = ctx.texture((size, size), 4, dtype="f4")
+    fbo = ctx.framebuffer([tex])
+    ctx.copy_framebuffer(fbo, ctx.framebuffer([gbuffer.textures[3]]))
+    raw = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32)[3::4].tobytes()
+    fbo.release()
+    tex.release()
+    return raw
+
+
 def main() -> None:
     import moderngl
 
@@ -157,6 +246,29 @@ def main() -> None:
     print(f"\nparameter edit -> next frame at 512²: {t * 1000:.0f} ms, "
           f"program links caused: {links}")
     r.release()
+
+    print("\n## forward and deferred previews side by side (MESA_SHADER_CACHE_DISABLE="
+          f"{os.environ.get('MESA_SHADER_CACHE_DISABLE')})\n")
+    print("| sample | forward link (ms) | forward first frame (ms) | forward total (ms) "
+          "| deferred link (ms) | deferred first frame (ms) | deferred total (ms) "
+          "| deferred / forward |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    for row in structural_edit_paths(ctx):
+        f, d = row["forward"], row["deferred"]
+        note = "" if row["deferred_path"] else " (translucent: forward)"
+        print(f"| {row['sample']}{note} | {f['link'] * 1e3:.0f} | {f['first_frame'] * 1e3:.0f} "
+              f"| {f['total'] * 1e3:.0f} | {d['link'] * 1e3:.0f} "
+              f"| {d['first_frame'] * 1e3:.0f} | {d['total'] * 1e3:.0f} "
+              f"| {d['total'] / f['total']:.2f} |")
+    print("\n| size | forward (ms) | forward floor (ms) | deferred (ms) | deferred floor (ms) "
+          "| deferred, edges lit once (ms) | edge pixels |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    for row in frames_forward_deferred(ctx, material):
+        print(f"| {row['size']}² | {row['forward material'] * 1e3:.0f} "
+              f"| {row['forward floor'] * 1e3:.0f} | {row['deferred material'] * 1e3:.0f} "
+              f"| {row['deferred floor'] * 1e3:.0f} "
+              f"| {row['deferred material edges once'] * 1e3:.0f} "
+              f"| {100 * row.get('edge_pixel_share', 0):.1f} % |")
 
 if __name__ == "__main__":
     main()

@@ -15,16 +15,9 @@
 // Total 176 bytes. matedit.shading.ibl.pack_ibl_block writes exactly these bytes.
 
 #include "bindings.glsl"
-
-
-#define IBL_MODE_SPLIT_SUM 0
-#define IBL_MODE_REFERENCE 1
-#define IBL_MODE_NONE 2
-
-#define MATEDIT_IBL_BINDING 1
-#define MATEDIT_PREFILTERED_ENV_BINDING 2
-#define MATEDIT_BRDF_LUT_BINDING 3
-#define MATEDIT_ENVIRONMENT_BINDING 4
+// IBL_MODE_* and the MATEDIT_*_BINDING numbers come from matedit/glsl/layout.py (IBL_BLOCK there
+// gives pack_ibl_block its offsets).
+#include "layout.glsl"
 
 MATEDIT_UBO(MATEDIT_IBL_BINDING) uniform IblBlock {
     vec4 sh[9];

@@ -9,17 +9,14 @@
 //     +32 directionInfluence  xyz = direction (directional: travel direction; tube: unit axis),
 //                             w = influence radius R (m)
 //     +48 shape               x = source radius (m), y = source length (m), z, w = 0
-// matedit.shading.lights_block.pack_lights writes exactly these bytes.
+// matedit.shading.lights_block.pack_lights writes exactly these bytes (matedit/glsl/layout.py's
+// LIGHTS_BLOCK, from which the packer takes its offsets).
 #include "lights.glsl"
 
 #include "bindings.glsl"
-
-#ifndef MATEDIT_MAX_LIGHTS
-#define MATEDIT_MAX_LIGHTS 16
-#endif
-
-// Binding point of the lights block (Vulkan: descriptor binding in set 0).
-#define MATEDIT_LIGHTS_BINDING 0
+// MATEDIT_MAX_LIGHTS and the binding point MATEDIT_LIGHTS_BINDING (Vulkan: descriptor binding in
+// set 0) come from matedit/glsl/layout.py, the source of the packer's offsets too.
+#include "layout.glsl"
 
 struct LightData {
     vec4 positionType;

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -9,7 +10,6 @@ import pytest
 from graphs_util import link, material, node
 
 from matedit.compiler import compile_document
-from matedit.compiler.api import CompiledMaterial
 from matedit.ibl import BakeSettings, Environment
 from matedit.io import document as fmt
 from matedit.io.document import FileResolver
@@ -231,13 +231,13 @@ def test_broken_program_keeps_the_last_good_one_and_names_the_node(fresh):
     fresh.set_material(good)
     fresh.render()
     image = fresh.read_hdr().copy()
-    line = next(l for l in good.fragment_text.splitlines() if "make_attributes(" in l
-                and "node_make_attributes(" in l)
-    broken_text = good.fragment_text.replace(line, line.replace("node_make_attributes(",
-                                                                "node_make_attributez("))
-    broken = CompiledMaterial(good.target, good.vertex,
-                              type(good.fragment)(broken_text, good.fragment.sources),
-                              good.source_map, good.ir, "broken-hash")
+    # a generator fault: the node's call names a function that does not exist (the renderer
+    # links entry variants emitted from the IR, so the fault goes into the IR)
+    ir = copy.deepcopy(good.ir)
+    op = next(op for op in ir.main.ops if op.kind == "make_attributes")
+    op.data["glsl"] = "node_make_attributez"
+    broken = compile_document(d, ir=ir)
+    assert "node_make_attributez(" in broken.fragment_text
     status = fresh.set_material(broken)
     assert not status.ok
     assert status.errors[0][0] == "make"

@@ -42,8 +42,10 @@ def make_application(argv: list[str] | None = None) -> QApplication:
 def run(path: str | Path | None = None) -> int:
     """Open the editor on `path` (None: the sample layered material) and run until it closes."""
     app = make_application()
+    from matedit.app.compile_service import MaterialCompiler
     from matedit.app.main_window import MainWindow
 
+    MaterialCompiler.asynchronous = True  # structural edits compile off the UI thread
     window = MainWindow(path)
     window.show()
     return int(app.exec())

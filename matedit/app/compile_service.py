@@ -50,23 +50,84 @@ def texture_paths(compiled: CompiledMaterial, doc: MaterialDocument) -> dict[str
 
 
 class MaterialCompiler(QObject):
-    """Recompiles on `structureChanged`; emits `compiled` or `failed(diagnostics)`."""
+    """Recompiles on `structureChanged`; emits `compiled` or `failed(diagnostics)`.
+
+    With `asynchronous` (the editor sets it; matedit.app.app.run) a structural edit compiles on
+    a worker thread (matedit.app.compile_worker) and the signals come when it is done; reading
+    `current`, `last_good`, `diagnostics` or `last_compile_ms` first waits for a pending result
+    (`latest` does not). `recompile()` called directly is always synchronous."""
 
     compiled = Signal(object)  # CompiledMaterial
     failed = Signal(list)  # list[Diagnostic]
     previewChanged = Signal(object)  # PreviewTarget | None: the viewport shows that socket
+    asynchronous = False
 
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
         self.controller = controller
-        self.current: CompiledMaterial | None = None
-        self.last_good: CompiledMaterial | None = None
-        self.diagnostics: list[Diagnostic] = []
-        self.last_compile_ms = 0.0
+        self._current: CompiledMaterial | None = None
+        self._last_good: CompiledMaterial | None = None
+        self._diagnostics: list[Diagnostic] = []
+        self._last_compile_ms = 0.0
         self._cache: dict[str, CompiledMaterial] = {}
         self.preview: PreviewTarget | None = None
-        controller.structureChanged.connect(self.recompile)
+        self.worker = None
+        controller.structureChanged.connect(self._structure_changed)
         controller.documentReplaced.connect(lambda: self.set_preview(None, recompile=False))
+
+    # what a pending compile will replace: wait for it first
+    def _settled(self, name: str):
+        if self.worker is not None and self.worker.pending:
+            self.worker.wait()
+        return getattr(self, name)
+
+    current = property(lambda self: self._settled("_current"),
+                       lambda self, v: setattr(self, "_current", v))
+    last_good = property(lambda self: self._settled("_last_good"),
+                         lambda self, v: setattr(self, "_last_good", v))
+    diagnostics = property(lambda self: self._settled("_diagnostics"),
+                           lambda self, v: setattr(self, "_diagnostics", v))
+    last_compile_ms = property(lambda self: self._settled("_last_compile_ms"),
+                               lambda self, v: setattr(self, "_last_compile_ms", v))
+
+    @property
+    def latest(self) -> CompiledMaterial | None:
+        """The newest compiled material delivered so far (never waits)."""
+        return self._current or self._last_good
+
+    def _structure_changed(self) -> None:
+        if not self.asynchronous:
+            self.recompile()
+            return
+        doc = self._viewport_document()
+        if doc.is_function:
+            self.recompile()
+            return
+        if self.worker is None:
+            from matedit.app.compile_worker import CompileWorker
+
+            self.worker = CompileWorker(self)
+            self.worker.finished.connect(self._finished)
+        self.worker.submit(doc, self.controller.resolver, VIEWPORT_TARGET)
+
+    def _finished(self, result) -> None:
+        """A worker's result, on the UI thread: the same outcome as a synchronous compile."""
+        self._cache.clear()
+        self._last_compile_ms = result.ms
+        if result.compiled is None:
+            self._current = None
+            if result.error is not None:
+                exc = result.error
+                self._diagnostics = [Diagnostic(Severity.ERROR, f"internal compiler error: "
+                                                f"{type(exc).__name__}: {exc}")]
+            else:
+                self._diagnostics = list(result.diagnostics)
+            self.failed.emit(self._diagnostics)
+            return
+        self._diagnostics = []
+        self._current = self._last_good = result.compiled
+        self._cache[VIEWPORT_TARGET] = result.compiled
+        self.compiled.emit(result.compiled)
 
     # --- preview any node ------------------------------------------------------------------
     def set_preview(self, target: PreviewTarget | None, recompile: bool = True) -> bool:
@@ -102,6 +163,8 @@ class MaterialCompiler(QObject):
         return preview_document(doc, self.preview, t)
 
     def recompile(self) -> CompiledMaterial | None:
+        if self.worker is not None:
+            self.worker.supersede()  # this compile is newer than any pending one
         doc = self.controller.document
         self._cache.clear()
         self.current = None

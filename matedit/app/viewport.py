@@ -472,7 +472,7 @@ class ViewportPanel(QWidget):
         self.push_values()
 
     def push_values(self) -> None:
-        cm = self.compiler.current or self.compiler.last_good
+        cm = self.compiler.latest  # never waits for a compile in flight
         if cm is None:
             return
         doc = self.controller.document

@@ -10,7 +10,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from matedit.compiler.emit import SourceMap, fragment_source, std140_layout, vertex_source
+from matedit.compiler.emit import Entry, SourceMap, fragment_source, std140_layout, vertex_source
 from matedit.compiler.ir import MaterialIR, Splat, Uni
 from matedit.compiler.lower import CompileError, lower_document
 from matedit.compiler.passes import optimise
@@ -38,6 +38,22 @@ class CompiledMaterial:
     @property
     def fragment_text(self) -> str:
         return self.fragment.text
+
+    def variant(self, entry: Entry | str, defines: tuple[str, ...] = ()) -> CompiledMaterial:
+        """The same material (same IR) through another entry point and/or extra defines,
+        memoised on this object (the compile worker warms it off the UI thread)."""
+        entry = Entry.of(entry)
+        key = (entry, tuple(defines))
+        cache = self.__dict__.setdefault("_variants", {})
+        hit = cache.get(key)
+        if hit is None:
+            t = TARGETS[self.target]
+            with _no_gc():
+                frag, smap = fragment_source(self.ir, t, entry, defines)
+            hit = CompiledMaterial(self.target, self.vertex, frag, smap, self.ir,
+                                   structure_hash(self.vertex.text, frag.text))
+            cache[key] = hit
+        return hit
 
     def reflection(self) -> dict[str, Any]:
         offsets, size = std140_layout(self.ir)
@@ -156,7 +172,7 @@ ENERGY_COMPENSATION_DEFINE = "MATEDIT_ENERGY_COMPENSATION"
 
 
 def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = None,
-                     target: str = "glsl330", mode: str = "shade",
+                     target: str = "glsl330", mode: str | Entry = "shade",
                      ir: MaterialIR | None = None) -> CompiledMaterial:
     """Compile for one target; raises CompileError (with diagnostics) for a bad graph."""
     if target not in TARGETS:
@@ -176,6 +192,14 @@ def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = 
     return CompiledMaterial(target, vert, frag, smap, ir, structure_hash(vert.text, frag.text))
 
 
+def compile_ir(ir: MaterialIR, target: str = "glsl330") -> CompiledMaterial:
+    """A CompiledMaterial of an IR built by hand (the renderer's warm-up, benchmarks' floor)."""
+    t = TARGETS[target]
+    vert = vertex_source(t)
+    frag, smap = fragment_source(ir, t)
+    return CompiledMaterial(target, vert, frag, smap, ir, structure_hash(vert.text, frag.text))
+
+
 def compile_all(doc: MaterialDocument, resolver: FunctionResolver | None = None,
                 targets: list[str] | None = None) -> dict[str, CompiledMaterial]:
     if resolver is None:
@@ -187,5 +211,5 @@ def compile_all(doc: MaterialDocument, resolver: FunctionResolver | None = None,
             for t in (targets or list(TARGETS))}
 
 
-__all__ = ["CompileError", "CompiledMaterial", "compile_all", "compile_document",
+__all__ = ["CompileError", "CompiledMaterial", "Entry", "compile_all", "compile_document",
            "lower_and_optimise"]

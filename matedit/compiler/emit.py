@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from enum import Enum
+from functools import cache
 
 from matedit.compiler.ir import Expr, Lit, MaterialIR, Op, Param, Scope, Splat, SurfaceUV, Uni, Var
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING, Target
+from matedit.glsl import layout as _layout
 from matedit.glsl.include import Assembly, assemble
 from matedit.graph import nodes
 from matedit.graph.types import PortType
@@ -173,13 +176,9 @@ def std140_layout(ir: MaterialIR) -> tuple[dict[str, int], int]:
     return offsets, (off + 15) // 16 * 16
 
 
-FRAME_BLOCK = """MATEDIT_UBO({binding}) uniform FrameBlock {{
-    mat4 viewProjection;
-    mat4 model;
-    mat4 normalMatrix;
-    vec4 cameraPosition;  // xyz: eye in world space (m)
-    vec4 params;          // x: time (s), y: exposure (EV), zw: viewport size (px)
-}} uFrame;"""
+# The FrameBlock declaration, a str.format template of {binding} (matedit/glsl/layout.py)
+FRAME_BLOCK = (_layout.FRAME_BLOCK.declaration("@B@").replace("{", "{{").replace("}", "}}")
+               .replace("@B@", "{binding}"))
 
 
 def vertex_source(target: Target) -> Assembly:
@@ -205,40 +204,58 @@ def vertex_source(target: Target) -> Assembly:
     return assemble(body, target.version, [], "<vertex>", prelude=target.prelude())
 
 
-SHADE_MAIN = """void main() {
-    vec3 Ng = normalize(v_normal);
-    if (!gl_FrontFacing) Ng = -Ng;
-    vec3 V = normalize(uFrame.cameraPosition.xyz - v_position);
-    g_surface.uv = v_uv;
-    g_surface.position = v_position;
-    g_surface.normal = Ng;
-    g_surface.view = V;
-    g_surface.time = uFrame.params.x;
-    nodeSurfaceFrame(v_tangent, uFrame.model, uFrame.viewProjection);
-    MaterialAttributes m = evaluateMaterial();
-    vec3 N = Ng;
-#ifdef MATERIAL_HAS_NORMAL
-    vec3 T = normalize(v_tangent.xyz - Ng * dot(Ng, v_tangent.xyz));
-    vec3 B = cross(Ng, T) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
-    N = tangentToWorldNormal(m.normal, T, B, Ng);
-#endif
-    fragColor = vec4(shadeSurface(m, v_position, N, V), clamp(m.opacity, 0.0, 1.0));
-}"""
+class Entry(Enum):
+    """The fragment entry points; each is a GLSL file `shaders/entry/<value>.frag.glsl`.
 
-# Writes the attributes themselves to four float targets (tests, debug views).
-ATTRIBUTES_MAIN = """void main() {
-    g_surface.uv = v_uv;
-    g_surface.position = v_position;
-    g_surface.normal = normalize(v_normal);
-    g_surface.view = normalize(uFrame.cameraPosition.xyz - v_position);
-    g_surface.time = uFrame.params.x;
-    nodeSurfaceFrame(v_tangent, uFrame.model, uFrame.viewProjection);
-    MaterialAttributes m = evaluateMaterial();
-    out0 = vec4(m.baseColor, m.metallic);
-    out1 = vec4(m.normal, m.roughness);
-    out2 = vec4(m.emissive, m.cavity);
-    out3 = vec4(m.opacity, 0.0, 0.0, 1.0);
-}"""
+    FORWARD: attributes and `shadeSurface` in one shader (what `compile` exports).
+    GBUFFER: the attributes and the world-space shading normal into four float targets, for the
+    preview's deferred lighting pass (shaders/render/lighting.frag).
+    ATTRIBUTES: the raw MaterialAttributes into four float targets (tests, `bake`).
+    """
+
+    FORWARD = "forward"
+    GBUFFER = "gbuffer"
+    ATTRIBUTES = "attributes"
+
+    @classmethod
+    def of(cls, mode: str | Entry) -> Entry:
+        """An Entry from itself or an older mode name ("shade" is FORWARD)."""
+        if isinstance(mode, Entry):
+            return mode
+        return {"shade": cls.FORWARD}.get(mode) or cls(mode)
+
+
+# Output variables of each entry (location order); the entry file writes them.
+ENTRY_OUTPUTS = {
+    Entry.FORWARD: ("fragColor",),
+    Entry.GBUFFER: ("gbuffer0", "gbuffer1", "gbuffer2", "gbuffer3"),
+    Entry.ATTRIBUTES: ("out0", "out1", "out2", "out3"),
+}
+# Library files an entry needs beyond the material's own.
+ENTRY_INCLUDES = {Entry.FORWARD: ("surface.glsl",), Entry.GBUFFER: (), Entry.ATTRIBUTES: ()}
+
+
+@cache
+def entry_text(entry: Entry) -> str:
+    """The entry file's `main`, without its leading comment lines (the file's documentation)."""
+    from matedit.resources import shaders_dir
+
+    lines = (shaders_dir() / "entry" / f"{entry.value}.frag.glsl").read_text().split("\n")
+    while lines and lines[0].startswith("//"):
+        lines.pop(0)
+    return "\n".join(lines).rstrip("\n")
+
+
+def __getattr__(name: str) -> str:
+    # Older names of the entries' text (benchmarks import SHADE_MAIN)
+    if name == "SHADE_MAIN":
+        return entry_text(Entry.FORWARD)
+    if name == "ATTRIBUTES_MAIN":
+        return entry_text(Entry.ATTRIBUTES)
+    raise AttributeError(name)
+
+
+_DEFINE = re.compile(r"MATEDIT_[A-Z0-9_]+")
 
 
 def has_defines(ir: MaterialIR) -> list[str]:
@@ -246,8 +263,14 @@ def has_defines(ir: MaterialIR) -> list[str]:
     return ["MATERIAL_HAS_" + re.sub(r"(?<!^)([A-Z])", r"_\1", f).upper() for f in ir.attributes]
 
 
-def fragment_source(ir: MaterialIR, target: Target, mode: str = "shade"
-                    ) -> tuple[Assembly, SourceMap]:
+def fragment_source(ir: MaterialIR, target: Target, mode: str | Entry = Entry.FORWARD,
+                    defines: tuple[str, ...] | list[str] = ()) -> tuple[Assembly, SourceMap]:
+    """The fragment stage of one entry; `defines` are extra `#define NAME 1` lines after the
+    material's own (the preview's MATEDIT_SPLIT_SUM_ONLY, MATEDIT_ENERGY_COMPENSATION)."""
+    entry = Entry.of(mode)
+    for d in defines:
+        if not _DEFINE.fullmatch(d):
+            raise ValueError(f"not a define name: {d!r}")
     w = _Writer()
     w.add(FRAME_BLOCK.format(binding=FRAME_BINDING))
     if ir.uniforms:
@@ -260,15 +283,12 @@ def fragment_source(ir: MaterialIR, target: Target, mode: str = "shade"
               t.node, ir.main.source)
     for i, decl in enumerate(["vec3 v_position", "vec3 v_normal", "vec4 v_tangent", "vec2 v_uv"]):
         w.add(target.varying("in", i, decl))
-    if mode == "shade":
-        w.add("layout(location = 0) out vec4 fragColor;")
-    else:
-        for i in range(4):
-            w.add(f"layout(location = {i}) out vec4 out{i};")
+    for i, name in enumerate(ENTRY_OUTPUTS[entry]):
+        w.add(f"layout(location = {i}) out vec4 {name};")
     for scope in ir.functions:
         _scope(w, scope, main=False)
     _scope(w, ir.main, main=True)
-    w.add(SHADE_MAIN if mode == "shade" else ATTRIBUTES_MAIN)
+    w.add(entry_text(entry))
     includes = ["common.glsl", "material.glsl", "nodes/context.glsl"]
     kinds = set(ir.node_kinds)
     if any(op.kind == "blend" for s in [ir.main, *ir.functions] for op in s.ops):
@@ -276,10 +296,12 @@ def fragment_source(ir: MaterialIR, target: Target, mode: str = "shade"
     for kind in sorted(kinds):
         if nodes.REGISTRY[kind].glsl:
             includes.append(f"nodes/{kind}.glsl")
-    if mode == "shade":
-        includes.append("surface.glsl")
-    defines = "\n".join(f"#define {d} 1" for d in has_defines(ir) + list(ir.defines))
+    includes += ENTRY_INCLUDES[entry]
+    lines = "\n".join(f"#define {d} 1" for d in has_defines(ir) + list(ir.defines))
+    for d in defines:
+        if d not in ir.defines:
+            lines += f"\n#define {d} 1"
     asm = assemble("\n".join(w.lines), target.version, includes, "<material>",
-                   prelude=target.prelude() + "\n" + defines)
+                   prelude=target.prelude() + "\n" + lines)
     smap = SourceMap(w.map, len(asm.sources) - 1)
     return asm, smap

@@ -3,16 +3,19 @@
 Bindings (Vulkan: set 0; desktop GL and WebGL2 assign block bindings and texture
 units by name at link time): 0 LightsBlock, 1 IblBlock, 2 prefiltered
 environment, 3 BRDF LUT, 4 unfiltered environment (see shaders/ibl_inputs.glsl),
-5 FrameBlock, 6 MaterialParams, 7 and up the material's textures.
+5 FrameBlock, 6 MaterialParams, 7 and up the material's textures: matedit/glsl/layout.py,
+the one source of these numbers.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-FRAME_BINDING = 5
-MATERIAL_BINDING = 6
-FIRST_TEXTURE_BINDING = 7
+from matedit.glsl.layout import BINDINGS
+
+FRAME_BINDING = BINDINGS["FRAME"]
+MATERIAL_BINDING = BINDINGS["MATERIAL"]
+FIRST_TEXTURE_BINDING = BINDINGS["FIRST_TEXTURE"]
 
 
 @dataclass(frozen=True)

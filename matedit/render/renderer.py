@@ -10,7 +10,6 @@ mode accumulate frames with rotated sample sets; finally the display pass
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -18,11 +17,23 @@ import moderngl
 import numpy as np
 
 from matedit.compiler.api import CompiledMaterial
+from matedit.compiler.emit import Entry
+from matedit.compiler.ir import MaterialIR, Scope
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING
+from matedit.glsl import layout as _layout
 from matedit.glsl.include import assemble
 from matedit.render.camera import OrbitCamera
+from matedit.render.deferred import (
+    ENERGY_COMPENSATION,
+    SPLIT_SUM_ONLY,
+    GBuffer,
+    LightingPass,
+    wants_forward,
+)
 from matedit.render.lights import default_rig
 from matedit.render.mesh import GpuMesh, mesh_from_spec, uv_sphere
+from matedit.render.programs import MaterialStatus, ProgramCache, failure
+from matedit.render.textures import file_stamp, texture_from
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
     IBL_MODE_REFERENCE,
@@ -33,19 +44,14 @@ from matedit.shading.lights import Light
 from matedit.shading.lights_block import pack_lights
 
 MODES = ("splitsum", "reference", "difference")
-LIGHTS_BINDING, IBL_BINDING = 0, 1
-PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = 2, 3, 4
-GL_SRGB8_ALPHA8 = 0x8C43
+# binding numbers and block sizes: matedit/glsl/layout.py, the one source
+LIGHTS_BINDING, IBL_BINDING = _layout.BINDINGS["LIGHTS"], _layout.BINDINGS["IBL"]
+PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = (
+    _layout.BINDINGS[k] for k in ("PREFILTERED_ENV", "BRDF_LUT", "ENVIRONMENT"))
+_FRAME_OFFSETS = _layout.FRAME_BLOCK.offsets()
 # SH irradiance coefficients -> radiance coefficients: divide by the cosine lobe's A_l
 # (Ramamoorthi and Hanrahan 2001): pi, 2pi/3, pi/4 for bands 0, 1, 2.
 _SH_BAND_SCALE = np.array([math.pi] + [2 * math.pi / 3] * 3 + [math.pi / 4] * 5)
-
-
-@dataclass
-class MaterialStatus:
-    ok: bool
-    errors: list[tuple[str, str]] = field(default_factory=list)  # (node id, message)
-    log: str = ""
 
 
 def _program(ctx, vert: str, frag: str, defines: str = "") -> moderngl.Program:
@@ -80,9 +86,13 @@ class Renderer:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int] = (512, 512),
                  samples: int = 4, environment: str | None = "studio",
-                 bake_settings=None) -> None:
+                 bake_settings=None, deferred: bool = True) -> None:
         self.ctx = ctx
         self.samples = samples
+        # deferred preview (GBUFFER entry + one lighting pass) for opaque materials; forward
+        # (FORWARD entry) for materials that write opacity, or when asked
+        self.deferred = bool(deferred) and samples >= 2
+        self.is_forward = True  # the current material's path
         self.camera = OrbitCamera()
         self.lights: list[Light] = default_rig()
         self.mode = "splitsum"
@@ -99,16 +109,17 @@ class Renderer:
         # multiple-scattering compensation in every material (beyond the talk; off), on top
         # of materials that ask for it themselves (preview "energy_compensation": true)
         self.energy_compensation = False
-        self.link_count = 0
         self._difference_cache: tuple[int, float] | None = None
         self._frames_drawn = 0
         self.bake_settings = bake_settings
-        self._programs: dict[tuple, moderngl.Program] = {}  # (hash, variant, compensation)
+        self.programs = ProgramCache(ctx, self._bind_program)
+        self._programs = self.programs.table  # variant structure hash -> program
         self._compiled: CompiledMaterial | None = None
         self._program: moderngl.Program | None = None
         self._values: dict[str, Any] = {}
         self._textures: dict[str, moderngl.Texture] = {}
         self._texture_keys: dict[str, tuple[str | None, str]] = {}  # name: (path, space)
+        self._texture_stamps: dict[str, tuple] = {}  # name: textures.file_stamp
         self._accum_frames = 0
         self._frame_index = 0
         self._size = (0, 0)
@@ -134,14 +145,31 @@ class Renderer:
                                            self._gizmo_ibo)
         self._line_vbo = ctx.buffer(reserve=24)
         self._line_vao = ctx.vertex_array(self._gizmo, [(self._line_vbo, "3f", "a_position")])
-        self._frame_buf = ctx.buffer(reserve=224)
+        self._frame_buf = ctx.buffer(reserve=_layout.FRAME_BLOCK.size)
         self._lights_buf = ctx.buffer(pack_lights(self.lights))
-        self._ibl_buf = ctx.buffer(reserve=176)
+        self._ibl_buf = ctx.buffer(reserve=_layout.IBL_BLOCK.size)
         self._params_buf: moderngl.Buffer | None = None
+        self._gbuffer: GBuffer | None = None
+        self.lighting = LightingPass(ctx, samples, self._bind_program)
+        if self.deferred:
+            self.lighting.program(True, False)  # linked once, at start-up
         self.set_mesh("sphere")
         self.resize(*size)
         if environment is not None:
             self.set_environment(environment)
+        if self.deferred:
+            self._warm_up()
+
+    def _warm_up(self) -> None:
+        """The driver compiles at a program's first draw (and builds its per-framebuffer state
+        the first time a target is used): one frame of a constant material now, at start-up,
+        so that the lighting pass and the G-buffer targets cost nothing at the first edit."""
+        from matedit.compiler.api import compile_ir
+
+        self.set_material(compile_ir(MaterialIR(Scope("evaluateMaterial"), [], [], [], set(),
+                                                [])))
+        self.render()
+        self._program = self._compiled = None
 
     # --- configuration --------------------------------------------------------------------
     @property
@@ -156,9 +184,12 @@ class Renderer:
         self._release_targets()
         ctx = self.ctx
         s = self.samples
+        depth = ctx.depth_renderbuffer((width, height), samples=s)
         self._msaa_fbo = ctx.framebuffer(
-            [ctx.renderbuffer((width, height), 4, samples=s, dtype="f4")],
-            ctx.depth_renderbuffer((width, height), samples=s))
+            [ctx.renderbuffer((width, height), 4, samples=s, dtype="f4")], depth)
+        if self.deferred:
+            self._gbuffer = GBuffer(ctx, (width, height), s, depth)
+            self._background_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
         self._resolve_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
         self._accum_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
         self._split_fbo = ctx.framebuffer([ctx.texture((width, height), 4, dtype="f4")])
@@ -170,6 +201,9 @@ class Renderer:
         otherwise bind a released framebuffer again later (GL_INVALID_OPERATION)."""
         if any(getattr(self, n, None) is not None for n in self._TARGETS):
             self.ctx.detect_framebuffer(0).use()
+        if self._gbuffer is not None:
+            self._gbuffer.release()  # before the depth it shares with _msaa_fbo
+            self._gbuffer = None
         for name in self._TARGETS:
             fbo = getattr(self, name, None)
             if fbo is not None:
@@ -180,7 +214,8 @@ class Renderer:
                 fbo.release()
                 setattr(self, name, None)
 
-    _TARGETS = ("_msaa_fbo", "_resolve_fbo", "_accum_fbo", "_split_fbo", "_out_fbo")
+    _TARGETS = ("_msaa_fbo", "_resolve_fbo", "_accum_fbo", "_split_fbo", "_out_fbo",
+                "_background_fbo")
 
     def reset_accumulation(self) -> None:
         self._accum_frames = 0
@@ -225,52 +260,44 @@ class Renderer:
         self.reset_accumulation()
 
     # --- material -------------------------------------------------------------------------
-    def _link(self, compiled: CompiledMaterial, variant: str) -> moderngl.Program:
-        """The program of one variant: "splitsum" leaves the reference estimator out (a third
-        less for llvmpipe to compile at the first draw), "full" keeps it."""
-        key = (compiled.structure_hash, variant, self.energy_compensation)
-        prog = self._programs.get(key)
-        if prog is None:
-            frag = compiled.fragment_text
-            extra = ["MATEDIT_SPLIT_SUM_ONLY"] if variant == "splitsum" else []
-            if self.energy_compensation and "#define MATEDIT_ENERGY_COMPENSATION" not in frag:
-                extra.append("MATEDIT_ENERGY_COMPENSATION")  # the preview's option
-            if extra:
-                first, rest = frag.split("\n", 1)  # after #version, before any #line
-                frag = first + "\n" + "".join(f"#define {d} 1\n" for d in extra) + rest
-            prog = self.ctx.program(vertex_shader=compiled.vertex_text, fragment_shader=frag)
-            self.link_count += 1
-            self._bind_program(prog)
-            self._programs[key] = prog
-        return prog
+    @property
+    def link_count(self) -> int:
+        """Material programs linked so far (the lighting pass's are `lighting.link_count`)."""
+        return self.programs.link_count
+
+    def _forward_defines(self, split_sum_only: bool) -> tuple[str, ...]:
+        return (((SPLIT_SUM_ONLY,) if split_sum_only else ())
+                + ((ENERGY_COMPENSATION,) if self.energy_compensation else ()))
+
+    def _material_program(self, compiled: CompiledMaterial, forward: bool):
+        if forward:  # split sum only: the reference estimator is a third of llvmpipe's work
+            return self.programs.get(compiled, Entry.FORWARD, self._forward_defines(True))
+        return self.programs.get(compiled, Entry.GBUFFER)
 
     def _program_for(self, ibl_mode: int) -> moderngl.Program | None:
-        if ibl_mode != IBL_MODE_REFERENCE or self._compiled is None:
+        if ibl_mode != IBL_MODE_REFERENCE or self._compiled is None or not self.is_forward:
             return self._program
         try:
-            return self._link(self._compiled, "full")
+            return self.programs.get(self._compiled, Entry.FORWARD,
+                                     self._forward_defines(False))[0]
         except moderngl.Error:
             return self._program  # cannot happen when the split-sum variant linked
 
     def set_material(self, compiled: CompiledMaterial) -> MaterialStatus:
-        """Structural edit: link (or reuse) the program; keep the last good one on failure."""
-        prog = self._programs.get((compiled.structure_hash, "splitsum",
-                                   self.energy_compensation))
-        if prog is None:
-            try:
-                prog = self._link(compiled, "splitsum")
-            except moderngl.Error as exc:
-                log = str(exc)
-                located = compiled.locate_error(log)
-                errors = [(node, msg) for node, _, _, msg in located
-                          if node and "error" in msg.lower()]
-                if not errors:
-                    errors = [("", next((m for _, _, _, m in located if "error" in m.lower()),
-                                        log.strip().splitlines()[-1] if log.strip() else log))]
-                return MaterialStatus(False, errors, log)
+        """Structural edit: link (or reuse) the material's program, its GBUFFER entry when
+        deferred; keep the last good one on failure."""
+        values = {u.name: u.default for u in compiled.ir.uniforms}
+        forward = not self.deferred or wants_forward(compiled, values)
+        try:
+            prog, _ = self._material_program(compiled, forward)
+        except moderngl.Error as exc:  # located in the variant that failed
+            entry = Entry.FORWARD if forward else Entry.GBUFFER
+            defines = self._forward_defines(True) if forward else ()
+            return failure(compiled.variant(entry, defines), exc)
         self._program = prog
+        self.is_forward = forward
         self._compiled = compiled
-        self._values = {u.name: u.default for u in compiled.ir.uniforms}
+        self._values = values
         size = max(16, len(compiled.pack_uniforms()))
         if self._params_buf is None or self._params_buf.size != size:
             if self._params_buf is not None:
@@ -298,7 +325,7 @@ class Renderer:
             return
         self.energy_compensation = on
         if self._compiled is not None:
-            self._program = self._link(self._compiled, "splitsum")
+            self._program = self._material_program(self._compiled, self.is_forward)[0]
         self.reset_accumulation()
 
     def set_uniforms(self, values: dict[str, Any]) -> None:
@@ -308,18 +335,29 @@ class Renderer:
         known = {u.name for u in self._compiled.ir.uniforms}
         self._values.update({k: v for k, v in values.items() if k in known})
         self._params_buf.write(self._compiled.pack_uniforms(self._values))
+        forward = not self.deferred or wants_forward(self._compiled, self._values)
+        if forward != self.is_forward:  # opacity crossed 1: the other path (linked once)
+            try:
+                self._program = self._material_program(self._compiled, forward)[0]
+                self.is_forward = forward
+            except moderngl.Error:
+                pass  # keeps the current path: the variants share the material's code
         self.reset_accumulation()
 
     def set_texture(self, name: str, path: str | None, color_space: str | None = None) -> None:
         """Loads a material texture (a value edit); a missing file shows a checker. The colour
         space defaults to the compiled material's setting for that texture (srgb, linear or an
         OpenColorIO space; matedit.shading.colorspace)."""
+        space = color_space or self._texture_space(name)
+        stamp = file_stamp(path, space)
+        if name in self._textures and self._texture_stamps.get(name) == stamp:
+            return  # the same unchanged file: nothing to read, upload or redraw
         old = self._textures.pop(name, None)
         if old is not None:
             old.release()
-        space = color_space or self._texture_space(name)
         self._textures[name] = self._texture_from(path, space)
         self._texture_keys[name] = (path, space)
+        self._texture_stamps[name] = stamp
         self.reset_accumulation()
 
     def _texture_space(self, name: str) -> str:
@@ -331,38 +369,7 @@ class Renderer:
         return "srgb"
 
     def _texture_from(self, path: str | None, space: str = "srgb") -> moderngl.Texture:
-        """sRGB 8-bit files go to an sRGB internal format (decoded before filtering), their
-        mips built in linear space and encoded back; everything else is linear float RGBA,
-        decoded on the CPU (matedit.shading.colorspace), mips in linear space."""
-        from matedit.compiler.cpu_eval import checker_texture
-        from matedit.shading.colorspace import linear_to_srgb, load_texture_cached, mip_chain
-
-        image = None
-        if path:
-            try:
-                image = load_texture_cached(path, space)
-            except (ValueError, OSError):
-                image = None
-        linear = image.linear if image is not None else checker_texture(8)
-        levels = mip_chain(linear)
-        size = (linear.shape[1], linear.shape[0])
-        if image is not None and image.srgb8 is not None:
-            tex = self.ctx.texture(size, 4, image.srgb8.tobytes(), dtype="f1",
-                                   internal_format=GL_SRGB8_ALPHA8)
-            tex.build_mipmaps()  # allocates the chain; every level is rewritten below
-            for i, lev in enumerate(levels[1:], start=1):
-                codes = np.concatenate([linear_to_srgb(lev[..., :3]), lev[..., 3:]], axis=2)
-                tex.write(np.rint(codes * 255.0).clip(0, 255).astype(np.uint8).tobytes(),
-                          level=i)
-        else:
-            tex = self.ctx.texture(size, 4, np.ascontiguousarray(linear, "f4").tobytes(),
-                                   dtype="f4")
-            tex.build_mipmaps()
-            for i, lev in enumerate(levels[1:], start=1):
-                tex.write(np.ascontiguousarray(lev, "f4").tobytes(), level=i)
-        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-        tex.repeat_x = tex.repeat_y = True
-        return tex
+        return texture_from(self.ctx, path, space)
 
     def _load_textures(self, compiled: CompiledMaterial) -> None:
         from matedit.shading.colorspace import effective_space
@@ -372,6 +379,7 @@ class Renderer:
             if name not in wanted:
                 self._textures.pop(name).release()
                 self._texture_keys.pop(name, None)
+                self._texture_stamps.pop(name, None)
         for name, info in wanted.items():
             key = (info.path, effective_space(getattr(info, "color_space", ""), info.srgb))
             if name not in self._textures or self._texture_keys.get(name, key)[1] != key[1]:
@@ -382,6 +390,7 @@ class Renderer:
                     else info.path
                 self._textures[name] = self._texture_from(path, key[1])
                 self._texture_keys[name] = (path, key[1])
+                self._texture_stamps[name] = file_stamp(path, key[1])
 
     # --- drawing --------------------------------------------------------------------------
     @property
@@ -403,18 +412,29 @@ class Renderer:
         view = self.camera.view_matrix()
         proj = self.camera.projection(w / h)
         vp = proj @ view
-        data = b"".join([_mat_bytes(vp), _mat_bytes(np.eye(4)), _mat_bytes(np.eye(4)),
-                         np.array([*self.camera.eye, 1.0], "f4").tobytes(),
-                         np.array([self.time, self.exposure, w, h], "f4").tobytes()])
-        self._frame_buf.write(data)
+        data = bytearray(_layout.FRAME_BLOCK.size)
+        for name, value in (("viewProjection", _mat_bytes(vp)), ("model", _mat_bytes(np.eye(4))),
+                            ("normalMatrix", _mat_bytes(np.eye(4))),
+                            ("cameraPosition", np.array([*self.camera.eye, 1.0], "f4").tobytes()),
+                            ("params", np.array([self.time, self.exposure, w, h], "f4").tobytes())):
+            off = _FRAME_OFFSETS[name]
+            data[off:off + len(value)] = value
+        self._frame_buf.write(bytes(data))
         return vp
 
     def _scene(self, ibl_mode: int, offset=(0.0, 0.0)) -> None:
-        """Background, mesh and gizmos into the multisampled HDR target, then resolve."""
+        """Background, mesh and gizmos into the multisampled HDR target, then resolve. Deferred:
+        the mesh's GBUFFER program fills the G-buffer (sharing the depth), the lighting pass
+        shades it into the target; forward: the mesh's FORWARD program draws into it."""
         ctx = self.ctx
         vp = self._write_frame_block()
-        self._msaa_fbo.use()
-        self._msaa_fbo.viewport = (0, 0, *self._size)
+        program = self._program_for(ibl_mode)
+        deferred = program is not None and self._mesh is not None and not self.is_forward
+        # the background: into the target itself (forward), or a one-sample texture that the
+        # lighting pass reads where the mesh is not (deferred)
+        backdrop = self._background_fbo if deferred else self._msaa_fbo
+        backdrop.use()
+        backdrop.viewport = (0, 0, *self._size)
         ctx.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
         if self.show_background and self._ibl is not None:
@@ -426,34 +446,52 @@ class Renderer:
             self._bg["uLod"].value = float(self.background_blur * (self._env_levels - 1))
             self._bg["uIntensity"].value = float(self.environment_intensity)
             self._fs_vaos[self._bg.glo].render(vertices=3)
-        ctx.enable(moderngl.DEPTH_TEST)
-        program = self._program_for(ibl_mode)
         if program is not None and self._mesh is not None:
-            self._lights_buf.bind_to_uniform_block(LIGHTS_BINDING)
-            mode = ibl_mode if self._ibl is not None else IBL_MODE_NONE
-            self._ibl_buf.write(pack_ibl_block(
-                self._sh, float(self._env_levels), self.environment_intensity,
-                self.reference_samples, mode, offset,
-                reference_lights=ibl_mode == IBL_MODE_REFERENCE and self.reference_lights))
-            self._ibl_buf.bind_to_uniform_block(IBL_BINDING)
-            self._frame_buf.bind_to_uniform_block(FRAME_BINDING)
-            self._params_buf.bind_to_uniform_block(MATERIAL_BINDING)
-            if self._ibl is not None:
-                self._ibl.prefiltered.use(location=PREFILTERED_UNIT)
-                self._ibl.brdf_lut.use(location=LUT_UNIT)
-                self._env_cube.use(location=ENVIRONMENT_UNIT)
-            for i, t in enumerate(self._compiled.ir.textures):
-                unit = FIRST_TEXTURE_BINDING + i
-                self._textures[t.name].use(location=unit)
-                _set(program, t.name, unit)
-            ctx.enable(moderngl.BLEND)
-            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-            self._mesh.render(program)
-            ctx.disable(moderngl.BLEND)
+            self._bind_scene_inputs(program, ibl_mode, offset)
+            if not deferred:
+                ctx.enable(moderngl.DEPTH_TEST | moderngl.BLEND)
+                ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+                self._mesh.render(program)
+                ctx.disable(moderngl.BLEND)
+            else:
+                self._gbuffer.fbo.use()
+                self._gbuffer.fbo.viewport = (0, 0, *self._size)
+                ctx.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+                ctx.enable(moderngl.DEPTH_TEST)
+                self._mesh.render(program)
+                ctx.disable(moderngl.DEPTH_TEST)
+                self._msaa_fbo.use()  # no clear: the pass writes every sample; depth is kept
+                self._msaa_fbo.viewport = (0, 0, *self._size)
+                compensation = self.energy_compensation or \
+                    ENERGY_COMPENSATION in self._compiled.ir.defines
+                self.lighting.draw(self._gbuffer, self._background_fbo.color_attachments[0],
+                                   np.array(self.camera.eye, "f4"),
+                                   ibl_mode != IBL_MODE_REFERENCE, compensation)
         if self.show_gizmos:
+            ctx.enable(moderngl.DEPTH_TEST)
             self._draw_gizmos(vp)
         ctx.disable(moderngl.DEPTH_TEST)
         ctx.copy_framebuffer(self._resolve_fbo, self._msaa_fbo)
+
+    def _bind_scene_inputs(self, program, ibl_mode: int, offset) -> None:
+        """Uniform blocks and textures of the material and lighting programs."""
+        self._lights_buf.bind_to_uniform_block(LIGHTS_BINDING)
+        mode = ibl_mode if self._ibl is not None else IBL_MODE_NONE
+        self._ibl_buf.write(pack_ibl_block(
+            self._sh, float(self._env_levels), self.environment_intensity,
+            self.reference_samples, mode, offset,
+            reference_lights=ibl_mode == IBL_MODE_REFERENCE and self.reference_lights))
+        self._ibl_buf.bind_to_uniform_block(IBL_BINDING)
+        self._frame_buf.bind_to_uniform_block(FRAME_BINDING)
+        self._params_buf.bind_to_uniform_block(MATERIAL_BINDING)
+        if self._ibl is not None:
+            self._ibl.prefiltered.use(location=PREFILTERED_UNIT)
+            self._ibl.brdf_lut.use(location=LUT_UNIT)
+            self._env_cube.use(location=ENVIRONMENT_UNIT)
+        for i, t in enumerate(self._compiled.ir.textures):
+            unit = FIRST_TEXTURE_BINDING + i
+            self._textures[t.name].use(location=unit)
+            _set(program, t.name, unit)
 
     def _draw_gizmos(self, vp: np.ndarray) -> None:
         self._gizmo["uViewProjection"].write(_mat_bytes(vp))
@@ -609,11 +647,8 @@ class Renderer:
 
     def release(self) -> None:
         self._release_targets()
-        for p in self._programs.values():
-            if self._mesh is not None:
-                self._mesh.forget(p)
-            p.release()
-        self._programs.clear()
+        self.programs.release(self._mesh.forget if self._mesh is not None else None)
+        self.lighting.release()
         if self._mesh is not None:
             self._mesh.release()
         for t in self._textures.values():

@@ -12,6 +12,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from matedit.glsl import layout as _layout
 from matedit.shading.brdf import F_SchlickExact, G1_Schlick, k_IBL
 from matedit.shading.common import INV_PI, dot, f64, saturate, sq
 from matedit.shading.sampling import hammersley, importanceSampleCosine, importanceSampleGGX
@@ -19,10 +20,11 @@ from matedit.shading.sampling import hammersley, importanceSampleCosine, importa
 Environment = Callable[[np.ndarray], np.ndarray]
 PrefilteredEnvironment = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
-IBL_MODE_SPLIT_SUM = 0
-IBL_MODE_REFERENCE = 1
-IBL_MODE_NONE = 2
-IBL_BLOCK_SIZE = 176
+# from the one layout source (matedit/glsl/layout.py), like the shader's defines
+IBL_MODE_SPLIT_SUM = _layout.IBL_MODES["SPLIT_SUM"]
+IBL_MODE_REFERENCE = _layout.IBL_MODES["REFERENCE"]
+IBL_MODE_NONE = _layout.IBL_MODES["NONE"]
+IBL_BLOCK_SIZE = _layout.IBL_BLOCK.size  # 176
 
 # Real SH basis constants, order L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22.
 _Y0 = 0.5 * np.sqrt(1.0 / np.pi)
@@ -165,9 +167,11 @@ def pack_ibl_block(
 ) -> bytes:
     """Bytes of IblBlock (std140, 176 bytes): vec4 sh[9], vec4 params, vec4 sampleOffset
     (z = 1: sphere and tube lights by Monte Carlo, lights_reference.glsl)."""
-    data = np.zeros((11, 4), dtype="<f4")
-    data[:9, :3] = f64(sh).reshape(9, 3)
-    data[9] = (mip_count, intensity, samples, mode)
-    data[10, :2] = sample_offset
-    data[10, 2] = 1.0 if reference_lights else 0.0
+    offsets = _layout.IBL_BLOCK.offsets()
+    data = np.zeros((IBL_BLOCK_SIZE // 16, 4), dtype="<f4")  # rows of one vec4
+    sh_row, params_row, offset_row = (offsets[k] // 16 for k in ("sh", "params", "sampleOffset"))
+    data[sh_row:sh_row + 9, :3] = f64(sh).reshape(9, 3)
+    data[params_row] = (mip_count, intensity, samples, mode)
+    data[offset_row, :2] = sample_offset
+    data[offset_row, 2] = 1.0 if reference_lights else 0.0
     return data.tobytes()

@@ -11,12 +11,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from matedit.glsl import layout as _layout
 from matedit.shading.lights import Light
 
-MAX_LIGHTS = 16
-LIGHT_STRIDE = 64
-LIGHTS_HEADER = 16
-LIGHTS_BLOCK_SIZE = LIGHTS_HEADER + LIGHT_STRIDE * MAX_LIGHTS  # 1040 bytes
+# from the one layout source (matedit/glsl/layout.py), like the shader's defines
+MAX_LIGHTS = _layout.MAX_LIGHTS
+LIGHT_STRIDE = _layout.LIGHT_STRIDE
+LIGHTS_HEADER = _layout.LIGHTS_BLOCK.offsets()["light"]
+LIGHTS_BLOCK_SIZE = _layout.LIGHTS_BLOCK.size  # 1040 bytes
 
 
 def pack_lights(lights: Sequence[Light], max_lights: int = MAX_LIGHTS) -> bytes:

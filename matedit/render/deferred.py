@@ -1,0 +1,143 @@
+"""The deferred preview: the material's GBUFFER program fills multisampled float targets, and
+one lighting program (shaders/render/lighting.frag), linked once a variant for the renderer's
+lifetime, shades them in a full-screen pass over the background (drawn first into a one-sample
+texture), writing every sample; see that file for how edges are anti-aliased.
+
+G-buffer layout (GBUFFER entry, shaders/entry/gbuffer.frag.glsl), RGBA float32 each:
+  0: baseColor.rgb, metallic      1: world-space shading normal, roughness
+  2: emissive.rgb, cavity         3: world position (m), coverage (1 drawn, 0 cleared)
+Float32 keeps every value the material computed exactly, so the lighting pass sees the same
+arguments shadeSurface gets in the FORWARD entry.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from matedit.glsl.include import assemble
+from matedit.resources import shaders_dir
+
+GBUFFER_TARGETS = 4
+GBUFFER_FIRST_UNIT = 8  # texture units of the G-buffer in the lighting pass
+SPLIT_SUM_ONLY = "MATEDIT_SPLIT_SUM_ONLY"
+ENERGY_COMPENSATION = "MATEDIT_ENERGY_COMPENSATION"
+
+
+def _opacity_index() -> int:
+    from matedit.graph import nodes
+
+    return [i.name for i in nodes.REGISTRY["make_attributes"].inputs].index("opacity")
+
+
+def _is_one(e, values: dict) -> bool:
+    """A literal 1, or a uniform whose current value is at least 1 (the forward entry clamps
+    opacity to [0, 1], so it draws those fully opaque)."""
+    from matedit.compiler.ir import Lit, Splat, Uni
+
+    while isinstance(e, Splat):
+        e = e.expr
+    if isinstance(e, Lit):
+        return e.value == 1.0
+    if isinstance(e, Uni):
+        try:
+            return float(values[e.name]) >= 1.0
+        except (KeyError, TypeError, ValueError):
+            return False
+    return False
+
+
+def may_be_translucent(ir, values: dict | None = None) -> bool:
+    """Whether any code of the material can give an opacity other than 1 with these uniform
+    values: a MakeAttributes whose opacity is not 1 (a literal, or a uniform now at 1 or
+    above), or a SetAttributes of opacity, in any scope (through layers and functions too).
+    Conservative: anything computed counts as translucent."""
+    values = {u.name: u.default for u in ir.uniforms} | dict(values or {})
+    if "opacity" not in ir.attributes:
+        return False
+    k = _opacity_index()
+    for scope in [ir.main, *ir.functions]:
+        for op in scope.ops:
+            if op.kind == "make_attributes" and not _is_one(op.args[k], values):
+                return True
+            if op.kind == "set_attributes" and "opacity" in op.data.get("fields", ()):
+                return True
+    return False
+
+
+def wants_forward(compiled, values: dict | None = None) -> bool:
+    """Translucent materials are blended in draw order (every layer of the mesh), which a
+    G-buffer of the nearest surface cannot reproduce: they take the forward path. A value edit
+    that makes a material translucent moves it there (one link, the first time)."""
+    return may_be_translucent(compiled.ir, values)
+
+
+class GBuffer:
+    """The multisampled targets of one size; shares its depth with the colour target."""
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int], samples: int,
+                 depth: moderngl.Renderbuffer) -> None:
+        self.textures = [ctx.texture(size, 4, dtype="f4", samples=samples)
+                         for _ in range(GBUFFER_TARGETS)]
+        self.fbo = ctx.framebuffer(self.textures, depth)
+
+    def release(self) -> None:
+        self.fbo.release()
+        for t in self.textures:
+            t.release()
+
+
+class LightingPass:
+    """The lighting programs, keyed by (split sum only, energy compensation), each linked on
+    first use and then kept for the renderer's lifetime."""
+
+    def __init__(self, ctx: moderngl.Context, samples: int, bind) -> None:
+        self.ctx = ctx
+        self.samples = max(1, samples)
+        self._bind = bind
+        self._quad = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
+        self._programs: dict[tuple[bool, bool, bool], tuple] = {}
+        self.link_count = 0
+        self.edges_once = False  # benchmarks only (see program)
+
+    def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False):
+        """`edges_once` (benchmarks only) shades every pixel once, edges too: no anti-aliasing
+        of the lighting, to measure what lighting edges per sample costs."""
+        key = (bool(split_sum_only), bool(compensation), bool(edges_once))
+        hit = self._programs.get(key)
+        if hit is None:
+            defines = ([SPLIT_SUM_ONLY] if split_sum_only else []) + \
+                      ([ENERGY_COMPENSATION] if compensation else []) + \
+                      (["MATEDIT_EDGES_ONCE"] if edges_once else [])
+            lines = [f"#define {d} 1" for d in defines]
+            lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")
+            root = shaders_dir() / "render"
+            v = assemble((root / "fullscreen.vert").read_text(), "330 core", [], "<vertex>")
+            f = assemble((root / "lighting.frag").read_text(), "330 core", [], "<lighting>",
+                         roots=[root, shaders_dir()], prelude="\n".join(lines))
+            prog = self.ctx.program(vertex_shader=v.text, fragment_shader=f.text)
+            self._bind(prog)
+            for i in range(GBUFFER_TARGETS):
+                prog[f"uGBuffer{i}"].value = GBUFFER_FIRST_UNIT + i
+            prog["uBackground"].value = GBUFFER_FIRST_UNIT + GBUFFER_TARGETS
+            self.link_count += 1
+            hit = (prog, self.ctx.vertex_array(prog, [(self._quad, "2f", "a_pos")]))
+            self._programs[key] = hit
+        return hit
+
+    def draw(self, gbuffer: GBuffer, background: moderngl.Texture, eye,
+             split_sum_only: bool, compensation: bool) -> None:
+        """Shades the G-buffer over `background` into every sample of the bound target."""
+        for i, t in enumerate(gbuffer.textures):
+            t.use(location=GBUFFER_FIRST_UNIT + i)
+        background.use(location=GBUFFER_FIRST_UNIT + GBUFFER_TARGETS)
+        prog, vao = self.program(split_sum_only, compensation, self.edges_once)
+        prog["uCameraPosition"].value = tuple(float(x) for x in eye)
+        vao.render(vertices=3)
+
+    def release(self) -> None:
+        for prog, vao in self._programs.values():
+            vao.release()
+            prog.release()
+        self._programs.clear()
+        self._quad.release()

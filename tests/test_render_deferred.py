@@ -1,0 +1,223 @@
+"""The deferred preview: entry variants, deferred image = forward image on every sample
+material and mode, structural edits link only the GBUFFER program, translucency falls back."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from graphs_util import link, material, node
+
+from matedit.compiler import compile_document
+from matedit.compiler.emit import Entry, entry_text
+from matedit.ibl import BakeSettings
+from matedit.io.document import FileResolver, load
+from matedit.render import Renderer
+from matedit.render.deferred import may_be_translucent
+from matedit.resources import graphs_dir, shaders_dir
+
+MATERIALS = sorted((graphs_dir() / "materials").glob("*.json"))
+SMALL = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
+SIZE = (64, 64)
+# Deferred against forward, |a - b| / max(1, |b|) on every pixel of the resolved image: the
+# G-buffer holds float32 copies of what the forward shader passes to shadeSurface, and edge
+# pixels are lit per sample, so the bound is float rounding (measured: at most 4.8e-7, in
+# reference and difference modes, where frames are summed; split sum: at most 6e-8, and
+# exactly 0 on all but a few pixels). Interior and edge pixels are held to the same bound.
+REL = 1e-6
+
+
+def flat_material(opacity=None, roughness=0.4):
+    d = material()
+    node(d, "r", "scalar_parameter", {"name": "rough"}, {"value": roughness})
+    values = {"baseColor": [0.8, 0.4, 0.2], "metallic": 0.3}
+    if opacity is not None:
+        node(d, "o", "scalar_parameter", {"name": "alpha"}, {"value": opacity})
+    node(d, "make", "make_attributes", values=values)
+    node(d, "out", "material_output")
+    link(d, "r", "value", "make", "roughness")
+    if opacity is not None:
+        link(d, "o", "value", "make", "opacity")
+    link(d, "make", "attributes", "out", "attributes")
+    return d
+
+
+@pytest.fixture(scope="module")
+def pair(gl_ctx):
+    rs = {name: Renderer(gl_ctx, SIZE, samples=4, environment="studio", bake_settings=SMALL,
+                         deferred=(name == "deferred"))
+          for name in ("forward", "deferred")}
+    for r in rs.values():
+        r.set_reference_samples(8)  # 8 a frame, one frame: enough to compare, quick
+    yield rs
+    for r in rs.values():
+        r.release()
+
+
+def _both(pair, compiled, mode="splitsum"):
+    out = {}
+    for name, r in pair.items():
+        r.mode = mode
+        status = r.set_material(compiled)
+        assert status.ok, status.errors
+        r.render_converged()
+        out[name] = r.read_linear().copy()
+    return out["deferred"], out["forward"]
+
+
+def _rel(a, b):
+    return np.abs(a - b) / np.maximum(1.0, np.abs(b))
+
+
+# --- entry variants ---------------------------------------------------------------------------
+
+def test_entries_are_glsl_files_and_forward_is_what_compile_exports():
+    for entry in Entry:
+        assert (shaders_dir() / "entry" / f"{entry.value}.frag.glsl").is_file()
+        assert entry_text(entry).startswith("void main() {")
+    doc = load(MATERIALS[0])
+    cm = compile_document(doc, FileResolver())
+    assert cm.fragment_text == cm.variant(Entry.FORWARD).fragment_text
+    assert cm.fragment_text.rstrip().endswith(entry_text(Entry.FORWARD))
+    assert "shadeSurface" in cm.fragment_text
+    gb = cm.variant(Entry.GBUFFER)
+    assert "shadeSurface" not in gb.fragment_text and "LightsBlock" not in gb.fragment_text
+    for i in range(4):
+        assert f"layout(location = {i}) out vec4 gbuffer{i};" in gb.fragment_text
+    attrs = compile_document(doc, FileResolver(), mode=Entry.ATTRIBUTES)
+    assert attrs.fragment_text == compile_document(doc, FileResolver(),
+                                                   mode="attributes").fragment_text
+    assert "out3 = vec4(m.opacity" in attrs.fragment_text
+    assert len({cm.structure_hash, gb.structure_hash, attrs.structure_hash}) == 3
+
+
+def test_extra_defines_are_names_only_and_change_the_hash():
+    cm = compile_document(flat_material())
+    split = cm.variant(Entry.FORWARD, ("MATEDIT_SPLIT_SUM_ONLY",))
+    assert "#define MATEDIT_SPLIT_SUM_ONLY 1" in split.fragment_text
+    assert split.structure_hash != cm.structure_hash
+    with pytest.raises(ValueError, match="not a define name"):
+        cm.variant(Entry.FORWARD, ("X 1\nvoid main(){}",))
+
+
+def test_every_entry_of_every_sample_links(gl_ctx):
+    doc = load(MATERIALS[-1])
+    cm = compile_document(doc, FileResolver())
+    for entry in Entry:
+        v = cm.variant(entry)
+        gl_ctx.program(vertex_shader=v.vertex_text, fragment_shader=v.fragment_text).release()
+
+
+# --- deferred = forward -----------------------------------------------------------------------
+
+@pytest.mark.parametrize("path", MATERIALS, ids=[p.stem for p in MATERIALS])
+def test_deferred_equals_forward_split_sum(pair, path):
+    cm = compile_document(load(path), FileResolver())
+    a, b = _both(pair, cm)
+    assert not pair["deferred"].is_forward and pair["forward"].is_forward
+    assert b.max() > 0.05
+    assert _rel(a, b).max() <= REL
+
+
+@pytest.mark.parametrize("mode", ["reference", "difference"])
+def test_deferred_equals_forward_reference_and_difference(pair, mode):
+    cm = compile_document(load(graphs_dir() / "materials" / "worn_painted_steel.json"),
+                          FileResolver())
+    a, b = _both(pair, cm, mode)
+    assert np.abs(b).max() > 0.01
+    assert _rel(a, b).max() <= REL
+
+
+def test_silhouettes_are_antialiased_like_forward(pair):
+    """Edge pixels mix the background and the surface in the proportion of covered samples:
+    with a black background and no gizmos, a silhouette pixel is strictly between 0 and the
+    surface; the deferred values equal the forward ones there too."""
+    for r in pair.values():
+        r.show_background = False
+        r.show_gizmos = False
+    try:
+        a, b = _both(pair, compile_document(flat_material(roughness=0.2)))
+    finally:
+        for r in pair.values():
+            r.show_background = r.show_gizmos = True
+    lum = b.sum(axis=2)
+    inside = lum > 0
+    edge = inside & ~(np.roll(inside, 1, 0) & np.roll(inside, -1, 0) & np.roll(inside, 1, 1)
+                      & np.roll(inside, -1, 1))
+    assert edge.sum() > 20
+    # partial coverage: many silhouette pixels far darker than the surface beside them
+    dark = lum[edge] < 0.6 * np.median(lum[inside & ~edge])
+    assert dark.sum() > 10
+    assert _rel(a, b)[edge].max() <= REL
+    assert _rel(a, b)[inside & ~edge].max() <= REL
+
+
+def test_energy_compensation_and_gizmos_match(pair):
+    for r in pair.values():
+        r.set_energy_compensation(True)
+    try:
+        a, b = _both(pair, compile_document(flat_material(roughness=0.9)))
+    finally:
+        for r in pair.values():
+            r.set_energy_compensation(False)
+    assert _rel(a, b).max() <= REL
+
+
+# --- programs ---------------------------------------------------------------------------------
+
+def test_a_structural_edit_links_only_the_gbuffer_program(pair):
+    r = pair["deferred"]
+    r.mode = "splitsum"
+    r.set_material(compile_document(flat_material(roughness=0.3)))
+    r.render()
+    lighting, links = r.lighting.link_count, r.link_count
+    d = flat_material(roughness=0.3)
+    node(d, "extra", "scalar_parameter", {"name": "metal"}, {"value": 0.5})
+    link(d, "extra", "value", "make", "metallic")
+    r.set_material(compile_document(d))
+    r.render()
+    assert r.link_count == links + 1
+    assert r.lighting.link_count == lighting  # the lighting program is shared
+    prog = r._program
+    linked = [k for k, p in r._programs.items() if p is prog]
+    assert linked == [compile_document(d).variant(Entry.GBUFFER).structure_hash]
+
+
+def test_translucent_materials_fall_back_to_forward_and_back(pair):
+    cm = compile_document(flat_material(opacity=1.0))
+    assert not may_be_translucent(cm.ir)
+    assert may_be_translucent(cm.ir, {"p_alpha": 0.5})
+    r = pair["deferred"]
+    r.mode = "splitsum"
+    r.set_material(cm)
+    assert not r.is_forward
+    r.set_uniforms({"p_alpha": 0.5})
+    assert r.is_forward
+    r.render()
+    a = r.read_linear().copy()
+    f = pair["forward"]
+    f.mode = "splitsum"
+    f.set_material(cm)
+    f.set_uniforms({"p_alpha": 0.5})
+    f.render()
+    assert np.array_equal(a, f.read_linear())
+    links = r.link_count
+    r.set_uniforms({"p_alpha": 1.0})
+    assert not r.is_forward and r.link_count == links  # both programs kept
+    translucent = compile_document(flat_material(opacity=0.5))
+    r.set_material(translucent)
+    assert r.is_forward
+
+
+def test_render_command_uses_the_deferred_path(gl_ctx):
+    """`matedit render` builds its renderer through commands.render._renderer with the
+    defaults: the deferred preview (4 samples where GL has them; with 1 sample, forward). Its
+    image equals the forward path's by the tests above."""
+    from matedit.commands.render import _renderer
+
+    r = _renderer(gl_ctx, (48, 48), Renderer)
+    try:
+        assert r.deferred == (r.samples >= 2)
+        r.set_material(compile_document(load(MATERIALS[0]), FileResolver()))
+        assert r.is_forward == (not r.deferred)
+    finally:
+        r.release()
