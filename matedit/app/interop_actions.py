@@ -20,13 +20,17 @@ FOLDER_KEY = "interop/folder"
 
 
 def _in_worker(fn):
-    """Run `fn` on a worker thread and wait (the GUI shows a busy cursor); re-raise its
-    exception here."""
+    """Run `fn(ctx)` on a worker thread with a headless GL context made there (EGL must not
+    be current on the GUI thread, which uses GLX) and wait (the GUI shows a busy cursor);
+    re-raise its exception here."""
     box: dict = {}
 
     def run():
         try:
-            box["value"] = fn()
+            from matedit.render.context import headless
+
+            with headless() as ctx:
+                box["value"] = fn(ctx)
         except BaseException as exc:  # handed back to the GUI thread
             box["error"] = exc
 
@@ -150,7 +154,8 @@ class InteropActions:
                 named if named in BUILTIN_MESHES else "sphere")
             outs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
             refuse_overwrite(outs, self._inputs())
-            attrs, ir = _in_worker(lambda: bake_attributes(self.doc, self.resolver, size))
+            attrs, ir = _in_worker(lambda ctx: bake_attributes(ctx, self.doc, self.resolver,
+                                                               size))
             import numpy as np
 
             emax = float(max(1.0, np.max(attrs["emissive"])))
@@ -191,7 +196,7 @@ class InteropActions:
         try:
             refuse_overwrite(map_paths(folder, self._stem(), MAP_NAMES, "png").values(),
                              self._inputs())
-            maps, _ = _in_worker(lambda: bake_document(self.doc, self.resolver, size))
+            maps, _ = _in_worker(lambda ctx: bake_document(ctx, self.doc, self.resolver, size))
             paths = map_paths(folder, self._stem(), [m.name for m in maps], "png")
             for m in maps:
                 encode_file(paths[m.name], m)

@@ -67,6 +67,7 @@ def run(args) -> int:
     from matedit.io.document import FileResolver
     from matedit.io.images import ImageError
     from matedit.io.inputs import OverwriteError, document_inputs, refuse_overwrite
+    from matedit.render.context import headless
 
     size = parse_size(args.size)
     path = Path(args.file)
@@ -84,7 +85,9 @@ def run(args) -> int:
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
     try:
-        maps, _ = bake_document(doc, resolver, size, progress_printer("baking"), args.format)
+        with headless() as ctx:
+            maps, _ = bake_document(ctx, doc, resolver, size, progress_printer("baking"),
+                                    args.format)
     except CompileError as exc:
         raise compile_error(exc, path) from None
     paths = map_paths(out, stem, [m.name for m in maps], args.format)

@@ -63,6 +63,7 @@ def _gltf(args, out: Path) -> int:
     from matedit.interop.bake import bake_attributes, maps_from
     from matedit.io.document import FileResolver
     from matedit.io.inputs import BUILTIN_MESHES, OverwriteError, preview_file, refuse_overwrite
+    from matedit.render.context import headless
     from matedit.render.mesh import MeshError, mesh_from_spec
 
     size = parse_size(args.size or "1024")
@@ -84,7 +85,8 @@ def _gltf(args, out: Path) -> int:
     except OSError as exc:
         raise UsageError(f"{mesh_spec}: cannot read mesh: {exc.strerror or exc}") from None
     try:
-        attrs, ir = bake_attributes(doc, resolver, size, progress_printer("baking"))
+        with headless() as ctx:
+            attrs, ir = bake_attributes(ctx, doc, resolver, size, progress_printer("baking"))
     except CompileError as exc:
         raise compile_error(exc, path) from None
     emax = float(max(1.0, np.max(attrs["emissive"])))

@@ -225,26 +225,22 @@ def map_paths(folder: Path, stem: str, names, fmt: str) -> dict[str, Path]:
     return {n: Path(folder) / f"{stem}_{n}.{fmt}" for n in names}
 
 
-def bake_document(doc, resolver, size: int, progress: Callable[[float], None] | None = None,
-                  fmt: str = "png"):
-    """Compile `doc` in attribute mode and bake it on a headless GL context.
+def bake_document(ctx, doc, resolver, size: int,
+                  progress: Callable[[float], None] | None = None, fmt: str = "png"):
+    """Compile `doc` in attribute mode and bake it on the GL context `ctx`.
 
     Returns (maps, ir). Raises CompileError for a bad graph."""
-    attrs, ir = bake_attributes(doc, resolver, size, progress)
+    attrs, ir = bake_attributes(ctx, doc, resolver, size, progress)
     return maps_from(attrs, ir.attributes, fmt), ir
 
 
-def bake_attributes(doc, resolver, size: int,
+def bake_attributes(ctx, doc, resolver, size: int,
                     progress: Callable[[float], None] | None = None):
-    """(attributes (size, size, k) float32 from the GPU pass, the optimised IR)."""
+    """(attributes (size, size, k) float32 from the GPU pass on `ctx`, the optimised IR).
+    The caller owns the context (matedit.render.context.headless in the command line, one
+    made on the worker thread in the editor)."""
     from matedit.compiler.api import compile_document, lower_and_optimise
-    from matedit.render.context import headless_context
 
     ir = lower_and_optimise(doc, resolver)
     compiled = compile_document(doc, resolver, "glsl330", mode="attributes", ir=ir)
-    ctx = headless_context()
-    try:
-        attrs = attributes_gpu(ctx, compiled, size, progress=progress)
-    finally:
-        ctx.release()
-    return attrs, ir
+    return attributes_gpu(ctx, compiled, size, progress=progress), ir

@@ -2,7 +2,20 @@
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+
 import moderngl
+
+
+@contextlib.contextmanager
+def headless() -> Iterator[moderngl.Context]:
+    """A headless context for the duration of a `with` block, released after it."""
+    ctx = headless_context()
+    try:
+        yield ctx
+    finally:
+        ctx.release()
 
 
 def headless_context() -> moderngl.Context:
