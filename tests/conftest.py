@@ -17,6 +17,14 @@ def _private_cache(tmp_path_factory):
     # Recovery files (platformdirs' user data folder) are per run too: parallel runs, and the
     # user's own crashed work, never meet the tests'.
     os.environ["XDG_DATA_HOME"] = str(tmp_path_factory.mktemp("data"))
+    # Qt's settings (the editor's remembered view, recent files, export choices) too: under
+    # pytest-qt's test mode they would otherwise be ~/.qttest/config, shared by every run.
+    from PySide6.QtCore import QSettings
+
+    settings = str(tmp_path_factory.mktemp("settings"))
+    for fmt in (QSettings.Format.NativeFormat, QSettings.Format.IniFormat):
+        QSettings.setPath(fmt, QSettings.Scope.UserScope, settings)
+    os.environ["XDG_CONFIG_HOME"] = settings
     yield
 
 
