@@ -176,3 +176,72 @@ def test_emissive_hdr_and_opacity_bake_and_export(tmp_path):
     assert mat.alphaMode == "BLEND" and mat.emissiveTexture is not None
     strength = mat.extensions["KHR_materials_emissive_strength"]["emissiveStrength"]
     assert strength == pytest.approx(cpu["emissive"].max(), rel=1e-4)
+
+
+@pytest.mark.gl
+def test_bake_decodes_textures_by_their_colour_space(ctx, tmp_path):
+    """An sRGB 8-bit texture bakes as its decoded values (IEC 61966-2-1, the test's own
+    formula), a linear one as its codes / 255: the GPU bake and the CPU evaluator both within
+    1/255 at texel centres (bake size = texture size), and the baked base colour PNG, sRGB
+    encoded again, gives back the texture's own codes within one code."""
+    from tests.interop_tools import srgb_decode, textured_material
+
+    src, albedo, data = textured_material(tmp_path, 8)
+    doc = load(src)
+    r = FileResolver()
+    ir = lower_and_optimise(doc, r)
+    cm = compile_document(doc, r, "glsl330", mode="attributes", ir=ir)
+    gpu = bake.attributes_gpu(ctx, cm, 8)
+    cpu = bake.attributes_cpu(lower_and_optimise(doc, r), 8)
+    tol = 1.0 / 255.0
+    for name, got in (("gpu", gpu), ("cpu", cpu)):
+        np.testing.assert_allclose(got["baseColor"], srgb_decode(albedo), atol=tol,
+                                   err_msg=f"{name} base colour")
+        np.testing.assert_allclose(got["roughness"][..., 0], data[..., 0] / 255.0, atol=tol,
+                                   err_msg=f"{name} roughness")
+        np.testing.assert_allclose(got["metallic"][..., 0], data[..., 1] / 255.0, atol=tol,
+                                   err_msg=f"{name} metallic")
+    out = tmp_path / "maps"
+    res = cli("bake", str(src), "-o", str(out), "--size", "8")
+    assert res.returncode == 0, res.stderr
+    base = file_pixels(out / "textured_base_color.png") * 255.0
+    assert np.abs(base - albedo).max() <= 1.0
+    orm = file_pixels(out / "textured_orm.png") * 255.0
+    assert np.abs(orm[..., 1] - data[..., 0]).max() <= 1.0
+    assert np.abs(orm[..., 2] - data[..., 1]).max() <= 1.0
+
+
+@pytest.mark.gl
+def test_gltf_base_colour_is_srgb_and_orm_linear(tmp_path):
+    """In the .glb the base colour map holds sRGB codes (glTF decodes it as sRGB) and the
+    metallic-roughness map linear values: from an sRGB albedo and a linear data texture
+    each comes back as the source texture's codes within one."""
+    import OpenImageIO as oiio
+    import pygltflib
+
+    from tests.interop_tools import textured_material
+
+    src, albedo, data = textured_material(tmp_path, 8)
+    out = tmp_path / "t.glb"
+    res = cli("export", str(src), "-o", str(out), "--size", "8")
+    assert res.returncode == 0, res.stderr
+    issues = validate_gltf(out, tmp_path)
+    assert issues["numErrors"] == 0, issues["messages"][:5]
+    g = pygltflib.GLTF2().load(str(out))
+    blob = g.binary_blob()
+
+    def image(index: int) -> np.ndarray:
+        view = g.bufferViews[g.images[g.textures[index].source].bufferView]
+        png = tmp_path / f"img{index}.png"
+        png.write_bytes(blob[view.byteOffset or 0:(view.byteOffset or 0) + view.byteLength])
+        buf = oiio.ImageBuf(str(png))
+        px = buf.get_pixels(oiio.UINT8)
+        assert px is not None, buf.geterror()
+        return np.asarray(px, np.float64)[::-1]  # row 0 = v = 0
+
+    pbr = g.materials[0].pbrMetallicRoughness
+    base = image(pbr.baseColorTexture.index)
+    mr = image(pbr.metallicRoughnessTexture.index)
+    assert np.abs(base[..., :3] - albedo).max() <= 1.0
+    assert np.abs(mr[..., 1] - data[..., 0]).max() <= 1.0  # G roughness
+    assert np.abs(mr[..., 2] - data[..., 1]).max() <= 1.0  # B metallic
