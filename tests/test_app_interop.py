@@ -132,3 +132,31 @@ def test_export_shaders_dialog_greys_hlsl_and_msl_without_spirv_cross(qtbot, tmp
     assert dlg.run_export()
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
         "mossy_stone.glsl330.frag", "mossy_stone.glsl330.vert", "mossy_stone.reflection.json"]
+
+
+def test_editor_import_of_several_materials_asks_which(qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QInputDialog
+
+    from tests.test_interop_mtlx import MATERIALS, _several
+
+    src = tmp_path / "many.mtlx"
+    src.write_text(_several())
+    asked = []
+
+    def pick(parent, title, label, items, current, editable):
+        asked.append(list(items))
+        return pick.answer
+
+    monkeypatch.setattr(QInputDialog, "getItem", pick)
+    w = make_window(qtbot, SAMPLE)
+    ia = w.interop
+    pick.answer = ("", False)  # cancelled: nothing imported
+    assert not ia.import_mtlx(src, tmp_path / "none.json")
+    assert not (tmp_path / "none.json").exists()
+    pick.answer = ("blue", True)
+    assert ia.import_mtlx(src, tmp_path / "blue.json"), ia.last_message
+    assert asked == [list(MATERIALS)] * 2
+    doc = w.controller.document
+    assert doc.path == tmp_path / "blue.json"
+    (surface,) = [n for n in doc.graph.nodes.values() if n.kind == "make_attributes"]
+    assert surface.values["baseColor"] == pytest.approx(list(MATERIALS["blue"]))

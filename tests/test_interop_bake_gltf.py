@@ -9,6 +9,7 @@ must also be 0 for our files).
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -245,3 +246,59 @@ def test_gltf_base_colour_is_srgb_and_orm_linear(tmp_path):
     assert np.abs(base[..., :3] - albedo).max() <= 1.0
     assert np.abs(mr[..., 1] - data[..., 0]).max() <= 1.0  # G roughness
     assert np.abs(mr[..., 2] - data[..., 1]).max() <= 1.0  # B metallic
+
+
+def _on_a_terminal(args: list[str], timeout: float = 300) -> tuple[int, str]:
+    """Run `python -m matedit ARGS` with its stderr (and stdout) on a pseudo-terminal."""
+    import os
+    import pty
+
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: exec at once
+        os.execv(sys.executable, [sys.executable, "-m", "matedit", *args])
+    chunks = []
+    while True:
+        try:
+            data = os.read(fd, 4096)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    _, status = os.waitpid(pid, 0)
+    os.close(fd)
+    return os.waitstatus_to_exitcode(status), b"".join(chunks).decode("utf-8", "replace")
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("command", ["bake", "export"])
+def test_bake_and_gltf_export_show_progress_on_a_terminal(tmp_path, command):
+    """On a terminal both report the bake's progress up to 100% (tiles of bake.TILE texels:
+    a map of 2 x TILE is four steps); piped, they print nothing (checked elsewhere)."""
+    path = graphs_dir() / "materials" / "mossy_stone.json"
+    out = tmp_path / ("maps" if command == "bake" else "m.glb")
+    code, text = _on_a_terminal([command, str(path), "-o", str(out), "--size",
+                                 str(2 * bake.TILE)])
+    assert code == 0, text
+    steps = [float(s) for s in re.findall(r"baking\s+([\d.]+)%", text)]
+    assert steps == [25.0, 50.0, 75.0, 100.0], text
+
+
+def test_bake_refuses_to_write_over_a_texture_the_material_reads(tmp_path):
+    """The texture is named as the bake's base colour map would be: refused, exit 2, the
+    texture untouched and no map written."""
+    from matedit.io.document import save
+    from tests.interop_tools import textured_material
+
+    src, _, _ = textured_material(tmp_path, 4)
+    trap = tmp_path / "textured_base_color.png"
+    (tmp_path / "albedo.png").rename(trap)
+    doc = load(src)
+    doc.graph.nodes["ta"].settings["path"] = trap.name
+    save(doc, src)
+    before = trap.read_bytes()
+    r = cli("bake", str(src), "-o", str(tmp_path), "--size", "4")
+    assert r.returncode == 2 and r.stderr.startswith("error: "), r.stderr
+    assert "refusing to write over" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert trap.read_bytes() == before
+    assert not (tmp_path / "textured_orm.png").exists()
