@@ -1,7 +1,9 @@
 """Draw a MaterialX nodegraph output with MaterialX's own GLSL generator on the bake plane
 (matedit.interop.bake): the UV square at z = 0, normal +Z, tangent +X, bitangent +Y, camera at
 bake.CAMERA, one pixel per texel centre. Images the document reads are bound as float
-textures (row 0 = v = 0, MaterialX's convention)."""
+textures of their stored values (codes / 255 for 8-bit; row 0 = v = 0, MaterialX's
+convention); MaterialX's colour management decodes them in its shader, from each file's
+colorspace to lin_rec709."""
 
 from __future__ import annotations
 
@@ -24,7 +26,13 @@ class MtlxDrawer:
         search = mx.getDefaultDataSearchPath()
         mx.loadLibraries(mx.getDefaultDataLibraryFolders(), search, self.library)
         self.generator = mx_glsl.GlslShaderGenerator.create()
+        # MaterialX's own colour management: images are decoded from their file's
+        # colorspace to the document's (lin_rec709) in the generated shader
+        cms = mx_gen.DefaultColorManagementSystem.create(self.generator.getTarget())
+        cms.loadLibrary(self.library)
+        self.generator.setColorManagementSystem(cms)
         self.context = mx_gen.GenContext(self.generator)
+        self.context.getOptions().targetColorSpaceOverride = "lin_rec709"
         self.context.registerSourceCodeSearchPath(search)
         quad = np.array([[0, 0], [1, 0], [0, 1], [1, 1]], "f4")
         n = len(quad)

@@ -69,3 +69,94 @@ def test_editor_import_error_names_the_node(qtbot, tmp_path, monkeypatch):
     assert shown and "NG/lumpy" in shown[0] and "noise3d" in shown[0]
     assert not (tmp_path / "x.json").exists()
     assert w.controller.document.path == SAMPLE
+
+
+def test_export_shaders_dialog_offers_every_compile_target(qtbot, tmp_path):
+    """Every `matedit compile --target` choice is a box in File › Export Shaders, and the
+    dialog writes byte-for-byte what `matedit compile --target all` writes."""
+    import argparse
+
+    from matedit.app.export_dialog import ExportDialog
+    from matedit.cli import main
+    from matedit.commands.compile import register
+    from matedit.interop.cross import available
+
+    sub = argparse.ArgumentParser().add_subparsers()
+    register(sub)
+    (compile_parser,) = sub.choices.values()
+    (choices,) = [a.choices for a in compile_parser._actions if a.dest == "target"]
+    w = make_window(qtbot, SAMPLE)
+    dlg = ExportDialog(w.controller.document, w.controller.resolver, w)
+    assert set(dlg.boxes) == set(choices) - {"all"}
+    if not available():
+        pytest.skip("glslang-tools, spirv-tools or spirv-cross missing: only the GLSL targets")
+    assert dlg.boxes["hlsl"].isEnabled() and dlg.boxes["msl"].isEnabled()
+    for box in dlg.boxes.values():
+        box.setChecked(True)
+    dlg.folder.setText(str(tmp_path / "dialog"))
+    assert dlg.run_export()
+    assert main(["compile", str(SAMPLE), "-o", str(tmp_path / "cli"), "--target", "all"]) == 0
+    ours = {p.name: p.read_bytes() for p in (tmp_path / "dialog").iterdir()}
+    theirs = {p.name: p.read_bytes() for p in (tmp_path / "cli").iterdir()}
+    assert "mossy_stone.hlsl.frag" in ours and "mossy_stone.msl.vert" in ours
+    assert ours == theirs
+
+
+def test_export_shaders_dialog_greys_hlsl_and_msl_without_spirv_cross(qtbot, tmp_path,
+                                                                     monkeypatch):
+    """With spirv-cross off PATH the HLSL/MSL boxes are greyed (a remembered choice of them
+    is not exported) and the tooltip names the Debian package."""
+    import os
+    import shutil
+
+    from PySide6.QtCore import QSettings
+
+    from matedit.app.export_dialog import TARGETS_KEY, ExportDialog
+
+    bindir = tmp_path / "bin"
+    bindir.mkdir()
+    for name in ("glslangValidator", "spirv-val"):
+        if shutil.which(name):
+            os.symlink(shutil.which(name), bindir / name)
+    QSettings().setValue(TARGETS_KEY, ["glsl330", "hlsl"])
+    monkeypatch.setenv("PATH", str(bindir))
+    w = make_window(qtbot, SAMPLE)
+    dlg = ExportDialog(w.controller.document, w.controller.resolver, w)
+    for t in ("hlsl", "msl"):
+        box = dlg.boxes[t]
+        assert not box.isEnabled() and not box.isChecked()
+        assert "Debian package spirv-cross" in box.toolTip()
+        assert "apt-get install spirv-cross" in box.toolTip()
+    assert dlg.boxes["glsl330"].isEnabled() and dlg.targets() == ["glsl330"]
+    dlg.folder.setText(str(tmp_path / "out"))
+    assert dlg.run_export()
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "mossy_stone.glsl330.frag", "mossy_stone.glsl330.vert", "mossy_stone.reflection.json"]
+
+
+def test_editor_import_of_several_materials_asks_which(qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QInputDialog
+
+    from tests.test_interop_mtlx import MATERIALS, _several
+
+    src = tmp_path / "many.mtlx"
+    src.write_text(_several())
+    asked = []
+
+    def pick(parent, title, label, items, current, editable):
+        asked.append(list(items))
+        return pick.answer
+
+    monkeypatch.setattr(QInputDialog, "getItem", pick)
+    w = make_window(qtbot, SAMPLE)
+    ia = w.interop
+    pick.answer = ("", False)  # cancelled: nothing imported
+    assert not ia.import_mtlx(src, tmp_path / "none.json")
+    assert not (tmp_path / "none.json").exists()
+    pick.answer = ("blue", True)
+    assert ia.import_mtlx(src, tmp_path / "blue.json"), ia.last_message
+    assert asked == [list(MATERIALS)] * 2
+    doc = w.controller.document
+    assert doc.path == tmp_path / "blue.json"
+    (surface,) = [n for n in doc.graph.nodes.values() if n.kind == "make_attributes"]
+    assert surface.values["baseColor"] == pytest.approx(list(MATERIALS["blue"]))

@@ -9,6 +9,7 @@ must also be 0 for our files).
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -176,3 +177,128 @@ def test_emissive_hdr_and_opacity_bake_and_export(tmp_path):
     assert mat.alphaMode == "BLEND" and mat.emissiveTexture is not None
     strength = mat.extensions["KHR_materials_emissive_strength"]["emissiveStrength"]
     assert strength == pytest.approx(cpu["emissive"].max(), rel=1e-4)
+
+
+@pytest.mark.gl
+def test_bake_decodes_textures_by_their_colour_space(ctx, tmp_path):
+    """An sRGB 8-bit texture bakes as its decoded values (IEC 61966-2-1, the test's own
+    formula), a linear one as its codes / 255: the GPU bake and the CPU evaluator both within
+    1/255 at texel centres (bake size = texture size), and the baked base colour PNG, sRGB
+    encoded again, gives back the texture's own codes within one code."""
+    from tests.interop_tools import srgb_decode, textured_material
+
+    src, albedo, data = textured_material(tmp_path, 8)
+    doc = load(src)
+    r = FileResolver()
+    ir = lower_and_optimise(doc, r)
+    cm = compile_document(doc, r, "glsl330", mode="attributes", ir=ir)
+    gpu = bake.attributes_gpu(ctx, cm, 8)
+    cpu = bake.attributes_cpu(lower_and_optimise(doc, r), 8)
+    tol = 1.0 / 255.0
+    for name, got in (("gpu", gpu), ("cpu", cpu)):
+        np.testing.assert_allclose(got["baseColor"], srgb_decode(albedo), atol=tol,
+                                   err_msg=f"{name} base colour")
+        np.testing.assert_allclose(got["roughness"][..., 0], data[..., 0] / 255.0, atol=tol,
+                                   err_msg=f"{name} roughness")
+        np.testing.assert_allclose(got["metallic"][..., 0], data[..., 1] / 255.0, atol=tol,
+                                   err_msg=f"{name} metallic")
+    out = tmp_path / "maps"
+    res = cli("bake", str(src), "-o", str(out), "--size", "8")
+    assert res.returncode == 0, res.stderr
+    base = file_pixels(out / "textured_base_color.png") * 255.0
+    assert np.abs(base - albedo).max() <= 1.0
+    orm = file_pixels(out / "textured_orm.png") * 255.0
+    assert np.abs(orm[..., 1] - data[..., 0]).max() <= 1.0
+    assert np.abs(orm[..., 2] - data[..., 1]).max() <= 1.0
+
+
+@pytest.mark.gl
+def test_gltf_base_colour_is_srgb_and_orm_linear(tmp_path):
+    """In the .glb the base colour map holds sRGB codes (glTF decodes it as sRGB) and the
+    metallic-roughness map linear values: from an sRGB albedo and a linear data texture
+    each comes back as the source texture's codes within one."""
+    import OpenImageIO as oiio
+    import pygltflib
+
+    from tests.interop_tools import textured_material
+
+    src, albedo, data = textured_material(tmp_path, 8)
+    out = tmp_path / "t.glb"
+    res = cli("export", str(src), "-o", str(out), "--size", "8")
+    assert res.returncode == 0, res.stderr
+    issues = validate_gltf(out, tmp_path)
+    assert issues["numErrors"] == 0, issues["messages"][:5]
+    g = pygltflib.GLTF2().load(str(out))
+    blob = g.binary_blob()
+
+    def image(index: int) -> np.ndarray:
+        view = g.bufferViews[g.images[g.textures[index].source].bufferView]
+        png = tmp_path / f"img{index}.png"
+        png.write_bytes(blob[view.byteOffset or 0:(view.byteOffset or 0) + view.byteLength])
+        buf = oiio.ImageBuf(str(png))
+        px = buf.get_pixels(oiio.UINT8)
+        assert px is not None, buf.geterror()
+        return np.asarray(px, np.float64)[::-1]  # row 0 = v = 0
+
+    pbr = g.materials[0].pbrMetallicRoughness
+    base = image(pbr.baseColorTexture.index)
+    mr = image(pbr.metallicRoughnessTexture.index)
+    assert np.abs(base[..., :3] - albedo).max() <= 1.0
+    assert np.abs(mr[..., 1] - data[..., 0]).max() <= 1.0  # G roughness
+    assert np.abs(mr[..., 2] - data[..., 1]).max() <= 1.0  # B metallic
+
+
+def _on_a_terminal(args: list[str], timeout: float = 300) -> tuple[int, str]:
+    """Run `python -m matedit ARGS` with its stderr (and stdout) on a pseudo-terminal."""
+    import os
+    import pty
+
+    pid, fd = pty.fork()
+    if pid == 0:  # the child: exec at once
+        os.execv(sys.executable, [sys.executable, "-m", "matedit", *args])
+    chunks = []
+    while True:
+        try:
+            data = os.read(fd, 4096)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    _, status = os.waitpid(pid, 0)
+    os.close(fd)
+    return os.waitstatus_to_exitcode(status), b"".join(chunks).decode("utf-8", "replace")
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("command", ["bake", "export"])
+def test_bake_and_gltf_export_show_progress_on_a_terminal(tmp_path, command):
+    """On a terminal both report the bake's progress up to 100% (tiles of bake.TILE texels:
+    a map of 2 x TILE is four steps); piped, they print nothing (checked elsewhere)."""
+    path = graphs_dir() / "materials" / "mossy_stone.json"
+    out = tmp_path / ("maps" if command == "bake" else "m.glb")
+    code, text = _on_a_terminal([command, str(path), "-o", str(out), "--size",
+                                 str(2 * bake.TILE)])
+    assert code == 0, text
+    steps = [float(s) for s in re.findall(r"baking\s+([\d.]+)%", text)]
+    assert steps == [25.0, 50.0, 75.0, 100.0], text
+
+
+def test_bake_refuses_to_write_over_a_texture_the_material_reads(tmp_path):
+    """The texture is named as the bake's base colour map would be: refused, exit 2, the
+    texture untouched and no map written."""
+    from matedit.io.document import save
+    from tests.interop_tools import textured_material
+
+    src, _, _ = textured_material(tmp_path, 4)
+    trap = tmp_path / "textured_base_color.png"
+    (tmp_path / "albedo.png").rename(trap)
+    doc = load(src)
+    doc.graph.nodes["ta"].settings["path"] = trap.name
+    save(doc, src)
+    before = trap.read_bytes()
+    r = cli("bake", str(src), "-o", str(tmp_path), "--size", "4")
+    assert r.returncode == 2 and r.stderr.startswith("error: "), r.stderr
+    assert "refusing to write over" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    assert trap.read_bytes() == before
+    assert not (tmp_path / "textured_orm.png").exists()

@@ -499,3 +499,184 @@ def test_import_of_a_very_deep_chain_is_one_error_or_a_material(tmp_path):
         assert not out.exists()
     else:
         assert r.returncode == 0 and out.is_file()
+
+
+@pytest.mark.gl
+def test_texture_colour_spaces_in_materialx(ctx, tmp_path):
+    """An sRGB texture's image reads its file as srgb_texture (a color4 image, the type
+    MaterialX decodes), a linear one as lin_rec709, in a lin_rec709 document that validates;
+    MaterialX's own GLSL, with its colour management, then gives the CPU evaluator's decoded
+    values (2e-3), and the import brings the sRGB flag back (round trip within 1e-6)."""
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+    from tests.interop_tools import srgb_decode, textured_material
+    from tests.mtlx_gpu import MtlxDrawer
+
+    n = 8
+    src, albedo, _ = textured_material(tmp_path, n)
+    out = tmp_path / "textured.mtlx"
+    r = cli("export", str(src), "-o", str(out), "--size", str(n))
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    doc = load_with_stdlib(out)
+    ok, msg = doc.validate()
+    assert ok, msg
+    assert doc.getColorSpace() == "lin_rec709"
+    images = {i.getInputValue("file"): i for i in doc.getNodeGraph("NG_textured").getNodes(
+        "image")}
+    assert set(images) == {"albedo.png", "data.png"}
+    assert images["albedo.png"].getInput("file").getColorSpace() == "srgb_texture"
+    assert images["albedo.png"].getType() == "color4"
+    assert images["data.png"].getInput("file").getColorSpace() == "lin_rec709"
+    cpu = bake.attributes_cpu(lower_and_optimise(load(src), FileResolver()), n)
+    np.testing.assert_allclose(cpu["baseColor"], srgb_decode(albedo), atol=1.0 / 255.0)
+    shader = next(s for s in doc.getNodes() if s.getCategory() == "standard_surface")
+    drawer = MtlxDrawer(ctx, n)
+    try:
+        for inp in ("base_color", "specular_roughness", "metalness"):
+            i = shader.getInput(inp)
+            o = doc.getNodeGraph(i.getNodeGraphString()).getOutput(i.getOutputString())
+            got = drawer.draw(doc, o, tmp_path)
+            want = cpu[SURFACE_INPUTS[inp]]
+            np.testing.assert_allclose(got[..., :want.shape[-1]], want, atol=2e-3,
+                                       err_msg=inp)
+    finally:
+        drawer.release()
+    back = tmp_path / "back.json"
+    r = cli("import", str(out), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    textures = {nd.settings["path"]: nd.settings for nd in load(back).graph.nodes.values()
+                if nd.kind == "texture_parameter"}
+    assert textures["albedo.png"]["srgb"] is True
+    assert textures["data.png"]["srgb"] is False
+    again = bake.attributes_cpu(lower_and_optimise(load(back), FileResolver()), n)
+    for k in cpu:
+        np.testing.assert_allclose(again[k], cpu[k], atol=1e-6, err_msg=k)
+
+
+def test_opencolorio_spaces_map_to_materialx_names_or_are_refused(tmp_path):
+    """An OpenColorIO space MaterialX 1.39 knows is written by its MaterialX name (ACEScg as
+    acescg) and imported back to the same space; one it lacks (Linear Rec.2020) is an
+    `error:` naming the node and the space."""
+    from matedit.io.document import load, save
+
+    src, _, _ = textured_material_with(tmp_path, "ACEScg")
+    out = tmp_path / "t.mtlx"
+    r = cli("export", str(src), "-o", str(out), "--size", "4")
+    assert r.returncode == 0, r.stderr
+    doc = load_with_stdlib(out)
+    assert doc.validate()[0]
+    (img,) = [i for i in doc.getNodeGraph("NG_textured").getNodes("image")
+              if i.getInputValue("file") == "albedo.png"]
+    assert img.getInput("file").getColorSpace() == "acescg"
+    back = tmp_path / "back.json"
+    r = cli("import", str(out), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    (tex,) = [nd for nd in load(back).graph.nodes.values()
+              if nd.kind == "texture_parameter" and nd.settings["path"] == "albedo.png"]
+    assert tex.settings["color_space"] == "ACEScg"
+
+    d = load(src)
+    d.graph.nodes["ta"].settings["color_space"] = "Linear Rec.2020"
+    save(d, src)
+    r = cli("export", str(src), "-o", str(tmp_path / "u.mtlx"), "--size", "4")
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ")
+    assert lines[0].startswith(f"error: {src}: node sa: colour space 'Linear Rec.2020'")
+    assert "srgb_texture" in lines[0]  # the names MaterialX knows are listed
+    assert not (tmp_path / "u.mtlx").exists()
+
+
+def textured_material_with(folder: Path, space: str):
+    from matedit.io.document import load, save
+    from tests.interop_tools import textured_material
+
+    src, albedo, data = textured_material(folder, 4)
+    d = load(src)
+    d.graph.nodes["ta"].settings["color_space"] = space
+    save(d, src)
+    return src, albedo, data
+
+
+# --- several materials in one document ----------------------------------------------------
+
+MATERIALS = {"Red_Paint": (0.8, 0.1, 0.1), "9lives": (0.1, 0.8, 0.1), "blue": (0.1, 0.1, 0.8)}
+
+
+def _several(extra: str = "") -> str:
+    body = "".join(f'''
+  <standard_surface name="S_{name}" type="surfaceshader">
+    <input name="base_color" type="color3" value="{', '.join(map(str, c))}" />
+  </standard_surface>
+  <surfacematerial name="{name}" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S_{name}" />
+  </surfacematerial>''' for name, c in MATERIALS.items())
+    return _doc(body + extra)
+
+
+def test_import_of_several_materials_asks_for_one_or_a_folder(tmp_path):
+    src = tmp_path / "many.mtlx"
+    src.write_text(_several())
+    out = tmp_path / "out.json"
+    r = cli("import", str(src), "-o", str(out))
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {src}: 3 materials (")
+    assert "Red_Paint, 9lives, blue" in lines[0]
+    assert "--material NAME" in lines[0] and "-o DIR" in lines[0]
+    assert not out.exists()
+    r = cli("import", str(src), "-o", str(out), "--material", "nope")
+    assert r.returncode == 2 and "no material named 'nope'" in r.stderr
+    assert "Red_Paint, 9lives, blue" in r.stderr and not out.exists()
+    r = cli("import", str(src), "-o", str(out), "--material", "9lives")
+    assert r.returncode == 0, r.stderr
+    np.testing.assert_allclose(_eval(out)["baseColor"][0, 0], MATERIALS["9lives"], atol=1e-9)
+
+
+def test_import_of_every_material_into_a_folder(tmp_path):
+    src = tmp_path / "many.mtlx"
+    src.write_text(_several())
+    folder = tmp_path / "mats"  # created
+    r = cli("import", str(src), "-o", str(folder))
+    assert r.returncode == 0, r.stderr
+    files = {"Red_Paint": "Red_Paint.json", "9lives": "m_9lives.json", "blue": "blue.json"}
+    assert sorted(p.name for p in folder.iterdir()) == sorted(files.values())
+    for name, file in files.items():
+        assert cli("validate", str(folder / file)).returncode == 0
+        np.testing.assert_allclose(_eval(folder / file)["baseColor"][0, 0], MATERIALS[name],
+                                   atol=1e-9, err_msg=name)
+    one = tmp_path / "one"
+    r = cli("import", str(src), "-o", str(one), "--material", "blue")
+    assert r.returncode == 0, r.stderr
+    assert [p.name for p in one.iterdir()] == ["blue.json"]
+
+
+def test_import_into_a_folder_writes_nothing_when_one_material_fails(tmp_path):
+    src = tmp_path / "many.mtlx"
+    src.write_text(_several('''
+  <nodegraph name="NG"><cellnoise2d name="cells" type="float" />
+    <output name="m" type="float" nodename="cells" /></nodegraph>
+  <standard_surface name="S_bad" type="surfaceshader">
+    <input name="metalness" type="float" nodegraph="NG" output="m" /></standard_surface>
+  <surfacematerial name="bad" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="S_bad" /></surfacematerial>'''))
+    folder = tmp_path / "mats"
+    r = cli("import", str(src), "-o", str(folder))
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "NG/cells" in lines[0] and "cellnoise2d" in lines[0]
+    assert not folder.exists()
+
+
+def test_output_names_are_checked_identifiers_and_distinct():
+    from matedit.graph.names import identifier_problem
+    from matedit.interop.mtlx_import import output_paths
+
+    names = ["a b", "a_b", "A_B", "gl_x", "for", "../../etc", "x" * 80]
+    paths = output_paths(names, Path("d"))
+    stems = [paths[n].stem for n in names]
+    assert stems[:3] == ["a_b", "a_b_2", "A_B_3"]
+    assert all(identifier_problem(s) is None for s in stems), stems
+    assert all(paths[n].parent == Path("d") for n in names)
+    assert len({s.lower() for s in stems}) == len(stems)

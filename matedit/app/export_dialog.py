@@ -1,6 +1,10 @@
 """Export compiled shaders: targets and a folder; the same files as `matedit compile`
 (STEM.TARGET.vert, STEM.TARGET.frag and STEM.reflection.json), never over the material or a
-file it uses."""
+file it uses.
+
+Every target `matedit compile --target` knows is offered: the GLSL dialects, and HLSL and MSL
+(translated from glsl450 through SPIR-V by spirv-cross). Where a tool HLSL/MSL need is not
+installed, their boxes are greyed and the tooltip names the Debian package to install."""
 
 from __future__ import annotations
 
@@ -22,12 +26,23 @@ from PySide6.QtWidgets import (
 
 from matedit.compiler import TARGETS, CompileError
 from matedit.compiler.export import export_shaders
+from matedit.compiler.targets import CROSS_TARGETS
 from matedit.graph.model import MaterialDocument
 from matedit.io.document import FileResolver
 from matedit.io.inputs import OverwriteError
 
 FOLDER_KEY = "export/folder"
 TARGETS_KEY = "export/targets"
+LABELS = {"hlsl": "hlsl (shader model 5.0)", "msl": "msl (Metal 2.0)"}
+
+
+def missing_packages() -> list[tuple[str, str]]:
+    """(tool, Debian package) for each tool HLSL/MSL need that is not on PATH."""
+    import shutil
+
+    from matedit.interop.cross import TOOLS
+
+    return [(t, pkg) for t, pkg in TOOLS.items() if not shutil.which(t)]
 
 
 class ExportDialog(QDialog):
@@ -41,9 +56,19 @@ class ExportDialog(QDialog):
         self.boxes = {}
         remembered = QSettings().value(TARGETS_KEY, ["glsl330"])
         remembered = [remembered] if isinstance(remembered, str) else list(remembered or [])
-        for t in TARGETS:
-            box = QCheckBox(t)
-            box.setChecked(t in remembered)
+        missing = missing_packages()
+        for t in [*TARGETS, *CROSS_TARGETS]:
+            box = QCheckBox(LABELS.get(t, t))
+            if t in CROSS_TARGETS:
+                if missing:
+                    box.setEnabled(False)
+                    box.setToolTip(f"{t.upper()} needs " + ", ".join(
+                        f"{tool} (Debian package {pkg}: apt-get install {pkg})"
+                        for tool, pkg in missing))
+                else:
+                    box.setToolTip(f"{t.upper()} translated from glsl450 through SPIR-V "
+                                   "(glslangValidator, spirv-cross)")
+            box.setChecked(t in remembered and box.isEnabled())
             box.toggled.connect(self._remember_targets)
             lay.addWidget(box)
             self.boxes[t] = box
@@ -69,7 +94,7 @@ class ExportDialog(QDialog):
         QSettings().setValue(TARGETS_KEY, self.targets())
 
     def targets(self) -> list[str]:
-        return [t for t, b in self.boxes.items() if b.isChecked()]
+        return [t for t, b in self.boxes.items() if b.isChecked() and b.isEnabled()]
 
     def _browse(self) -> None:
         folder = QFileDialog.getExistingDirectory(self, "Export into", self.folder.text())
@@ -82,8 +107,13 @@ class ExportDialog(QDialog):
         if not targets or not folder:
             QMessageBox.warning(self, "Export shaders", "Choose at least one target and a folder.")
             return False
+        from matedit.interop.cross import CrossCompileError
+
         try:
             self.written = export_shaders(self.doc, self.resolver, targets, Path(folder))
+        except CrossCompileError as exc:
+            QMessageBox.critical(self, "Export shaders", f"Nothing was written: {exc}")
+            return False
         except CompileError as exc:
             QMessageBox.critical(self, "Export shaders", "The material does not compile:\n"
                                  + "\n".join(d.format() for d in exc.diagnostics[:10]))

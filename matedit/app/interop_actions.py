@@ -14,7 +14,7 @@ from pathlib import Path
 
 from PySide6.QtCore import QSettings, Qt
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QFileDialog, QInputDialog, QMessageBox
 
 FOLDER_KEY = "interop/folder"
 
@@ -217,7 +217,27 @@ class InteropActions:
             return self._fail(title, exc)
         return self._done(f"exported {len(written)} files to {folder}")
 
-    def import_mtlx(self, src: Path | None = None, out: Path | None = None) -> bool:
+    def _choose_material(self, src: Path, title: str) -> tuple[bool, str | None]:
+        """(go on, the material to import): with several in the document, the one picked
+        from a list; None when there is only one (or the file cannot be read: the import
+        then reports why)."""
+        from matedit.interop.mtlx_import import MtlxImportError, material_names
+
+        try:
+            names = material_names(src)
+        except MtlxImportError:
+            return True, None
+        if len(names) < 2:
+            return True, None
+        name, ok = QInputDialog.getItem(self.window, title,
+                                        f"{src.name} holds {len(names)} materials; import:",
+                                        names, 0, False)
+        return bool(ok), (name if ok else None)
+
+    def import_mtlx(self, src: Path | None = None, out: Path | None = None,
+                    material: str | None = None) -> bool:
+        """Import one material of a .mtlx (`material`, else the only one, else the one the
+        artist picks) and open it."""
         title = "Import MaterialX"
         if src is None:
             path, _ = QFileDialog.getOpenFileName(self.window, title, self._start_dir(),
@@ -225,8 +245,15 @@ class InteropActions:
             if not path:
                 return False
             src = Path(path)
+        if material is None:
+            go, material = self._choose_material(src, title)
+            if not go:
+                return False
+        from matedit.interop.mtlx_import import file_stem
+
+        default = f"{file_stem(material)}.json" if material else f"{src.stem}.json"
         out = out or self._ask_save("Save the imported material as", "Material (*.json)",
-                                    f"{src.stem}.json")
+                                    default)
         if out is None:
             return False
         out = out.with_suffix(".json")
@@ -239,7 +266,7 @@ class InteropActions:
 
         try:
             refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
-            doc = import_mtlx(src, out)
+            doc = import_mtlx(src, out, material)
             if not self.window.actions.maybe_save():
                 return False
             atomic_write_text(out, dumps(doc))

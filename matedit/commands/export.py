@@ -120,7 +120,8 @@ def _mtlx(args, out: Path) -> int:
     except CompileError as exc:
         raise compile_error(exc, path) from None
     except mtlx_export.MtlxExportError as exc:
-        raise UsageError(str(exc)) from None
+        msg = str(exc)  # a node's problem is named in the document it belongs to
+        raise UsageError(f"{path}: {msg}" if msg.startswith("node ") else msg) from None
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:

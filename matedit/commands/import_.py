@@ -1,7 +1,16 @@
-"""`matedit import FILE.mtlx -o OUT.json`: a MaterialX material as a matedit material.
+"""`matedit import FILE.mtlx -o OUT.json|DIR [--material NAME]`: MaterialX materials as
+matedit materials.
+
+`-o OUT.json` writes one material: the document's only one, or the one `--material` names.
+`-o DIR` (any output not ending in .json; created if missing) writes every material, or the
+one named, as DIR/NAME.json, NAME the material's name as a checked identifier
+(matedit.interop.mtlx_import.output_paths). A document with several materials, written to
+OUT.json without `--material`, is an `error:` listing their names (exit 2).
 
 Every unsupported node or input is an `error:` line naming it (exit 2); nothing is written
-then. See matedit.interop.mtlx_import for what is read."""
+then (with -o DIR: nothing at all, every material is read before the first file is written).
+No output may replace the MaterialX document or an image a material reads. See
+matedit.interop.mtlx_import for what is read."""
 
 from __future__ import annotations
 
@@ -12,51 +21,75 @@ from matedit.cli import UsageError, report
 
 
 def register(sub) -> None:
-    p = sub.add_parser("import", help="import a MaterialX material",
-                       description="Convert a MaterialX document's material (standard_surface,"
+    p = sub.add_parser("import", help="import MaterialX materials",
+                       description="Convert a MaterialX document's materials (standard_surface,"
                        " open_pbr_surface, gltf_pbr or UsdPreviewSurface, with nodegraphs of "
-                       "stdlib nodes matedit has) into a matedit material.")
+                       "stdlib nodes matedit has) into matedit materials.")
     p.add_argument("file", metavar="FILE.mtlx")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.json")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.json|DIR",
+                   help="one material to OUT.json, or every material (or the one named) to "
+                   "DIR/NAME.json")
+    p.add_argument("--material", metavar="NAME",
+                   help="the surfacematerial to import (required for OUT.json when the "
+                   "document holds several)")
     p.set_defaults(run=run)
+
+
+def _fail(exc) -> UsageError:
+    for m in exc.messages[1:]:
+        report("error", m)
+    return UsageError(exc.messages[0])
 
 
 def run(args) -> int:
     import os
 
-    from matedit.interop.mtlx_import import MtlxImportError, import_mtlx
+    from matedit.interop.mtlx_import import MtlxImportError, import_all, import_mtlx, output_paths
     from matedit.io.atomic import atomic_write_text
-    from matedit.io.document import dumps
+    from matedit.io.document import dumps, reference_fields
     from matedit.io.inputs import OverwriteError, refuse_overwrite
 
     path = Path(args.file)
     out = Path(args.output)
-    if out.suffix.lower() != ".json":
-        raise UsageError(f"{out}: the output must be a .json file")
-    if not out.parent.is_dir():
+    to_folder = out.suffix.lower() != ".json"
+    if to_folder:
+        if out.exists() and not out.is_dir():
+            raise UsageError(f"{out}: exists and is not a folder (a single material's output "
+                             "must end in .json)")
+    elif not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
+    source = {Path(os.path.realpath(path)): "the MaterialX document"}
+    if not to_folder:
+        try:
+            refuse_overwrite([out], source)
+        except OverwriteError as exc:
+            raise UsageError(str(exc)) from None
     try:
-        refuse_overwrite([out], {Path(os.path.realpath(path)): "the MaterialX document"})
-    except OverwriteError as exc:
-        raise UsageError(str(exc)) from None
-    try:
-        doc = import_mtlx(path, out)
+        if to_folder and args.material is None:
+            docs = import_all(path, out)
+        else:
+            target = out
+            if to_folder:
+                target = output_paths([args.material], out)[args.material]
+            docs = {target: import_mtlx(path, target, args.material)}
     except MtlxImportError as exc:
-        for m in exc.messages[1:]:
-            report("error", m)
-        raise UsageError(exc.messages[0]) from None
-    inputs = {}
-    from matedit.io.document import reference_fields
-
-    for container, key in reference_fields(doc):
-        inputs[Path(os.path.realpath(out.parent / container[key]))] = "an image the material reads"
+        raise _fail(exc) from None
+    inputs = dict(source)
+    for target, doc in docs.items():
+        for container, key in reference_fields(doc):
+            inputs[Path(os.path.realpath(target.parent / container[key]))] = \
+                "an image a material reads"
     try:
-        refuse_overwrite([out], inputs)
-        atomic_write_text(out, dumps(doc))
+        refuse_overwrite(list(docs), inputs)
+        if to_folder:
+            out.mkdir(parents=True, exist_ok=True)
+        for target, doc in docs.items():
+            atomic_write_text(target, dumps(doc))
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:
-        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+        raise UsageError(f"{getattr(exc, 'filename', None) or out}: cannot write: "
+                         f"{exc.strerror or exc}") from None
     if sys.stderr.isatty():
-        print(f"imported {path} into {out}", file=sys.stderr)
+        print(f"imported {path} into {', '.join(str(p) for p in docs)}", file=sys.stderr)
     return 0

@@ -53,25 +53,24 @@ def surface(size: int, rows: tuple[int, int] | None = None) -> SurfaceArrays:
 
 
 def load_textures(ir) -> dict[str, np.ndarray]:
-    """The material's textures as the renderer loads them (row 0 = v = 0; a checker if
-    missing), so the GPU and CPU passes read the same texels."""
+    """The material's textures decoded to linear RGBA by their colour space, as the viewport
+    and the CPU evaluator decode them (matedit.shading.colorspace: an sRGB 8-bit file through
+    the sRGB transfer function, a linear one as stored, an OpenColorIO space converted), row
+    0 = v = 0; the checker when a file is missing or unreadable. The GPU and CPU passes sample
+    these same linear texels (bilinear, no mipmaps), so decoding happens before filtering,
+    as in the viewport's sRGB textures."""
     from matedit.compiler.cpu_eval import checker_texture
-    from matedit.io.images import ImageError, read_image
+    from matedit.shading.colorspace import effective_space, load_texture_cached
 
     out = {}
     for t in ir.textures:
         img = None
         if t.path:
             try:
-                data = read_image(t.path).pixels
-                if data.shape[2] == 1:
-                    data = np.repeat(data, 3, axis=2)
-                if data.shape[2] == 2:
-                    data = np.concatenate([data, np.zeros(data.shape[:2] + (1,), "f4")], 2)
-                if data.shape[2] == 3:
-                    data = np.concatenate([data, np.ones(data.shape[:2] + (1,), "f4")], 2)
-                img = np.ascontiguousarray(data[::-1, :, :4], dtype="f4")
-            except (ImageError, OSError):
+                space = effective_space(getattr(t, "color_space", ""), t.srgb)
+                img = np.ascontiguousarray(load_texture_cached(t.path, space).linear,
+                                           dtype="f4")
+            except (ValueError, OSError):  # ImageError and ColorSpaceError are ValueErrors
                 img = None
         out[t.name] = img if img is not None else checker_texture(8)
     return out

@@ -19,8 +19,12 @@ of matedit.interop.bake) into a float EXR beside the document, read by an `image
 texture coordinate 0, and reported; a baked node that reads the position, normal, view or
 time is exact on the bake plane only, and the report says so.
 
-Textures are referenced relative to the document's folder. matedit reads texels as stored
-(the texture's sRGB flag is informational), so images carry no colour space.
+Textures are referenced relative to the document's folder, each image's file with the
+texture's colour space (matedit.interop.mtlx_colorspace: `srgb_texture` for sRGB, `lin_rec709`
+for linear, the MaterialX name of an OpenColorIO space); the document's colour space is
+`lin_rec709`, so MaterialX decodes a texture as matedit does (an image not in lin_rec709 is
+read as color4, the type MaterialX converts, then made a vector4). Baked images are float EXR
+in lin_rec709.
 """
 
 from __future__ import annotations
@@ -39,6 +43,7 @@ from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV,
 from matedit.graph import nodes
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES
 from matedit.graph.types import PortType
+from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, to_materialx
 from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
 
 MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "vector3",
@@ -110,6 +115,7 @@ class _Exporter:
         self.stem = stem
         self.doc = mx.createDocument()
         self.doc.setVersionString(MTLX_VERSION)
+        self.doc.setColorSpace(WORKING)  # images in other spaces are converted to it
         self.ng = self.doc.addNodeGraph(mx.createValidName(f"NG_{stem}"))
         n = size * size
         uniforms = {u.name: u.default for u in ir.uniforms}
@@ -269,6 +275,7 @@ class _Exporter:
             self.baked.append((hint, why))
             n = self.ng.addNode("image", name, MX_TYPE[t])
             n.setInputValue("file", file, "filename")
+            n.getInput("file").setColorSpace(WORKING)  # float EXR, linear as evaluated
             self.set_input(n, "texcoord", self.uv0(), "vector2")
             return ("node", n, None)
         return V(num, t, make, geo)
@@ -464,6 +471,22 @@ class _Exporter:
         n.setInputValue("index", i, "integer")
         return ("node", n, None)
 
+    def colorspace(self, info, hint: str) -> str:
+        """The MaterialX colour space of a texture (its colour space setting, else its sRGB
+        flag); raises MtlxExportError when MaterialX 1.39 has no equivalent."""
+        from matedit.shading.colorspace import ColorSpaceError, effective_space
+
+        space = effective_space(getattr(info, "color_space", ""), info.srgb)
+        try:
+            name = to_materialx(space)
+        except ColorSpaceError as exc:
+            raise MtlxExportError(f"node {hint}: {exc}") from None
+        if name is None:
+            raise MtlxExportError(f"node {hint}: colour space {space!r} has no MaterialX "
+                                  f"1.39 equivalent (known: "
+                                  f"{', '.join(sorted(materialx_spaces()))})")
+        return name
+
     def _to3(self, r: tuple, hint: str) -> tuple:
         if r[0] == "value":
             return ("value", tuple(r[1][:3]))
@@ -479,12 +502,20 @@ class _Exporter:
                 if info is None:
                     raise MtlxExportError(f"node {hint}: texture input is not a texture "
                                           "parameter")
-                n = self.ng.addNode("image", self.name(hint), "vector4")
+                space = self.colorspace(info, hint)
+                # MaterialX decodes colour-typed values only: an image in another space than
+                # the document's is read as color4 (decoded) and converted to vector4.
+                decoded = space != WORKING
+                n = self.ng.addNode("image", self.name(hint), "color4" if decoded else "vector4")
                 if info.path:
                     rel = os.path.relpath(info.path, self.folder)
                     n.setInputValue("file", Path(rel).as_posix(), "filename")
+                    n.getInput("file").setColorSpace(space)
                 self.set_input(n, "texcoord", args[1].ref(), "vector2")
                 shared["n"] = ("node", n, None)
+                if decoded:
+                    shared["n"] = self.node("convert", "vector4", f"{hint}_linear",
+                                            [("in", shared["n"], "color4")])
             return shared["n"]
 
         makers = [image, lambda: self._to3(image(), hint)] + [

@@ -1,6 +1,7 @@
 """A MaterialX document as a matedit material: `matedit import FILE.mtlx -o OUT.json`.
 
-The first `surfacematerial` is read; its surface must be a standard_surface,
+One `surfacematerial` is read (`import_mtlx`: the only one, or the one named), or every one
+(`import_all`, a file each); its surface must be a standard_surface,
 open_pbr_surface, gltf_pbr or UsdPreviewSurface (SURFACES maps each one's inputs to our
 attributes). Its inputs may be values or connections into nodegraphs (or top-level nodes) of
 the stdlib nodes that matedit.interop.mtlx_map maps from our catalogue, read back here; any
@@ -23,6 +24,7 @@ from typing import Any
 
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.names import identifier_problem, mangle
+from matedit.interop.mtlx_colorspace import from_materialx
 from matedit.io.atomic import read_bounded
 
 MAX_MTLX_BYTES = 16 << 20
@@ -433,13 +435,23 @@ class _Importer:
                 self.err(f"{where}: {opt} {v.getValueString()!r} is not supported (periodic "
                          "addressing, linear filtering only)")
                 return None
+        srgb, space = False, ""
+        if node.getType() in ("color3", "color4"):  # MaterialX decodes colour types only
+            active = file_in.getActiveColorSpace()
+            found = from_materialx(active)
+            if found is None:
+                self.err(f"{where}: unknown colour space {active!r} on its file")
+                return None
+            srgb, space = found
         target = (self.source.parent / file)
         rel = Path(os.path.relpath(os.path.abspath(target),
                                    os.path.abspath(self.out.parent))).as_posix()
         pname = self.new_id(f"{node.getName()}_file")
         self.ids.discard(pname)
-        tex = self.add(pname, "texture_parameter", {"name": pname, "path": rel, "srgb": False},
-                       depth=depth)
+        settings = {"name": pname, "path": rel, "srgb": srgb}
+        if space:
+            settings["color_space"] = space
+        tex = self.add(pname, "texture_parameter", settings, depth=depth)
         nid = self.add(node.getName(), "texture_sample", depth=depth)
         self.connect(Src(tex, "texture"), nid, "texture")
         uv = self.input_src(node, "texcoord", depth)
@@ -585,15 +597,98 @@ def _load_mtlx(path: Path):
     return doc, lib
 
 
-def import_mtlx(path: Path, out: Path) -> MaterialDocument:
-    """The material of `path` as a matedit document to be saved at `out`; raises
-    MtlxImportError with every problem found."""
+class SeveralMaterials(MtlxImportError):
+    """The document holds several materials and none was chosen (`names`, in order)."""
+
+    def __init__(self, path: Path, names: list[str]) -> None:
+        self.names = names
+        super().__init__([f"{path}: {len(names)} materials ({_listing(names)}): choose one "
+                          "with --material NAME, or import every one with -o DIR"])
+
+
+def _listing(names: list[str]) -> str:
+    return ", ".join(n if n.isprintable() and n.strip() == n and n else repr(n)
+                     for n in names)
+
+
+def _materials(doc) -> list:
+    return [m for m in doc.getMaterialNodes() if not m.hasSourceUri()]
+
+
+def material_names(path: Path) -> list[str]:
+    """The names of the document's surfacematerials, in document order (raises
+    MtlxImportError for a file that cannot be read)."""
+    doc, _ = _load_mtlx(Path(path))
+    return [m.getName() for m in _materials(doc)]
+
+
+def file_stem(name: str) -> str:
+    """A material's file name stem, from its name as a checked identifier."""
+    stem = mangle(name)
+    return stem if identifier_problem(stem) is None else f"m_{stem}"
+
+
+def output_paths(names: list[str], folder: Path) -> dict[str, Path]:
+    """Material name -> FOLDER/STEM.json, stems from `file_stem`, made distinct (also when
+    only their case differs, for case-insensitive file systems) by a _2, _3... suffix."""
+    taken: set[str] = set()
+    out = {}
+    for name in names:
+        base = stem = file_stem(name)
+        k = 1
+        while stem.lower() in taken:
+            k += 1
+            stem = f"{base}_{k}"
+        taken.add(stem.lower())
+        out[name] = Path(folder) / f"{stem}.json"
+    return out
+
+
+def import_mtlx(path: Path, out: Path, material: str | None = None) -> MaterialDocument:
+    """The material of `path` (the one named `material`; without a name the document must
+    hold exactly one, else SeveralMaterials) as a matedit document to be saved at `out`;
+    raises MtlxImportError with every problem found."""
     path, out = Path(path), Path(out)
     doc, lib = _load_mtlx(path)
-    materials = [m for m in doc.getMaterialNodes() if not m.hasSourceUri()]
+    materials = _materials(doc)
     if not materials:
         raise MtlxImportError([f"{path}: no surfacematerial in the document"])
-    mat = materials[0]
+    if material is not None:
+        chosen = [m for m in materials if m.getName() == material]
+        if not chosen:
+            raise MtlxImportError([f"{path}: no material named {material!r} (materials: "
+                                   f"{_listing([m.getName() for m in materials])})"])
+        mat = chosen[0]
+    elif len(materials) > 1:
+        raise SeveralMaterials(path, [m.getName() for m in materials])
+    else:
+        mat = materials[0]
+    return _import_material(path, out, doc, lib, mat)
+
+
+def import_all(path: Path, folder: Path) -> dict[Path, MaterialDocument]:
+    """Every material of `path`, each as FOLDER/STEM.json (`output_paths`) -> document;
+    raises MtlxImportError with every problem of every material (then nothing is returned)."""
+    path = Path(path)
+    doc, lib = _load_mtlx(path)
+    materials = _materials(doc)
+    if not materials:
+        raise MtlxImportError([f"{path}: no surfacematerial in the document"])
+    paths = output_paths([m.getName() for m in materials], folder)
+    out: dict[Path, MaterialDocument] = {}
+    errors: list[str] = []
+    for mat in materials:
+        try:
+            out[paths[mat.getName()]] = _import_material(path, paths[mat.getName()], doc, lib,
+                                                         mat)
+        except MtlxImportError as exc:
+            errors += exc.messages
+    if errors:
+        raise MtlxImportError(errors)
+    return out
+
+
+def _import_material(path: Path, out: Path, doc, lib, mat) -> MaterialDocument:
     sin = mat.getInput("surfaceshader")
     shader = None
     if sin is not None and sin.getNodeName():
