@@ -157,6 +157,9 @@ class NodeDef:
     values: tuple[InputDef, ...] = ()
     # MaterialX: an MxNode, an MxRecipe, BAKE (not expressible node for node) or LOWERED.
     mtlx: Mtlx = BAKE
+    # Where `mtlx` is a recipe: the one stdlib node the importer also reads back as this
+    # kind (MaterialX's dotproduct as our dot, say).
+    mtlx_reads: MxNode | None = None
     role: Role | None = None
     # The compiler lowers the kind from the graph itself: no GLSL function, no numpy twin.
     lowered: bool = False
@@ -266,11 +269,11 @@ def _o(name, type_, doc="") -> OutputDef:
 
 
 def _op(kind, title, inline, inputs, doc, out_type=GENERIC, category="Math", glsl=None,
-        mtlx=BAKE):
+        mtlx=BAKE, reads=None):
     register(NodeDef(
         kind=kind, title=title, category=category, description=doc,
         inputs=tuple(inputs), outputs=(_o("result", out_type),),
-        inline=inline if glsl is None else None, glsl=glsl, mtlx=mtlx,
+        inline=inline if glsl is None else None, glsl=glsl, mtlx=mtlx, mtlx_reads=reads,
     ))
 
 
@@ -317,7 +320,7 @@ register(NodeDef(
     settings=_PARAM_SETTINGS,
     values=(_i("value", "vec4", [0.0, 0.0, 0.0, 1.0], "current value"),),
     glsl="node_vector_parameter", role=Role.VECTOR_PARAMETER, parameter="vector",
-    mtlx=MxRecipe("vector_parameter"), impure=True, thumbnail=Thumbnail.NEVER,
+    mtlx=MxRecipe("vector_and_xyz"), impure=True, thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
     "color_parameter", "Colour Parameter", "Parameters",
@@ -365,28 +368,31 @@ _op("saturate", "Saturate", "clamp({value}, 0.0, 1.0)", [_i("value", T)],
     "Clamps value into [0, 1].",
     mtlx=MxNode("clamp", (("value", "in"),), (("low", 0.0), ("high", 1.0))))
 _op("one_minus", "One Minus", "(1.0 - {value})", [_i("value", T)], "1 − value.",
-    mtlx=MxRecipe("one_minus"))  # subtract(1, value)
+    mtlx=MxRecipe("subtract_from_one"))  # subtract(1, value)
 _op("power", "Power", "pow(max({base}, 0.0), {exponent})",
     [_i("base", T, 1.0), _i("exponent", T, 1.0)],
     "base raised to exponent; negative bases clamp to 0 (GLSL's pow is undefined there).",
-    mtlx=MxRecipe("power"))  # power(max(base, 0), exponent)
+    mtlx=MxRecipe("positive_power"),
+    reads=MxNode("power", (("base", "in1"), ("exponent", "in2"))))  # power(max(base, 0), exponent)
 _op("abs", "Abs", "abs({value})", [_i("value", T)], "Absolute value.", mtlx=_un("absval"))
 _op("min", "Min", "min({a}, {b})", [_i("a", T), _i("b", T)], "Smaller of a and b.", mtlx=_bin("min"))
 _op("max", "Max", "max({a}, {b})", [_i("a", T), _i("b", T)], "Larger of a and b.", mtlx=_bin("max"))
 _op("dot", "Dot", "dot({a}, {b})", [_i("a", T), _i("b", T)], "Dot product.", out_type="float",
-    category="Vector", mtlx=MxRecipe("dot"))  # dotproduct, or multiply for floats
+    category="Vector", mtlx=MxRecipe("dot_or_multiply"), reads=_bin("dotproduct"))  # dotproduct, or multiply for floats
 _op("cross", "Cross", "cross({a}, {b})",
     [_i("a", "vec3", [1.0, 0.0, 0.0]), _i("b", "vec3", [0.0, 1.0, 0.0])],
     "Cross product of two vec3.", out_type="vec3", category="Vector",
     mtlx=_bin("crossproduct"))
 _op("normalize", "Normalize", None, [_i("value", T, 1.0)],
     "Unit vector in the direction of value (zero stays zero).", category="Vector",
-    glsl="node_normalize", mtlx=MxRecipe("normalize"))
+    glsl="node_normalize", mtlx=MxRecipe("normalize_vector"),
+    reads=_un("normalize"))
 _op("length", "Length", "length({value})", [_i("value", T)], "Euclidean length.",
-    out_type="float", category="Vector", mtlx=MxRecipe("length"))  # magnitude, or absval
+    out_type="float", category="Vector", mtlx=MxRecipe("magnitude_or_absval"),
+    reads=_un("magnitude"))  # magnitude, or absval
 _op("sqrt", "Square Root", "sqrt(max({value}, 0.0))", [_i("value", T, 1.0)],
     "Square root; negative input clamps to 0.",
-    mtlx=MxRecipe("sqrt"))  # sqrt(max(value, 0))
+    mtlx=MxRecipe("positive_sqrt"), reads=_un("sqrt"))  # sqrt(max(value, 0))
 _op("sin", "Sine", "sin({value})", [_i("value", T)], "Sine of radians.", mtlx=_un("sin"))
 _op("cos", "Cosine", "cos({value})", [_i("value", T)], "Cosine of radians.", mtlx=_un("cos"))
 _op("frac", "Frac", "fract({value})", [_i("value", T)], "Fractional part, value − floor(value).",
@@ -395,7 +401,7 @@ _op("floor", "Floor", "floor({value})", [_i("value", T)], "Largest integer not a
     mtlx=_un("floor"))
 _op("step", "Step", "step({edge}, {value})", [_i("edge", T, 0.5), _i("value", T)],
     "0 below edge, 1 at or above it.",
-    mtlx=MxRecipe("step"))  # clamp(floor(value - edge) + 1, 0, 1)
+    mtlx=MxRecipe("floor_step"))  # clamp(floor(value - edge) + 1, 0, 1)
 _op("smoothstep", "Smooth Step", "smoothstep({edge0}, {edge1}, {value})",
     [_i("edge0", T, 0.0), _i("edge1", T, 1.0), _i("value", T)],
     "Hermite ramp from 0 at edge0 to 1 at edge1.",
@@ -422,19 +428,19 @@ register(NodeDef(
     inputs=(_i("value", "vec4"),),
     outputs=(_o("x", "float"), _o("y", "float"), _o("z", "float"), _o("w", "float")),
     glsl="node_split", ports_rule=PortsRule.COMPONENTS,
-    mtlx=MxRecipe("split"),  # extract per component
+    mtlx=MxRecipe("extract_each"),  # extract per component
 ))
 register(NodeDef(
     "append", "Append", "Vector", "Concatenates two values into a longer vector (up to 4).",
     inputs=(_i("a", T), _i("b", T)), outputs=(_o("result", T),),
     inline="{result_type}({a}, {b})", ports_rule=PortsRule.CONCATENATION,
-    role=Role.APPEND, lowered=True, mtlx=MxRecipe("append"),  # extract / combineN
+    role=Role.APPEND, lowered=True, mtlx=MxRecipe("concatenate"),  # extract / combineN
 ))
 register(NodeDef(
     "combine", "Combine", "Vector", "Builds vectors from four scalars.",
     inputs=(_i("x", "float"), _i("y", "float"), _i("z", "float"), _i("w", "float", 1.0)),
     outputs=(_o("xy", "vec2"), _o("xyz", "vec3"), _o("xyzw", "vec4")),
-    glsl="node_combine", mtlx=MxRecipe("combine"),  # combine2/3/4
+    glsl="node_combine", mtlx=MxRecipe("combine_n"),  # combine2/3/4
 ))
 register(NodeDef(
     "reroute", "Reroute", "Utility", "A wire waypoint; passes its value through.",
@@ -451,7 +457,7 @@ register(NodeDef(
             _i("offset", "vec2", [0.0, 0.0], "shift in UV units")),
     outputs=(_o("uv", "vec2"),),
     glsl="node_texcoord", impure=True,
-    mtlx=MxRecipe("texcoord"),  # texcoord * tiling + offset
+    mtlx=MxRecipe("tiled_texcoord"),  # texcoord * tiling + offset
 ))
 register(NodeDef("world_position", "World Position", "Coordinates",
                  "Surface position in world space (metres).",
@@ -465,7 +471,7 @@ register(NodeDef("view_direction", "View Direction", "Coordinates",
                  "Unit vector from the surface towards the camera, world space.",
                  outputs=(_o("direction", "vec3"),), glsl="node_view_direction",
                  impure=True, geometry=True,
-                 mtlx=MxRecipe("view_direction")))  # -viewdirection: ours points at the eye
+                 mtlx=MxRecipe("negated_viewdirection")))  # -viewdirection: ours points at the eye
 register(NodeDef("time", "Time", "Coordinates", "Seconds since the preview started.",
                  outputs=(_o("seconds", "float"),), glsl="node_time",
                  impure=True, geometry=True, thumbnail=Thumbnail.NEVER,
@@ -479,7 +485,7 @@ register(NodeDef(
     outputs=(_o("rgba", "vec4"), _o("rgb", "vec3"), _o("r", "float"), _o("g", "float"),
              _o("b", "float"), _o("a", "float")),
     glsl="node_texture_sample", role=Role.TEXTURE_SAMPLE, impure=True,
-    thumbnail=Thumbnail.ALWAYS, mtlx=MxRecipe("texture_sample"),  # image (vector4)
+    thumbnail=Thumbnail.ALWAYS, mtlx=MxRecipe("image_read"),  # image (vector4)
 ))
 register(NodeDef(
     "value_noise", "Value Noise", "Procedural",
@@ -498,14 +504,14 @@ register(NodeDef(
             _i("filter_width", "float", 1.0, "edge blur in pixels (0: hard edges)", (0.0, 4.0))),
     outputs=(_o("color", "vec3"), _o("mask", "float")),
     glsl="node_checker", thumbnail=Thumbnail.ALWAYS,
-    mtlx=MxRecipe("checker"),  # modulo(floor(u s) + floor(v s), 2) into a mix
+    mtlx=MxRecipe("checkerboard"),  # modulo(floor(u s) + floor(v s), 2) into a mix
 ))
 register(NodeDef(
     "gradient", "Gradient", "Procedural", "Linear ramp 0→1 across uv along an angle.",
     inputs=(_i("uv", "vec2", MESH_UV), _i("angle", "float", 0.0, "degrees", (0.0, 360.0))),
     outputs=(_o("value", "float"),),
     glsl="node_gradient", thumbnail=Thumbnail.ALWAYS,
-    mtlx=MxRecipe("gradient"),  # clamp(dot(uv - 0.5, d) / (|dx| + |dy|) + 0.5)
+    mtlx=MxRecipe("linear_ramp"),  # clamp(dot(uv - 0.5, d) / (|dx| + |dy|) + 0.5)
 ))
 
 # --- normals ---------------------------------------------------------------------------------
@@ -515,14 +521,14 @@ register(NodeDef(
     inputs=(_i("packed", "vec3", [0.5, 0.5, 1.0]), _i("strength", "float", 1.0, "", (0.0, 2.0))),
     outputs=(_o("normal", "vec3"),),
     glsl="node_unpack_normal",
-    mtlx=MxRecipe("unpack_normal"),  # normalize((2 p - 1) * (s, s, 1))
+    mtlx=MxRecipe("decode_normal"),  # normalize((2 p - 1) * (s, s, 1))
 ))
 register(NodeDef(
     "blend_normals", "Blend Normals", "Normal",
     "Detail normal on a base normal by reoriented normal mapping (Barré-Brisebois & Hill 2012).",
     inputs=(_i("base", "vec3", [0.0, 0.0, 1.0]), _i("detail", "vec3", [0.0, 0.0, 1.0])),
     outputs=(_o("normal", "vec3"),),
-    glsl="node_blend_normals", mtlx=MxRecipe("blend_normals"),  # reoriented normal mapping
+    glsl="node_blend_normals", mtlx=MxRecipe("reoriented_normals"),  # reoriented normal mapping
 ))
 register(NodeDef(
     "flatten_normal", "Flatten Normal", "Normal",
@@ -530,7 +536,7 @@ register(NodeDef(
     inputs=(_i("normal", "vec3", [0.0, 0.0, 1.0]), _i("flatness", "float", 0.5, "", UNIT)),
     outputs=(_o("normal", "vec3"),),
     glsl="node_flatten_normal",
-    mtlx=MxRecipe("flatten_normal"),  # normalize(mix(n, +Z, flatness))
+    mtlx=MxRecipe("mix_towards_z"),  # normalize(mix(n, +Z, flatness))
 ))
 
 # --- material attributes ---------------------------------------------------------------------
