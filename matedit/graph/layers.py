@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 from matedit.graph.commands import Command, CommandError, Connect, Disconnect, Macro, SetSetting
 from matedit.graph.model import Link, MaterialGraph
-from matedit.graph.ports import LAYER_BLENDS, layer_entries
 from matedit.graph.nodes import Role, role_of
+from matedit.graph.ports import LAYER_BLENDS, layer_entries
 
 # Ports a layer has only when it is not the base (the blend inputs).
 BLEND_SUFFIXES = ("_mask", "_opacity", "_base_height", "_contrast")

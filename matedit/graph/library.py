@@ -189,7 +189,8 @@ _fn("cellular_noise_3d", "Cellular Noise 3D", "Noise",
     [_i("position", "vec3", [0.0, 0.0, 0.0]), _i("scale", "float", 2.0, "cells per unit",
                                                  (0.0, 64.0)),
      _i("jitter", "float", 1.0, "", UNIT), _i(*_SEED)],
-    [_o("f1", "float"), _o("f2", "float"), _o("edge", "float"), _o("cell_id", "float")], thumbnail=Thumbnail.ALWAYS)
+    [_o("f1", "float"), _o("f2", "float"), _o("edge", "float"), _o("cell_id", "float")],
+    thumbnail=Thumbnail.ALWAYS)
 _OCT = [_i("octaves", "float", 4.0, "detail levels (fractional fades the last in)", (1.0, 8.0)),
         _i("lacunarity", "float", 2.0, "frequency ratio between octaves", (1.0, 4.0)),
         _i("gain", "float", 0.5, "amplitude ratio between octaves", (0.0, 1.0))]
@@ -218,7 +219,8 @@ _fn("domain_warp", "Domain Warp", "Noise",
     "Displaces uv by fractal noise, so any pattern fed the result swirls and breaks up.",
     [_i(*_UV), _i("scale", "float", 4.0, "", (0.0, 64.0)),
      _i("strength", "float", 0.1, "displacement in UV units", (0.0, 1.0)),
-     _i("octaves", "float", 3.0, "", (1.0, 8.0)), _i(*_SEED)], [_o("uv", "vec2")], thumbnail=Thumbnail.ALWAYS)
+     _i("octaves", "float", 3.0, "", (1.0, 8.0)), _i(*_SEED)], [_o("uv", "vec2")],
+    thumbnail=Thumbnail.ALWAYS)
 
 # --- patterns --------------------------------------------------------------------------------
 _fn("bricks", "Bricks", "Procedural",
@@ -254,11 +256,13 @@ _fn("rings", "Rings", "Procedural",
     [_o("value", "float"), _o("saw", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("radial_gradient", "Radial Gradient", "Procedural",
     "The angle about a centre, 0 → 1 counter-clockwise from +u.",
-    [_i(*_UV), _i("center", "vec2", [0.5, 0.5])], [_o("value", "float")], thumbnail=Thumbnail.ALWAYS)
+    [_i(*_UV), _i("center", "vec2", [0.5, 0.5])], [_o("value", "float")],
+    thumbnail=Thumbnail.ALWAYS)
 _fn("spherical_gradient", "Spherical Gradient", "Procedural",
     "1 at the centre falling to 0 at radius.",
     [_i(*_UV), _i("center", "vec2", [0.5, 0.5]),
-     _i("radius", "float", 0.5, "UV units", (0.0, 2.0))], [_o("value", "float")], thumbnail=Thumbnail.ALWAYS)
+     _i("radius", "float", 0.5, "UV units", (0.0, 2.0))], [_o("value", "float")],
+    thumbnail=Thumbnail.ALWAYS)
 _fn("filtered_step", "Filtered Step", "Procedural",
     "step(edge, value) with the edge blurred over the pixel footprint of value: an "
     "anti-aliased threshold for any pattern.",
@@ -277,12 +281,14 @@ _fn("rotate_uv", "Rotate UV", "Coordinates", "Rotates uv about a pivot, counter-
     [_i(*_UV), _i("angle", "float", 0.0, "degrees", (0.0, 360.0)),
      _i("pivot", "vec2", [0.5, 0.5])], [_o("uv", "vec2")])
 _fn("panner", "Panner", "Coordinates", "Scrolls uv over time: uv + speed × seconds.",
-    [_i(*_UV), _i("speed", "vec2", [0.1, 0.0], "UV units per second")], [_o("uv", "vec2")], impure=True, geometry=True)
+    [_i(*_UV), _i("speed", "vec2", [0.1, 0.0], "UV units per second")], [_o("uv", "vec2")],
+    impure=True, geometry=True)
 _fn("polar_coordinates", "Polar Coordinates", "Coordinates",
     "uv as (angle in turns, distance) about a centre: wraps patterns around a point.",
     [_i(*_UV), _i("center", "vec2", [0.5, 0.5])], [_o("uv", "vec2")])
 _fn("object_position", "Object Position", "Coordinates",
-    "Surface position in the object's own space.", [], [_o("position", "vec3")], impure=True, geometry=True)
+    "Surface position in the object's own space.", [], [_o("position", "vec3")],
+    impure=True, geometry=True)
 _fn("tangent", "Tangent", "Coordinates",
     "World-space unit tangent (along +u), orthogonal to the normal.", [],
     [_o("tangent", "vec3")], impure=True, geometry=True)
@@ -300,7 +306,8 @@ _fn("triplanar_mapping", "Triplanar Mapping", "Coordinates",
     "weights from the normal: feed each UV to a procedural, then a Triplanar Blend.",
     [_i("scale", "float", 1.0, "repeats per metre", (0.0, 64.0)),
      _i("sharpness", "float", 4.0, "blend sharpness (higher: crisper seams)", (1.0, 64.0))],
-    [_o("uv_x", "vec2"), _o("uv_y", "vec2"), _o("uv_z", "vec2"), _o("weights", "vec3")], impure=True, geometry=True)
+    [_o("uv_x", "vec2"), _o("uv_y", "vec2"), _o("uv_z", "vec2"), _o("weights", "vec3")],
+    impure=True, geometry=True)
 _op("triplanar_blend", "Triplanar Blend",
     "({x} * {weights}.x + {y} * {weights}.y + {z} * {weights}.z)",
     [_i("x", T), _i("y", T), _i("z", T), _i("weights", "vec3", [1 / 3] * 3, "", UNIT)],
@@ -332,25 +339,29 @@ _fn("fresnel", "Fresnel", "Mask",
     "Schlick's Fresnel of the geometric normal and view: base at normal incidence, 1 at "
     "grazing.",
     [_i("base", "float", 0.04, "reflectance facing the viewer", UNIT),
-     _i("exponent", "float", 5.0, "", (0.0, 16.0))], [_o("value", "float")], impure=True, geometry=True)
+     _i("exponent", "float", 5.0, "", (0.0, 16.0))], [_o("value", "float")],
+    impure=True, geometry=True)
 _fn("facing_ratio", "Facing Ratio", "Mask",
     "N · V: 1 where the surface faces the camera, 0 at its silhouette.", [],
     [_o("value", "float")], impure=True, geometry=True)
 _fn("slope_mask", "Slope Mask", "Mask",
     "1 where the surface faces up (world normal · up above threshold): snow, dust, moss.",
     [_i("up", "vec3", [0.0, 1.0, 0.0]), _i("threshold", "float", 0.5, "cosine", (-1.0, 1.0)),
-     _i("softness", "float", 0.1, "", (0.0, 1.0))], [_o("mask", "float")], impure=True, geometry=True)
+     _i("softness", "float", 0.1, "", (0.0, 1.0))], [_o("mask", "float")],
+    impure=True, geometry=True)
 _fn("height_mask", "Height Mask", "Mask",
     "0 below low, 1 above high along the up axis in world space: grime at the bottom, "
     "water lines.",
     [_i("up", "vec3", [0.0, 1.0, 0.0]), _i("low", "float", -1.0, "metres", (-10.0, 10.0)),
-     _i("high", "float", 1.0, "metres", (-10.0, 10.0))], [_o("mask", "float")], impure=True, geometry=True)
+     _i("high", "float", 1.0, "metres", (-10.0, 10.0))], [_o("mask", "float")],
+    impure=True, geometry=True)
 _fn("curvature", "Curvature", "Mask",
     "Mean curvature of the surface from screen-space derivatives of its normal (1/m), and "
     "its convex and concave parts scaled into [0, 1]: edge wear and cavity dirt without "
     "baked maps.",
     [_i("scale", "float", 0.5, "metres: mask reaches 1 at curvature 1/scale", (0.0, 10.0))],
-    [_o("curvature", "float"), _o("convex", "float"), _o("concave", "float")], thumbnail=Thumbnail.ALWAYS, impure=True, geometry=True)
+    [_o("curvature", "float"), _o("convex", "float"), _o("concave", "float")],
+    thumbnail=Thumbnail.ALWAYS, impure=True, geometry=True)
 
 # The kinds this module adds, in registration order.
 KINDS: tuple[str, ...] = tuple(k for k in REGISTRY if k not in _BEFORE)

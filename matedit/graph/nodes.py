@@ -311,7 +311,7 @@ register(NodeDef(
         SettingDef("ui_max", "number", 1.0, "slider maximum", structural=False),
     ),
     values=(_i("value", "float", 0.5, "current value"),),
-    inline="{value}", role=Role.SCALAR_PARAMETER, parameter="scalar", lowered=True, mtlx=LOWERED, 
+    inline="{value}", role=Role.SCALAR_PARAMETER, parameter="scalar", lowered=True, mtlx=LOWERED,
     thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
@@ -328,7 +328,7 @@ register(NodeDef(
     outputs=(_o("color", "vec3"),),
     settings=_PARAM_SETTINGS,
     values=(_i("value", "vec3", [0.5, 0.5, 0.5], "linear RGB"),),
-    inline="{value}", role=Role.COLOR_PARAMETER, parameter="color", lowered=True, mtlx=LOWERED, 
+    inline="{value}", role=Role.COLOR_PARAMETER, parameter="color", lowered=True, mtlx=LOWERED,
     thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
@@ -343,8 +343,8 @@ register(NodeDef(
                    "OpenColorIO space of OpenImageIO's built-in config (e.g. ACEScg); "
                    "empty: the srgb setting decides"),
     ),
-    inline="{texture}", role=Role.TEXTURE_PARAMETER, parameter="texture", lowered=True, mtlx=LOWERED, 
-    thumbnail=Thumbnail.NEVER,
+    inline="{texture}", role=Role.TEXTURE_PARAMETER, parameter="texture", lowered=True,
+    mtlx=LOWERED, thumbnail=Thumbnail.NEVER,
 ))
 
 # --- maths -----------------------------------------------------------------------------------
@@ -375,10 +375,12 @@ _op("power", "Power", "pow(max({base}, 0.0), {exponent})",
     mtlx=MxRecipe("positive_power"),
     reads=MxNode("power", (("base", "in1"), ("exponent", "in2"))))  # power(max(base, 0), exponent)
 _op("abs", "Abs", "abs({value})", [_i("value", T)], "Absolute value.", mtlx=_un("absval"))
-_op("min", "Min", "min({a}, {b})", [_i("a", T), _i("b", T)], "Smaller of a and b.", mtlx=_bin("min"))
-_op("max", "Max", "max({a}, {b})", [_i("a", T), _i("b", T)], "Larger of a and b.", mtlx=_bin("max"))
+_op("min", "Min", "min({a}, {b})", [_i("a", T), _i("b", T)], "Smaller of a and b.",
+    mtlx=_bin("min"))
+_op("max", "Max", "max({a}, {b})", [_i("a", T), _i("b", T)], "Larger of a and b.",
+    mtlx=_bin("max"))
 _op("dot", "Dot", "dot({a}, {b})", [_i("a", T), _i("b", T)], "Dot product.", out_type="float",
-    category="Vector", mtlx=MxRecipe("dot_or_multiply"), reads=_bin("dotproduct"))  # dotproduct, or multiply for floats
+    category="Vector", mtlx=MxRecipe("dot_or_multiply"), reads=_bin("dotproduct"))
 _op("cross", "Cross", "cross({a}, {b})",
     [_i("a", "vec3", [1.0, 0.0, 0.0]), _i("b", "vec3", [0.0, 1.0, 0.0])],
     "Cross product of two vec3.", out_type="vec3", category="Vector",
@@ -606,7 +608,7 @@ register(NodeDef(
                          choices=("float", "vec2", "vec3", "vec4", MA, "texture2d")),
               SettingDef("default", "value", 0.0, "value when the caller leaves it unconnected"),
               SettingDef("order", "number", 0, "position among the inputs", structural=True)),
-    ports_rule=PortsRule.FUNCTION_INPUT, role=Role.FUNCTION_INPUT, lowered=True, mtlx=LOWERED, 
+    ports_rule=PortsRule.FUNCTION_INPUT, role=Role.FUNCTION_INPUT, lowered=True, mtlx=LOWERED,
 ))
 register(NodeDef(
     "function_output", "Function Output", "Function",
@@ -616,14 +618,14 @@ register(NodeDef(
               SettingDef("type", "type", "float", "output type",
                          choices=("float", "vec2", "vec3", "vec4", MA)),
               SettingDef("order", "number", 0, "position among the outputs")),
-    ports_rule=PortsRule.FUNCTION_OUTPUT, role=Role.FUNCTION_OUTPUT, lowered=True, mtlx=LOWERED, 
+    ports_rule=PortsRule.FUNCTION_OUTPUT, role=Role.FUNCTION_OUTPUT, lowered=True, mtlx=LOWERED,
     thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
     "function_call", "Function Call", "Function",
     "Calls a material function stored in its own file.",
     settings=(SettingDef("function", "path", "", "function file, relative to this file"),),
-    ports_rule=PortsRule.FUNCTION_SIGNATURE, role=Role.FUNCTION_CALL, lowered=True, mtlx=LOWERED, 
+    ports_rule=PortsRule.FUNCTION_SIGNATURE, role=Role.FUNCTION_CALL, lowered=True, mtlx=LOWERED,
     thumbnail=Thumbnail.ALWAYS,
 ))
 register(NodeDef(
@@ -632,7 +634,8 @@ register(NodeDef(
     "compiles to blends of attributes and one shading evaluation.",
     outputs=(_o("attributes", MA),),
     settings=(SettingDef("layers", "list", [], "base layer first, then the layers above"),),
-    ports_rule=PortsRule.LAYERS, role=Role.LAYER_STACK, lowered=True, mtlx=LOWERED, thumbnail=Thumbnail.ALWAYS,
+    ports_rule=PortsRule.LAYERS, role=Role.LAYER_STACK, lowered=True, mtlx=LOWERED,
+    thumbnail=Thumbnail.ALWAYS,
 ))
 register(NodeDef(
     "material_output", "Material Output", "Output",
@@ -654,7 +657,7 @@ register(NodeDef(
     settings=_PARAM_SETTINGS + (
         SettingDef("value", "bool", True, "on: use the 'true' input; structural"),),
     inline="{true}",  # never emitted: matedit.compiler.lower chooses the branch
-    role=Role.STATIC_SWITCH, parameter="switch", lowered=True, mtlx=LOWERED, 
+    role=Role.STATIC_SWITCH, parameter="switch", lowered=True, mtlx=LOWERED,
 ))
 PARAMETER_KINDS = tuple(k for k, d in REGISTRY.items() if d.parameter is not None)
 _PRESENTATION = {
