@@ -21,7 +21,8 @@ from __future__ import annotations
 from matedit.graph import nodes
 from matedit.graph.nodes import BAKE, LOWERED, MxNode, MxRecipe
 
-__all__ = ["BAKE", "LOWERED", "MxNode", "MxRecipe", "direct", "mapping", "mapped_kinds",
+__all__ = ["BAKE", "LOWERED", "MxNode", "MxRecipe", "direct", "kind_mapped_to", "mapping",
+           "mapped_kinds",
            "baked_kinds", "lowered_kinds"]
 
 
@@ -54,3 +55,15 @@ def direct() -> dict[str, tuple[str, dict[str, str]]]:
             if isinstance(m, MxNode) and m.ports and not m.fixed and m.category not in out:
                 out[m.category] = (kind, {theirs: ours for ours, theirs in m.ports})
     return out
+
+
+def kind_mapped_to(name: str) -> str:
+    """The catalogue kind that exports as the stdlib node `name` (an MxNode category, first
+    registered wins) or as the recipe `name`: what the importer builds when it reads one
+    back."""
+    for kind, d in nodes.REGISTRY.items():
+        m = d.mtlx
+        if (isinstance(m, MxNode) and m.category == name) or \
+                (isinstance(m, MxRecipe) and m.name == name):
+            return kind
+    raise LookupError(f"no catalogue kind exports as MaterialX {name!r}")
