@@ -238,9 +238,9 @@ class _Importer:
             self.err(f"interface input {gin.getName()}: {t} needs {width} numbers")
             return None
         if width == 1:
-            nid = self.add(name, kind_for(Role.SCALAR_PARAMETER), {"name": name, "ui_min": min(0.0, vals[0]),
-                                                      "ui_max": max(1.0, vals[0])},
-                           {"value": vals[0]})
+            nid = self.add(name, kind_for(Role.SCALAR_PARAMETER),
+                           {"name": name, "ui_min": min(0.0, vals[0]),
+                            "ui_max": max(1.0, vals[0])}, {"value": vals[0]})
             src = Src(nid, "value", width=1)
         elif width == 3:
             nid = self.add(name, kind_for(Role.COLOR_PARAMETER), {"name": name}, {"value": vals})
@@ -308,7 +308,8 @@ class _Importer:
             if not 0 <= idx <= 3:
                 self.err(f"{where}: extract index {idx} out of range")
                 return None
-            nid = self.add(name, kind_for(Role.COMPONENT_MASK), {"channels": "xyzw"[idx]}, depth=depth)
+            nid = self.add(name, kind_for(Role.COMPONENT_MASK), {"channels": "xyzw"[idx]},
+                           depth=depth)
             self.connect(self.input_src(node, "in", depth), nid, "value")
             return Src(nid, "result", width=1)
         if cat in ("separate2", "separate3", "separate4"):
@@ -420,8 +421,8 @@ class _Importer:
                                    os.path.abspath(self.out.parent))).as_posix()
         pname = self.new_id(f"{node.getName()}_file")
         self.ids.discard(pname)
-        tex = self.add(pname, kind_for(Role.TEXTURE_PARAMETER), {"name": pname, "path": rel, "srgb": False},
-                       depth=depth)
+        tex = self.add(pname, kind_for(Role.TEXTURE_PARAMETER),
+                       {"name": pname, "path": rel, "srgb": False}, depth=depth)
         nid = self.add(node.getName(), kind_for(Role.TEXTURE_SAMPLE), depth=depth)
         self.connect(Src(tex, "texture"), nid, "texture")
         uv = self.input_src(node, "texcoord", depth)
@@ -433,7 +434,8 @@ class _Importer:
             return Src(nid, "rgb", width=3)
         if width == 4:
             return Src(nid, "rgba", width=4)
-        m = self.add(f"{node.getName()}_xy", kind_for(Role.COMPONENT_MASK), {"channels": "xy"}, depth=depth)
+        m = self.add(f"{node.getName()}_xy", kind_for(Role.COMPONENT_MASK), {"channels": "xy"},
+                     depth=depth)
         self.connect(Src(nid, "rgba", width=4), m, "value")
         return Src(m, "result", width=2)
 
