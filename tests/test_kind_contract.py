@@ -185,3 +185,16 @@ def test_parameters_and_flags():
         assert d.impure or not d.geometry, kind
     out = nodes.definition(nodes.kind_for(Role.MATERIAL_OUTPUT))
     assert out.thumbnail == Thumbnail.NEVER
+
+
+def test_the_materialx_doc_matches_the_catalogue():
+    """docs/materialx.md is what docs/materialx.py writes from the catalogue today."""
+    from matedit.interop import mtlx_map
+
+    doc = Path(__file__).resolve().parent.parent / "docs" / "materialx.md"
+    text = doc.read_text(encoding="utf-8")
+    assert text == mtlx_map.document(), "docs/materialx.md is stale: run docs/materialx.py"
+    for kind in mtlx_map.mapped_kinds() + mtlx_map.baked_kinds() + mtlx_map.lowered_kinds():
+        assert f"`{kind}`" in text
+    assert len(mtlx_map.mapped_kinds() + mtlx_map.baked_kinds()
+               + mtlx_map.lowered_kinds()) == len(nodes.REGISTRY)

@@ -67,3 +67,48 @@ def kind_mapped_to(name: str) -> str:
                 (isinstance(m, MxRecipe) and m.name == name):
             return kind
     raise LookupError(f"no catalogue kind exports as MaterialX {name!r}")
+
+
+def _entry_text(m) -> str:
+    if isinstance(m, MxNode):
+        ins = ", ".join(f"{ours}→{theirs}" for ours, theirs in m.ports)
+        fixed = ", ".join(f"{name}={value:g}" for name, value in m.fixed)
+        return f"`{m.category}`" + (f" ({ins}" + (f"; {fixed}" if fixed else "") + ")"
+                                    if ins or fixed else "")
+    return f"recipe `{m.name}`"
+
+
+def document() -> str:
+    """docs/materialx.md: which catalogue kinds map to MaterialX and which bake (generated
+    from the catalogue by docs/materialx.py; tests/test_kind_contract.py keeps it true)."""
+    by_kind = nodes.REGISTRY
+    mapped, baked, lowered = mapped_kinds(), baked_kinds(), lowered_kinds()
+    lines = [
+        "# MaterialX: what maps and what bakes",
+        "",
+        "Generated from the node catalogue (`NodeDef.mtlx` in matedit/graph/nodes.py) by",
+        "`docs/materialx.py`; a test fails when it is out of date. `matedit export OUT.mtlx`",
+        "(see [cli.md](cli.md)) writes a MaterialX 1.39 nodegraph feeding one",
+        "`standard_surface`. Each kind is exported one of three ways:",
+        "",
+        "- **maps**: one stdlib node (its inputs named, ours→MaterialX's) or a recipe, a few",
+        "  stdlib nodes that compute the same thing (matedit/interop/mtlx_export.py). Each is",
+        "  checked against MaterialX's own GLSL generator in tests/test_interop_mtlx.py.",
+        "- **bakes**: not expressible node for node; the export evaluates its outputs over UV",
+        "  space into EXR images read by `image` nodes, and reports each baked node.",
+        "- **lowered**: never reaches the exporter; the compiler turns it into interface",
+        "  inputs (parameters), values (constants), inlined calls and blends.",
+        "",
+        f"{len(mapped)} kinds map, {len(baked)} bake, {len(lowered)} are lowered.",
+        "",
+        "## Kinds that map to MaterialX",
+        "",
+        "| kind | MaterialX |",
+        "|---|---|",
+    ]
+    lines += [f"| `{k}` | {_entry_text(by_kind[k].mtlx)} |" for k in mapped]
+    lines += ["", "## Kinds that bake", ""]
+    lines += [", ".join(f"`{k}`" for k in baked), ""]
+    lines += ["## Kinds lowered before export", ""]
+    lines += [", ".join(f"`{k}`" for k in lowered), ""]
+    return "\n".join(lines)
