@@ -20,6 +20,7 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import matedit
@@ -198,3 +199,41 @@ def test_the_materialx_doc_matches_the_catalogue():
         assert f"`{kind}`" in text
     assert len(mtlx_map.mapped_kinds() + mtlx_map.baked_kinds()
                + mtlx_map.lowered_kinds()) == len(nodes.REGISTRY)
+
+
+def test_a_new_geometry_kind_is_its_definition_and_its_numpy_twin(monkeypatch):
+    """A kind added to the catalogue (and its numpy twin) compiles, evaluates, keeps its
+    op (impure: never folded), shows thumbnails when selected and bakes for MaterialX,
+    with no other code touched."""
+    from matedit.compiler import cpu_nodes
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.compiler.cpu_eval import evaluate
+    from matedit.compiler.cpu_nodes import SurfaceArrays
+    from matedit.graph.nodes import InputDef, NodeDef, OutputDef
+    from matedit.interop import mtlx_map
+    from tests.graphs_util import link, material, node
+
+    kind = "test_height_above"
+    d = NodeDef(kind, "Height Above", "Coordinates", "World height plus an offset.",
+                inputs=(InputDef("offset", "float", 0.0),),
+                outputs=(OutputDef("value", "float"),), glsl=f"node_{kind}",
+                impure=True, geometry=True)
+    monkeypatch.setitem(nodes.REGISTRY, kind, d)
+    monkeypatch.setitem(cpu_nodes.IMPLS, kind,
+                        lambda ctx, offset: (ctx.position[:, 1] + offset,))
+    doc = material()
+    node(doc, "h", kind, values={"offset": 0.25})
+    node(doc, "make", nodes.kind_for(Role.MAKE_ATTRIBUTES))
+    node(doc, "out", nodes.kind_for(Role.MATERIAL_OUTPUT))
+    link(doc, "h", "value", "make", "roughness")
+    link(doc, "make", "attributes", "out", "attributes")
+    ir = lower_and_optimise(doc, None)
+    assert [op.kind for op in ir.main.ops].count(kind) == 1
+    y = np.array([0.0, 0.1, 0.5])
+    pos = np.stack([np.zeros(3), y, np.zeros(3)], axis=1)
+    surface = SurfaceArrays(np.zeros((3, 2)), pos, np.tile([0.0, 0.0, 1.0], (3, 1)),
+                            np.tile([0.0, 0.0, 1.0], (3, 1)))
+    got = evaluate(ir, surface)["roughness"]
+    np.testing.assert_allclose(got, y + 0.25, atol=1e-12)  # exact: one addition
+    assert nodes.definition(kind).thumbnail == Thumbnail.SELECTED
+    assert mtlx_map.mapping(kind) == BAKE
