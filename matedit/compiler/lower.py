@@ -83,6 +83,7 @@ class _Ctx:
     textures: dict[str, TextureInfo] = field(default_factory=dict)
     kinds: set[str] = field(default_factory=set)
     input_uniforms: dict[tuple[str, str], str] = field(default_factory=dict)
+    input_uniform_names: set[str] = field(default_factory=set)  # its values, to look up
     switches: dict[str, tuple[bool, str]] = field(default_factory=dict)  # name -> (on, node)
 
 
@@ -141,9 +142,11 @@ class _Lowerer:
             return taken[key]
         base = f"u_{nid}_{port}"
         name, i = base, 2
-        while name in self.ctx.uniforms or name in taken.values():
+        names = self.ctx.input_uniform_names
+        while name in self.ctx.uniforms or name in names:
             name, i = f"{base}_{i}", i + 1
         taken[key] = name
+        names.add(name)
         return name
 
     def _uniform(self, info: UniformInfo) -> None:
