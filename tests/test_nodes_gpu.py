@@ -15,7 +15,7 @@ import pytest
 
 from matedit.compiler import cpu_nodes
 from matedit.compiler.cpu_nodes import IMPLS, SurfaceArrays
-from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, GENERIC, REGISTRY
+from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, GENERIC, REGISTRY, PortsRule
 from matedit.resources import shaders_dir
 from tests.gpu_eval import gpu_eval, gpu_eval_many
 
@@ -31,6 +31,7 @@ COMPILER_HANDLED = {
     "component_mask", "append", "reroute",
 }  # fmt: skip
 COMPILER_HANDLED |= {"static_switch"}  # chosen at compile time (issue 14)
+# (written out here, not read from NodeDef.lowered, so the catalogue is checked against it)
 VEC = {1: "float", 2: "vec2", 3: "vec3", 4: "vec4"}
 MAX_ERRORS: dict[str, tuple[float, float]] = {}  # name -> (abs, rel to |numpy| + atol)
 
@@ -122,7 +123,7 @@ def test_every_glsl_kind_has_a_file_defining_its_function():
         assert path.is_file(), f"{kind}: no shaders/nodes/{kind}.glsl"
         first_types = {t for name, t, _ in _functions(path.read_text()) if name == d.glsl}
         assert first_types, f"{kind}: {d.glsl} not defined"
-        if d.inputs and (d.inputs[0].type == GENERIC or d.ports_rule == "split"):
+        if d.inputs and (d.inputs[0].type == GENERIC or d.ports_rule == PortsRule.COMPONENTS):
             assert first_types == set(VEC.values()), f"{kind}: overloads {first_types}"
     kinds = {k for k, d in REGISTRY.items() if d.glsl}
     helpers = {f.removesuffix(".glsl") for f in HELPER_FILES}

@@ -36,6 +36,7 @@ from matedit.app.recovery import (
     write_meta_text,
 )
 from matedit.graph.model import MaterialDocument, Node
+from matedit.graph.nodes import Role, kind_for
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import FormatError, dumps, load, loads, save
 
@@ -50,7 +51,7 @@ SAVE, DISCARD, CANCEL = "save", "discard", "cancel"
 def new_material() -> MaterialDocument:
     """What File > New makes: an untitled material with its Material Output in place."""
     doc = MaterialDocument(name="Untitled")
-    doc.graph.nodes["out"] = Node("out", "material_output", (300.0, 0.0))
+    doc.graph.nodes["out"] = Node("out", kind_for(Role.MATERIAL_OUTPUT), (300.0, 0.0))
     return doc
 
 

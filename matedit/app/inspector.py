@@ -39,7 +39,7 @@ from matedit.app.paths import absolute_of, reference_for
 from matedit.graph import nodes
 from matedit.graph.commands import SetLabel, SetSetting, SetValue
 from matedit.graph.model import ChangeEvent, ChangeKind, Node
-from matedit.graph.nodes import MESH_UV, SettingDef
+from matedit.graph.nodes import MESH_UV, Role, SettingDef, role_of
 from matedit.graph.ports import PortSpec, normalize_channels
 from matedit.graph.types import PortType, coerce_value
 
@@ -49,7 +49,7 @@ _COMPONENTS = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
 
 def is_colour(name: str, node_kind: str) -> bool:
     n = name.lower()
-    return node_kind == "color_parameter" or any(w in n for w in _COLOUR_WORDS)
+    return role_of(node_kind) == Role.COLOR_PARAMETER or any(w in n for w in _COLOUR_WORDS)
 
 
 class InspectorPanel(QScrollArea):
@@ -203,7 +203,7 @@ class InspectorPanel(QScrollArea):
                               else "color: #e5b94a;")
             lay.addWidget(msg)
         if d is not None:
-            if node.kind == "color_ramp":  # the stops editor (matedit/app/ramp_widget.py)
+            if role_of(node.kind) == Role.COLOR_RAMP:  # the stops editor (app/ramp_widget.py)
                 from matedit.app.ramp_widget import RampEditor
                 lay.addWidget(RampEditor(self.controller, node.id))
             self._build_settings(lay, node, d)
@@ -234,18 +234,18 @@ class InspectorPanel(QScrollArea):
 
     def _build_settings(self, lay, node: Node, d) -> None:
         shown = [s for s in d.settings if s.name != "layers"]
-        if node.kind == "texture_parameter":
+        if role_of(node.kind) == Role.TEXTURE_PARAMETER:
             shown = [s for s in shown if s.name != "path"]
-        if not shown and node.kind not in ("texture_parameter", "layer_stack"):
+        if not shown and role_of(node.kind) not in (Role.TEXTURE_PARAMETER, Role.LAYER_STACK):
             return
         form = self._section(lay, "Settings")
-        if node.kind == "texture_parameter":
+        if role_of(node.kind) == Role.TEXTURE_PARAMETER:
             ref = str(node.settings.get("path", ""))
             f = TextureField(ref, absolute_of(self.controller.document, ref))
             f.edited.connect(lambda v, _m: self._set_texture(v))
             self._fields[("setting", "path")] = f
             form.addRow(self._label("image", "image file, relative to the material"), f)
-        if node.kind == "layer_stack":
+        if role_of(node.kind) == Role.LAYER_STACK:
             n = len(node.settings.get("layers", []) or [])
             form.addRow(self._label("layers"),
                         QLabel(f"{n} layer{'s' if n != 1 else ''}: edit them in the Layers panel"))
@@ -297,7 +297,7 @@ class InspectorPanel(QScrollArea):
             return self._path_editor(node, s, str(cur or ""))
         if s.kind == "value":
             return self._value_setting_editor(node, s, cur)
-        if s.kind == "list" and node.kind == "set_attributes":
+        if s.kind == "list" and role_of(node.kind) == Role.SET_ATTRIBUTES:
             return self._fields_editor(node, cur)
         if s.kind == "string":
             edit = QLineEdit(str(cur))
@@ -327,7 +327,7 @@ class InspectorPanel(QScrollArea):
         browse.clicked.connect(pick)
         row.addWidget(edit, 1)
         row.addWidget(browse)
-        if node.kind == "function_call" and ref:
+        if role_of(node.kind) == Role.FUNCTION_CALL and ref:
             open_btn = QPushButton("Open")
             open_btn.setToolTip("Open the function in a tab")
             target = absolute_of(self.controller.document, ref)
@@ -370,7 +370,7 @@ class InspectorPanel(QScrollArea):
             cur = node.values.get(v.name, v.default)
             n = _COMPONENTS.get(v.type, 1)
             rng = v.range
-            if node.kind == "scalar_parameter":
+            if role_of(node.kind) == Role.SCALAR_PARAMETER:
                 lo = node.settings.get("ui_min", 0.0)
                 hi = node.settings.get("ui_max", 1.0)
                 if isinstance(lo, (int, float)) and isinstance(hi, (int, float)) and hi > lo:
@@ -392,7 +392,7 @@ class InspectorPanel(QScrollArea):
         in_types = (a.in_types.get(node.id) or {}) if a else {}
         groups: list[tuple[str, list[PortSpec]]] = []
         layer_names = {}
-        if node.kind == "layer_stack":
+        if role_of(node.kind) == Role.LAYER_STACK:
             for e in node.settings.get("layers", []) or []:
                 if isinstance(e, dict) and isinstance(e.get("id"), str):
                     layer_names[e["id"]] = str(e.get("name") or e["id"])
@@ -412,7 +412,7 @@ class InspectorPanel(QScrollArea):
                 if form is None:
                     form = self._section(lay, group)
                 label_text = p.name
-                if node.kind == "layer_stack":
+                if role_of(node.kind) == Role.LAYER_STACK:
                     lid = next((k for k in layer_names if p.name.startswith(k + "_")), None)
                     if lid:
                         label_text = p.name[len(lid) + 1:]

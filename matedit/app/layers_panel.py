@@ -42,6 +42,7 @@ from matedit.graph.commands import (
 )
 from matedit.graph.layers import Layer, LayerStack, parked_wires
 from matedit.graph.model import ChangeEvent, ChangeKind, Link, Node
+from matedit.graph.nodes import Role, kind_for, role_of
 from matedit.graph.ports import LAYER_BLENDS
 from matedit.io.document import FormatError, load
 from matedit.resources import graphs_dir
@@ -468,10 +469,10 @@ class LayersPanel(QWidget):
             entries.append(Layer(lid, reference_for(self.controller.document, first_layer),
                                  fn.name or first_layer.stem).to_json())
         out = next((n for n in sorted(graph.nodes.values(), key=lambda n: n.id)
-                    if n.kind == "material_output"), None)
+                    if role_of(n.kind) == Role.MATERIAL_OUTPUT), None)
         pos = (out.position[0] - 260, out.position[1]) if out else (0.0, 0.0)
         sid = graph.new_id("stack")
-        cmds = [AddNode(Node(sid, "layer_stack", pos, {"layers": entries}))]
+        cmds = [AddNode(Node(sid, kind_for(Role.LAYER_STACK), pos, {"layers": entries}))]
         if out is not None and graph.incoming(out.id, "attributes") is None:
             cmds.append(Connect(Link(sid, "attributes", out.id, "attributes")))
         if not self.controller.push(Macro(cmds, text="add layer stack")):

@@ -44,6 +44,7 @@ from matedit.app.node_preview import PreviewTarget
 from matedit.app.problems import ProblemsModel
 from matedit.app.theme import icon
 from matedit.app.viewport import EnvironmentPanel, ViewportPanel
+from matedit.graph.nodes import Role, kind_for
 from matedit.resources import graphs_dir
 from matedit.shading.lights import Light
 
@@ -361,7 +362,7 @@ class MainWindow(QMainWindow):
     def show_selected_docs(self) -> None:
         ids = self.tabs.active.canvas.selected_ids()
         node = self.tabs.active.controller.document.graph.nodes.get(ids[0]) if ids else None
-        self.show_docs(node.kind if node is not None else "material_output")
+        self.show_docs(node.kind if node is not None else kind_for(Role.MATERIAL_OUTPUT))
 
     def show_about(self) -> None:
         show_about(self, self.viewport.gl_renderer())

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from matedit.graph.model import Link, MaterialDocument, Node
+from matedit.graph.nodes import Role, kind_for, role_of
 from matedit.graph.types import PortType
 
 
@@ -31,9 +32,9 @@ def preview_document(doc: MaterialDocument, target: PreviewTarget,
     preview = MaterialDocument(doc.kind, g, doc.name, doc.description, doc.path,
                                dict(doc.preview))
     out = next((n for n in sorted(g.nodes.values(), key=lambda n: n.id)
-                if n.kind == "material_output"), None)
+                if role_of(n.kind) == Role.MATERIAL_OUTPUT), None)
     if out is None:
-        out = Node(g.new_id("previewOutput"), "material_output", (0.0, 0.0))
+        out = Node(g.new_id("previewOutput"), kind_for(Role.MATERIAL_OUTPUT), (0.0, 0.0))
         g.nodes[out.id] = out
     old = next((lk for lk in g.links if lk.dst == out.id and lk.dst_port == "attributes"),
                None)
@@ -45,19 +46,19 @@ def preview_document(doc: MaterialDocument, target: PreviewTarget,
         return preview
     if out_type == PortType.VEC2:  # (x, y, 0)
         nid = g.new_id("previewAppend")
-        g.nodes[nid] = Node(nid, "append", (0.0, 0.0), values={"b": 0.0})
+        g.nodes[nid] = Node(nid, kind_for(Role.APPEND), (0.0, 0.0), values={"b": 0.0})
         g.links.add(Link(*src, nid, "a"))
         src = (nid, "result")
     elif out_type == PortType.VEC4:
         nid = g.new_id("previewMask")
-        g.nodes[nid] = Node(nid, "component_mask", (0.0, 0.0), {"channels": "xyz"})
+        g.nodes[nid] = Node(nid, kind_for(Role.COMPONENT_MASK), (0.0, 0.0), {"channels": "xyz"})
         g.links.add(Link(*src, nid, "value"))
         src = (nid, "result")
     elif not out_type.is_numeric:
         raise ValueError(f"{target.label()} ({out_type}) cannot be shown on the mesh")
     make = g.new_id("previewMake")
     # Black, rough, no specular (cavity 0): only the emission shows, as the value itself.
-    g.nodes[make] = Node(make, "make_attributes", (0.0, 0.0), values={
+    g.nodes[make] = Node(make, kind_for(Role.MAKE_ATTRIBUTES), (0.0, 0.0), values={
         "baseColor": [0.0, 0.0, 0.0], "metallic": 0.0, "roughness": 1.0, "cavity": 0.0})
     g.links.add(Link(*src, make, "emissive"))
     g.links.add(Link(make, "attributes", out.id, "attributes"))

@@ -6,7 +6,7 @@ from normals and positions read as well as those built from UVs; each shown
 node's first float, vector or MaterialAttributes output becomes a thumbnail:
 floats as grey, vectors as colour, MaterialAttributes as their base colour, all
 display-encoded (sRGB). Thumbnails show on pattern nodes (noise, checker,
-gradient, textures, function calls, layer stacks) and on the selected nodes, so
+gradient, textures, function calls, layer stacks: NodeDef.thumbnail) and on the selected nodes, so
 they do not crowd the graph; large graphs skip them: previews never slow editing.
 """
 
@@ -21,20 +21,12 @@ from PySide6.QtGui import QImage
 from matedit.compiler.cpu_eval import evaluate
 from matedit.compiler.cpu_nodes import SurfaceArrays
 from matedit.compiler.lower import CompileError, lower_document
+from matedit.graph import nodes
+from matedit.graph.nodes import Thumbnail
 from matedit.graph.types import PortType
 
 SIZE = 48
 MAX_NODES = 400
-# Kinds whose output is the same everywhere, or not an image: no thumbnail.
-SKIP = {"constant", "scalar_parameter", "vector_parameter", "color_parameter",
-        "texture_parameter", "material_output", "reroute", "time", "function_output"}
-# Kinds that show a thumbnail without being selected.
-ALWAYS = {"value_noise", "checker", "gradient", "texture_sample", "function_call",
-          "layer_stack", "make_attributes", "layer_blend", "height_blend"}
-ALWAYS |= {"gradient_noise", "gradient_noise_3d", "cellular_noise", "cellular_noise_3d", "fbm",
-           "fbm_3d", "ridged_noise", "domain_warp", "bricks", "stripes", "wave", "rings",
-           "radial_gradient", "spherical_gradient", "color_ramp", "triplanar_texture",
-           "normal_from_height", "curvature"}  # the node library's patterns
 BACKGROUND = np.array([0.035, 0.04, 0.05])  # linear; matches the node body once encoded
 
 
@@ -159,7 +151,10 @@ class NodePreviews(QObject):
             return {}
         out: dict[str, QImage] = {}
         for nid, node in doc.graph.nodes.items():
-            if node.kind in SKIP or (node.kind not in ALWAYS and nid not in self._selection):
+            d = nodes.get(node.kind)
+            shown = d.thumbnail if d is not None else Thumbnail.NEVER  # NodeDef.thumbnail
+            if shown == Thumbnail.NEVER or (shown == Thumbnail.SELECTED
+                                             and nid not in self._selection):
                 continue
             for port, t in self._outputs(nid):
                 if t.is_numeric or t == PortType.MATERIAL:

@@ -36,7 +36,7 @@ class RampStops:
     """The ramp's stops as the node holds them (values, else the catalogue's defaults)."""
 
     def __init__(self, values: dict) -> None:
-        d = nodes.REGISTRY["color_ramp"]
+        d = nodes.definition(nodes.kind_for(nodes.Role.COLOR_RAMP))
         get = {i.name: values.get(i.name, i.default) for i in d.inputs}
         self.count = int(min(max(float(get["stops"]), 2), RAMP_STOPS))
         self.positions = [float(get[f"position{k}"]) for k in range(RAMP_STOPS)]
@@ -49,7 +49,8 @@ class RampStops:
         n = len(t)
         col = [np.full(n, p) for p in self.positions]
         colors = [np.tile(c, (n, 1)) for c in self.colors]
-        (out,) = IMPLS["color_ramp"](None, t, np.full(n, float(self.count)), *col, *colors)
+        ramp = IMPLS[nodes.kind_for(nodes.Role.COLOR_RAMP)]
+        (out,) = ramp(None, t, np.full(n, float(self.count)), *col, *colors)
         return out
 
     def values(self) -> dict:

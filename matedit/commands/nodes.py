@@ -73,6 +73,7 @@ SCHEMA: dict[str, Any] = {
                         "required": ["glsl", "numpy"]},
                     "materialx": {"type": ["object", "null"], "properties": {
                         "node": {"type": "string"},
+                        "recipe": {"type": "string"},
                         "inputs": {"type": "object",
                                    "additionalProperties": {"type": "string"}}}},
                 },
@@ -92,11 +93,15 @@ def _port(p) -> dict[str, Any]:
 
 
 def _mtlx(m) -> dict[str, Any] | None:
-    if m is None:
-        return None
-    if isinstance(m, str):
-        return {"node": m, "inputs": {}}
-    return {"node": m["node"], "inputs": dict(m.get("inputs", {}))}
+    """The catalogue's MaterialX mapping (NodeDef.mtlx): one stdlib node and its inputs, or a
+    recipe of a few nodes; None where the exporter bakes the kind or it is lowered away."""
+    from matedit.graph.nodes import MxNode, MxRecipe
+
+    if isinstance(m, MxNode):
+        return {"node": m.category, "inputs": dict(m.ports)}
+    if isinstance(m, MxRecipe):
+        return {"recipe": m.name, "inputs": {}}
+    return None
 
 
 def catalogue(category: str | None = None) -> dict[str, Any]:
@@ -120,7 +125,7 @@ def catalogue(category: str | None = None) -> dict[str, Any]:
             targets = list(GLSL_TARGETS)
             if d.kind in IMPLS or d.kind in COMPILER_HANDLED:
                 targets.append("numpy")
-            if d.mtlx is not None:
+            if _mtlx(d.mtlx) is not None:
                 targets.append("materialx")
             rec: dict[str, Any] = {
                 "kind": d.kind, "title": d.title, "category": d.category,
@@ -155,7 +160,9 @@ def format_text(data: dict[str, Any]) -> str:
             lines += ["", f"{category}"]
         lines.append(f"  {rec['kind']:24s} {rec['title']}")
         lines.append(f"  {'':24s} {rec['description']}")
-        mx = f" (MaterialX {rec['materialx']['node']})" if rec["materialx"] else ""
+        m = rec["materialx"]
+        mx = "" if not m else f" (MaterialX {m['node']})" if "node" in m else \
+            f" (MaterialX recipe {m['recipe']})"
         lines.append(f"  {'':24s}   targets: {' '.join(rec['targets'])}{mx}")
         for p in rec["inputs"]:
             rng = f" in [{p['range'][0]:g}, {p['range'][1]:g}]" if p.get("range") else ""

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from matedit.compiler.ir import Expr, Lit, MaterialIR, Op, Param, Scope, Splat, SurfaceUV, Uni, Var
-from matedit.graph.nodes import ATTRIBUTE_FIELDS
+from matedit.graph.nodes import ATTRIBUTE_FIELDS, Role, role_of
 from matedit.graph.types import PortType
 
 
@@ -81,10 +81,11 @@ def eval_op(op: Op, args: list[Any], env: Env | None) -> tuple:
         a = a.reshape(a.shape[0], -1)
         r = a[:, idx]
         return (r[:, 0] if len(idx) == 1 else r,)
-    if k == "append":
+    role = role_of(k)
+    if role == Role.APPEND:
         parts = [np.asarray(a).reshape(np.asarray(a).shape[0], -1) for a in args]
         return (np.concatenate(parts, axis=1),)
-    if k == "set_attributes":
+    if role == Role.SET_ATTRIBUTES:
         m = {f: np.array(v, copy=True) for f, v in args[0].items()}
         for name, v in zip(op.data["fields"], args[1:]):
             m[name] = np.asarray(v, dtype=np.float64)

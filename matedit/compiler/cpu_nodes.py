@@ -15,15 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matedit.graph.nodes import ATTRIBUTE_NAMES
+from matedit.graph.nodes import ATTRIBUTE_NAMES, kinds_where
 
 # Kinds with no entry in IMPLS: the compiler evaluates them from the graph itself.
-COMPILER_HANDLED = frozenset({
-    "constant", "scalar_parameter", "color_parameter", "texture_parameter", "function_input",
-    "function_output", "function_call", "layer_stack", "material_output", "set_attributes",
-    "component_mask", "append", "reroute",
-})  # fmt: skip
-COMPILER_HANDLED = COMPILER_HANDLED | {"static_switch"}  # chosen at compile time (issue 14)
+COMPILER_HANDLED = kinds_where(lambda d: d.lowered)
 
 Attributes = dict[str, np.ndarray]
 

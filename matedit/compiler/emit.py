@@ -118,10 +118,11 @@ def _op_line(op: Op, names: _Names) -> str:
     if k == "mask":
         (name, t), = outs
         return f"{t.glsl} {name} = ({args[0]}).{op.data['channels']};"
-    if k == "append":
+    role = nodes.role_of(k)
+    if role == nodes.Role.APPEND:
         (name, t), = outs
         return f"{t.glsl} {name} = {t.glsl}({', '.join(args)});"
-    if k == "set_attributes":
+    if role == nodes.Role.SET_ATTRIBUTES:
         (name, _), = outs
         sets = " ".join(f"{name}.{f} = {a};" for f, a in zip(op.data["fields"], args[1:]))
         return f"MaterialAttributes {name} = {args[0]}; {sets}"
@@ -292,7 +293,7 @@ def fragment_source(ir: MaterialIR, target: Target, mode: str | Entry = Entry.FO
     includes = ["common.glsl", "material.glsl", "nodes/context.glsl"]
     kinds = set(ir.node_kinds)
     if any(op.kind == "blend" for s in [ir.main, *ir.functions] for op in s.ops):
-        kinds.add("layer_blend")
+        kinds.add(nodes.kind_for(nodes.Role.MASK_BLEND))
     for kind in sorted(kinds):
         if nodes.REGISTRY[kind].glsl:
             includes.append(f"nodes/{kind}.glsl")

@@ -30,17 +30,14 @@ from matedit.compiler.ir import (
 from matedit.graph import nodes
 from matedit.graph.model import MaterialDocument
 from matedit.graph.names import mangle
-from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, MA, MESH_UV
+from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, MA, MESH_UV, Role, kind_for
 from matedit.graph.ports import FunctionResolver, function_interface, layer_entries
 from matedit.graph.types import PortType, coerce_value
 from matedit.graph.validate import Analysis, Diagnostic, Severity, analyse
 
-# Kinds the compiler lowers itself; every other kind calls its GLSL function or inline template.
-SPECIAL_KINDS = {
-    "constant", "scalar_parameter", "color_parameter", "texture_parameter", "function_input",
-    "function_output", "function_call", "layer_stack", "material_output", "set_attributes",
-    "component_mask", "append", "reroute", "static_switch",
-}
+# Kinds the compiler lowers itself (NodeDef.lowered): a `_k_<role>` method each; every other
+# kind calls its GLSL function or inline template.
+SPECIAL_KINDS = nodes.kinds_where(lambda d: d.lowered)
 ALL_FIELDS = frozenset(ATTRIBUTE_NAMES)
 
 
@@ -86,6 +83,7 @@ class _Ctx:
     textures: dict[str, TextureInfo] = field(default_factory=dict)
     kinds: set[str] = field(default_factory=set)
     input_uniforms: dict[tuple[str, str], str] = field(default_factory=dict)
+    input_uniform_names: set[str] = field(default_factory=set)  # its values, to look up
     switches: dict[str, tuple[bool, str]] = field(default_factory=dict)  # name -> (on, node)
 
 
@@ -144,9 +142,11 @@ class _Lowerer:
             return taken[key]
         base = f"u_{nid}_{port}"
         name, i = base, 2
-        while name in self.ctx.uniforms or name in taken.values():
+        names = self.ctx.input_uniform_names
+        while name in self.ctx.uniforms or name in names:
             name, i = f"{base}_{i}", i + 1
         taken[key] = name
+        names.add(name)
         return name
 
     def _uniform(self, info: UniformInfo) -> None:
@@ -169,7 +169,9 @@ class _Lowerer:
     def lower(self) -> None:
         for nid in self.a.order:
             node = self.doc.graph.nodes[nid]
-            getattr(self, f"_k_{node.kind}", self._generic)(nid, node)
+            role = nodes.role_of(node.kind)
+            special = getattr(self, f"_k_{role.name.lower()}", None) if role else None
+            (special or self._generic)(nid, node)
         for (nid, port), e in self.alias.items():
             # An alias is what the node outputs (a layer stack's blended result), even where
             # the node also emitted ops under its id (the layers' calls).
@@ -182,7 +184,8 @@ class _Lowerer:
     def _generic(self, nid, node) -> None:
         d = nodes.REGISTRY[node.kind]
         args = self._inputs(nid)
-        if node.kind == "make_attributes":
+        role = d.role
+        if role == Role.MAKE_ATTRIBUTES:
             # The tangent-space normal is only written when connected (MATERIAL_HAS_NORMAL).
             idx = [f.name for f in ATTRIBUTE_FIELDS].index("normal")
             if "normal" not in self.incoming[nid]:
@@ -191,12 +194,12 @@ class _Lowerer:
         data = {"glsl": d.glsl} if d.glsl else {"inline": d.inline}
         self.ctx.kinds.add(node.kind)
         op = self.emit(Op(nid, nid, node.kind, args, outs, data))
-        if node.kind == "make_attributes":
+        if role == Role.MAKE_ATTRIBUTES:
             w = set(ALL_FIELDS)
             if "normal" not in self.incoming[nid]:
                 w.discard("normal")
             self.written[op.out("attributes").key()] = frozenset(w)
-        elif node.kind in ("layer_blend", "height_blend"):
+        elif role in (Role.MASK_BLEND, Role.HEIGHT_BLEND):
             self.written[op.out("result").key()] = self._w(args[0]) | self._w(args[1])
 
     def _w(self, e: Expr) -> frozenset:
@@ -231,7 +234,7 @@ class _Lowerer:
         self.ctx.kinds.add(node.kind)
         self.emit(Op(nid, nid, node.kind, [Uni(name, PortType.VEC4)],
                      [("value", PortType.VEC4), ("xyz", PortType.VEC3)],
-                     {"glsl": "node_vector_parameter"}))
+                     {"glsl": nodes.definition(node.kind).glsl}))
 
     def _k_texture_parameter(self, nid, node) -> None:
         pname = str(node.settings.get("name", nid))
@@ -285,12 +288,12 @@ class _Lowerer:
     def _k_append(self, nid, node) -> None:
         args = self._inputs(nid)
         t = self.a.out_types[nid]["result"]
-        self.emit(Op(nid, nid, "append", args, [("result", t)], {}))
+        self.emit(Op(nid, nid, node.kind, args, [("result", t)], {}))
 
     def _k_set_attributes(self, nid, node) -> None:
         args = self._inputs(nid)
         fields = [p.name for p in self.a.ports[nid].inputs[1:]]
-        op = self.emit(Op(nid, nid, "set_attributes", args, [("attributes", PortType.MATERIAL)],
+        op = self.emit(Op(nid, nid, node.kind, args, [("attributes", PortType.MATERIAL)],
                           {"fields": tuple(fields)}))
         self.written[op.out("attributes").key()] = self._w(args[0]) | frozenset(fields)
 
@@ -368,12 +371,13 @@ class _Lowerer:
                                        [("result", PortType.MATERIAL)], {}))
             else:
                 if blend == "height":
-                    self.ctx.kinds.add("height_blend")
+                    hb = nodes.definition(kind_for(Role.HEIGHT_BLEND))
+                    self.ctx.kinds.add(hb.kind)
                     shaped = self.emit(Op(
-                        f"{nid}.{lid}.h", nid, "height_blend",
+                        f"{nid}.{lid}.h", nid, hb.kind,
                         [acc, value, port(f"{lid}_base_height"), port(f"{lid}_mask"),
                          port(f"{lid}_contrast")],
-                        [("result", PortType.MATERIAL)], {"glsl": "node_height_blend"}))
+                        [("result", PortType.MATERIAL)], {"glsl": hb.glsl}))
                 else:
                     biface = function_interface(self.ctx.resolver.resolve(blend, self.doc))
                     mas = [p.name for p in biface.inputs if p.type == MA][:2]
@@ -387,7 +391,7 @@ class _Lowerer:
                                        [acc, shaped.out(out_name), convert(opacity,
                                                                            PortType.FLOAT)],
                                        [("result", PortType.MATERIAL)], {}))
-            self.ctx.kinds.add("layer_blend")
+            self.ctx.kinds.add(kind_for(Role.MASK_BLEND))
             self.written[blended.out("result").key()] = self._w(acc) | self._w(value)
             acc = blended.out("result")
         if acc is None:

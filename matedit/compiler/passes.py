@@ -9,11 +9,12 @@ from __future__ import annotations
 import numpy as np
 
 from matedit.compiler.ir import Expr, Lit, Op, Scope, Splat, Var
+from matedit.graph.nodes import is_impure
 from matedit.graph.types import PortType
 
-# Kinds whose value depends on more than their inputs (geometry, time, textures, uniforms).
-IMPURE = {"texcoord", "world_position", "world_normal", "view_direction", "time",
-          "texture_sample", "vector_parameter", "call"}
+# The compiler's own ops whose value depends on more than their operands; catalogue kinds
+# declare it (NodeDef.impure: geometry, time, textures, uniforms).
+IMPURE_OPS = {"call"}
 
 
 def _subst(e: Expr, table: dict[str, Expr]) -> Expr:
@@ -69,7 +70,7 @@ def _fold(op: Op) -> list[Lit] | None:
     """The op's outputs as literals when all its operands are literals (numpy evaluation)."""
     from matedit.compiler import cpu_eval
 
-    if (op.kind in IMPURE or not op.args
+    if (op.kind in IMPURE_OPS or is_impure(op.kind) or not op.args
             or not all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
             or not all(t.is_numeric for _, t in op.outs)):
         return None

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from matedit.graph.commands import Command, CommandError, Connect, Disconnect, Macro, SetSetting
 from matedit.graph.model import Link, MaterialGraph
+from matedit.graph.nodes import Role, role_of
 from matedit.graph.ports import LAYER_BLENDS, layer_entries
 
 # Ports a layer has only when it is not the base (the blend inputs).
@@ -43,8 +44,9 @@ class LayerStack:
     def __init__(self, graph: MaterialGraph, node_id: str, resolver=None, owner=None) -> None:
         """With a function resolver (and the owning document), edits cut only the links into
         ports that the edit removes; without one, every link into an edited layer's ports."""
-        if graph.nodes.get(node_id) is None or graph.nodes[node_id].kind != "layer_stack":
-            raise ValueError(f"{node_id!r} is not a layer_stack node")
+        if graph.nodes.get(node_id) is None or \
+                role_of(graph.nodes[node_id].kind) != Role.LAYER_STACK:
+            raise ValueError(f"{node_id!r} is not a layer stack node")
         self.graph = graph
         self.node_id = node_id
         self.resolver = resolver
@@ -52,7 +54,7 @@ class LayerStack:
 
     @classmethod
     def find(cls, graph: MaterialGraph, resolver=None, owner=None) -> LayerStack | None:
-        ids = sorted(n.id for n in graph.nodes.values() if n.kind == "layer_stack")
+        ids = sorted(n.id for n in graph.nodes.values() if role_of(n.kind) == Role.LAYER_STACK)
         return cls(graph, ids[0], resolver, owner) if ids else None
 
     def _surviving_ports(self, entries: list[dict]) -> set[str] | None:
@@ -62,7 +64,8 @@ class LayerStack:
         from matedit.graph.model import Node
         from matedit.graph.ports import node_ports
 
-        trial = Node(self.node_id, "layer_stack", settings={"layers": entries})
+        trial = Node(self.node_id, self.graph.nodes[self.node_id].kind,
+                     settings={"layers": entries})
         try:
             return {p.name for p in node_ports(trial, self.resolver, self.owner).inputs}
         except (LookupError, ValueError):

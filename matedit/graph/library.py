@@ -2,10 +2,11 @@
 and masks. Registered into `matedit.graph.nodes.REGISTRY` when that module is imported.
 
 Every kind here has a GLSL function in `shaders/nodes/<kind>.glsl` or an inline template,
-a numpy twin in `matedit.compiler.cpu_nodes`, port ranges, and `mtlx`: its MaterialX
-standard-library equivalent where one exists, as {"node": stdlib node, "inputs": {our port:
-its input}} (ports left out have no MaterialX input: a scale, say, becomes a multiply
-before the node when exporting). None: not expressible node for node (bake it).
+a numpy twin in `matedit.compiler.cpu_nodes`, port ranges, and the facts of
+`matedit.graph.nodes.NodeDef`: patterns show a thumbnail always, kinds that read the
+surface's geometry or time are impure. Their MaterialX mapping is the default, BAKE: the
+MaterialX exporter bakes them (a stdlib node is mapped only once MaterialX's own shader
+generator is shown to agree with our CPU evaluator, tests/test_interop_mtlx.py).
 
 Pattern edges are band-limited: kinds with a `filter_width` input box-filter their edges
 over `filter_width` pixels of screen-space footprint (`fwidth`); the numpy twins take the
@@ -14,7 +15,18 @@ same footprint from the evaluator's pixel grid (`SurfaceArrays.grid`).
 
 from __future__ import annotations
 
-from matedit.graph.nodes import GENERIC, MESH_UV, REGISTRY, NodeDef, _i, _o, _op, register
+from matedit.graph.nodes import (
+    GENERIC,
+    MESH_UV,
+    REGISTRY,
+    NodeDef,
+    Role,
+    Thumbnail,
+    _i,
+    _o,
+    _op,
+    register,
+)
 
 _BEFORE = frozenset(REGISTRY)
 T = GENERIC
@@ -23,41 +35,35 @@ _FILTER = ("filter_width", "float", 1.0, "edge blur in pixels (0: hard edges)", 
 _SEED = ("seed", "float", 0.0, "integer seed: another seed, another pattern", (0.0, 1000.0))
 
 
-def _fn(kind, title, category, description, inputs, outputs, mtlx=None):
+def _fn(kind, title, category, description, inputs, outputs, **facts):
+    """A kind with a GLSL function `node_<kind>`; `facts` are further NodeDef fields
+    (thumbnail, geometry...)."""
     register(NodeDef(kind, title, category, description, inputs=tuple(inputs),
-                     outputs=tuple(outputs), glsl=f"node_{kind}", numpy=kind, mtlx=mtlx))
-
-
-def _mx(node, **inputs):
-    return {"node": node, "inputs": inputs}
+                     outputs=tuple(outputs), glsl=f"node_{kind}", **facts))
 
 
 # --- maths -----------------------------------------------------------------------------------
 _op("atan2", "Atan2", "atan({y}, {x})", [_i("y", T), _i("x", T, 1.0)],
-    "Angle of the point (x, y) in radians, in (−π, π].", mtlx=_mx("atan2", y="iny", x="inx"))
-_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.",
-    mtlx=_mx("exp", value="in"))
+    "Angle of the point (x, y) in radians, in (−π, π].")
+_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.")
 _op("log", "Log", "log(max({value}, 1e-30))", [_i("value", T, 1.0)],
-    "Natural logarithm; values at or below 0 read as 1e-30.", mtlx=_mx("ln", value="in"))
+    "Natural logarithm; values at or below 0 read as 1e-30.")
 _op("mod", "Modulo", "mod({a}, {b})", [_i("a", T), _i("b", T, 1.0)],
-    "a − b floor(a / b): the remainder with the sign of b.",
-    mtlx=_mx("modulo", a="in1", b="in2"))
-_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.", mtlx=_mx("sign", value="in"))
+    "a − b floor(a / b): the remainder with the sign of b.")
+_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.")
 _op("round", "Round", "floor({value} + 0.5)", [_i("value", T)],
-    "Nearest integer; halves round up.", mtlx=_mx("round", value="in"))
-_op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.",
-    mtlx=_mx("ceil", value="in"))
+    "Nearest integer; halves round up.")
+_op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.")
 _op("trunc", "Truncate", "trunc({value})", [_i("value", T)],
     "Integer part, rounding towards zero.")
 _op("negate", "Negate", "(-{value})", [_i("value", T)], "−value.")
 _op("reciprocal", "Reciprocal", "(1.0 / {value})", [_i("value", T, 1.0)],
     "1 ÷ value (zero gives the GPU's infinity).")
-_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.",
-    mtlx=_mx("tan", value="in"))
+_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.")
 _op("asin", "Arcsine", "asin(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arcsine in radians; input clamped to [−1, 1].", mtlx=_mx("asin", value="in"))
+    "Arcsine in radians; input clamped to [−1, 1].")
 _op("acos", "Arccosine", "acos(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arccosine in radians; input clamped to [−1, 1].", mtlx=_mx("acos", value="in"))
+    "Arccosine in radians; input clamped to [−1, 1].")
 _op("radians", "To Radians", "radians({value})", [_i("value", T)], "Degrees to radians.")
 _op("degrees", "To Degrees", "degrees({value})", [_i("value", T)], "Radians to degrees.")
 _op("multiply_add", "Multiply Add", "({a} * {b} + {c})",
@@ -70,8 +76,7 @@ _op("smooth_min", "Soft Minimum", None,
     "The smaller of a and b with a rounded join (polynomial smooth minimum).",
     glsl="node_smooth_min")
 _op("distance", "Distance", "distance({a}, {b})", [_i("a", T), _i("b", T)],
-    "Euclidean distance between a and b.", out_type="float", category="Vector",
-    mtlx=_mx("distance", a="in1", b="in2"))
+    "Euclidean distance between a and b.", out_type="float", category="Vector")
 _op("reflect", "Reflect", "reflect({incident}, {normal})",
     [_i("incident", "vec3", [0.0, 0.0, -1.0]), _i("normal", "vec3", [0.0, 0.0, 1.0], "unit")],
     "Mirror direction of incident about normal.", out_type="vec3", category="Vector")
@@ -83,8 +88,7 @@ _op("refract", "Refract", "refract({incident}, {normal}, {eta})",
     category="Vector")
 _op("if_greater", "If Greater", "({a} > {b} ? {if_true} : {if_false})",
     [_i("a", "float"), _i("b", "float"), _i("if_true", T, 1.0), _i("if_false", T, 0.0)],
-    "if_true where a > b, else if_false.", category="Logic",
-    mtlx=_mx("ifgreater", a="value1", b="value2", if_true="in1", if_false="in2"))
+    "if_true where a > b, else if_false.", category="Logic")
 _op("if_equal", "If Equal", "(abs({a} - {b}) <= {tolerance} ? {if_true} : {if_false})",
     [_i("a", "float"), _i("b", "float"), _i("tolerance", "float", 1e-4, "", (0.0, 1.0)),
      _i("if_true", T, 1.0), _i("if_false", T, 0.0)],
@@ -96,12 +100,11 @@ _op("fwidth", "Pixel Footprint", "fwidth({value})", [_i("value", T)],
 # --- colour ----------------------------------------------------------------------------------
 _C = ("color", "vec3", [0.5, 0.5, 0.5], "linear RGB")
 _fn("luminance", "Luminance", "Colour", "Rec. 709 luminance of a linear colour.",
-    [_i(*_C)], [_o("value", "float")], mtlx=_mx("luminance", color="in"))
+    [_i(*_C)], [_o("value", "float")])
 _fn("rgb_to_hsv", "RGB to HSV", "Colour", "Hue (turns), saturation and value of a colour.",
-    [_i(*_C)], [_o("hsv", "vec3")], mtlx=_mx("rgbtohsv", color="in"))
+    [_i(*_C)], [_o("hsv", "vec3")])
 _fn("hsv_to_rgb", "HSV to RGB", "Colour", "The colour of a hue (turns), saturation, value.",
-    [_i("hsv", "vec3", [0.0, 1.0, 1.0])], [_o("color", "vec3")],
-    mtlx=_mx("hsvtorgb", hsv="in"))
+    [_i("hsv", "vec3", [0.0, 1.0, 1.0])], [_o("color", "vec3")])
 _fn("hsv_adjust", "HSV Adjust", "Colour",
     "Rotates hue, scales saturation and value (in HSV space).",
     [_i(*_C), _i("hue", "float", 0.0, "hue shift in turns", (-0.5, 0.5)),
@@ -123,31 +126,29 @@ _fn("levels", "Levels", "Colour",
      _i("out_black", "float", 0.0, "", UNIT), _i("out_white", "float", 1.0, "", UNIT)],
     [_o("result", "vec3")])
 _fn("saturation", "Saturation", "Colour", "Mixes between grey (0) and the colour (1) and past.",
-    [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")],
-    mtlx=_mx("saturate", color="in", amount="amount"))
+    [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")])
 _fn("srgb_to_linear", "sRGB to Linear", "Colour", "Decodes sRGB-encoded values (IEC 61966-2-1).",
     [_i("color", "vec3", [0.5, 0.5, 0.5], "sRGB-encoded")], [_o("result", "vec3")])
 _fn("linear_to_srgb", "Linear to sRGB", "Colour", "Encodes linear values as sRGB.",
     [_i(*_C)], [_o("result", "vec3")])
 _BLENDS = {
-    "multiply": ("Multiply", "base × blend: darkens.", None),
-    "screen": ("Screen", "1 − (1 − base)(1 − blend): lightens.", "screen"),
-    "overlay": ("Overlay", "Multiply in the darks, screen in the lights of base.", "overlay"),
-    "soft_light": ("Soft Light", "A gentle overlay (the W3C compositing formula).", None),
-    "add": ("Add", "base + blend.", "plus"),
-    "subtract": ("Subtract", "base − blend.", "minus"),
-    "difference": ("Difference", "|base − blend|.", "difference"),
-    "dodge": ("Colour Dodge", "Brightens base by dividing by 1 − blend.", "dodge"),
-    "burn": ("Colour Burn", "Darkens base: 1 − (1 − base) / blend.", "burn"),
-    "lighten": ("Lighten", "The larger of base and blend.", None),
-    "darken": ("Darken", "The smaller of base and blend.", None),
+    "multiply": ("Multiply", "base × blend: darkens."),
+    "screen": ("Screen", "1 − (1 − base)(1 − blend): lightens."),
+    "overlay": ("Overlay", "Multiply in the darks, screen in the lights of base."),
+    "soft_light": ("Soft Light", "A gentle overlay (the W3C compositing formula)."),
+    "add": ("Add", "base + blend."),
+    "subtract": ("Subtract", "base − blend."),
+    "difference": ("Difference", "|base − blend|."),
+    "dodge": ("Colour Dodge", "Brightens base by dividing by 1 − blend."),
+    "burn": ("Colour Burn", "Darkens base: 1 − (1 − base) / blend."),
+    "lighten": ("Lighten", "The larger of base and blend."),
+    "darken": ("Darken", "The smaller of base and blend."),
 }
-for _name, (_title, _doc, _mxn) in _BLENDS.items():
+for _name, (_title, _doc) in _BLENDS.items():
     _fn(f"blend_{_name}", f"Blend: {_title}", "Colour",
         f"{_doc} Mixed over base by opacity.",
         [_i("base", "vec3", [0.5, 0.5, 0.5]), _i("blend", "vec3", [0.5, 0.5, 0.5]),
-         _i("opacity", "float", 1.0, "", UNIT)], [_o("result", "vec3")],
-        mtlx=_mx(_mxn, base="bg", blend="fg", opacity="mix") if _mxn else None)
+         _i("opacity", "float", 1.0, "", UNIT)], [_o("result", "vec3")])
 RAMP_STOPS = 6
 _GREYS = (0.0, 1.0, 1.0, 1.0, 1.0, 1.0)
 register(NodeDef(
@@ -160,7 +161,8 @@ register(NodeDef(
             for k in range(RAMP_STOPS))
     + tuple(_i(f"color{k}", "vec3", [_GREYS[k]] * 3, f"stop {k} colour", UNIT)
             for k in range(RAMP_STOPS)),
-    outputs=(_o("color", "vec3"),), glsl="node_color_ramp", numpy="color_ramp",
+    outputs=(_o("color", "vec3"),), glsl="node_color_ramp", role=Role.COLOR_RAMP,
+    thumbnail=Thumbnail.ALWAYS,
 ))
 
 # --- noise -----------------------------------------------------------------------------------
@@ -168,13 +170,12 @@ _UV = ("uv", "vec2", MESH_UV)
 _SCALE = ("scale", "float", 8.0, "features per UV unit", (0.0, 64.0))
 _fn("gradient_noise", "Gradient Noise", "Noise",
     "Perlin-style gradient noise over uv, in about [−1, 1], smooth (quintic fade).",
-    [_i(*_UV), _i(*_SCALE), _i(*_SEED)], [_o("value", "float")],
-    mtlx=_mx("noise2d", uv="texcoord"))
+    [_i(*_UV), _i(*_SCALE), _i(*_SEED)], [_o("value", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("gradient_noise_3d", "Gradient Noise 3D", "Noise",
     "Perlin-style gradient noise over a 3D position (e.g. world position), about [−1, 1].",
     [_i("position", "vec3", [0.0, 0.0, 0.0]), _i("scale", "float", 2.0, "features per unit",
                                                  (0.0, 64.0)), _i(*_SEED)],
-    [_o("value", "float")], mtlx=_mx("noise3d", position="position"))
+    [_o("value", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("cellular_noise", "Cellular Noise", "Noise",
     "Worley noise over uv: distances to the nearest (F1) and second nearest (F2) feature "
     "points, F2 − F1 (cell borders), a random value per cell, and a filtered edge mask.",
@@ -182,34 +183,30 @@ _fn("cellular_noise", "Cellular Noise", "Noise",
      _i("edge_width", "float", 0.05, "border width, in cells, of the edge mask", (0.0, 0.5)),
      _i(*_SEED), _i(*_FILTER)],
     [_o("f1", "float"), _o("f2", "float"), _o("edge", "float"), _o("cell_id", "float"),
-     _o("edges", "float")],
-    mtlx=_mx("worleynoise2d", uv="texcoord", jitter="jitter"))
+     _o("edges", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("cellular_noise_3d", "Cellular Noise 3D", "Noise",
     "Worley noise over a 3D position: F1, F2, F2 − F1 and a random value per cell.",
     [_i("position", "vec3", [0.0, 0.0, 0.0]), _i("scale", "float", 2.0, "cells per unit",
                                                  (0.0, 64.0)),
      _i("jitter", "float", 1.0, "", UNIT), _i(*_SEED)],
     [_o("f1", "float"), _o("f2", "float"), _o("edge", "float"), _o("cell_id", "float")],
-    mtlx=_mx("worleynoise3d", position="position", jitter="jitter"))
+    thumbnail=Thumbnail.ALWAYS)
 _OCT = [_i("octaves", "float", 4.0, "detail levels (fractional fades the last in)", (1.0, 8.0)),
         _i("lacunarity", "float", 2.0, "frequency ratio between octaves", (1.0, 4.0)),
         _i("gain", "float", 0.5, "amplitude ratio between octaves", (0.0, 1.0))]
 _fn("fbm", "Fractal Noise", "Noise",
     "Fractal Brownian motion: octaves of gradient noise, in about [0, 1] around 0.5.",
     [_i(*_UV), _i("scale", "float", 4.0, "base features per UV unit", (0.0, 64.0)), *_OCT,
-     _i(*_SEED)], [_o("value", "float")],
-    mtlx=_mx("fractal2d", octaves="octaves", lacunarity="lacunarity", gain="diminish"))
+     _i(*_SEED)], [_o("value", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("fbm_3d", "Fractal Noise 3D", "Noise",
     "Fractal Brownian motion over a 3D position, in about [0, 1] around 0.5.",
     [_i("position", "vec3", [0.0, 0.0, 0.0]), _i("scale", "float", 2.0, "", (0.0, 64.0)),
-     *_OCT, _i(*_SEED)], [_o("value", "float")],
-    mtlx=_mx("fractal3d", position="position", octaves="octaves", lacunarity="lacunarity",
-             gain="diminish"))
+     *_OCT, _i(*_SEED)], [_o("value", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("ridged_noise", "Ridged Noise", "Noise",
     "Ridged multifractal: octaves of (1 − |noise|)², sharp crests like cracks and veins, "
     "in [0, 1].",
     [_i(*_UV), _i("scale", "float", 4.0, "", (0.0, 64.0)), *_OCT, _i(*_SEED)],
-    [_o("value", "float")])
+    [_o("value", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("white_noise", "White Noise", "Noise",
     "A random value (and colour) for every distinct input, from its bits: per-pixel grain, "
     "or per cell when fed a cell id.",
@@ -217,13 +214,13 @@ _fn("white_noise", "White Noise", "Noise",
     [_o("value", "float"), _o("color", "vec3")])
 _fn("cell_hash", "Random per Cell", "Noise",
     "A random value and colour per integer cell of the input (floor of each component).",
-    [_i("cell", "vec2", [0.0, 0.0]), _i(*_SEED)], [_o("value", "float"), _o("color", "vec3")],
-    mtlx=_mx("cellnoise2d", cell="texcoord"))
+    [_i("cell", "vec2", [0.0, 0.0]), _i(*_SEED)], [_o("value", "float"), _o("color", "vec3")])
 _fn("domain_warp", "Domain Warp", "Noise",
     "Displaces uv by fractal noise, so any pattern fed the result swirls and breaks up.",
     [_i(*_UV), _i("scale", "float", 4.0, "", (0.0, 64.0)),
      _i("strength", "float", 0.1, "displacement in UV units", (0.0, 1.0)),
-     _i("octaves", "float", 3.0, "", (1.0, 8.0)), _i(*_SEED)], [_o("uv", "vec2")])
+     _i("octaves", "float", 3.0, "", (1.0, 8.0)), _i(*_SEED)], [_o("uv", "vec2")],
+    thumbnail=Thumbnail.ALWAYS)
 
 # --- patterns --------------------------------------------------------------------------------
 _fn("bricks", "Bricks", "Procedural",
@@ -235,20 +232,20 @@ _fn("bricks", "Bricks", "Procedural",
      _i("offset", "float", 0.5, "row shift in bricks (0: tiles)", UNIT), _i(*_SEED),
      _i(*_FILTER)],
     [_o("mask", "float"), _o("height", "float"), _o("tile_id", "float"),
-     _o("tile_uv", "vec2")])
+     _o("tile_uv", "vec2")], thumbnail=Thumbnail.ALWAYS)
 _fn("stripes", "Stripes", "Procedural",
     "Parallel stripes along an angle, band-limited so they never moiré.",
     [_i(*_UV), _i("frequency", "float", 8.0, "stripes per UV unit", (0.0, 128.0)),
      _i("width", "float", 0.5, "stripe share of each period", UNIT),
      _i("angle", "float", 0.0, "degrees", (0.0, 360.0)), _i(*_FILTER)],
-    [_o("mask", "float")])
+    [_o("mask", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("wave", "Wave", "Procedural",
     "Bands along an angle with a sine profile, optionally distorted by noise.",
     [_i(*_UV), _i("frequency", "float", 8.0, "bands per UV unit", (0.0, 128.0)),
      _i("angle", "float", 0.0, "degrees", (0.0, 360.0)),
      _i("distortion", "float", 0.0, "noise displacement in bands", (0.0, 4.0)),
      _i("detail_scale", "float", 4.0, "noise features per UV unit", (0.0, 64.0))],
-    [_o("value", "float"), _o("saw", "float")])
+    [_o("value", "float"), _o("saw", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("rings", "Rings", "Procedural",
     "Concentric rings about a centre with a sine profile and noise distortion (wood, "
     "ripples); saw is the ramp within each ring.",
@@ -256,14 +253,16 @@ _fn("rings", "Rings", "Procedural",
      _i("frequency", "float", 8.0, "rings per UV unit", (0.0, 128.0)),
      _i("distortion", "float", 0.0, "noise displacement in rings", (0.0, 4.0)),
      _i("detail_scale", "float", 4.0, "noise features per UV unit", (0.0, 64.0))],
-    [_o("value", "float"), _o("saw", "float")])
+    [_o("value", "float"), _o("saw", "float")], thumbnail=Thumbnail.ALWAYS)
 _fn("radial_gradient", "Radial Gradient", "Procedural",
     "The angle about a centre, 0 → 1 counter-clockwise from +u.",
-    [_i(*_UV), _i("center", "vec2", [0.5, 0.5])], [_o("value", "float")])
+    [_i(*_UV), _i("center", "vec2", [0.5, 0.5])], [_o("value", "float")],
+    thumbnail=Thumbnail.ALWAYS)
 _fn("spherical_gradient", "Spherical Gradient", "Procedural",
     "1 at the centre falling to 0 at radius.",
     [_i(*_UV), _i("center", "vec2", [0.5, 0.5]),
-     _i("radius", "float", 0.5, "UV units", (0.0, 2.0))], [_o("value", "float")])
+     _i("radius", "float", 0.5, "UV units", (0.0, 2.0))], [_o("value", "float")],
+    thumbnail=Thumbnail.ALWAYS)
 _fn("filtered_step", "Filtered Step", "Procedural",
     "step(edge, value) with the edge blurred over the pixel footprint of value: an "
     "anti-aliased threshold for any pattern.",
@@ -282,32 +281,33 @@ _fn("rotate_uv", "Rotate UV", "Coordinates", "Rotates uv about a pivot, counter-
     [_i(*_UV), _i("angle", "float", 0.0, "degrees", (0.0, 360.0)),
      _i("pivot", "vec2", [0.5, 0.5])], [_o("uv", "vec2")])
 _fn("panner", "Panner", "Coordinates", "Scrolls uv over time: uv + speed × seconds.",
-    [_i(*_UV), _i("speed", "vec2", [0.1, 0.0], "UV units per second")], [_o("uv", "vec2")])
+    [_i(*_UV), _i("speed", "vec2", [0.1, 0.0], "UV units per second")], [_o("uv", "vec2")],
+    impure=True, geometry=True)
 _fn("polar_coordinates", "Polar Coordinates", "Coordinates",
     "uv as (angle in turns, distance) about a centre: wraps patterns around a point.",
     [_i(*_UV), _i("center", "vec2", [0.5, 0.5])], [_o("uv", "vec2")])
 _fn("object_position", "Object Position", "Coordinates",
     "Surface position in the object's own space.", [], [_o("position", "vec3")],
-    mtlx=_mx("position"))
+    impure=True, geometry=True)
 _fn("tangent", "Tangent", "Coordinates",
     "World-space unit tangent (along +u), orthogonal to the normal.", [],
-    [_o("tangent", "vec3")], mtlx=_mx("tangent"))
+    [_o("tangent", "vec3")], impure=True, geometry=True)
 _fn("bitangent", "Bitangent", "Coordinates",
     "World-space unit bitangent (along +v), normal × tangent with the mesh's handedness.",
-    [], [_o("bitangent", "vec3")], mtlx=_mx("bitangent"))
+    [], [_o("bitangent", "vec3")], impure=True, geometry=True)
 _V3 = ("vector", "vec3", [0.0, 0.0, 1.0], "a direction")
 for _a, _b in (("tangent", "world"), ("world", "tangent"), ("object", "world"),
                ("world", "object"), ("world", "view"), ("view", "world")):
     _fn(f"{_a}_to_{_b}", f"{_a.title()} to {_b.title()}", "Coordinates",
         f"Transforms a direction from {_a} space to {_b} space.", [_i(*_V3)],
-        [_o("vector", "vec3")],
-        mtlx=_mx("transformvector", vector="in") if "tangent" not in (_a, _b) else None)
+        [_o("vector", "vec3")], impure=True, geometry=True)
 _fn("triplanar_mapping", "Triplanar Mapping", "Coordinates",
     "Three planar projections of world position (onto YZ, XZ and XY) and their blend "
     "weights from the normal: feed each UV to a procedural, then a Triplanar Blend.",
     [_i("scale", "float", 1.0, "repeats per metre", (0.0, 64.0)),
      _i("sharpness", "float", 4.0, "blend sharpness (higher: crisper seams)", (1.0, 64.0))],
-    [_o("uv_x", "vec2"), _o("uv_y", "vec2"), _o("uv_z", "vec2"), _o("weights", "vec3")])
+    [_o("uv_x", "vec2"), _o("uv_y", "vec2"), _o("uv_z", "vec2"), _o("weights", "vec3")],
+    impure=True, geometry=True)
 _op("triplanar_blend", "Triplanar Blend",
     "({x} * {weights}.x + {y} * {weights}.y + {z} * {weights}.z)",
     [_i("x", T), _i("y", T), _i("z", T), _i("weights", "vec3", [1 / 3] * 3, "", UNIT)],
@@ -317,7 +317,7 @@ _fn("triplanar_texture", "Triplanar Texture", "Texture",
     [_i("texture", "texture2d", None, "from a Texture Parameter", required=True),
      _i("scale", "float", 1.0, "repeats per metre", (0.0, 64.0)),
      _i("sharpness", "float", 4.0, "", (1.0, 64.0))],
-    [_o("rgba", "vec4"), _o("rgb", "vec3")], mtlx=_mx("triplanarprojection", texture="filex"))
+    [_o("rgba", "vec4"), _o("rgb", "vec3")], thumbnail=Thumbnail.ALWAYS, impure=True, geometry=True)
 
 # --- normals ---------------------------------------------------------------------------------
 _fn("normal_from_height", "Normal from Height", "Normal",
@@ -325,7 +325,7 @@ _fn("normal_from_height", "Normal from Height", "Normal",
     "mapping without a texture): strength is the relief depth, in UV units, of height 1.",
     [_i("height", "float", 0.0, "", UNIT),
      _i("strength", "float", 0.005, "relief depth in UV units", (0.0, 0.1))],
-    [_o("normal", "vec3")], mtlx=_mx("heighttonormal", height="in", strength="scale"))
+    [_o("normal", "vec3")], thumbnail=Thumbnail.ALWAYS)
 _fn("normal_strength", "Normal Strength", "Normal",
     "Scales a tangent-space normal's tilt (0: flat, 1: unchanged, 2: twice as steep).",
     [_i("normal", "vec3", [0.0, 0.0, 1.0]), _i("strength", "float", 1.0, "", (0.0, 4.0))],
@@ -339,25 +339,29 @@ _fn("fresnel", "Fresnel", "Mask",
     "Schlick's Fresnel of the geometric normal and view: base at normal incidence, 1 at "
     "grazing.",
     [_i("base", "float", 0.04, "reflectance facing the viewer", UNIT),
-     _i("exponent", "float", 5.0, "", (0.0, 16.0))], [_o("value", "float")])
+     _i("exponent", "float", 5.0, "", (0.0, 16.0))], [_o("value", "float")],
+    impure=True, geometry=True)
 _fn("facing_ratio", "Facing Ratio", "Mask",
     "N · V: 1 where the surface faces the camera, 0 at its silhouette.", [],
-    [_o("value", "float")])
+    [_o("value", "float")], impure=True, geometry=True)
 _fn("slope_mask", "Slope Mask", "Mask",
     "1 where the surface faces up (world normal · up above threshold): snow, dust, moss.",
     [_i("up", "vec3", [0.0, 1.0, 0.0]), _i("threshold", "float", 0.5, "cosine", (-1.0, 1.0)),
-     _i("softness", "float", 0.1, "", (0.0, 1.0))], [_o("mask", "float")])
+     _i("softness", "float", 0.1, "", (0.0, 1.0))], [_o("mask", "float")],
+    impure=True, geometry=True)
 _fn("height_mask", "Height Mask", "Mask",
     "0 below low, 1 above high along the up axis in world space: grime at the bottom, "
     "water lines.",
     [_i("up", "vec3", [0.0, 1.0, 0.0]), _i("low", "float", -1.0, "metres", (-10.0, 10.0)),
-     _i("high", "float", 1.0, "metres", (-10.0, 10.0))], [_o("mask", "float")])
+     _i("high", "float", 1.0, "metres", (-10.0, 10.0))], [_o("mask", "float")],
+    impure=True, geometry=True)
 _fn("curvature", "Curvature", "Mask",
     "Mean curvature of the surface from screen-space derivatives of its normal (1/m), and "
     "its convex and concave parts scaled into [0, 1]: edge wear and cavity dirt without "
     "baked maps.",
     [_i("scale", "float", 0.5, "metres: mask reaches 1 at curvature 1/scale", (0.0, 10.0))],
-    [_o("curvature", "float"), _o("convex", "float"), _o("concave", "float")])
+    [_o("curvature", "float"), _o("convex", "float"), _o("concave", "float")],
+    thumbnail=Thumbnail.ALWAYS, impure=True, geometry=True)
 
 # The kinds this module adds, in registration order.
 KINDS: tuple[str, ...] = tuple(k for k in REGISTRY if k not in _BEFORE)

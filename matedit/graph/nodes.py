@@ -1,9 +1,14 @@
 """Node definitions as data: the catalogue of node kinds.
 
 Each kind declares typed inputs (default, range, one-line doc), typed outputs, a
-category and a description for the palette, and the names of its GLSL function
-(`shaders/nodes/<kind>.glsl`) or inline template, and its numpy implementation.
-Adding a node kind touches no compiler code.
+category and a description for the palette, its implementations per target (the name
+of its GLSL function in `shaders/nodes/<kind>.glsl` or an inline template; its numpy
+twin is `matedit.compiler.cpu_nodes.IMPLS[kind]`; its MaterialX mapping, `mtlx`), and
+the facts code elsewhere needs: whether it is impure (not constant-foldable), when it
+shows a thumbnail, whether it is a parameter, and for the structural kinds whose
+semantics code must know, a `Role`. Code asks the definition (`definition(kind)`,
+`role_of(kind)`, `kind_for(role)`), never compares kind names, so adding a node kind
+touches no compiler, editor or exporter code.
 
 Types are PortType names or `T`, a generic float-or-vector type resolved per
 node from its connected inputs (a float input splats). A few kinds have ports
@@ -14,6 +19,7 @@ rules live in `matedit.graph.ports`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import Enum, auto
 from typing import Any
 
 GENERIC = "T"
@@ -54,6 +60,87 @@ class SettingDef:
     choices: tuple[str, ...] = ()
 
 
+class Role(Enum):
+    """The structural kinds whose meaning code must know (most kinds have no role)."""
+
+    CONSTANT = auto()
+    SCALAR_PARAMETER = auto()
+    VECTOR_PARAMETER = auto()
+    COLOR_PARAMETER = auto()
+    TEXTURE_PARAMETER = auto()
+    STATIC_SWITCH = auto()
+    COMPONENT_MASK = auto()
+    APPEND = auto()
+    REROUTE = auto()
+    TEXTURE_SAMPLE = auto()
+    COLOR_RAMP = auto()
+    MAKE_ATTRIBUTES = auto()
+    SET_ATTRIBUTES = auto()
+    MASK_BLEND = auto()  # blends two MaterialAttributes by a mask
+    HEIGHT_BLEND = auto()  # ... by height
+    FUNCTION_INPUT = auto()
+    FUNCTION_OUTPUT = auto()
+    FUNCTION_CALL = auto()
+    LAYER_STACK = auto()
+    MATERIAL_OUTPUT = auto()
+
+
+class Thumbnail(Enum):
+    """When the canvas shows a node's live preview thumbnail."""
+
+    NEVER = auto()  # the same everywhere, or not an image
+    SELECTED = auto()  # only while selected (most kinds: they would crowd the graph)
+    ALWAYS = auto()  # patterns, textures, materials
+
+
+class PortsRule(str, Enum):
+    """Ports that depend on a node's settings, a material function or its connections
+    (the rules live in `matedit.graph.ports`)."""
+
+    TYPE_SETTING = "type setting"  # one output of the type the settings name
+    FUNCTION_INPUT = "function input"
+    FUNCTION_OUTPUT = "function output"
+    FUNCTION_SIGNATURE = "function signature"  # the called function's inputs and outputs
+    LAYERS = "layers"  # one input per layer mask and layer input
+    ATTRIBUTE_FIELDS = "attribute fields"  # one input per overridden field
+    CHANNELS = "channels"  # output width from the chosen channels
+    COMPONENTS = "components"  # a float per component of the input
+    CONCATENATION = "concatenation"  # output width: the sum of the input widths
+    PASSTHROUGH = "passthrough"  # the output has the input's type
+
+    def __str__(self) -> str:
+        return self.value
+
+
+@dataclass(frozen=True)
+class MxNode:
+    """A MaterialX 1.39 stdlib node of `category`: `ports` maps our inputs to its inputs in
+    order, `fixed` adds constant inputs, `output` names its output. The exporter converts
+    every input to the op's result type first, so the same-type node definition is chosen."""
+
+    category: str
+    ports: tuple[tuple[str, str], ...]  # (our input, MaterialX input)
+    fixed: tuple[tuple[str, float], ...] = field(default_factory=tuple)
+    output: str = "out"
+
+
+@dataclass(frozen=True)
+class MxRecipe:
+    """A few stdlib nodes, built by `matedit.interop.mtlx_export` (the recipe of that name)
+    and read back by `matedit.interop.mtlx_import`."""
+
+    name: str
+
+
+# A kind's MaterialX mapping when no stdlib node or recipe expresses it: the exporter bakes
+# its outputs over UV space into images read by `image` nodes.
+BAKE = "bake"
+# ... when the compiler lowers the kind away before export (parameters become interface
+# inputs, constants values, functions inlined, layer stacks blends).
+LOWERED = "lowered"
+Mtlx = MxNode | MxRecipe | str
+
+
 @dataclass(frozen=True)
 class NodeDef:
     kind: str
@@ -65,15 +152,26 @@ class NodeDef:
     settings: tuple[SettingDef, ...] = ()
     glsl: str | None = None  # GLSL function name in shaders/nodes/<kind>.glsl
     inline: str | None = None  # inline GLSL template, e.g. "({a} + {b})"
-    numpy: str | None = None  # name of the numpy implementation
-    ports_rule: str | None = None  # dynamic ports, see matedit.graph.ports
+    ports_rule: PortsRule | None = None  # dynamic ports, see matedit.graph.ports
     # Extra value fields that are not ports (a parameter's value): edits are value edits.
     values: tuple[InputDef, ...] = ()
-    # Output type rule for generic nodes: "T" (same as inputs) or fixed per output.
-    keywords: tuple[str, ...] = field(default_factory=tuple)
-    # MaterialX standard-library equivalent: a node name (same port names) or
-    # {"node": name, "inputs": {our port: its input}, "outputs": {...}}; None: not expressible.
-    mtlx: str | dict[str, Any] | None = None
+    # MaterialX: an MxNode, an MxRecipe, BAKE (not expressible node for node) or LOWERED.
+    mtlx: Mtlx = BAKE
+    # Where `mtlx` is a recipe: the one stdlib node the importer also reads back as this
+    # kind (MaterialX's dotproduct as our dot, say).
+    mtlx_reads: MxNode | None = None
+    role: Role | None = None
+    # The compiler lowers the kind from the graph itself: no GLSL function, no numpy twin.
+    lowered: bool = False
+    # Its value depends on more than its inputs (geometry, time, textures, uniforms), so
+    # it is never constant-folded.
+    impure: bool = False
+    # It reads the surface's position, normal, view or time (not only its inputs and UVs).
+    geometry: bool = False
+    thumbnail: Thumbnail = Thumbnail.SELECTED
+    # A named parameter an instance may override: its instance type ("scalar", "vector",
+    # "color", "texture", "switch"); None: not a parameter.
+    parameter: str | None = None
 
     def input(self, name: str) -> InputDef | None:
         return next((i for i in self.inputs if i.name == name), None)
@@ -94,14 +192,62 @@ REGISTRY: dict[str, NodeDef] = {}
 def register(defn: NodeDef) -> NodeDef:
     if defn.kind in REGISTRY:
         raise ValueError(f"node kind {defn.kind!r} registered twice")
-    if (defn.glsl is None) == (defn.inline is None) and defn.ports_rule is None:
+    if (defn.glsl is None) == (defn.inline is None) and not defn.lowered:
         raise ValueError(f"node kind {defn.kind!r} needs exactly one of glsl= or inline=")
+    if defn.role is not None and any(d.role == defn.role for d in REGISTRY.values()):
+        raise ValueError(f"node kind {defn.kind!r}: role {defn.role.name} taken")
     REGISTRY[defn.kind] = defn
     return defn
 
 
 def get(kind: str) -> NodeDef | None:
     return REGISTRY.get(kind)
+
+
+def definition(kind: str) -> NodeDef:
+    """The definition of a registered kind (KeyError names an unknown one)."""
+    try:
+        return REGISTRY[kind]
+    except KeyError:
+        raise KeyError(f"unknown node kind {kind!r}") from None
+
+
+def role_of(kind: str) -> Role | None:
+    """The role of `kind`; None for kinds without one and for names that are no kind (the
+    compiler's own op names, say)."""
+    d = REGISTRY.get(kind)
+    return d.role if d is not None else None
+
+
+def kind_for(role: Role) -> str:
+    """The kind that plays `role`, to create a node of it (a new material's output, say)."""
+    for d in REGISTRY.values():
+        if d.role == role:
+            return d.kind
+    raise LookupError(f"no node kind has role {role.name}")
+
+
+def is_parameter(kind: str) -> bool:
+    """A named parameter an instance may override (static switches included)."""
+    d = REGISTRY.get(kind)
+    return d is not None and d.parameter is not None
+
+
+def is_value_parameter(kind: str) -> bool:
+    """A parameter that compiles to a uniform or a texture (not a static switch)."""
+    d = REGISTRY.get(kind)
+    return d is not None and d.parameter is not None and d.role != Role.STATIC_SWITCH
+
+
+def is_impure(kind: str) -> bool:
+    """Never constant-folded; names that are no kind (the compiler's ops) are pure."""
+    d = REGISTRY.get(kind)
+    return d is not None and d.impure
+
+
+def kinds_where(test) -> frozenset[str]:
+    """The kinds whose definition passes `test`."""
+    return frozenset(k for k, d in REGISTRY.items() if test(d))
 
 
 def categories() -> dict[str, list[NodeDef]]:
@@ -123,12 +269,20 @@ def _o(name, type_, doc="") -> OutputDef:
 
 
 def _op(kind, title, inline, inputs, doc, out_type=GENERIC, category="Math", glsl=None,
-        mtlx=None):
+        mtlx=BAKE, reads=None):
     register(NodeDef(
         kind=kind, title=title, category=category, description=doc,
         inputs=tuple(inputs), outputs=(_o("result", out_type),),
-        inline=inline if glsl is None else None, glsl=glsl, numpy=kind, mtlx=mtlx,
+        inline=inline if glsl is None else None, glsl=glsl, mtlx=mtlx, mtlx_reads=reads,
     ))
+
+
+def _bin(category: str) -> MxNode:
+    return MxNode(category, (("a", "in1"), ("b", "in2")))
+
+
+def _un(category: str) -> MxNode:
+    return MxNode(category, (("value", "in"),))
 
 
 T = GENERIC
@@ -141,7 +295,8 @@ register(NodeDef(
     settings=(SettingDef("type", "type", "float", "float, vec2, vec3 or vec4",
                          choices=("float", "vec2", "vec3", "vec4")),
               SettingDef("value", "value", 0.0, "the constant (a number or a list)")),
-    inline="{value}", numpy="constant", ports_rule="constant",
+    inline="{value}", ports_rule=PortsRule.TYPE_SETTING,
+    role=Role.CONSTANT, lowered=True, mtlx=LOWERED, thumbnail=Thumbnail.NEVER,
 ))
 _PARAM_SETTINGS = (
     SettingDef("name", "string", "param", "uniform name shown to artists"),
@@ -156,14 +311,16 @@ register(NodeDef(
         SettingDef("ui_max", "number", 1.0, "slider maximum", structural=False),
     ),
     values=(_i("value", "float", 0.5, "current value"),),
-    inline="{value}", numpy="parameter",
+    inline="{value}", role=Role.SCALAR_PARAMETER, parameter="scalar", lowered=True, mtlx=LOWERED,
+    thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
     "vector_parameter", "Vector Parameter", "Parameters", "A named vec4 uniform.",
     outputs=(_o("value", "vec4"), _o("xyz", "vec3")),
     settings=_PARAM_SETTINGS,
     values=(_i("value", "vec4", [0.0, 0.0, 0.0, 1.0], "current value"),),
-    glsl="node_vector_parameter", numpy="vector_parameter",
+    glsl="node_vector_parameter", role=Role.VECTOR_PARAMETER, parameter="vector",
+    mtlx=MxRecipe("vector_and_xyz"), impure=True, thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
     "color_parameter", "Colour Parameter", "Parameters",
@@ -171,7 +328,8 @@ register(NodeDef(
     outputs=(_o("color", "vec3"),),
     settings=_PARAM_SETTINGS,
     values=(_i("value", "vec3", [0.5, 0.5, 0.5], "linear RGB"),),
-    inline="{value}", numpy="parameter",
+    inline="{value}", role=Role.COLOR_PARAMETER, parameter="color", lowered=True, mtlx=LOWERED,
+    thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
     "texture_parameter", "Texture Parameter", "Parameters",
@@ -185,56 +343,78 @@ register(NodeDef(
                    "OpenColorIO space of OpenImageIO's built-in config (e.g. ACEScg); "
                    "empty: the srgb setting decides"),
     ),
-    inline="{texture}", numpy="texture_parameter",
+    inline="{texture}", role=Role.TEXTURE_PARAMETER, parameter="texture", lowered=True,
+    mtlx=LOWERED, thumbnail=Thumbnail.NEVER,
 ))
 
 # --- maths -----------------------------------------------------------------------------------
-_op("add", "Add", "({a} + {b})", [_i("a", T), _i("b", T)], "a + b, per component.")
-_op("subtract", "Subtract", "({a} - {b})", [_i("a", T), _i("b", T)], "a − b, per component.")
+_op("add", "Add", "({a} + {b})", [_i("a", T), _i("b", T)], "a + b, per component.",
+    mtlx=_bin("add"))
+_op("subtract", "Subtract", "({a} - {b})", [_i("a", T), _i("b", T)], "a − b, per component.",
+    mtlx=_bin("subtract"))
 _op("multiply", "Multiply", "({a} * {b})", [_i("a", T, 1.0), _i("b", T, 1.0)],
-    "a × b, per component.")
+    "a × b, per component.", mtlx=_bin("multiply"))
 _op("divide", "Divide", "({a} / {b})", [_i("a", T, 1.0), _i("b", T, 1.0)],
-    "a ÷ b, per component (division by zero gives the GPU's infinity).")
+    "a ÷ b, per component (division by zero gives the GPU's infinity).",
+    mtlx=_bin("divide"))
 _op("lerp", "Lerp", "mix({a}, {b}, {alpha})",
     [_i("a", T), _i("b", T, 1.0), _i("alpha", T, 0.5, "blend factor", UNIT)],
-    "Linear interpolation: a at alpha 0, b at alpha 1.")
+    "Linear interpolation: a at alpha 0, b at alpha 1.",
+    mtlx=MxNode("mix", (("a", "bg"), ("b", "fg"), ("alpha", "mix"))))
 _op("clamp", "Clamp", "clamp({value}, {min}, {max})",
-    [_i("value", T), _i("min", T, 0.0), _i("max", T, 1.0)], "Clamps value into [min, max].")
+    [_i("value", T), _i("min", T, 0.0), _i("max", T, 1.0)], "Clamps value into [min, max].",
+    mtlx=MxNode("clamp", (("value", "in"), ("min", "low"), ("max", "high"))))
 _op("saturate", "Saturate", "clamp({value}, 0.0, 1.0)", [_i("value", T)],
-    "Clamps value into [0, 1].")
-_op("one_minus", "One Minus", "(1.0 - {value})", [_i("value", T)], "1 − value.")
+    "Clamps value into [0, 1].",
+    mtlx=MxNode("clamp", (("value", "in"),), (("low", 0.0), ("high", 1.0))))
+_op("one_minus", "One Minus", "(1.0 - {value})", [_i("value", T)], "1 − value.",
+    mtlx=MxRecipe("subtract_from_one"))  # subtract(1, value)
 _op("power", "Power", "pow(max({base}, 0.0), {exponent})",
     [_i("base", T, 1.0), _i("exponent", T, 1.0)],
-    "base raised to exponent; negative bases clamp to 0 (GLSL's pow is undefined there).")
-_op("abs", "Abs", "abs({value})", [_i("value", T)], "Absolute value.")
-_op("min", "Min", "min({a}, {b})", [_i("a", T), _i("b", T)], "Smaller of a and b.")
-_op("max", "Max", "max({a}, {b})", [_i("a", T), _i("b", T)], "Larger of a and b.")
+    "base raised to exponent; negative bases clamp to 0 (GLSL's pow is undefined there).",
+    mtlx=MxRecipe("positive_power"),
+    reads=MxNode("power", (("base", "in1"), ("exponent", "in2"))))  # power(max(base, 0), exponent)
+_op("abs", "Abs", "abs({value})", [_i("value", T)], "Absolute value.", mtlx=_un("absval"))
+_op("min", "Min", "min({a}, {b})", [_i("a", T), _i("b", T)], "Smaller of a and b.",
+    mtlx=_bin("min"))
+_op("max", "Max", "max({a}, {b})", [_i("a", T), _i("b", T)], "Larger of a and b.",
+    mtlx=_bin("max"))
 _op("dot", "Dot", "dot({a}, {b})", [_i("a", T), _i("b", T)], "Dot product.", out_type="float",
-    category="Vector")
+    category="Vector", mtlx=MxRecipe("dot_or_multiply"), reads=_bin("dotproduct"))
 _op("cross", "Cross", "cross({a}, {b})",
     [_i("a", "vec3", [1.0, 0.0, 0.0]), _i("b", "vec3", [0.0, 1.0, 0.0])],
-    "Cross product of two vec3.", out_type="vec3", category="Vector")
+    "Cross product of two vec3.", out_type="vec3", category="Vector",
+    mtlx=_bin("crossproduct"))
 _op("normalize", "Normalize", None, [_i("value", T, 1.0)],
     "Unit vector in the direction of value (zero stays zero).", category="Vector",
-    glsl="node_normalize")
+    glsl="node_normalize", mtlx=MxRecipe("normalize_vector"),
+    reads=_un("normalize"))
 _op("length", "Length", "length({value})", [_i("value", T)], "Euclidean length.",
-    out_type="float", category="Vector")
+    out_type="float", category="Vector", mtlx=MxRecipe("magnitude_or_absval"),
+    reads=_un("magnitude"))  # magnitude, or absval
 _op("sqrt", "Square Root", "sqrt(max({value}, 0.0))", [_i("value", T, 1.0)],
-    "Square root; negative input clamps to 0.")
-_op("sin", "Sine", "sin({value})", [_i("value", T)], "Sine of radians.")
-_op("cos", "Cosine", "cos({value})", [_i("value", T)], "Cosine of radians.")
-_op("frac", "Frac", "fract({value})", [_i("value", T)], "Fractional part, value − floor(value).")
-_op("floor", "Floor", "floor({value})", [_i("value", T)], "Largest integer not above value.")
+    "Square root; negative input clamps to 0.",
+    mtlx=MxRecipe("positive_sqrt"), reads=_un("sqrt"))  # sqrt(max(value, 0))
+_op("sin", "Sine", "sin({value})", [_i("value", T)], "Sine of radians.", mtlx=_un("sin"))
+_op("cos", "Cosine", "cos({value})", [_i("value", T)], "Cosine of radians.", mtlx=_un("cos"))
+_op("frac", "Frac", "fract({value})", [_i("value", T)], "Fractional part, value − floor(value).",
+    mtlx=MxNode("modulo", (("value", "in1"),), (("in2", 1.0),)))  # x - floor(x)
+_op("floor", "Floor", "floor({value})", [_i("value", T)], "Largest integer not above value.",
+    mtlx=_un("floor"))
 _op("step", "Step", "step({edge}, {value})", [_i("edge", T, 0.5), _i("value", T)],
-    "0 below edge, 1 at or above it.")
+    "0 below edge, 1 at or above it.",
+    mtlx=MxRecipe("floor_step"))  # clamp(floor(value - edge) + 1, 0, 1)
 _op("smoothstep", "Smooth Step", "smoothstep({edge0}, {edge1}, {value})",
     [_i("edge0", T, 0.0), _i("edge1", T, 1.0), _i("value", T)],
-    "Hermite ramp from 0 at edge0 to 1 at edge1.")
+    "Hermite ramp from 0 at edge0 to 1 at edge1.",
+    mtlx=MxNode("smoothstep", (("value", "in"), ("edge0", "low"), ("edge1", "high"))))
 _op("remap", "Remap", None,
     [_i("value", T), _i("in_min", T, 0.0), _i("in_max", T, 1.0),
      _i("out_min", T, 0.0), _i("out_max", T, 1.0)],
     "Maps value linearly from [in_min, in_max] to [out_min, out_max], unclamped.",
-    glsl="node_remap")
+    glsl="node_remap",
+    mtlx=MxNode("remap", (("value", "in"), ("in_min", "inlow"), ("in_max", "inhigh"),
+                          ("out_min", "outlow"), ("out_max", "outhigh"))))
 
 # --- vectors ---------------------------------------------------------------------------------
 register(NodeDef(
@@ -242,29 +422,33 @@ register(NodeDef(
     "Keeps the chosen channels of a vector (e.g. 'xy', 'b', 'rgb').",
     inputs=(_i("value", T),), outputs=(_o("result", T),),
     settings=(SettingDef("channels", "channels", "xy", "up to 4 of x y z w (or r g b a)"),),
-    inline="{value}.{channels}", numpy="component_mask", ports_rule="component_mask",
+    inline="{value}.{channels}", ports_rule=PortsRule.CHANNELS,
+    role=Role.COMPONENT_MASK, lowered=True, mtlx=MxRecipe("mask"),  # extract / combineN
 ))
 register(NodeDef(
     "split", "Split", "Vector", "Splits a vector into its components (missing ones read 0).",
     inputs=(_i("value", "vec4"),),
     outputs=(_o("x", "float"), _o("y", "float"), _o("z", "float"), _o("w", "float")),
-    glsl="node_split", numpy="split", ports_rule="split",
+    glsl="node_split", ports_rule=PortsRule.COMPONENTS,
+    mtlx=MxRecipe("extract_each"),  # extract per component
 ))
 register(NodeDef(
     "append", "Append", "Vector", "Concatenates two values into a longer vector (up to 4).",
     inputs=(_i("a", T), _i("b", T)), outputs=(_o("result", T),),
-    inline="{result_type}({a}, {b})", numpy="append", ports_rule="append",
+    inline="{result_type}({a}, {b})", ports_rule=PortsRule.CONCATENATION,
+    role=Role.APPEND, lowered=True, mtlx=MxRecipe("concatenate"),  # extract / combineN
 ))
 register(NodeDef(
     "combine", "Combine", "Vector", "Builds vectors from four scalars.",
     inputs=(_i("x", "float"), _i("y", "float"), _i("z", "float"), _i("w", "float", 1.0)),
     outputs=(_o("xy", "vec2"), _o("xyz", "vec3"), _o("xyzw", "vec4")),
-    glsl="node_combine", numpy="combine",
+    glsl="node_combine", mtlx=MxRecipe("combine_n"),  # combine2/3/4
 ))
 register(NodeDef(
     "reroute", "Reroute", "Utility", "A wire waypoint; passes its value through.",
     inputs=(_i("value", T),), outputs=(_o("value", T),),
-    inline="{value}", numpy="reroute", ports_rule="reroute",
+    inline="{value}", ports_rule=PortsRule.PASSTHROUGH,
+    role=Role.REROUTE, lowered=True, mtlx=LOWERED, thumbnail=Thumbnail.NEVER,
 ))
 
 # --- geometry --------------------------------------------------------------------------------
@@ -274,22 +458,26 @@ register(NodeDef(
     inputs=(_i("tiling", "vec2", [1.0, 1.0], "repeats across the surface"),
             _i("offset", "vec2", [0.0, 0.0], "shift in UV units")),
     outputs=(_o("uv", "vec2"),),
-    glsl="node_texcoord", numpy="texcoord",
+    glsl="node_texcoord", impure=True,
+    mtlx=MxRecipe("tiled_texcoord"),  # texcoord * tiling + offset
 ))
 register(NodeDef("world_position", "World Position", "Coordinates",
                  "Surface position in world space (metres).",
                  outputs=(_o("position", "vec3"),), glsl="node_world_position",
-                 numpy="world_position"))
+                 impure=True, geometry=True, mtlx=MxNode("position", ())))
 register(NodeDef("world_normal", "World Normal", "Coordinates",
                  "Interpolated geometric normal in world space (before normal maps).",
                  outputs=(_o("normal", "vec3"),), glsl="node_world_normal",
-                 numpy="world_normal"))
+                 impure=True, geometry=True, mtlx=MxNode("normal", ())))
 register(NodeDef("view_direction", "View Direction", "Coordinates",
                  "Unit vector from the surface towards the camera, world space.",
                  outputs=(_o("direction", "vec3"),), glsl="node_view_direction",
-                 numpy="view_direction"))
+                 impure=True, geometry=True,
+                 mtlx=MxRecipe("negated_viewdirection")))  # -viewdirection: ours points at the eye
 register(NodeDef("time", "Time", "Coordinates", "Seconds since the preview started.",
-                 outputs=(_o("seconds", "float"),), glsl="node_time", numpy="time"))
+                 outputs=(_o("seconds", "float"),), glsl="node_time",
+                 impure=True, geometry=True, thumbnail=Thumbnail.NEVER,
+                 mtlx=MxNode("time", ())))
 
 # --- textures and procedurals ----------------------------------------------------------------
 register(NodeDef(
@@ -298,7 +486,8 @@ register(NodeDef(
             _i("uv", "vec2", MESH_UV, "texture coordinates")),
     outputs=(_o("rgba", "vec4"), _o("rgb", "vec3"), _o("r", "float"), _o("g", "float"),
              _o("b", "float"), _o("a", "float")),
-    glsl="node_texture_sample", numpy="texture_sample",
+    glsl="node_texture_sample", role=Role.TEXTURE_SAMPLE, impure=True,
+    thumbnail=Thumbnail.ALWAYS, mtlx=MxRecipe("image_read"),  # image (vector4)
 ))
 register(NodeDef(
     "value_noise", "Value Noise", "Procedural",
@@ -306,7 +495,8 @@ register(NodeDef(
     inputs=(_i("uv", "vec2", MESH_UV), _i("scale", "float", 8.0, "cells per UV unit", (0.0, 64.0)),
             _i("octaves", "float", 3.0, "detail levels (1-6)", (1.0, 6.0))),
     outputs=(_o("value", "float"),),
-    glsl="node_value_noise", numpy="value_noise",
+    glsl="node_value_noise", thumbnail=Thumbnail.ALWAYS,
+    mtlx=BAKE,  # our PCG-hash lattice noise: the stdlib has no integer hash
 ))
 register(NodeDef(
     "checker", "Checker", "Procedural",
@@ -315,13 +505,15 @@ register(NodeDef(
             _i("color_a", "vec3", [0.9, 0.9, 0.9]), _i("color_b", "vec3", [0.1, 0.1, 0.1]),
             _i("filter_width", "float", 1.0, "edge blur in pixels (0: hard edges)", (0.0, 4.0))),
     outputs=(_o("color", "vec3"), _o("mask", "float")),
-    glsl="node_checker", numpy="checker",
+    glsl="node_checker", thumbnail=Thumbnail.ALWAYS,
+    mtlx=MxRecipe("checkerboard"),  # modulo(floor(u s) + floor(v s), 2) into a mix
 ))
 register(NodeDef(
     "gradient", "Gradient", "Procedural", "Linear ramp 0→1 across uv along an angle.",
     inputs=(_i("uv", "vec2", MESH_UV), _i("angle", "float", 0.0, "degrees", (0.0, 360.0))),
     outputs=(_o("value", "float"),),
-    glsl="node_gradient", numpy="gradient",
+    glsl="node_gradient", thumbnail=Thumbnail.ALWAYS,
+    mtlx=MxRecipe("linear_ramp"),  # clamp(dot(uv - 0.5, d) / (|dx| + |dy|) + 0.5)
 ))
 
 # --- normals ---------------------------------------------------------------------------------
@@ -330,21 +522,23 @@ register(NodeDef(
     "Tangent-space normal from a normal-map texel in [0, 1] (OpenGL convention, +Y up).",
     inputs=(_i("packed", "vec3", [0.5, 0.5, 1.0]), _i("strength", "float", 1.0, "", (0.0, 2.0))),
     outputs=(_o("normal", "vec3"),),
-    glsl="node_unpack_normal", numpy="unpack_normal",
+    glsl="node_unpack_normal",
+    mtlx=MxRecipe("decode_normal"),  # normalize((2 p - 1) * (s, s, 1))
 ))
 register(NodeDef(
     "blend_normals", "Blend Normals", "Normal",
     "Detail normal on a base normal by reoriented normal mapping (Barré-Brisebois & Hill 2012).",
     inputs=(_i("base", "vec3", [0.0, 0.0, 1.0]), _i("detail", "vec3", [0.0, 0.0, 1.0])),
     outputs=(_o("normal", "vec3"),),
-    glsl="node_blend_normals", numpy="blend_normals",
+    glsl="node_blend_normals", mtlx=MxRecipe("reoriented_normals"),  # reoriented normal mapping
 ))
 register(NodeDef(
     "flatten_normal", "Flatten Normal", "Normal",
     "Moves a tangent-space normal towards (0, 0, 1) by flatness.",
     inputs=(_i("normal", "vec3", [0.0, 0.0, 1.0]), _i("flatness", "float", 0.5, "", UNIT)),
     outputs=(_o("normal", "vec3"),),
-    glsl="node_flatten_normal", numpy="flatten_normal",
+    glsl="node_flatten_normal",
+    mtlx=MxRecipe("mix_towards_z"),  # normalize(mix(n, +Z, flatness))
 ))
 
 # --- material attributes ---------------------------------------------------------------------
@@ -363,14 +557,15 @@ register(NodeDef(
     "make_attributes", "Make Material Attributes", "Material",
     "Builds a MaterialAttributes from its seven fields.",
     inputs=ATTRIBUTE_FIELDS, outputs=(_o("attributes", MA),),
-    glsl="node_make_attributes", numpy="make_attributes",
+    glsl="node_make_attributes", role=Role.MAKE_ATTRIBUTES, thumbnail=Thumbnail.ALWAYS,
+    mtlx=MxRecipe("attributes"),
 ))
 register(NodeDef(
     "break_attributes", "Break Material Attributes", "Material",
     "Splits a MaterialAttributes into its fields.",
     inputs=(_i("attributes", MA, None, required=True),),
     outputs=tuple(_o(f.name, f.type) for f in ATTRIBUTE_FIELDS),
-    glsl="node_break_attributes", numpy="break_attributes",
+    glsl="node_break_attributes", mtlx=MxRecipe("attributes"),
 ))
 register(NodeDef(
     "set_attributes", "Set Material Attributes", "Material",
@@ -378,7 +573,8 @@ register(NodeDef(
     inputs=(_i("attributes", MA, None, required=True),),
     outputs=(_o("attributes", MA),),
     settings=(SettingDef("fields", "list", ["baseColor"], "fields to override"),),
-    inline="", numpy="set_attributes", ports_rule="set_attributes",
+    ports_rule=PortsRule.ATTRIBUTE_FIELDS, role=Role.SET_ATTRIBUTES, lowered=True,
+    mtlx=MxRecipe("attributes"),
 ))
 register(NodeDef(
     "layer_blend", "Layer Blend (mask)", "Layers",
@@ -386,7 +582,8 @@ register(NodeDef(
     inputs=(_i("base", MA, None, required=True), _i("layer", MA, None, required=True),
             _i("mask", "float", 1.0, "layer coverage", UNIT)),
     outputs=(_o("result", MA),),
-    glsl="node_layer_blend", numpy="layer_blend",
+    glsl="node_layer_blend", role=Role.MASK_BLEND, thumbnail=Thumbnail.ALWAYS,
+    mtlx=MxRecipe("blend"),  # a mix per field, the normal normalised
 ))
 register(NodeDef(
     "height_blend", "Layer Blend (height)", "Layers",
@@ -397,7 +594,8 @@ register(NodeDef(
             _i("layer_height", "float", 0.5, "height of the layer (e.g. its mask)", UNIT),
             _i("contrast", "float", 0.1, "transition width", (0.001, 1.0))),
     outputs=(_o("result", MA),),
-    glsl="node_height_blend", numpy="height_blend",
+    glsl="node_height_blend", role=Role.HEIGHT_BLEND, thumbnail=Thumbnail.ALWAYS,
+    mtlx=MxRecipe("blend"),  # smoothstep(-c, c, dh) as the blend factor
 ))
 
 # --- functions, layers, output ---------------------------------------------------------------
@@ -410,7 +608,7 @@ register(NodeDef(
                          choices=("float", "vec2", "vec3", "vec4", MA, "texture2d")),
               SettingDef("default", "value", 0.0, "value when the caller leaves it unconnected"),
               SettingDef("order", "number", 0, "position among the inputs", structural=True)),
-    inline="", numpy="function_input", ports_rule="function_input",
+    ports_rule=PortsRule.FUNCTION_INPUT, role=Role.FUNCTION_INPUT, lowered=True, mtlx=LOWERED,
 ))
 register(NodeDef(
     "function_output", "Function Output", "Function",
@@ -420,13 +618,15 @@ register(NodeDef(
               SettingDef("type", "type", "float", "output type",
                          choices=("float", "vec2", "vec3", "vec4", MA)),
               SettingDef("order", "number", 0, "position among the outputs")),
-    inline="", numpy="function_output", ports_rule="function_output",
+    ports_rule=PortsRule.FUNCTION_OUTPUT, role=Role.FUNCTION_OUTPUT, lowered=True, mtlx=LOWERED,
+    thumbnail=Thumbnail.NEVER,
 ))
 register(NodeDef(
     "function_call", "Function Call", "Function",
     "Calls a material function stored in its own file.",
     settings=(SettingDef("function", "path", "", "function file, relative to this file"),),
-    inline="", numpy="function_call", ports_rule="function_call",
+    ports_rule=PortsRule.FUNCTION_SIGNATURE, role=Role.FUNCTION_CALL, lowered=True, mtlx=LOWERED,
+    thumbnail=Thumbnail.ALWAYS,
 ))
 register(NodeDef(
     "layer_stack", "Layer Stack", "Layers",
@@ -434,13 +634,14 @@ register(NodeDef(
     "compiles to blends of attributes and one shading evaluation.",
     outputs=(_o("attributes", MA),),
     settings=(SettingDef("layers", "list", [], "base layer first, then the layers above"),),
-    inline="", numpy="layer_stack", ports_rule="layer_stack",
+    ports_rule=PortsRule.LAYERS, role=Role.LAYER_STACK, lowered=True, mtlx=LOWERED,
+    thumbnail=Thumbnail.ALWAYS,
 ))
 register(NodeDef(
     "material_output", "Material Output", "Output",
     "The material's result: one MaterialAttributes, shaded once.",
     inputs=(_i("attributes", MA, None, required=True),),
-    inline="", numpy="material_output",
+    role=Role.MATERIAL_OUTPUT, lowered=True, mtlx=LOWERED, thumbnail=Thumbnail.NEVER,
 ))
 
 # --- instances: static switches and parameter presentation (issue 14) ----------------------
@@ -456,9 +657,9 @@ register(NodeDef(
     settings=_PARAM_SETTINGS + (
         SettingDef("value", "bool", True, "on: use the 'true' input; structural"),),
     inline="{true}",  # never emitted: matedit.compiler.lower chooses the branch
+    role=Role.STATIC_SWITCH, parameter="switch", lowered=True, mtlx=LOWERED,
 ))
-PARAMETER_KINDS = ("scalar_parameter", "vector_parameter", "color_parameter",
-                   "texture_parameter", "static_switch")
+PARAMETER_KINDS = tuple(k for k, d in REGISTRY.items() if d.parameter is not None)
 _PRESENTATION = {
     "*": (SettingDef("order", "number", 0, "position within its group", structural=False),
           SettingDef("tooltip", "string", "", "help shown in parameter panels",

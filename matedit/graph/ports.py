@@ -14,7 +14,7 @@ from typing import Any, Protocol
 from matedit.graph import nodes
 from matedit.graph.model import MaterialDocument, Node
 from matedit.graph.names import identifier_problem
-from matedit.graph.nodes import GENERIC, MA
+from matedit.graph.nodes import GENERIC, MA, PortsRule, Role, role_of
 from matedit.graph.types import PortType, parse_type
 
 
@@ -84,7 +84,8 @@ def function_interface(doc: MaterialDocument) -> NodePorts:
     """A function's inputs and outputs, from its function_input/function_output nodes."""
     ins, outs = [], []
     for node in doc.graph.nodes.values():
-        if node.kind not in ("function_input", "function_output"):
+        role = role_of(node.kind)
+        if role not in (Role.FUNCTION_INPUT, Role.FUNCTION_OUTPUT):
             continue
         s = {**nodes.REGISTRY[node.kind].setting_defaults(), **node.settings}
         try:
@@ -97,9 +98,10 @@ def function_interface(doc: MaterialDocument) -> NodePorts:
         why = identifier_problem(s["name"])
         if why:
             where = f" in {Path(doc.path).name}" if doc.path else ""
-            raise PortError(node.id, "name", f"function {node.kind.split('_')[1]} name "
+            side = "input" if role == Role.FUNCTION_INPUT else "output"
+            raise PortError(node.id, "name", f"function {side} name "
                             f"{s['name']!r}{where} {why}")
-        if node.kind == "function_input":
+        if role == Role.FUNCTION_INPUT:
             ins.append((key, PortSpec(str(s["name"]), t, s.get("default"), None,
                                       f"function input {s['name']}", t in (MA, "texture2d")
                                       and s.get("default") is None)))
@@ -114,7 +116,8 @@ def layer_entries(node: Node) -> list[dict]:
     return layers if isinstance(layers, list) else []
 
 
-_STATIC_RULES = ("component_mask", "split", "append", "reroute")
+_STATIC_RULES = (PortsRule.CHANNELS, PortsRule.COMPONENTS, PortsRule.CONCATENATION,
+                 PortsRule.PASSTHROUGH)
 _STATIC: dict[str, NodePorts] = {}
 
 
@@ -141,7 +144,7 @@ def node_ports(
     ins = tuple(_spec(i) for i in d.inputs)
     outs = tuple(_spec(o) for o in d.outputs)
     s = {**d.setting_defaults(), **node.settings}
-    if rule == "constant":
+    if rule == PortsRule.TYPE_SETTING:
         try:
             t = parse_type(str(s["type"]))
         except ValueError as exc:
@@ -149,19 +152,19 @@ def node_ports(
         if not t.is_numeric:
             raise PortError(node.id, "type", "a constant must be float, vec2, vec3 or vec4")
         return NodePorts((), (PortSpec("value", t.value),))
-    if rule == "function_input":
+    if rule == PortsRule.FUNCTION_INPUT:
         try:
             t = parse_type(str(s["type"])).value
         except ValueError as exc:
             raise PortError(node.id, "type", str(exc)) from None
         return NodePorts((), (PortSpec("value", t),))
-    if rule == "function_output":
+    if rule == PortsRule.FUNCTION_OUTPUT:
         try:
             t = parse_type(str(s["type"])).value
         except ValueError as exc:
             raise PortError(node.id, "type", str(exc)) from None
         return NodePorts((PortSpec("value", t, None, required=True),), ())
-    if rule == "set_attributes":
+    if rule == PortsRule.ATTRIBUTE_FIELDS:
         fields = s.get("fields")
         if not isinstance(fields, list) or not all(isinstance(f, str) for f in fields):
             raise PortError(node.id, "fields", "fields must be a list of attribute names")
@@ -173,7 +176,7 @@ def node_ports(
                                 f"{', '.join(nodes.ATTRIBUTE_NAMES)})")
             extra.append(_spec(fd))
         return NodePorts(ins + tuple(extra), outs)
-    if rule == "function_call":
+    if rule == PortsRule.FUNCTION_SIGNATURE:
         ref = s.get("function")
         if not ref or not isinstance(ref, str):
             raise PortError(node.id, "function", "no function file chosen")
@@ -181,7 +184,7 @@ def node_ports(
             raise LookupError(f"cannot resolve function {ref!r} without a resolver")
         fn = resolver.resolve(ref, owner)
         return function_interface(fn)
-    if rule == "layer_stack":
+    if rule == PortsRule.LAYERS:
         return NodePorts(tuple(_layer_stack_inputs(node, resolver, owner)), outs)
     raise PortError(node.id, "kind", f"node kind {node.kind!r} has an unknown ports rule")
 
@@ -291,7 +294,7 @@ def resolve_types(
         return None if spec.type == GENERIC else PortType(spec.type)
 
     in_types: dict[str, PortType] = {}
-    if rule == "append":
+    if rule == PortsRule.CONCATENATION:
         sizes = {}
         for p in ports.inputs:
             t = connected.get(p.name) or _default_type(node.values.get(p.name, p.default))
@@ -304,7 +307,7 @@ def resolve_types(
             raise ValueError(f"append makes at most 4 components, got {total}")
         return in_types, {"result": {2: PortType.VEC2, 3: PortType.VEC3,
                                      4: PortType.VEC4}[total]}
-    if rule == "reroute":
+    if rule == PortsRule.PASSTHROUGH:
         t = connected.get("value") or _default_type(node.values.get("value", 0.0))
         return {"value": t}, {"value": t}
 
@@ -329,7 +332,7 @@ def resolve_types(
         in_types[p.name] = generic if p.type == GENERIC else PortType(p.type)
 
     out_types: dict[str, PortType] = {}
-    if rule == "component_mask":
+    if rule == PortsRule.CHANNELS:
         channels = normalize_channels(node.settings.get("channels", "xy"))
         n = generic.components
         if any(_VALID_CHANNELS.index(c) >= n for c in channels):
@@ -337,7 +340,7 @@ def resolve_types(
         out_types["result"] = {1: PortType.FLOAT, 2: PortType.VEC2, 3: PortType.VEC3,
                                4: PortType.VEC4}[len(channels)]
         return in_types, out_types
-    if rule == "split":
+    if rule == PortsRule.COMPONENTS:
         t = connected.get("value") or PortType.VEC4
         if not t.is_numeric:
             raise ValueError(f"split takes a float or a vector, got {t}")

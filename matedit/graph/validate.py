@@ -57,7 +57,7 @@ class Diagnostic:
 # value through, so they have none of their own.
 _UNCONNECTED_DEFAULT = {PortType.MATERIAL: "the default material attributes",
                         PortType.TEXTURE: "a checker texture"}
-_NO_DEFAULT = {"reroute", "function_output"}
+_NO_DEFAULT = {nodes.Role.REROUTE, nodes.Role.FUNCTION_OUTPUT}
 
 
 def error(msg, node=None, port=None, file=None) -> Diagnostic:
@@ -196,7 +196,8 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             if spec.required or (t is not None and not t.is_numeric):
                 if blocked:
                     continue
-                fallback = _UNCONNECTED_DEFAULT.get(t) if node.kind not in _NO_DEFAULT else None
+                passes_on = nodes.role_of(node.kind) in _NO_DEFAULT
+                fallback = None if passes_on else _UNCONNECTED_DEFAULT.get(t)
                 if fallback is not None:  # the rest of the graph keeps compiling
                     diags.append(warning(f"input {spec.name!r} ({t}) is not connected: it "
                                          f"uses {fallback}", nid, spec.name, f))
@@ -216,7 +217,7 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
                     coerce_value(PortType(vf.type), node.values[vf.name])
                 except ValueError as exc:
                     diags.append(error(str(exc), nid, vf.name, f))
-        if node.kind == "constant":
+        if d.role == nodes.Role.CONSTANT:
             try:
                 coerce_value(outs["value"], node.settings.get("value", 0.0))
             except ValueError as exc:
@@ -234,17 +235,18 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
 
 def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
     diags = []
-    kinds = [n.kind for n in doc.graph.nodes.values()]
+    R = nodes.Role
+    roles = [nodes.role_of(n.kind) for n in doc.graph.nodes.values()]
     if doc.is_function:
-        if "function_output" not in kinds:
+        if R.FUNCTION_OUTPUT not in roles:
             diags.append(error("a material function needs at least one Function Output node",
                                file=f))
-        if "material_output" in kinds:
+        if R.MATERIAL_OUTPUT in roles:
             diags.append(error("a material function cannot contain a Material Output node",
                                file=f))
         names: dict[tuple[str, str], str] = {}
         for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
-            if n.kind in ("function_input", "function_output"):
+            if nodes.role_of(n.kind) in (R.FUNCTION_INPUT, R.FUNCTION_OUTPUT):
                 key = (n.kind, str(n.settings.get("name", "")))
                 if key in names:
                     diags.append(error(f"two {n.kind.replace('_', ' ')}s named {key[1]!r} "
@@ -253,20 +255,21 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                 why = identifier_problem(n.settings.get("name", ""))
                 if why:
                     diags.append(error(f"name {key[1]!r} {why}", n.id, "name", f))
-                if n.kind == "function_input":
+                if nodes.role_of(n.kind) == R.FUNCTION_INPUT:
                     diags.extend(_check_input_default(n, f))
     else:
-        outs = [n.id for n in doc.graph.nodes.values() if n.kind == "material_output"]
+        outs = [n.id for n in doc.graph.nodes.values()
+                if nodes.role_of(n.kind) == R.MATERIAL_OUTPUT]
         if len(outs) != 1:
             diags.append(error(f"a material needs exactly one Material Output node, "
                                f"found {len(outs)}", file=f))
         for n in doc.graph.nodes.values():
-            if n.kind in ("function_input", "function_output"):
+            if nodes.role_of(n.kind) in (R.FUNCTION_INPUT, R.FUNCTION_OUTPUT):
                 diags.append(error("function inputs and outputs belong in material functions",
                                    n.id, None, f))
     params: dict[str, str] = {}
     for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
-        if n.kind == "texture_parameter":
+        if nodes.role_of(n.kind) == R.TEXTURE_PARAMETER:
             tex = n.settings.get("path", "")
             if isinstance(tex, str) and tex:
                 base = Path(doc.path).parent if doc.path else Path.cwd()
@@ -286,7 +289,7 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                 if not found:
                     diags.append(warning(f"texture file {tex!r} not found; it shows as a checker",
                                          n.id, "path", f))
-        if n.kind.endswith("_parameter"):
+        if nodes.is_value_parameter(n.kind):
             name = str(n.settings.get("name", ""))
             why = identifier_problem(n.settings.get("name", ""))
             if why:
@@ -323,9 +326,10 @@ def function_refs(doc: MaterialDocument) -> list[tuple[str, str]]:
     """(node id, function file) for every function a document uses directly."""
     refs = []
     for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
-        if n.kind == "function_call" and isinstance(n.settings.get("function"), str):
+        role = nodes.role_of(n.kind)
+        if role == nodes.Role.FUNCTION_CALL and isinstance(n.settings.get("function"), str):
             refs.append((n.id, n.settings["function"]))
-        elif n.kind == "layer_stack":
+        elif role == nodes.Role.LAYER_STACK:
             for e in layer_entries(n):
                 if isinstance(e, dict):
                     for key in ("function", "blend"):

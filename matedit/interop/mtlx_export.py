@@ -11,9 +11,10 @@ scales the dielectric reflection). open_pbr_surface would do as well, but is new
 widely implemented; the importer reads both.
 
 The graph comes from the lowered IR (matedit.compiler.lower), before optimisation, so the
-nodes are ours, one for one where matedit.interop.mtlx_map has a mapping: material function
-calls are inlined (their nodes named CALL_NODE), layer stacks are their blends, parameters are
-the nodegraph's interface inputs, other unconnected inputs are values. What cannot be
+nodes are ours, one for one where the catalogue has a mapping (NodeDef.mtlx, read through
+matedit.interop.mtlx_map): material function calls are inlined (their nodes named
+CALL_NODE), layer stacks are their blends, parameters are the nodegraph's interface inputs,
+other unconnected inputs are values. What cannot be
 expressed (`BAKE` in the map) is evaluated by the CPU evaluator over UV space (the bake plane
 of matedit.interop.bake) into a float EXR beside the document, read by an `image` node on
 texture coordinate 0, and reported; a baked node that reads the position, normal, view or
@@ -41,14 +42,15 @@ import numpy as np
 
 from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV, Uni, Var
 from matedit.graph import nodes
-from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES
+from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, Role, kind_for, role_of
 from matedit.graph.types import PortType
 from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, to_materialx
 from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
 
 MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "vector3",
            PortType.VEC4: "vector4"}
-GEOMETRY = {"world_position", "world_normal", "view_direction", "time"}
+# The compiler's own ops that stand for a catalogue kind's mapping.
+IR_OP_ROLES = {"blend": Role.MASK_BLEND, "mask": Role.COMPONENT_MASK}
 MTLX_VERSION = "1.39"
 
 
@@ -238,12 +240,12 @@ class _Exporter:
             return self.scope(scope, dict(zip((p for p, _ in scope.params), args)),
                               f"{hint}_")
         nums = eval_op(op, [a.num for a in args], self.env)
-        geo = op.kind in GEOMETRY or any(a.geo for a in args)
-        kind = {"blend": "layer_blend", "weight": "weight", "mask": "component_mask"}.get(
-            op.kind, op.kind)
-        entry = mapping(kind) if kind not in ("weight",) else MxRecipe("weight")
-        if kind == "normalize" and args[0].type == PortType.FLOAT:
-            entry = BAKE
+        d = nodes.get(op.kind)
+        geo = (d is not None and d.geometry) or any(a.geo for a in args)
+        kind = kind_for(IR_OP_ROLES[op.kind]) if op.kind in IR_OP_ROLES else op.kind
+        entry = mapping(kind) if op.kind != "weight" else MxRecipe("weight")
+        if entry == MxRecipe("normalize_vector") and args[0].type == PortType.FLOAT:
+            entry = BAKE  # the stdlib normalizes vectors only
         outs_t = [t for _, t in op.outs]
         if entry == BAKE:
             return [self.bake(hint, port, num, t, geo, op.kind)
@@ -308,19 +310,19 @@ class _Exporter:
             return self.node(f"combine{len(parts)}", MX_TYPE[t], hint,
                              [(f"in{i + 1}", p, "float") for i, p in enumerate(parts)])
 
-        if name == "one_minus":
+        if name == "subtract_from_one":
             return one(lambda: self.node("subtract", mt, hint, [
                 ("in1", _const(1.0, outs_t[0]), mt), ("in2", *arg(0))]))
-        if name == "power":
+        if name == "positive_power":
             return one(lambda: self.node("power", mt, hint, [
                 ("in1", self.node("max", mt, f"{hint}_max", [
                     ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt),
                 ("in2", *arg(1))]))
-        if name == "sqrt":
+        if name == "positive_sqrt":
             return one(lambda: self.node("sqrt", mt, hint, [
                 ("in", self.node("max", mt, f"{hint}_max", [
                     ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt)]))
-        if name == "step":
+        if name == "floor_step":
             def make_step():
                 d = self.node("subtract", mt, f"{hint}_d", [("in1", *arg(1)), ("in2", *arg(0))])
                 f = self.node("floor", mt, f"{hint}_floor", [("in", d, mt)])
@@ -330,16 +332,16 @@ class _Exporter:
                                                      ("low", _const(0.0, outs_t[0]), mt),
                                                      ("high", _const(1.0, outs_t[0]), mt)])
             return one(make_step)
-        if name == "dot":
+        if name == "dot_or_multiply":
             if args[0].type == PortType.FLOAT:
                 return one(lambda: self.node("multiply", "float", hint,
                                              [("in1", *arg(0)), ("in2", *arg(1))]))
             return one(lambda: self.node("dotproduct", "float", hint,
                                          [("in1", *arg(0)), ("in2", *arg(1))]))
-        if name == "length":
+        if name == "magnitude_or_absval":
             cat = "absval" if args[0].type == PortType.FLOAT else "magnitude"
             return one(lambda: self.node(cat, "float", hint, [("in", *arg(0))]))
-        if name == "normalize":
+        if name == "normalize_vector":
             return one(lambda: self.node("normalize", mt, hint, [("in", *arg(0))]))
         if name == "weight":
             return one(lambda: self.node("clamp", "float", hint, [
@@ -349,37 +351,37 @@ class _Exporter:
         if name == "mask":
             idx = ["xyzw".index(c) for c in op.data["channels"]]
             return one(lambda: combine([extract(args[0], i) for i in idx], outs_t[0]))
-        if name == "append":
+        if name == "concatenate":
             def make_append():
                 parts = []
                 for a in args:
                     parts += [extract(a, i) for i in range(a.type.components)]
                 return combine(parts, outs_t[0])
             return one(make_append)
-        if name == "split":
+        if name == "extract_each":
             return [V(n, t, (lambda i=i: extract(args[0], i)), geo)
                     for i, (n, t) in enumerate(zip(nums, outs_t))]
-        if name == "combine":
+        if name == "combine_n":
             sizes = (2, 3, 4)
             return [V(n, t, (lambda k=k, t=t: combine([a.ref() for a in args[:k]], t)), geo)
                     for k, n, t in zip(sizes, nums, outs_t)]
-        if name == "texcoord":
+        if name == "tiled_texcoord":
             return one(lambda: self.node("add", "vector2", hint, [
                 ("in1", self.node("multiply", "vector2", f"{hint}_tile", [
                     ("in1", self.uv0(), "vector2"), ("in2", *arg(0))]), "vector2"),
                 ("in2", *arg(1))]))
-        if name == "view_direction":
+        if name == "negated_viewdirection":
             return one(lambda: self.node("multiply", "vector3", hint, [
                 ("in1", self.node("viewdirection", "vector3", f"{hint}_eye", [],
                                   [("space", "world")]), "vector3"),
                 ("in2", ("value", -1.0), "float")]))
-        if name == "vector_parameter":
+        if name == "vector_and_xyz":
             return [V(nums[0], outs_t[0], args[0].ref, geo),
                     V(nums[1], outs_t[1], lambda: self._to3(args[0].ref(), hint), geo)]
-        if name in ("checker", "gradient", "unpack_normal", "blend_normals",
-                    "flatten_normal"):
+        if name in ("checkerboard", "linear_ramp", "decode_normal", "reoriented_normals",
+                    "mix_towards_z"):
             return self.procedural(name, op, args, nums, outs_t, hint, geo)
-        if name == "texture_sample":
+        if name == "image_read":
             return self.texture_sample(op, args, nums, outs_t, hint, geo)
         if name == "attributes":
             return self.attributes(op, args, nums)
@@ -406,7 +408,7 @@ class _Exporter:
             return (("value", v), t)
 
         shared: dict[str, tuple] = {}
-        if name == "gradient":
+        if name == "linear_ramp":
             def make():
                 ang = n("multiply", "float", "rad", a("angle"), val(math.pi / 180.0))
                 c = n("cos", "float", "cos", ang)
@@ -421,7 +423,7 @@ class _Exporter:
                       val(0.5))
                 return n("clamp", "float", "", v, val(0.0), val(1.0))[0]
             return [V(nums[0], outs_t[0], make, geo)]
-        if name == "checker":
+        if name == "checkerboard":
             def mask():
                 if "mask" not in shared:
                     cell = n("floor", "vector2", "cell",
@@ -437,7 +439,7 @@ class _Exporter:
                 return n("mix", "vector3", "", a("color_a"), a("color_b"),
                          (mask(), "float"))[0]
             return [V(nums[0], outs_t[0], color, geo), V(nums[1], outs_t[1], mask, geo)]
-        if name == "unpack_normal":
+        if name == "decode_normal":
             def make():
                 x = n("subtract", "vector3", "signed",
                       n("multiply", "vector3", "twice", a("packed"), val(2.0)), val(1.0))
@@ -447,7 +449,7 @@ class _Exporter:
                                 ("in3", ("value", 1.0), "float")]), "vector3")
                 return n("normalize", "vector3", "", n("multiply", "vector3", "scaled", x, k))[0]
             return [V(nums[0], outs_t[0], make, geo)]
-        if name == "flatten_normal":
+        if name == "mix_towards_z":
             def make():
                 m = n("mix", "vector3", "towards_z", a("normal"),
                       val((0.0, 0.0, 1.0), "vector3"), a("flatness"))
@@ -523,19 +525,20 @@ class _Exporter:
         return [V(n, t, m, geo) for n, t, m in zip(nums, outs_t, makers)]
 
     def attributes(self, op, args, nums) -> list[V]:
-        if op.kind == "make_attributes":
+        role = role_of(op.kind)
+        if role == Role.MAKE_ATTRIBUTES:
             return [V(nums[0], PortType.MATERIAL, None, any(a.geo for a in args),
                       dict(zip(ATTRIBUTE_NAMES, args)))]
-        if op.kind == "break_attributes":
+        if role != Role.SET_ATTRIBUTES:  # break_attributes
             return [args[0].fields[n] for n in ATTRIBUTE_NAMES]
-        fields = dict(args[0].fields)  # set_attributes
+        fields = dict(args[0].fields)
         for name, v in zip(op.data["fields"], args[1:]):
             fields[name] = v
         return [V(nums[0], PortType.MATERIAL, None, any(a.geo for a in args), fields)]
 
     def blend(self, op, args, num, hint) -> V:
         a, b = args[0], args[1]
-        if op.kind == "height_blend":
+        if role_of(op.kind) == Role.HEIGHT_BLEND:
             bh, lh, c = args[2], args[3], args[4]
 
             def make_t():

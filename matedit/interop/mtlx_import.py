@@ -24,6 +24,8 @@ from typing import Any
 
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.names import identifier_problem, mangle
+from matedit.graph.nodes import Role, kind_for
+from matedit.interop import mtlx_map
 from matedit.interop.mtlx_colorspace import from_materialx
 from matedit.io.atomic import read_bounded
 
@@ -59,30 +61,11 @@ SURFACES: dict[str, dict[str, tuple[str, str | None, float]]] = {
 # UsdPreviewSurface normal is tangent space already.
 WORLD_NORMAL = {"standard_surface", "open_pbr_surface", "gltf_pbr"}
 
-# MaterialX category -> (our kind, {MaterialX input: our input}) for one-to-one nodes.
-DIRECT: dict[str, tuple[str, dict[str, str]]] = {
-    "add": ("add", {"in1": "a", "in2": "b"}),
-    "subtract": ("subtract", {"in1": "a", "in2": "b"}),
-    "multiply": ("multiply", {"in1": "a", "in2": "b"}),
-    "divide": ("divide", {"in1": "a", "in2": "b"}),
-    "min": ("min", {"in1": "a", "in2": "b"}),
-    "max": ("max", {"in1": "a", "in2": "b"}),
-    "crossproduct": ("cross", {"in1": "a", "in2": "b"}),
-    "dotproduct": ("dot", {"in1": "a", "in2": "b"}),
-    "mix": ("lerp", {"bg": "a", "fg": "b", "mix": "alpha"}),
-    "clamp": ("clamp", {"in": "value", "low": "min", "high": "max"}),
-    "smoothstep": ("smoothstep", {"in": "value", "low": "edge0", "high": "edge1"}),
-    "remap": ("remap", {"in": "value", "inlow": "in_min", "inhigh": "in_max",
-                        "outlow": "out_min", "outhigh": "out_max"}),
-    "absval": ("abs", {"in": "value"}),
-    "sin": ("sin", {"in": "value"}),
-    "cos": ("cos", {"in": "value"}),
-    "floor": ("floor", {"in": "value"}),
-    "sqrt": ("sqrt", {"in": "value"}),
-    "power": ("power", {"in1": "base", "in2": "exponent"}),
-    "normalize": ("normalize", {"in": "value"}),
-    "magnitude": ("length", {"in": "value"}),
-}
+# MaterialX category -> (our kind, {MaterialX input: our input}) for one-to-one nodes, from
+# the catalogue (NodeDef.mtlx and mtlx_reads).
+DIRECT: dict[str, tuple[str, dict[str, str]]] = mtlx_map.direct()
+# Our kind for each stdlib node or export recipe the importer reads back.
+_kind = mtlx_map.kind_mapped_to
 _WIDTH = {"float": 1, "integer": 1, "vector2": 2, "vector3": 3, "color3": 3, "vector4": 4,
           "color4": 4}
 
@@ -257,20 +240,20 @@ class _Importer:
             self.err(f"interface input {gin.getName()}: {t} needs {width} numbers")
             return None
         if width == 1:
-            nid = self.add(name, "scalar_parameter", {"name": name, "ui_min": min(0.0, vals[0]),
-                                                      "ui_max": max(1.0, vals[0])},
-                           {"value": vals[0]})
+            nid = self.add(name, kind_for(Role.SCALAR_PARAMETER),
+                           {"name": name, "ui_min": min(0.0, vals[0]),
+                            "ui_max": max(1.0, vals[0])}, {"value": vals[0]})
             src = Src(nid, "value", width=1)
         elif width == 3:
-            nid = self.add(name, "color_parameter", {"name": name}, {"value": vals})
+            nid = self.add(name, kind_for(Role.COLOR_PARAMETER), {"name": name}, {"value": vals})
             src = Src(nid, "color", width=3)
         elif width == 4:
-            nid = self.add(name, "vector_parameter", {"name": name}, {"value": vals})
+            nid = self.add(name, kind_for(Role.VECTOR_PARAMETER), {"name": name}, {"value": vals})
             src = Src(nid, "value", width=4)
         else:  # vector2: a vec4 parameter, masked
-            nid = self.add(name, "vector_parameter", {"name": name},
+            nid = self.add(name, kind_for(Role.VECTOR_PARAMETER), {"name": name},
                            {"value": vals + [0.0, 0.0]})
-            m = self.add(f"{name}_xy", "component_mask", {"channels": "xy"})
+            m = self.add(f"{name}_xy", kind_for(Role.COMPONENT_MASK), {"channels": "xy"})
             self.connect(Src(nid, "value", width=4), m, "value")
             src = Src(m, "result", width=2)
         self.params[key] = src
@@ -305,19 +288,19 @@ class _Importer:
             in1 = self.input_src(node, "in1", depth) or Src(value=[0.0] * max(width, 1))
             in2 = self.input_src(node, "in2", depth)
             if in2 is None or (in2.node is None and all(v == 1.0 for v in in2.value)):
-                nid = self.add(name, "frac", depth=depth)
+                nid = self.add(name, _kind("modulo"), depth=depth)
                 self.connect(in1, nid, "value")
                 return Src(nid, "result", width=width)
             # MaterialX's modulo is GLSL mod: a - b floor(a / b)
-            q = self.add(f"{name}_q", "divide", depth=depth)
+            q = self.add(f"{name}_q", _kind("divide"), depth=depth)
             self.connect(in1, q, "a")
             self.connect(in2, q, "b")
-            f = self.add(f"{name}_floor", "floor", depth=depth)
+            f = self.add(f"{name}_floor", _kind("floor"), depth=depth)
             self.connect(Src(q, "result"), f, "value")
-            m = self.add(f"{name}_m", "multiply", depth=depth)
+            m = self.add(f"{name}_m", _kind("multiply"), depth=depth)
             self.connect(Src(f, "result"), m, "a")
             self.connect(in2, m, "b")
-            nid = self.add(name, "subtract", depth=depth)
+            nid = self.add(name, _kind("subtract"), depth=depth)
             self.connect(in1, nid, "a")
             self.connect(Src(m, "result"), nid, "b")
             return Src(nid, "result", width=width)
@@ -327,7 +310,8 @@ class _Importer:
             if not 0 <= idx <= 3:
                 self.err(f"{where}: extract index {idx} out of range")
                 return None
-            nid = self.add(name, "component_mask", {"channels": "xyzw"[idx]}, depth=depth)
+            nid = self.add(name, kind_for(Role.COMPONENT_MASK), {"channels": "xyzw"[idx]},
+                           depth=depth)
             self.connect(self.input_src(node, "in", depth), nid, "value")
             return Src(nid, "result", width=1)
         if cat in ("separate2", "separate3", "separate4"):
@@ -336,12 +320,12 @@ class _Importer:
             if port is None:
                 self.err(f"{where}: unknown output {output!r}")
                 return None
-            nid = self.add(name, "split", depth=depth)
+            nid = self.add(name, _kind("extract_each"), depth=depth)
             self.connect(self.input_src(node, "in", depth), nid, "value")
             return Src(nid, port, width=1)
         if cat in ("combine2", "combine3", "combine4"):
             k = int(cat[-1])
-            nid = self.add(name, "combine", depth=depth)
+            nid = self.add(name, _kind("combine_n"), depth=depth)
             for i, port in enumerate("xyzw"[:k]):
                 s = self.input_src(node, f"in{i + 1}", depth)
                 self.connect(s if s is not None else Src(value=[0.0]), nid, port)
@@ -353,16 +337,16 @@ class _Importer:
             if s is None:
                 s = Src(value=[0.0] * max(w_in, 1), width=max(w_in, 1))
             if w_in == width:  # vector3 <-> color3
-                nid = self.add(name, "reroute", depth=depth)
+                nid = self.add(name, kind_for(Role.REROUTE), depth=depth)
                 self.connect(s, nid, "value")
                 return Src(nid, "value", width=width)
             if w_in == 1 and width in (2, 3, 4):
-                nid = self.add(name, "combine", depth=depth)
+                nid = self.add(name, _kind("combine_n"), depth=depth)
                 for port in "xyzw"[:width]:
                     self.connect(s, nid, port)
                 return Src(nid, {2: "xy", 3: "xyz", 4: "xyzw"}[width], width=width)
             if w_in > width >= 1:
-                nid = self.add(name, "component_mask", {"channels": "xyzw"[:width]},
+                nid = self.add(name, kind_for(Role.COMPONENT_MASK), {"channels": "xyzw"[:width]},
                                depth=depth)
                 self.connect(s, nid, "value")
                 return Src(nid, "result", width=width)
@@ -373,29 +357,28 @@ class _Importer:
             if idx_in is not None and idx_in.getValueString() not in ("", "0"):
                 self.err(f"{where}: only texture coordinate set 0 is supported")
                 return None
-            nid = self.add(name, "texcoord", depth=depth)
+            nid = self.add(name, _kind("tiled_texcoord"), depth=depth)
             return Src(nid, "uv", width=2)
         if cat in ("position", "normal"):
             space = node.getInputValue("space") if node.getInput("space") else "object"
             if space != "world":
                 self.err(f"{where}: {cat} in {space} space is not supported (world only)")
                 return None
-            nid = self.add(name, "world_position" if cat == "position" else "world_normal",
-                           depth=depth)
+            nid = self.add(name, _kind(cat), depth=depth)
             return Src(nid, "position" if cat == "position" else "normal", width=3)
         if cat == "viewdirection":
-            v = self.add(f"{name}_eye", "view_direction", depth=depth)
-            nid = self.add(name, "multiply", values={"b": [-1.0, -1.0, -1.0]}, depth=depth)
+            v = self.add(f"{name}_eye", _kind("negated_viewdirection"), depth=depth)
+            nid = self.add(name, _kind("multiply"), values={"b": [-1.0, -1.0, -1.0]}, depth=depth)
             self.connect(Src(v, "direction", width=3), nid, "a")
             return Src(nid, "result", width=3)
         if cat == "time":
-            nid = self.add(name, "time", depth=depth)
+            nid = self.add(name, _kind("time"), depth=depth)
             return Src(nid, "seconds", width=1)
         if cat == "constant":
             s = self.input_src(node, "value", depth)
             return s if s is not None else Src(value=[0.0] * max(width, 1), width=max(width, 1))
         if cat == "dot":
-            nid = self.add(name, "reroute", depth=depth)
+            nid = self.add(name, kind_for(Role.REROUTE), depth=depth)
             self.connect(self.input_src(node, "in", depth), nid, "value")
             return Src(nid, "value", width=width)
         if cat == "image":
@@ -451,8 +434,8 @@ class _Importer:
         settings = {"name": pname, "path": rel, "srgb": srgb}
         if space:
             settings["color_space"] = space
-        tex = self.add(pname, "texture_parameter", settings, depth=depth)
-        nid = self.add(node.getName(), "texture_sample", depth=depth)
+        tex = self.add(pname, kind_for(Role.TEXTURE_PARAMETER), settings, depth=depth)
+        nid = self.add(node.getName(), kind_for(Role.TEXTURE_SAMPLE), depth=depth)
         self.connect(Src(tex, "texture"), nid, "texture")
         uv = self.input_src(node, "texcoord", depth)
         if uv is not None:
@@ -463,7 +446,8 @@ class _Importer:
             return Src(nid, "rgb", width=3)
         if width == 4:
             return Src(nid, "rgba", width=4)
-        m = self.add(f"{node.getName()}_xy", "component_mask", {"channels": "xy"}, depth=depth)
+        m = self.add(f"{node.getName()}_xy", kind_for(Role.COMPONENT_MASK), {"channels": "xy"},
+                     depth=depth)
         self.connect(Src(nid, "rgba", width=4), m, "value")
         return Src(m, "result", width=2)
 
@@ -485,8 +469,8 @@ class _Importer:
     def build(self, shader) -> MaterialDocument:
         cat = shader.getCategory()
         table = SURFACES[cat]
-        make = self.add("make", "make_attributes")
-        out = self.add("out", "material_output")
+        make = self.add("make", kind_for(Role.MAKE_ATTRIBUTES))
+        out = self.add("out", kind_for(Role.MATERIAL_OUTPUT))
         self.mat.graph.nodes[out].position = (260.0, 0.0)
         self.mat.graph.nodes[make].position = (0.0, 0.0)
         self.connect(Src(make, "attributes"), out, "attributes")
@@ -501,7 +485,7 @@ class _Importer:
                 if src.node is None:
                     src = Src(value=src.value[:1], width=1)
                 else:
-                    m = self.add(f"{attr}_x", "component_mask", {"channels": "x"})
+                    m = self.add(f"{attr}_x", kind_for(Role.COMPONENT_MASK), {"channels": "x"})
                     self.connect(src, m, "value")
                     src = Src(m, "result", width=1)
             if scale is not None:
@@ -512,14 +496,14 @@ class _Importer:
                     src = Src(value=[v * w.value[0] * factor for v in src.value],
                               width=src.width)
                 elif not (w.node is None and w.value[0] * factor == 1.0):
-                    mul = self.add(f"{attr}_weight", "multiply")
+                    mul = self.add(f"{attr}_weight", _kind("multiply"))
                     self.connect(src, mul, "a")
                     if w.node is None:
                         self.connect(Src(value=[w.value[0] * factor]), mul, "b")
                     else:
                         scaled = w
                         if factor != 1.0:
-                            s = self.add(f"{attr}_units", "multiply", values={"b": factor})
+                            s = self.add(f"{attr}_units", _kind("multiply"), values={"b": factor})
                             self.connect(w, s, "a")
                             scaled = Src(s, "result")
                         self.connect(scaled, mul, "b")
@@ -562,9 +546,9 @@ class _Importer:
             self.connect(Src(value=[v * 2.0 - 1.0 for v in enc.value], width=3), make,
                          "normal")
             return
-        two = self.add(f"{up.getName()}_x2", "multiply", values={"b": [2.0, 2.0, 2.0]})
+        two = self.add(f"{up.getName()}_x2", _kind("multiply"), values={"b": [2.0, 2.0, 2.0]})
         self.connect(enc, two, "a")
-        one = self.add(up.getName(), "subtract", values={"b": [1.0, 1.0, 1.0]})
+        one = self.add(up.getName(), _kind("subtract"), values={"b": [1.0, 1.0, 1.0]})
         self.connect(Src(two, "result", width=3), one, "a")
         self.connect(Src(one, "result", width=3), make, "normal")
 

@@ -1,7 +1,6 @@
-"""How each node kind of the catalogue maps to MaterialX 1.39 stdlib nodes, as data.
+"""How each node kind of the catalogue maps to MaterialX 1.39 stdlib nodes.
 
-Keyed by catalogue kind (matedit.graph.nodes) so that it can move into the catalogue as a
-per-kind field without changing its shape. An entry is one of:
+The one source is the catalogue: `NodeDef.mtlx` (matedit.graph.nodes). An entry is one of:
 
   MxNode(category, ports)   one stdlib node of that category; `ports` maps our input names
                             to its inputs in order, `fixed` adds constant inputs, `output`
@@ -11,97 +10,105 @@ per-kind field without changing its shape. An entry is one of:
                             recipe of that name) and read back by matedit.interop.mtlx_import.
   BAKE                      not expressible node for node: the exporter bakes the node's
                             outputs over UV space into EXR images read by `image` nodes.
+  LOWERED                   never reaches the exporter: the compiler lowers it to uniforms,
+                            literals, inlined calls and blends.
 
-Kinds that never reach the exporter (parameters, constants, reroutes, functions, layer
-stacks: the compiler lowers them to uniforms, literals, inlined calls and blends) are listed
-as LOWERED.
+This module only reads the catalogue for the exporter and the importer.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from matedit.graph import nodes
+from matedit.graph.nodes import BAKE, LOWERED, MxNode, MxRecipe
 
-
-@dataclass(frozen=True)
-class MxNode:
-    category: str
-    ports: tuple[tuple[str, str], ...]  # (our input, MaterialX input)
-    fixed: tuple[tuple[str, float], ...] = field(default_factory=tuple)
-    output: str = "out"
-
-
-@dataclass(frozen=True)
-class MxRecipe:
-    name: str
-
-
-BAKE = "bake"
-
-
-def _bin(cat: str) -> MxNode:
-    return MxNode(cat, (("a", "in1"), ("b", "in2")))
-
-
-def _un(cat: str) -> MxNode:
-    return MxNode(cat, (("value", "in"),))
-
-
-MTLX: dict[str, MxNode | MxRecipe | str] = {
-    "add": _bin("add"),
-    "subtract": _bin("subtract"),
-    "multiply": _bin("multiply"),
-    "divide": _bin("divide"),
-    "min": _bin("min"),
-    "max": _bin("max"),
-    "cross": _bin("crossproduct"),
-    "lerp": MxNode("mix", (("a", "bg"), ("b", "fg"), ("alpha", "mix"))),
-    "clamp": MxNode("clamp", (("value", "in"), ("min", "low"), ("max", "high"))),
-    "saturate": MxNode("clamp", (("value", "in"),), (("low", 0.0), ("high", 1.0))),
-    "abs": _un("absval"),
-    "sin": _un("sin"),
-    "cos": _un("cos"),
-    "floor": _un("floor"),
-    "frac": MxNode("modulo", (("value", "in1"),), (("in2", 1.0),)),  # x - floor(x)
-    "smoothstep": MxNode("smoothstep", (("value", "in"), ("edge0", "low"),
-                                        ("edge1", "high"))),
-    "remap": MxNode("remap", (("value", "in"), ("in_min", "inlow"), ("in_max", "inhigh"),
-                              ("out_min", "outlow"), ("out_max", "outhigh"))),
-    "one_minus": MxRecipe("one_minus"),  # subtract(1, value)
-    "power": MxRecipe("power"),  # power(max(base, 0), exponent)
-    "sqrt": MxRecipe("sqrt"),  # sqrt(max(value, 0))
-    "step": MxRecipe("step"),  # clamp(floor(value - edge) + 1, 0, 1)
-    "dot": MxRecipe("dot"),  # dotproduct, or multiply for floats
-    "length": MxRecipe("length"),  # magnitude, or absval for floats
-    "normalize": MxRecipe("normalize"),
-    "component_mask": MxRecipe("mask"),  # extract / combineN
-    "append": MxRecipe("append"),  # extract / combineN
-    "split": MxRecipe("split"),  # extract per component
-    "combine": MxRecipe("combine"),  # combine2/3/4
-    "texcoord": MxRecipe("texcoord"),  # texcoord * tiling + offset
-    "world_position": MxNode("position", (), output="out"),
-    "world_normal": MxNode("normal", (), output="out"),
-    "view_direction": MxRecipe("view_direction"),  # -viewdirection (ours points at the eye)
-    "time": MxNode("time", ()),
-    "texture_sample": MxRecipe("texture_sample"),  # image (vector4)
-    "vector_parameter": MxRecipe("vector_parameter"),
-    "make_attributes": MxRecipe("attributes"),
-    "break_attributes": MxRecipe("attributes"),
-    "set_attributes": MxRecipe("attributes"),
-    "layer_blend": MxRecipe("blend"),  # a mix per field, the normal normalised
-    "height_blend": MxRecipe("blend"),  # smoothstep(-c, c, dh) as the blend factor
-    "value_noise": BAKE,  # our PCG-hash lattice noise: the stdlib has no integer hash
-    "checker": MxRecipe("checker"),  # modulo(floor(u s) + floor(v s), 2) into a mix
-    "gradient": MxRecipe("gradient"),  # clamp(dot(uv - 0.5, d) / (|dx| + |dy|) + 0.5)
-    "unpack_normal": MxRecipe("unpack_normal"),  # normalize((2 p - 1) * (s, s, 1))
-    "blend_normals": MxRecipe("blend_normals"),  # reoriented normal mapping
-    "flatten_normal": MxRecipe("flatten_normal"),  # normalize(mix(n, +Z, flatness))
-}
-
-LOWERED = ("constant", "scalar_parameter", "color_parameter", "texture_parameter", "reroute",
-           "function_input", "function_output", "function_call", "layer_stack",
-           "material_output")
+__all__ = ["BAKE", "LOWERED", "MxNode", "MxRecipe", "direct", "kind_mapped_to", "mapping",
+           "mapped_kinds",
+           "baked_kinds", "lowered_kinds"]
 
 
 def mapping(kind: str) -> MxNode | MxRecipe | str:
-    """The entry for `kind`; unknown kinds (added to the catalogue later) bake."""
-    return MTLX.get(kind, BAKE)
+    """The catalogue's entry for `kind`; names that are no kind bake."""
+    d = nodes.get(kind)
+    return d.mtlx if d is not None else BAKE
+
+
+def mapped_kinds() -> list[str]:
+    """Kinds exported node for node (a stdlib node or a recipe), sorted."""
+    return sorted(k for k, d in nodes.REGISTRY.items() if isinstance(d.mtlx, (MxNode, MxRecipe)))
+
+
+def baked_kinds() -> list[str]:
+    return sorted(k for k, d in nodes.REGISTRY.items() if d.mtlx == BAKE)
+
+
+def lowered_kinds() -> list[str]:
+    return sorted(k for k, d in nodes.REGISTRY.items() if d.mtlx == LOWERED)
+
+
+def direct() -> dict[str, tuple[str, dict[str, str]]]:
+    """MaterialX category -> (our kind, {its input: our input}) for the kinds that map to one
+    stdlib node with inputs and no fixed ones, or name one in `mtlx_reads`: what the
+    importer reads back one for one."""
+    out: dict[str, tuple[str, dict[str, str]]] = {}
+    for kind, d in nodes.REGISTRY.items():
+        for m in (d.mtlx, d.mtlx_reads):
+            if isinstance(m, MxNode) and m.ports and not m.fixed and m.category not in out:
+                out[m.category] = (kind, {theirs: ours for ours, theirs in m.ports})
+    return out
+
+
+def kind_mapped_to(name: str) -> str:
+    """The catalogue kind that exports as the stdlib node `name` (an MxNode category, first
+    registered wins) or as the recipe `name`: what the importer builds when it reads one
+    back."""
+    for kind, d in nodes.REGISTRY.items():
+        m = d.mtlx
+        if (isinstance(m, MxNode) and m.category == name) or \
+                (isinstance(m, MxRecipe) and m.name == name):
+            return kind
+    raise LookupError(f"no catalogue kind exports as MaterialX {name!r}")
+
+
+def _entry_text(m) -> str:
+    if isinstance(m, MxNode):
+        ins = ", ".join(f"{ours}→{theirs}" for ours, theirs in m.ports)
+        fixed = ", ".join(f"{name}={value:g}" for name, value in m.fixed)
+        return f"`{m.category}`" + (f" ({ins}" + (f"; {fixed}" if fixed else "") + ")"
+                                    if ins or fixed else "")
+    return f"recipe `{m.name}`"
+
+
+def document() -> str:
+    """docs/materialx.md: which catalogue kinds map to MaterialX and which bake (generated
+    from the catalogue by docs/materialx.py; tests/test_kind_contract.py keeps it true)."""
+    by_kind = nodes.REGISTRY
+    mapped, baked, lowered = mapped_kinds(), baked_kinds(), lowered_kinds()
+    lines = [
+        "# MaterialX: what maps and what bakes",
+        "",
+        "Generated from the node catalogue (`NodeDef.mtlx` in matedit/graph/nodes.py) by",
+        "`docs/materialx.py`; a test fails when it is out of date. `matedit export OUT.mtlx`",
+        "(see [cli.md](cli.md)) writes a MaterialX 1.39 nodegraph feeding one",
+        "`standard_surface`. Each kind is exported one of three ways:",
+        "",
+        "- **maps**: one stdlib node (its inputs named, ours→MaterialX's) or a recipe, a few",
+        "  stdlib nodes that compute the same thing (matedit/interop/mtlx_export.py). Each is",
+        "  checked against MaterialX's own GLSL generator in tests/test_interop_mtlx.py.",
+        "- **bakes**: not expressible node for node; the export evaluates its outputs over UV",
+        "  space into EXR images read by `image` nodes, and reports each baked node.",
+        "- **lowered**: never reaches the exporter; the compiler turns it into interface",
+        "  inputs (parameters), values (constants), inlined calls and blends.",
+        "",
+        f"{len(mapped)} kinds map, {len(baked)} bake, {len(lowered)} are lowered.",
+        "",
+        "## Kinds that map to MaterialX",
+        "",
+        "| kind | MaterialX |",
+        "|---|---|",
+    ]
+    lines += [f"| `{k}` | {_entry_text(by_kind[k].mtlx)} |" for k in mapped]
+    lines += ["", "## Kinds that bake", ""]
+    lines += [", ".join(f"`{k}`" for k in baked), ""]
+    lines += ["## Kinds lowered before export", ""]
+    lines += [", ".join(f"`{k}`" for k in lowered), ""]
+    return "\n".join(lines)

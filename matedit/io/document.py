@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
+from matedit.graph.nodes import Role, role_of
 from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
 from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
 
@@ -318,11 +319,12 @@ def dumps(doc: MaterialDocument) -> str:
 def reference_fields(doc: MaterialDocument):
     """(container, key) for every stored file reference (functions, layers, textures)."""
     for n in doc.graph.nodes.values():
-        if n.kind == "function_call" and isinstance(n.settings.get("function"), str):
+        role = role_of(n.kind)
+        if role == Role.FUNCTION_CALL and isinstance(n.settings.get("function"), str):
             yield n.settings, "function"
-        elif n.kind == "texture_parameter" and isinstance(n.settings.get("path"), str):
+        elif role == Role.TEXTURE_PARAMETER and isinstance(n.settings.get("path"), str):
             yield n.settings, "path"
-        elif n.kind == "layer_stack" and isinstance(n.settings.get("layers"), list):
+        elif role == Role.LAYER_STACK and isinstance(n.settings.get("layers"), list):
             for e in n.settings["layers"]:
                 if isinstance(e, dict):
                     if isinstance(e.get("function"), str):

@@ -51,9 +51,8 @@ from matedit.io.migrations import CURRENT_VERSION
 FORMAT = "matedit.instance"
 MAX_CHAIN = 64  # parents deep; far beyond any real use, it bounds a hostile chain
 TYPES = ("scalar", "vector", "color", "texture", "switch")
-TYPE_OF_KIND = {"scalar_parameter": "scalar", "vector_parameter": "vector",
-                "color_parameter": "color", "texture_parameter": "texture",
-                "static_switch": "switch"}
+# Parameter kinds and their instance types, from the catalogue (NodeDef.parameter).
+TYPE_OF_KIND = {k: d.parameter for k, d in REGISTRY.items() if d.parameter is not None}
 TOP_FIELDS = frozenset({"format", "version", "name", "description", "parent", "parameters",
                         "parent_parameters", "preview"})
 PREVIEW_FILES = ("mesh", "environment")

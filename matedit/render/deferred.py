@@ -27,7 +27,8 @@ ENERGY_COMPENSATION = "MATEDIT_ENERGY_COMPENSATION"
 def _opacity_index() -> int:
     from matedit.graph import nodes
 
-    return [i.name for i in nodes.REGISTRY["make_attributes"].inputs].index("opacity")
+    make = nodes.definition(nodes.kind_for(nodes.Role.MAKE_ATTRIBUTES))
+    return [i.name for i in make.inputs].index("opacity")
 
 
 def _is_one(e, values: dict) -> bool:
@@ -55,12 +56,15 @@ def may_be_translucent(ir, values: dict | None = None) -> bool:
     values = {u.name: u.default for u in ir.uniforms} | dict(values or {})
     if "opacity" not in ir.attributes:
         return False
+    from matedit.graph.nodes import Role, role_of
+
     k = _opacity_index()
     for scope in [ir.main, *ir.functions]:
         for op in scope.ops:
-            if op.kind == "make_attributes" and not _is_one(op.args[k], values):
+            role = role_of(op.kind)
+            if role == Role.MAKE_ATTRIBUTES and not _is_one(op.args[k], values):
                 return True
-            if op.kind == "set_attributes" and "opacity" in op.data.get("fields", ()):
+            if role == Role.SET_ATTRIBUTES and "opacity" in op.data.get("fields", ()):
                 return True
     return False
 

@@ -10,6 +10,7 @@ from PySide6.QtCore import QPointF
 from matedit.app.paths import reference_for
 from matedit.graph.commands import AddNode, Connect
 from matedit.graph.model import Link
+from matedit.graph.nodes import Role, kind_for
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tga", ".tif", ".tiff", ".exr", ".hdr", ".bmp")
 
@@ -80,7 +81,7 @@ class CanvasDrops:
                     self.materialOpenRequested.emit(str(path))
                     continue
                 ref = reference_for(self.controller.document, path)
-                nid = self.add_node_at("function_call", at, {"function": ref})
+                nid = self.add_node_at(kind_for(Role.FUNCTION_CALL), at, {"function": ref})
                 if nid:
                     added.append(nid)
             at = at + QPointF(30, 120)
@@ -92,11 +93,11 @@ class CanvasDrops:
         """A Texture Parameter on `path` (sRGB guessed from the file) wired into a new Texture
         Sample, as one undo step; their ids."""
         srgb = guess_srgb(path)
-        tp = self._new_node("texture_parameter", scene_pos, {
+        tp = self._new_node(kind_for(Role.TEXTURE_PARAMETER), scene_pos, {
             "path": reference_for(self.controller.document, path), "srgb": srgb})
         if tp is None:
             return []
-        ts = self._new_node("texture_sample", scene_pos + QPointF(230, 0), None)
+        ts = self._new_node(kind_for(Role.TEXTURE_SAMPLE), scene_pos + QPointF(230, 0), None)
         if ts is None:
             return []
         if ts.id == tp.id:  # both took the first free id of their stems: keep them apart

@@ -28,6 +28,7 @@ from matedit.app.controller import DocumentController
 from matedit.graph import nodes
 from matedit.graph.commands import MoveNodes, PutComment
 from matedit.graph.model import ChangeEvent, Link, Node
+from matedit.graph.nodes import Role, is_value_parameter, role_of
 from matedit.graph.ports import node_ports
 from matedit.graph.validate import Analysis
 
@@ -48,22 +49,22 @@ def describe(node: Node, function_name: str = "") -> tuple[str, str, str, str]:
     title = node.label or kind_title
     s = node.settings
     sub = ""
-    if node.kind.endswith("_parameter"):
+    if is_value_parameter(node.kind):
         sub = str(s.get("name", "param"))
-        if node.kind == "scalar_parameter" and "value" in node.values:
+        if role_of(node.kind) == Role.SCALAR_PARAMETER and "value" in node.values:
             sub += f" = {_fmt(node.values['value'])}"
-    elif node.kind == "constant":
+    elif role_of(node.kind) == Role.CONSTANT:
         sub = _fmt(s.get("value", 0.0))
-    elif node.kind == "function_call":
+    elif role_of(node.kind) == Role.FUNCTION_CALL:
         stem = Path(str(s.get("function", ""))).stem
         if stem and not node.label:  # name the function, as Unreal does
             title = function_name or stem.replace("_", " ").capitalize()
         sub = f"{stem}.json" if stem else "no function chosen"
-    elif node.kind in ("function_input", "function_output"):
+    elif role_of(node.kind) in (Role.FUNCTION_INPUT, Role.FUNCTION_OUTPUT):
         sub = f"{s.get('name', '')} : {s.get('type', 'float')}"
-    elif node.kind == "component_mask":
+    elif role_of(node.kind) == Role.COMPONENT_MASK:
         sub = "." + str(s.get("channels", "xy"))
-    elif node.kind == "layer_stack":
+    elif role_of(node.kind) == Role.LAYER_STACK:
         layers = s.get("layers", [])
         if isinstance(layers, list):
             sub = " · ".join(str(e.get("name", e.get("id", "?"))) for e in layers
@@ -155,7 +156,7 @@ class NodeScene(QGraphicsScene):
 
     def _add_node(self, node_id: str) -> None:
         node = self.graph.nodes[node_id]
-        item = (RerouteItem if node.kind == "reroute" else NodeItem)(node_id, node.kind)
+        item = (RerouteItem if role_of(node.kind) == Role.REROUTE else NodeItem)(node_id, node.kind)
         self.node_items[node_id] = item
         self._wires_of.setdefault(node_id, set())
         item.setPos(node.position[0], node.position[1])
@@ -191,7 +192,7 @@ class NodeScene(QGraphicsScene):
 
     def function_name(self, node: Node) -> str:
         """The name a called function gives itself ("" if unknown or not a call)."""
-        ref = node.settings.get("function") if node.kind == "function_call" else None
+        ref = node.settings.get("function") if role_of(node.kind) == Role.FUNCTION_CALL else None
         if not isinstance(ref, str) or not ref:
             return ""
         try:

@@ -285,9 +285,9 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         graph = self.controller.document.graph
         nid = graph.new_id(_id_stem(kind))
         s = dict(settings or {})
-        if kind.endswith("_parameter") and "name" not in s:
+        if nodes.is_value_parameter(kind) and "name" not in s:
             taken = {str(n.settings.get("name")) for n in graph.nodes.values()
-                     if n.kind.endswith("_parameter")}
+                     if nodes.is_value_parameter(n.kind)}
             name, i = nid, 1
             while name in taken:
                 i += 1
@@ -316,8 +316,10 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
     def _show_palette(self, scene_pos: QPointF, accept, hint: str) -> None:
         self._palette_pos = QPointF(scene_pos)
         self.node_palette.out_of_place = frozenset(
-            {"material_output"} if self.controller.document.is_function
-            else {"function_input", "function_output"})
+            nodes.kinds_where(lambda d: d.role == nodes.Role.MATERIAL_OUTPUT)
+            if self.controller.document.is_function
+            else nodes.kinds_where(lambda d: d.role in (nodes.Role.FUNCTION_INPUT,
+                                                         nodes.Role.FUNCTION_OUTPUT)))
         at = self.viewport().mapTo(self, self.mapFromScene(scene_pos))
         self.node_palette.popup(at, accept, hint)
 
@@ -563,8 +565,8 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
 
     def insert_reroute(self, link: Link, scene_pos: QPointF) -> str:
         """A reroute on `link` at `scene_pos`, as one undo step; its id ('' if refused)."""
-        node = self._new_node("reroute", scene_pos - QPointF(C.REROUTE_RADIUS,
-                                                             C.REROUTE_RADIUS), None)
+        node = self._new_node(nodes.kind_for(nodes.Role.REROUTE),
+                              scene_pos - QPointF(C.REROUTE_RADIUS, C.REROUTE_RADIUS), None)
         if node is None or link not in self.controller.document.graph.links:
             return ""
         ok = self.controller.push_all(
@@ -581,13 +583,13 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             return
         while item is not None and not isinstance(item, (NodeItem, CommentItem)):
             item = item.parentItem()
-        if isinstance(item, NodeItem) and item.kind != "function_call" and \
+        if isinstance(item, NodeItem) and nodes.role_of(item.kind) != nodes.Role.FUNCTION_CALL and \
                 item.mapFromScene(self.mapToScene(event.position().toPoint())).y() \
                 < C.HEADER_HEIGHT:  # double-click on the title: rename
             self.start_rename(item.node_id)
             event.accept()
             return
-        if isinstance(item, NodeItem) and item.kind == "function_call":
+        if isinstance(item, NodeItem) and nodes.role_of(item.kind) == nodes.Role.FUNCTION_CALL:
             node = self.controller.document.graph.nodes.get(item.node_id)
             ref = node.settings.get("function") if node else None
             if isinstance(ref, str) and ref:
