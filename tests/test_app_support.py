@@ -32,6 +32,12 @@ QStandardPaths.setTestModeEnabled(True)
 if "MATEDIT_RECOVERY_DIR" not in os.environ:
     os.environ["MATEDIT_RECOVERY_DIR"] = tempfile.mkdtemp(prefix="matedit-recovery-")
     atexit.register(shutil.rmtree, os.environ["MATEDIT_RECOVERY_DIR"], True)
+# QSettings of this test run only: test mode alone puts every run on the machine in one
+# ~/.qttest file, where one run's clear() wipes what another just saved.
+_SETTINGS_DIR = tempfile.mkdtemp(prefix="matedit-settings-")
+atexit.register(shutil.rmtree, _SETTINGS_DIR, True)
+for _format in (QSettings.Format.NativeFormat, QSettings.Format.IniFormat):
+    QSettings.setPath(_format, QSettings.Scope.UserScope, _SETTINGS_DIR)
 
 
 @pytest.fixture

@@ -52,6 +52,9 @@ class RenderSettings:
     environment_intensity: float = 1.0
     show_background: bool = True
     background_blur: float = 0.0
+    # Multiple-scattering compensation (Fdez-Aguera 2019) for every material, not only those
+    # whose preview asks for it: relinks the program once per change.
+    energy_compensation: bool = False
 
 
 def _load_renderer_class():
@@ -70,6 +73,7 @@ class ViewportWidget(QOpenGLWidget):
     materialApplied = Signal(bool)  # True when the new program is live
     frameDrawn = Signal()
     statusMessage = Signal(str)
+    settingsChanged = Signal(object)  # the new RenderSettings
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -247,12 +251,20 @@ class ViewportWidget(QOpenGLWidget):
             self.update()
 
     def set_settings(self, settings: RenderSettings) -> None:
-        """New render settings (background, blur, IBL intensity): no GL work, a redraw."""
+        """New render settings (background, blur, IBL intensity: a redraw; energy
+        compensation: a relink, in the widget's context)."""
+        if settings == self.settings:
+            return
         self.settings = settings
         if self.renderer is not None:
-            self._apply_settings(self.renderer)
+            self.makeCurrent()
+            try:
+                self._apply_settings(self.renderer)
+            finally:
+                self.doneCurrent()
             self.renderer.reset_accumulation()
             self.update()
+        self.settingsChanged.emit(settings)
 
     def change_settings(self, **changes) -> None:
         self.set_settings(replace(self.settings, **changes))
@@ -262,6 +274,7 @@ class ViewportWidget(QOpenGLWidget):
         r.environment_intensity = s.environment_intensity
         r.show_background = s.show_background
         r.background_blur = s.background_blur
+        r.set_energy_compensation(s.energy_compensation)
 
     @property
     def lights(self) -> list:
@@ -621,10 +634,12 @@ class ViewportPanel(QWidget):
         self.diff_label.raise_()
 
     def view_state(self) -> dict:
-        """Mesh, mode, exposure and environment, as remembered across restarts."""
+        """Mesh, mode, exposure, environment and energy compensation, as remembered across
+        restarts."""
         return {"mesh": self.mesh_combo.currentText(), "mode": self.mode_combo.currentText(),
                 "exposure": self.exposure.value() / 10.0,
-                "environment": self.view._environment}
+                "environment": self.view._environment,
+                "energy_compensation": self.view.settings.energy_compensation}
 
     def restore_view_state(self, state: dict) -> None:
         mesh, mode = state.get("mesh"), state.get("mode")
@@ -635,6 +650,9 @@ class ViewportPanel(QWidget):
         ev = state.get("exposure")
         if isinstance(ev, (int, float)):
             self.exposure.setValue(int(round(float(ev) * 10)))
+        energy = state.get("energy_compensation")
+        if isinstance(energy, bool):
+            self.view.change_settings(energy_compensation=energy)
         env = state.get("environment")
         if isinstance(env, str) and env and env != self.view._environment and (
                 env in ENVIRONMENTS.values() or Path(env).is_file()):
@@ -760,7 +778,21 @@ class EnvironmentPanel(QWidget):
         self.blur.edited.connect(
             lambda v, _m: viewport.view.change_settings(background_blur=float(v)))
         form.addRow("blur", self.blur)
+        self.energy = QCheckBox("energy compensation")
+        self.energy.setToolTip("Adds back the light that single-scattering GGX loses on rough "
+                               "surfaces (multiple scattering), for every material")
+        self.energy.setChecked(viewport.view.settings.energy_compensation)
+        self.energy.toggled.connect(
+            lambda on: viewport.view.change_settings(energy_compensation=bool(on)))
+        viewport.view.settingsChanged.connect(self._settings_changed)
+        form.addRow("shading", self.energy)
         lay.addLayout(form)
+
+    def _settings_changed(self, settings: RenderSettings) -> None:
+        if self.energy.isChecked() != settings.energy_compensation:
+            self.energy.blockSignals(True)
+            self.energy.setChecked(settings.energy_compensation)
+            self.energy.blockSignals(False)
 
     def _chosen(self, index: int) -> None:
         self.viewport.env_combo.setCurrentIndex(index)

@@ -42,8 +42,15 @@ GRID_MAJOR = 100.0
 ZOOM_MIN = 0.05
 ZOOM_MAX = 3.0
 ZOOM_STEP = 1.15
-LOD_TEXT = 0.42  # below this zoom nodes draw as coloured blocks without text
+LOD_TEXT = 0.55  # below this zoom nodes draw as coloured blocks under a big title, no labels
 LOD_PORTS = 0.3  # below this zoom ports take no clicks (their items hide)
+# Zoomed out, a title keeps a constant size on screen: it never drops below LOD_TITLE_MIN_PX
+# device pixels in the header, and below LOD_TEXT it fills the whole node body (wrapped),
+# starting at LOD_TITLE_PX and shrinking to LOD_TITLE_MIN_PX before it elides.
+TITLE_PX = 12  # the title's size at zoom 1 (scene units)
+LOD_TITLE_PX = 12.0
+LOD_TITLE_MIN_PX = 8.5
+LOD_TITLE_NONE = 0.15  # below this zoom a block is too small for any title: none is drawn
 
 SCENE_EXTENT = 100_000.0  # the scene rect: room to pan anywhere
 
@@ -118,11 +125,45 @@ def wire_width(type_name: str) -> float:
 
 # --- fonts (created lazily: they need a QGuiApplication) ------------------------------------
 @cache
-def title_font() -> QFont:
+def title_font(pixel_size: int = TITLE_PX) -> QFont:
     f = QFont("DejaVu Sans")
-    f.setPixelSize(12)
+    f.setPixelSize(pixel_size)
     f.setBold(True)
     return f
+
+
+@cache
+def title_metrics(pixel_size: int) -> QFontMetricsF:
+    return QFontMetricsF(title_font(pixel_size))
+
+
+@cache
+def overview_font(pixel_size: int) -> QFont:
+    """The zoomed-out title: condensed bold, so more of a name fits a small block."""
+    f = QFont("DejaVu Sans")
+    f.setPixelSize(pixel_size)
+    f.setBold(True)
+    f.setStretch(QFont.Stretch.Condensed)
+    return f
+
+
+@cache
+def overview_metrics(pixel_size: int) -> QFontMetricsF:
+    return QFontMetricsF(overview_font(pixel_size))
+
+
+def header_title_px(lod: float) -> int:
+    """The title's pixel size (scene units) in the header at zoom `lod`: TITLE_PX, grown as
+    the view zooms out so it stays LOD_TITLE_MIN_PX on screen, as far as the header allows."""
+    want = LOD_TITLE_MIN_PX / max(lod, 1e-6)
+    return int(min(max(TITLE_PX, want), HEADER_HEIGHT - 4.0))
+
+
+def overview_title_px(lod: float) -> tuple[int, int]:
+    """The largest and smallest title sizes (scene units) tried on a zoomed-out block, for
+    LOD_TITLE_PX and LOD_TITLE_MIN_PX device pixels at zoom `lod`."""
+    lod = max(lod, 1e-6)
+    return int(round(LOD_TITLE_PX / lod)), int(round(LOD_TITLE_MIN_PX / lod))
 
 
 @cache

@@ -298,6 +298,7 @@ class NodeItem(QGraphicsRectItem):
     # --- painting ----------------------------------------------------------------------------
     def paint(self, painter: QPainter, option: QStyleOptionGraphicsItem, widget=None) -> None:
         lod = QStyleOptionGraphicsItem.levelOfDetailFromTransform(painter.worldTransform())
+        overview = lod < C.LOD_TEXT
         lay = self.layout
         rect = QRectF(0, 0, lay.width, lay.height)
         header = C.category_color(self.category)
@@ -305,7 +306,8 @@ class NodeItem(QGraphicsRectItem):
         body = QPainterPath()
         body.addRoundedRect(rect, C.CORNER, C.CORNER)
         painter.setPen(Qt.PenStyle.NoPen)
-        painter.setBrush(C.NODE_BODY)
+        # Zoomed out, the whole block takes the category's colour, under a big title.
+        painter.setBrush(header.darker(135) if overview else C.NODE_BODY)
         painter.drawPath(body)
         painter.save()
         painter.setClipRect(QRectF(0, 0, lay.width, C.HEADER_HEIGHT))
@@ -316,22 +318,26 @@ class NodeItem(QGraphicsRectItem):
         painter.drawPath(body)
         painter.restore()
         if self.isSelected():
-            edge = QPen(C.NODE_SELECTED, 2.0)
+            edge = QPen(C.NODE_SELECTED, 2.0 if not overview else 2.0 / max(lod, 0.1))
         elif self.has_error():
-            edge = QPen(C.ERROR, 1.6)
+            edge = QPen(C.ERROR, 1.6 if not overview else 1.6 / max(lod, 0.1))
         else:
             edge = QPen(C.NODE_BODY_EDGE, 1.2)
         painter.setPen(edge)
         painter.setBrush(Qt.BrushStyle.NoBrush)
         painter.drawPath(body)
-        if lod < C.LOD_TEXT:
+        if overview:
+            # No port labels, subtitle or thumbnail: only the port marks, for the wires' ends.
             self._paint_ports(painter, labels=False)
+            if lod >= C.LOD_TITLE_NONE:
+                self._paint_overview_title(painter, lod)
             return
-        # Title, elided when the node is at its widest.
-        painter.setFont(C.title_font())
+        # Title, elided when the node is at its widest; it grows as the view zooms out.
+        px = C.header_title_px(lod)
+        painter.setFont(C.title_font(px))
         painter.setPen(C.NODE_TEXT)
         room = lay.width - 14
-        title = C.metrics("title").elidedText(self.title, Qt.TextElideMode.ElideRight, room)
+        title = C.title_metrics(px).elidedText(self.title, Qt.TextElideMode.ElideRight, room)
         painter.drawText(QRectF(8, 0, room, C.HEADER_HEIGHT),
                          Qt.AlignmentFlag.AlignVCenter | Qt.AlignmentFlag.AlignLeft, title)
         if self.subtitle:
@@ -347,6 +353,48 @@ class NodeItem(QGraphicsRectItem):
             painter.setPen(QPen(C.NODE_BODY_EDGE, 1.0))
             painter.setBrush(Qt.BrushStyle.NoBrush)
             painter.drawRect(lay.preview)
+
+    def overview_title(self, lod: float) -> tuple[int, list[str]]:
+        """The zoomed-out title: its pixel size (scene units) and its lines, wrapped to fit the
+        node's body at zoom `lod` (the largest size that fits, else the smallest, elided)."""
+        inner = self._overview_rect(lod)
+        hi, lo = C.overview_title_px(lod)
+        step = max(1, (hi - lo) // 4)
+        sizes = list(range(hi, lo, -step)) + [lo]
+        for px in sizes:
+            fm = C.overview_metrics(px)
+            lines = _wrap(self.title, fm, inner.width())
+            if (len(lines) * fm.lineSpacing() <= inner.height()
+                    and all(fm.horizontalAdvance(t) <= inner.width() for t in lines)):
+                return px, lines
+        fm = C.overview_metrics(lo)
+        room = max(1, int(inner.height() // fm.lineSpacing()))
+        lines = _wrap(self.title, fm, inner.width())
+        if len(lines) > room:
+            lines = lines[:room - 1] + [" ".join(lines[room - 1:])]
+        return lo, [fm.elidedText(t, Qt.TextElideMode.ElideRight, inner.width()) for t in lines]
+
+    def _overview_rect(self, lod: float) -> QRectF:
+        pad = max(C.PORT_RADIUS + 1.0, 2.0 / max(lod, 1e-6))
+        return QRectF(pad, pad, self.layout.width - 2 * pad, self.layout.height - 2 * pad)
+
+    def _paint_overview_title(self, painter: QPainter, lod: float) -> None:
+        px, lines = self.overview_title(lod)
+        if not lines:
+            return
+        fm = C.overview_metrics(px)
+        inner = self._overview_rect(lod)
+        painter.save()
+        painter.setClipRect(QRectF(0, 0, self.layout.width, self.layout.height))
+        painter.setFont(C.overview_font(px))
+        painter.setPen(C.NODE_TEXT)
+        step = fm.lineSpacing()
+        y = inner.center().y() - len(lines) * step / 2
+        for text in lines:
+            painter.drawText(QRectF(inner.left(), y, inner.width(), step),
+                             Qt.AlignmentFlag.AlignCenter, text)
+            y += step
+        painter.restore()
 
     def _paint_ports(self, painter: QPainter, labels: bool) -> None:
         lay = self.layout
@@ -383,3 +431,14 @@ class NodeItem(QGraphicsRectItem):
                     r.setRight(C.LABEL_GAP + room)
                     align = Qt.AlignmentFlag.AlignLeft
                 painter.drawText(r, align | Qt.AlignmentFlag.AlignVCenter, text)
+
+
+def _wrap(text: str, fm, width: float) -> list[str]:
+    """Greedy word wrap: as many words a line as fit in `width` (a long word keeps its line)."""
+    lines: list[str] = []
+    for word in text.split():
+        if lines and fm.horizontalAdvance(lines[-1] + " " + word) <= width:
+            lines[-1] += " " + word
+        else:
+            lines.append(word)
+    return lines

@@ -1,0 +1,106 @@
+"""The shipped sample graphs are laid out for humans: no two nodes overlap, and no wire runs
+through the body of a node other than the two it joins.
+
+Each sample is loaded into the real canvas scene, so node sizes are the editor's own, and
+every node of a kind that always shows a thumbnail gets one (its tallest size: a node without
+its thumbnail is shorter, with its ports where they were, so it can only clear more room).
+The check is geometric, on the scene's items. tools/layout_samples.py writes the layouts.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
+
+from pathlib import Path  # noqa: E402
+
+import pytest  # noqa: E402
+from PySide6.QtGui import QColor, QImage  # noqa: E402
+
+from matedit.app.canvas import NodeCanvasView  # noqa: E402
+from matedit.app.controller import DocumentController  # noqa: E402
+from matedit.app.previews import ALWAYS, SIZE  # noqa: E402
+from matedit.io.document import load  # noqa: E402
+
+pytestmark = pytest.mark.gui
+
+GRAPHS = Path(__file__).resolve().parent.parent / "graphs"
+SAMPLES = sorted(p for sub in ("materials", "functions", "layers", "instances")
+                 for p in (GRAPHS / sub).glob("*.json") if '"position"' in p.read_text())
+
+NODE_MARGIN = 6.0  # scene units kept clear around each node's bounding rect (ports included)
+WIRE_STEPS = 200  # samples along each wire
+END_ALLOWANCE = 0.03  # the first and last 3 % of a wire sit at its ports: not checked
+BODY_INSET = 1.0  # a wire grazing a body's edge by under a unit is not "through" it
+
+
+def with_thumbnails(scene):
+    """Give each node that always shows a thumbnail in the editor a (grey) one."""
+    image = QImage(SIZE, SIZE, QImage.Format.Format_RGB32)
+    image.fill(QColor(90, 90, 90))
+    for nid, item in scene.node_items.items():
+        if item.kind in ALWAYS:
+            scene.set_node_preview(nid, image)
+    return scene
+
+
+def sample_scene(qtbot, path: Path):
+    view = NodeCanvasView(DocumentController(load(path)))
+    qtbot.addWidget(view)
+    return with_thumbnails(view.scene())
+
+
+def layout_problems(scene) -> list[str]:
+    """Overlapping node pairs and wires through foreign node bodies, as readable lines."""
+    items = dict(sorted(scene.node_items.items()))
+    rects = {nid: it.sceneBoundingRect().adjusted(-NODE_MARGIN, -NODE_MARGIN, NODE_MARGIN,
+                                                  NODE_MARGIN) for nid, it in items.items()}
+    problems = []
+    ids = list(rects)
+    for i, a in enumerate(ids):
+        for b in ids[i + 1:]:
+            if rects[a].intersects(rects[b]):
+                problems.append(f"nodes {a} and {b} overlap")
+    bodies = {nid: it.mapRectToScene(it.shape().boundingRect()).adjusted(
+        BODY_INSET, BODY_INSET, -BODY_INSET, -BODY_INSET) for nid, it in items.items()}
+    for link, wire in sorted(scene.wire_items.items(), key=lambda kv: str(kv[0])):
+        path = wire.mapToScene(wire.path())
+        lo, hi = int(END_ALLOWANCE * WIRE_STEPS), int((1 - END_ALLOWANCE) * WIRE_STEPS)
+        hit = set()
+        for k in range(lo, hi + 1):
+            pt = path.pointAtPercent(k / WIRE_STEPS)
+            for nid, body in bodies.items():
+                if nid not in (link.src, link.dst) and body.contains(pt):
+                    hit.add(nid)
+        for nid in sorted(hit):
+            problems.append(f"wire {link.src}.{link.src_port} -> {link.dst}.{link.dst_port} "
+                            f"crosses node {nid}")
+    return problems
+
+
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: f"{p.parent.name}/{p.stem}")
+def test_sample_has_no_overlapping_nodes_or_wires_through_nodes(qtbot, path):
+    problems = layout_problems(sample_scene(qtbot, path))
+    assert not problems, f"{path.name}:\n" + "\n".join(problems)
+
+
+def test_the_checker_sees_an_overlap_and_a_crossing(qtbot):
+    """The check can fail: a node moved onto another, and one placed across a wire."""
+    path = GRAPHS / "materials" / "brushed_gold.json"
+    doc = load(path)
+    out = doc.graph.nodes["out"]
+    make = doc.graph.nodes["make"]
+    out.position = (make.position[0] + 10, make.position[1] + 10)
+    view = NodeCanvasView(DocumentController(doc))
+    qtbot.addWidget(view)
+    problems = layout_problems(with_thumbnails(view.scene()))
+    assert any("overlap" in p for p in problems)
+    doc = load(path)
+    link = next(iter(sorted(doc.graph.links, key=str)))
+    a, b = doc.graph.nodes[link.src].position, doc.graph.nodes[link.dst].position
+    victim = next(n for n in sorted(doc.graph.nodes) if n not in (link.src, link.dst))
+    doc.graph.nodes[victim].position = ((a[0] + b[0]) / 2 + 60, (a[1] + b[1]) / 2)
+    view = NodeCanvasView(DocumentController(doc))
+    qtbot.addWidget(view)
+    assert any(f"crosses node {victim}" in p for p in layout_problems(view.scene()))
