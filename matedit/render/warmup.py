@@ -1,0 +1,252 @@
+"""Warming the viewport's programs in a helper process, so the UI thread's link is cheap.
+
+On llvmpipe most of a structural edit's cost is not our compile but the driver's: the GLSL
+link, and above all the JIT of the fragment shader's variant at its first draw. Mesa's shader
+cache (per user, ~/.cache/mesa_shader_cache unless MESA_SHADER_CACHE_DIR says otherwise) hands
+both between GL contexts of one process. So a worker that links and draws the new program once,
+in its own headless context, into a small target set up like the viewport's (the same
+framebuffer formats and sample count, the same texture formats and sampler state, the same entry
+variant and lighting pass), leaves the UI thread's link and first draw about one plain frame.
+With the cache disabled (MESA_SHADER_CACHE_DISABLE=true) the warm-up is wasted work on the worker
+and the UI thread pays what it paid before: nothing breaks.
+
+The warm-up runs in a child process (`WarmupClient`, serving `python -m matedit.render.warmup`),
+not on a thread of the editor's: moderngl holds Python's GIL through every GL call, and the link
+and first draw of a material are single calls of 100-900 ms on llvmpipe, during which a thread of
+the editor would stop the UI thread too (measured: benchmarks/bench_ui_block.py). Mesa's cache is
+on disk, so a child writes what the editor reads. The child gets the same environment (the same
+MESA_SHADER_CACHE_DIR, or the per-user default) and ends when the editor closes its pipe.
+
+moderngl only, no Qt. One `Warmer` per thread: its context is current on the thread that made it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import pickle
+import struct
+import subprocess
+import sys
+import threading
+import time
+import weakref
+from dataclasses import dataclass, field
+from pathlib import Path
+
+# Small: the variant key of llvmpipe's fragment shaders does not depend on the target's size
+# (benchmarks/bench_ui_block.py measures the UI thread's first draw after warming at this size).
+WARM_SIZE = (64, 64)
+
+
+@dataclass(frozen=True)
+class ViewportState:
+    """What of the viewport decides which programs it draws and the driver's variants of them
+    (the UI thread takes it when it submits an edit; the worker reads only this record)."""
+
+    samples: int = 4
+    deferred: bool = True
+    environment: str = "studio"
+    mode: str = "splitsum"
+    mesh: str = "sphere"
+    energy_compensation: bool = False
+    show_background: bool = True
+    textures: dict = field(default_factory=dict)  # texture name -> file (None: the checker)
+
+
+class Warmer:
+    """A headless context and a small Renderer like the viewport's, made on first use on the
+    calling thread and kept for the next edits (its environment, mesh, lighting pass and
+    textures stay loaded: a warm-up after the first links and draws only the new program)."""
+
+    def __init__(self, size: tuple[int, int] = WARM_SIZE) -> None:
+        self.size = size
+        self.ctx = None
+        self.renderer = None
+        self.thread: threading.Thread | None = None
+        self._key: tuple | None = None
+        self.count = 0  # warm-ups done (tests)
+        self.last_program = ""  # the structure hash of the variant drawn last
+
+    def _renderer_for(self, state: ViewportState):
+        from matedit.render.context import headless_context
+        from matedit.render.renderer import Renderer
+
+        if self.thread is not None and self.thread is not threading.current_thread():
+            raise RuntimeError("a Warmer is used on the thread that made it")
+        key = (state.samples, state.deferred)
+        if self.renderer is None or self._key != key:
+            self.release()
+            self.thread = threading.current_thread()
+            self.ctx = headless_context()
+            self.renderer = Renderer(self.ctx, self.size, samples=state.samples,
+                                     environment=state.environment, deferred=state.deferred)
+            self._key = key
+        r = self.renderer
+        if getattr(r, "environment_name", None) != str(state.environment):
+            r.set_environment(state.environment)
+        if r.mesh_name != str(state.mesh):
+            r.set_mesh(state.mesh)
+        r.mode = state.mode
+        r.show_background = state.show_background
+        r.set_energy_compensation(state.energy_compensation)
+        return r
+
+    def warm(self, compiled, state: ViewportState) -> bool:
+        """Links and draws `compiled` once as the viewport will; False when it does not link
+        (the viewport reports that itself, with the located errors)."""
+        r = self._renderer_for(state)
+        if not r.set_material(compiled).ok:
+            return False
+        for name, path in state.textures.items():
+            try:
+                r.set_texture(name, str(path) if path else None)
+            except ValueError:
+                pass  # the viewport shows the message; a checker stands in here
+        r.render()
+        self.ctx.finish()
+        self.count += 1
+        self.last_program = next((h for h, p in r.programs.table.items() if p is r._program), "")
+        return True
+
+    def release(self) -> None:
+        """Frees the context; call it on the thread that made it (or at process exit)."""
+        if self.renderer is not None:
+            self.renderer.release()
+            self.renderer = None
+        if self.ctx is not None:
+            self.ctx.release()
+            self.ctx = None
+        self._key = None
+
+
+def with_textures(state: ViewportState, textures: dict) -> ViewportState:
+    return dataclasses.replace(state, textures=dict(textures))
+
+
+@dataclass
+class WarmReply:
+    ok: bool  # linked and drawn
+    ms: float = 0.0  # the warm-up's time in the child
+    pid: int = 0  # the process that did it
+    program: str = ""  # the structure hash of the variant drawn ("" when none)
+    error: str = ""
+
+
+# --- the pipe: 4-byte big-endian length, then a pickle -----------------------------------------
+def _send(stream, obj) -> None:
+    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    stream.write(struct.pack(">I", len(data)) + data)
+    stream.flush()
+
+
+def _recv(stream):
+    head = stream.read(4)
+    if len(head) < 4:
+        raise EOFError("warm-up pipe closed")
+    (n,) = struct.unpack(">I", head)
+    data = stream.read(n)
+    if len(data) < n:
+        raise EOFError("warm-up pipe closed")
+    return pickle.loads(data)  # noqa: S301 - our own child process, over its own pipe
+
+
+def _end(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        try:
+            proc.stdin.close()
+            proc.wait(timeout=2)
+        except (OSError, subprocess.TimeoutExpired):
+            proc.kill()
+
+
+class WarmupClient:
+    """The editor's side: starts the child on first use and asks it to warm one material at a
+    time (from one thread, the compile worker's; waiting on the pipe releases the GIL). Any
+    failure (no GL in the child, a crash, a time-out) loses only the warm-up; the child is
+    started again at the next request."""
+
+    def __init__(self, timeout_s: float = 30.0) -> None:
+        self.timeout_s = timeout_s
+        self._proc: subprocess.Popen | None = None
+        self._lock = threading.Lock()
+
+    def _start(self) -> subprocess.Popen:
+        import matedit
+
+        env = dict(os.environ)
+        root = str(Path(matedit.__file__).resolve().parent.parent)
+        env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
+        proc = subprocess.Popen([sys.executable, "-m", "matedit.render.warmup"],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env,
+                                stderr=subprocess.DEVNULL)
+        weakref.finalize(self, _end, proc)  # a client dropped without close(): no orphan
+        return proc
+
+    def warm(self, compiled, state: ViewportState) -> WarmReply:
+        with self._lock:
+            if self._proc is None or self._proc.poll() is not None:
+                self._proc = self._start()
+            proc = self._proc
+            timer = threading.Timer(self.timeout_s, proc.kill)  # a hung driver: start over
+            timer.start()
+            try:
+                _send(proc.stdin, (compiled, state))
+                reply = _recv(proc.stdout)
+            except Exception as exc:  # noqa: BLE001 - a broken pipe, a bad pickle: start over
+                self._stop(proc)
+                return WarmReply(False, error=f"{type(exc).__name__}: {exc}")
+            finally:
+                timer.cancel()
+            return reply
+
+    @property
+    def pid(self) -> int | None:
+        return self._proc.pid if self._proc is not None and self._proc.poll() is None else None
+
+    def _stop(self, proc) -> None:
+        try:
+            proc.stdin.close()
+        except OSError:
+            pass
+        try:
+            proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+        if self._proc is proc:
+            self._proc = None
+
+    def close(self) -> None:
+        """Ends the child (it also ends by itself when the editor's process goes)."""
+        with self._lock:
+            if self._proc is not None:
+                self._stop(self._proc)
+
+
+def serve(inp, out) -> None:
+    """The child's loop: (compiled, state) in, WarmReply out, until the pipe closes."""
+    warmer = Warmer()
+    while True:
+        try:
+            compiled, state = _recv(inp)
+        except EOFError:
+            break
+        t0 = time.perf_counter()
+        try:
+            ok = warmer.warm(compiled, state)
+            reply = WarmReply(ok, (time.perf_counter() - t0) * 1e3, os.getpid(),
+                              warmer.last_program if ok else "")
+        except Exception as exc:  # noqa: BLE001 - reported to the editor, which carries on
+            reply = WarmReply(False, (time.perf_counter() - t0) * 1e3, os.getpid(),
+                              error=f"{type(exc).__name__}: {exc}")
+        _send(out, reply)
+    warmer.release()
+
+
+if __name__ == "__main__":
+    from matedit.render import warmup as _module  # replies pickle as matedit.render.warmup's
+
+    _inp, _out = sys.stdin.buffer, sys.stdout.buffer
+    sys.stdout = sys.stderr  # the pipe carries only replies
+    _module.serve(_inp, _out)
