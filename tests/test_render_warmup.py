@@ -1,0 +1,66 @@
+"""The warm-up child process (matedit.render.warmup.WarmupClient): it links and draws exactly the
+variant the viewport will draw (the structure hash it reports equals the one computed here, from
+the compiler, independently of the child), in another process, and a dead child is replaced.
+Whether Mesa's shader cache then hits is measured by benchmarks/bench_ui_block.py, not here."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from matedit.compiler import compile_document
+from matedit.compiler.emit import Entry
+from matedit.io.document import load
+from matedit.render.deferred import SPLIT_SUM_ONLY, wants_forward
+from matedit.render.warmup import ViewportState, WarmupClient
+from matedit.resources import graphs_dir
+
+MATERIALS = graphs_dir() / "materials"
+
+
+def _compiled(name: str):
+    return compile_document(load(MATERIALS / f"{name}.json"), None, "glsl330")
+
+
+@pytest.fixture(scope="module")
+def client():
+    c = WarmupClient(timeout_s=300)
+    yield c
+    c.close()
+
+
+def _expected(cm, deferred: bool = True) -> str:
+    if deferred and not wants_forward(cm):
+        return cm.variant(Entry.GBUFFER).structure_hash
+    return cm.variant(Entry.FORWARD, (SPLIT_SUM_ONLY,)).structure_hash
+
+
+def test_the_child_draws_the_viewports_variant_in_another_process(client):
+    a, b = _compiled("rusty_painted_metal"), _compiled("brushed_gold")
+    ra = client.warm(a, ViewportState())
+    assert ra.ok, ra.error
+    assert ra.pid not in (0, os.getpid())
+    assert ra.program == _expected(a)
+    rb = client.warm(b, ViewportState())
+    assert rb.ok, rb.error
+    assert rb.pid == ra.pid  # one child, kept for the next edits
+    assert rb.program == _expected(b) != ra.program
+
+
+def test_forward_viewports_get_the_forward_variant(client):
+    cm = _compiled("brushed_gold")
+    r = client.warm(cm, ViewportState(deferred=False))
+    assert r.ok, r.error
+    assert r.program == _expected(cm, deferred=False) != _expected(cm)
+
+
+def test_a_dead_child_is_replaced(client):
+    cm = _compiled("brushed_gold")
+    first = client.warm(cm, ViewportState())
+    assert first.ok, first.error
+    client._proc.kill()
+    client._proc.wait()
+    again = client.warm(cm, ViewportState())
+    assert again.ok, again.error
+    assert again.pid != first.pid
