@@ -144,66 +144,74 @@ def child_gl(quick: bool) -> dict:
     return out
 
 
-def _variant(cm, fragment_text: str, tag: str):
-    """`cm` with another fragment shader (and structure hash, so that it links anew)."""
-    import dataclasses
-
-    frag = dataclasses.replace(cm.fragment, text=fragment_text)
-    return dataclasses.replace(cm, fragment=frag, structure_hash=cm.structure_hash + tag)
-
-
 def child_jit(quick: bool) -> dict:
-    """Link + first frame of variants of the layered sample's program, under whatever
-    GALLIVM_PERF the parent set: the sample as compiled; the same with the reference-IBL
-    branch removed (what one program per IBL mode would give); the hand-written floor
-    (constant material, same lighting library)."""
+    """Link + first frame of the layered sample's FORWARD entry under whatever GALLIVM_PERF
+    the parent set, with and without the reference-IBL estimator: the variant the forward
+    preview's split-sum mode links (MATEDIT_SPLIT_SUM_ONLY defined, through the compiler's
+    Entry/defines mechanism, no shader text edited here), the variant its reference mode links
+    (no define: both IBL branches), and the hand-written floor (constant material, same
+    lighting library). A forward renderer (deferred=False), so that these are the programs
+    drawn; reference mode at 1 sample a pixel and 1 frame, so that the first frame is the
+    driver's compile plus one cheap frame, as in split-sum mode."""
     import moderngl
-    from bench_render import floor_material, frame_time
+    from bench_render import floor_material
+    from common import median_time
 
     from matedit.compiler import compile_document
+    from matedit.compiler.emit import Entry
     from matedit.io.document import FileResolver, load
     from matedit.render import Renderer
+    from matedit.render.deferred import SPLIT_SUM_ONLY
     from matedit.resources import graphs_dir
 
     ctx = moderngl.create_standalone_context(backend="egl")
-    r = Renderer(ctx, (512, 512))
+    r = Renderer(ctx, (512, 512), deferred=False)
+    r.reference_samples, r.reference_frames = 1, 1
     r.render()
     ctx.finish()
     cm = compile_document(load(graphs_dir() / "materials" / "worn_painted_steel.json"),
                           FileResolver())
-    text = cm.fragment_text
-    guard = "#ifndef MATEDIT_SPLIT_SUM_ONLY"
-    if guard in text:  # the renderer links a split-sum-only program by defining this macro
-        both = _variant(cm, text.replace(guard, "#if 1"), "-both")
-        split = cm
-    else:  # the renderer links one program with both IBL branches
-        both = cm
-        split = _variant(cm, text.replace("if (mode == IBL_MODE_REFERENCE) {", "if (false) {"),
-                         "-splitsum")
-    variants = {"worn_painted_steel, both IBL branches": both,
-                "worn_painted_steel, split-sum branch only": split,
-                "hand-written floor": floor_material()}
+    variants = {"worn_painted_steel, both IBL branches": (cm, "reference"),
+                "worn_painted_steel, split-sum branch only": (cm, "splitsum"),
+                "hand-written floor": (floor_material(), "splitsum")}
     out = {"gallivm_perf": os.environ.get("GALLIVM_PERF", ""), "variants": [],
-           "renderer_specialises": guard in text}
+           "renderer_specialises": True}
+
+    def link_and_draw(material, mode: str) -> tuple[float, float, float]:
+        r.programs.table.clear()  # links anew (not released: no program name is reused)
+        r.mode = mode
+        t0 = time.perf_counter()
+        r.set_material(material)  # the split-sum variant, FORWARD + MATEDIT_SPLIT_SUM_ONLY
+        if mode == "reference":  # and the one reference mode draws, FORWARD without it
+            t0 = time.perf_counter()  # (the split-sum variant's link is not this row's)
+            r.programs.get(material, Entry.FORWARD, ())
+        ctx.finish()
+        t1 = time.perf_counter()
+        r.render()
+        ctx.finish()
+        t2 = time.perf_counter()
+        return t1 - t0, t2 - t1, t2 - t0
+
     runs: dict[str, list] = {name: [] for name in variants}
     for _ in range(1 if quick else 5):  # interleaved, so that load on the machine hits all
-        for name, material in variants.items():
-            r._programs.clear()
-            t0 = time.perf_counter()
-            r.set_material(material)
-            ctx.finish()
-            t1 = time.perf_counter()
-            r.render()
-            ctx.finish()
-            t2 = time.perf_counter()
-            runs[name].append((t1 - t0, t2 - t1, t2 - t0))
-    for name, material in variants.items():
+        for name, (material, mode) in variants.items():
+            runs[name].append(link_and_draw(material, mode))
+    for name, (material, mode) in variants.items():
         rows = sorted(runs[name], key=lambda x: x[2])
         link, first, total = rows[len(rows) // 2]
+        r.mode = mode
         r.set_material(material)
+        variant = material.variant(Entry.FORWARD,
+                                   () if mode == "reference" else (SPLIT_SUM_ONLY,))
+
+        def frame():  # reference mode has converged after its one frame: start it again
+            r.reset_accumulation()
+            r.render()
+            ctx.finish()
+
         out["variants"].append({"name": name, "link": link, "first_frame": first,
-                                "total": total, "frame": frame_time(r, ctx, frames=3),
-                                "fragment_chars": len(material.fragment_text)})
+                                "total": total, "frame": median_time(frame, repeat=3),
+                                "fragment_chars": len(variant.fragment_text)})
     r.release()
     return out
 
