@@ -657,6 +657,83 @@ def startup_section(rep: Report, st: dict, goals: list) -> None:
         rep.add()
 
 
+def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
+    rep.add("## 6b. Structural edit in the editor: UI-thread blocking")
+    rep.add()
+    rep.add("benchmarks/bench_ui_block.py: the real MainWindow under Xvfb on the sample layered "
+            "material, compiles off the UI thread (as `matedit edit`), each structural edit "
+            "(add a constant node and wire it into `e1.b`, through the undo stack; a new "
+            "program every time) timed from the push to the first frame drawn with the new "
+            "program. *UI block* is the longest gap between ticks of a 5 ms timer on the UI "
+            "thread over that time. Each row is its own child process with Mesa's shader "
+            "cache enabled in a fresh, empty temporary MESA_SHADER_CACHE_DIR (the only part "
+            "of this report with the cache on): with the compile worker's warm-up "
+            "(matedit.render.warmup) and without it (`CompileWorker.warm_up = False`).")
+    rep.add()
+    rows = []
+    for key, label in (("cold", "no warm-up"), ("warm", "warm-up in a child process")):
+        r = ub.get(key, {})
+        if "error" in r or not r:
+            rows.append([label, r.get("error", "not run"), "", "", "", "", ""])
+            continue
+        rows.append([label, f"**{r['ui_block_max_ms']:.0f}**", f"{r['ui_block_median_ms']:.0f}",
+                     f"{r['latency_median_ms']:.0f}", f"{r['apply_median_ms']:.0f}",
+                     f"{r['first_paint_median_ms']:.0f}", f"{r['plain_paint_median_ms']:.0f}"])
+    rep.table(["", "UI block max (ms)", "UI block median (ms)", "edit → pixels median (ms)",
+               "UI-thread link (ms)", "first frame (ms)", "plain frame (ms)"], "lrrrrrr", rows)
+    w = ub.get("warm", {})
+    if "ui_block_max_ms" in w:
+        rep.add(f"{w['edits']} edits each, viewport {w['viewport'][0]}×{w['viewport'][1]} px. "
+                "With the warm-up the longest block is about one plain frame (the frame is "
+                "drawn on the UI thread).")
+        rep.add()
+        goals.append(["UI thread blocked during a structural edit", "≤ 50 ms",
+                      f"{w['ui_block_max_ms']:.0f} ms (plain frame "
+                      f"{w['plain_paint_median_ms']:.0f} ms)",
+                      verdict(w["ui_block_max_ms"] <= 50.0)])
+
+
+def results_json(results: dict, uiblock: dict, meta: dict) -> dict:
+    """The report's figures under stable keys (benchmarks/README.md); milliseconds as `_ms`,
+    seconds as `_seconds`; a figure not measured in this run is absent."""
+    out: dict = {"meta": dict(meta, cores=os.cpu_count())}
+    gl = results.get("gl", {})
+    out["meta"]["gl_renderer"] = gl.get("gl_renderer")
+    out["meta"]["mesa_shader_cache_disable"] = os.environ.get("MESA_SHADER_CACHE_DISABLE")
+    per = {"structural_edit_ms": {}, "materialx_per_layer_ms": {}, "materialx_mixed_ms": {}}
+    for r in gl.get("structural", []):
+        per["structural_edit_ms"][r["sample"]] = r["total"] * 1e3
+        if "mx_shaders" in r:
+            per["materialx_per_layer_ms"][r["sample"]] = r["mx_shaders"]["total"] * 1e3
+        if "mx_inputs" in r:
+            per["materialx_mixed_ms"][r["sample"]] = r["mx_inputs"]["total"] * 1e3
+    out.update({k: v for k, v in per.items() if v})
+    if "parameter" in gl:
+        p = gl["parameter"]
+        out["param_edit_links"] = p["links"]
+        out["param_edit_ms"] = p["edit_to_frame"] * 1e3
+        out["param_plain_frame_ms"] = p["frame"] * 1e3
+    if "frames" in gl:
+        out["frame_ms"] = {str(f["size"]): f["material"] * 1e3 for f in gl["frames"]}
+        out["floor_ms"] = {str(f["size"]): f["floor"] * 1e3 for f in gl["frames"]}
+    comp = results.get("compile", {})
+    if "scaling" in comp:
+        out["compile_ms"] = {str(s["nodes"]): s["seconds"] * 1e3 for s in comp["scaling"]}
+    tools = results.get("ibl", {}).get("tools", {})
+    if "matedit" in tools:
+        out["ibl_seconds"] = tools["matedit"]["prefilter_s"]
+        out["ibl_lut_error"] = tools["matedit"]["lut_error"]
+    if "cmgen" in tools:
+        out["cmgen_seconds"] = tools["cmgen"]["prefilter_s"]
+        out["cmgen_lut_error"] = tools["cmgen"]["lut_error"]
+    for key, suffix in (("warm", ""), ("cold", "_no_warmup")):
+        r = uiblock.get(key, {})
+        if "ui_block_max_ms" in r:
+            out["ui_block_max_ms" + suffix] = r["ui_block_max_ms"]
+            out["editor_structural_edit_ms" + suffix] = r["latency_median_ms"]
+    return out
+
+
 def optional_section(rep: Report, opt: dict) -> None:
     rep.add("## 7. Node canvas and editor responsiveness (benchmarks written elsewhere)")
     rep.add()
@@ -698,7 +775,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer repetitions, smaller IBL")
     parser.add_argument("--out", default=str(HERE / "RESULTS.md"))
     parser.add_argument("--skip", default="", help="comma-separated sections to skip: "
-                        "gl,jit,compile,ibl,profile,native,startup,optional")
+                        "gl,jit,compile,ibl,profile,native,startup,uiblock,optional")
     args = parser.parse_args(argv)
     if args.child:
         result = CHILDREN[args.child](args.quick)
@@ -746,6 +823,14 @@ def main(argv=None) -> int:
         except (subprocess.SubprocessError, OSError) as exc:
             startup["editor"] = {"skipped": f"failed: {exc}"}
         startup["wall"] = time.perf_counter() - t0
+    uiblock: dict = {}
+    if "uiblock" not in skip:
+        import bench_ui_block
+
+        print("[run_all] ui block …", file=sys.stderr, flush=True)
+        t0 = time.perf_counter()
+        uiblock = bench_ui_block.run(edits=4 if args.quick else 8)
+        uiblock["wall"] = time.perf_counter() - t0
     optional: dict = {}
     if "optional" not in skip:
         for script, _ in OPTIONAL_BENCHES:
@@ -781,6 +866,8 @@ def main(argv=None) -> int:
     ibl_section(rep, results["ibl"], goals)
     if startup:
         startup_section(rep, startup, goals)
+    if uiblock:
+        ui_block_section(rep, uiblock, goals)
     if optional:
         optional_section(rep, optional)
     rep.add("## Goals")
@@ -792,7 +879,12 @@ def main(argv=None) -> int:
         rep.add(notes.read_text().rstrip())
         rep.add()
     Path(args.out).write_text("\n".join(rep.lines).rstrip() + "\n")
-    print(f"[run_all] wrote {args.out} in {total / 60:.1f} min", file=sys.stderr)
+    figures = results_json(results, uiblock, {"date": when.isoformat(timespec="minutes"),
+                                              "command": command, "quick": bool(args.quick)})
+    json_out = Path(args.out).with_name("results.json")
+    json_out.write_text(json.dumps(figures, indent=1, sort_keys=True) + "\n")
+    print(f"[run_all] wrote {args.out} and {json_out.name} in {total / 60:.1f} min",
+          file=sys.stderr)
     return 0
 
 
