@@ -52,6 +52,11 @@ def _slow_compiles(window, threads: list, warm_up: bool = False):
         c.worker.finished.connect(c._finished)
     c.worker.compile_fn = slow
     c.worker.warm_up = warm_up
+    if warm_up:  # its child takes seconds to start: let it get ready before the edit
+        c.worker.prepare_warm_up()
+        end = time.monotonic() + 120
+        while not c.worker.warm_up_ready(0.5):
+            assert time.monotonic() < end, "the warm-up process never got ready"
 
 
 def _structural_edit(window, value: str):

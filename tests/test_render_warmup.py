@@ -26,6 +26,8 @@ def _compiled(name: str):
 @pytest.fixture(scope="module")
 def client():
     c = WarmupClient(timeout_s=300)
+    c.start()
+    assert c.wait_ready(300)
     yield c
     c.close()
 
@@ -61,6 +63,21 @@ def test_a_dead_child_is_replaced(client):
     assert first.ok, first.error
     client._proc.kill()
     client._proc.wait()
+    client.start()
+    assert client.wait_ready(300)
     again = client.warm(cm, ViewportState())
     assert again.ok, again.error
     assert again.pid != first.pid
+
+
+def test_until_the_child_is_ready_a_warm_up_returns_at_once_untried():
+    c = WarmupClient(timeout_s=300)
+    try:
+        r = c.warm(_compiled("brushed_gold"), ViewportState())  # the child was just started
+        assert r.starting and not r.ok and r.program == ""
+        assert c.pid is not None  # and it keeps starting: a later edit is warmed
+        assert c.wait_ready(300)
+        assert c.warm(_compiled("brushed_gold"), ViewportState()).ok
+    finally:
+        c.close()
+    assert c.pid is None

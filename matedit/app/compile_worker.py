@@ -120,6 +120,24 @@ class CompileWorker(QObject):
             result.warm_ms = (time.perf_counter() - t1) * 1e3
         return result
 
+    def prepare_warm_up(self) -> None:
+        """Starts the warm-up's child process now (it takes seconds to be ready; edits until
+        then are not warmed and not held back)."""
+        from matedit.render.warmup import WarmupClient
+
+        if self.warm_up:
+            if self._warmer is None:
+                self._warmer = WarmupClient()
+            self._warmer.start()
+
+    @property
+    def warm_up_started(self) -> bool:
+        return self._warmer is not None
+
+    def warm_up_ready(self, timeout: float = 0.0) -> bool:
+        """Whether the warm-up's child is ready (tests; it may wait for a running warm-up)."""
+        return self._warmer is not None and self._warmer.wait_ready(timeout)
+
     def _warm(self, gen: int, cm, doc, viewport) -> None:
         """On the worker thread. Any failure here only loses the warm-up: the UI thread links
         as it would without one (and reports link errors itself)."""
@@ -132,6 +150,8 @@ class CompileWorker(QObject):
             if self._warmer is None:
                 self._warmer = WarmupClient()
             reply = (self.warm_fn or WarmupClient.warm)(self._warmer, cm, state)
+            if reply.starting:
+                return  # no warm-up this time: the UI thread links as it did before
             self.warmed.append((gen, threading.current_thread(), reply))
         except Exception:  # noqa: BLE001 - a bad file, a pickling problem: no warm-up
             pass

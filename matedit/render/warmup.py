@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import pickle
+import select
 import struct
 import subprocess
 import sys
@@ -131,6 +132,7 @@ class WarmReply:
     pid: int = 0  # the process that did it
     program: str = ""  # the structure hash of the variant drawn ("" when none)
     error: str = ""
+    starting: bool = False  # not tried: the child is not ready yet
 
 
 # --- the pipe: 4-byte big-endian length, then a pickle -----------------------------------------
@@ -161,14 +163,17 @@ def _end(proc: subprocess.Popen) -> None:
 
 
 class WarmupClient:
-    """The editor's side: starts the child on first use and asks it to warm one material at a
-    time (from one thread, the compile worker's; waiting on the pipe releases the GIL). Any
-    failure (no GL in the child, a crash, a time-out) loses only the warm-up; the child is
-    started again at the next request."""
+    """The editor's side. `start()` starts the child without waiting; it makes its context and
+    renderer and says it is ready (seconds: imports, the environment from the bake cache).
+    `warm()` asks it to warm one material (from one thread, the compile worker's; waiting on
+    the pipe releases the GIL); until the child is ready it returns at once, unwarmed, so the
+    first edits after opening are not held back by the child's start-up. Any failure (no GL
+    in the child, a crash, a time-out) loses only that warm-up; the child is started again."""
 
     def __init__(self, timeout_s: float = 30.0) -> None:
         self.timeout_s = timeout_s
         self._proc: subprocess.Popen | None = None
+        self._ready = False
         self._lock = threading.Lock()
 
     def _start(self) -> subprocess.Popen:
@@ -183,11 +188,47 @@ class WarmupClient:
         weakref.finalize(self, _end, proc)  # a client dropped without close(): no orphan
         return proc
 
+    def _ensure(self) -> subprocess.Popen:
+        if self._proc is None or self._proc.poll() is not None:
+            self._proc = self._start()
+            self._ready = False
+        return self._proc
+
+    def start(self) -> None:
+        """Starts the child (if it does not run) and returns at once."""
+        with self._lock:
+            self._ensure()
+
+    def _check_ready(self, timeout: float) -> bool:
+        if self._ready:
+            return True
+        proc = self._proc
+        if proc is None or proc.poll() is not None:
+            return False
+        readable, _, _ = select.select([proc.stdout], [], [], max(0.0, timeout))
+        if not readable:
+            return False
+        try:
+            _recv(proc.stdout)  # the child's ("ready", pid)
+        except Exception:  # noqa: BLE001 - it died while starting
+            self._stop(proc)
+            return False
+        self._ready = True
+        return True
+
+    def wait_ready(self, timeout: float = 0.0) -> bool:
+        """Whether the child is ready, waiting up to `timeout` s (tests; start() first)."""
+        if self._ready:
+            return True
+        with self._lock:
+            return self._check_ready(timeout)
+
     def warm(self, compiled, state: ViewportState) -> WarmReply:
         with self._lock:
-            if self._proc is None or self._proc.poll() is not None:
-                self._proc = self._start()
-            proc = self._proc
+            proc = self._ensure()
+            if not self._check_ready(0.0):
+                return WarmReply(False, error="the warm-up process is starting",
+                                 starting=True)
             timer = threading.Timer(self.timeout_s, proc.kill)  # a hung driver: start over
             timer.start()
             try:
@@ -216,6 +257,7 @@ class WarmupClient:
             proc.wait()
         if self._proc is proc:
             self._proc = None
+            self._ready = False
 
     def close(self) -> None:
         """Ends the child (it also ends by itself when the editor's process goes)."""
@@ -225,8 +267,14 @@ class WarmupClient:
 
 
 def serve(inp, out) -> None:
-    """The child's loop: (compiled, state) in, WarmReply out, until the pipe closes."""
+    """The child's loop: ("ready", pid) out once its renderer is up (for the default
+    ViewportState), then (compiled, state) in, WarmReply out, until the pipe closes."""
     warmer = Warmer()
+    try:
+        warmer._renderer_for(ViewportState())
+    except Exception:  # noqa: BLE001 - reported at the first warm-up instead
+        pass
+    _send(out, ("ready", os.getpid()))
     while True:
         try:
             compiled, state = _recv(inp)
