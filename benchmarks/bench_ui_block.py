@@ -47,11 +47,13 @@ def child(warm: bool, edits: int) -> dict:
 
     app = make_application()
     from matedit.app.compile_service import MaterialCompiler
+    from matedit.app.compile_worker import CompileWorker
     from matedit.app.main_window import MainWindow
     from matedit.graph.commands import AddNode, Connect
     from matedit.graph.model import Link, Node
 
     MaterialCompiler.asynchronous = True  # as matedit.app.app.run
+    CompileWorker.warm_up = warm  # off: no child process at all
     w = MainWindow(restore_layout=False)
     w.resize(1600, 1000)
     w.show()
@@ -136,7 +138,6 @@ def child(warm: bool, edits: int) -> dict:
 
     edit(0)  # the first edit makes the worker and starts the warm-up's child: not measured
     worker = w.compiler.worker
-    worker.warm_up = warm
     if warm:  # edits before the child is ready are not warmed (nor held back): wait for it
         end = time.perf_counter() + 120
         while not worker.warm_up_ready(0.2) and time.perf_counter() < end:

@@ -69,6 +69,7 @@ class CompileWorker(QObject):
 
     finished = Signal(object)
     _done = Signal(object)  # emitted on the worker thread, delivered queued
+    warm_up = True  # per instance too (tests, benchmarks/bench_ui_block.py)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -77,7 +78,6 @@ class CompileWorker(QObject):
         self._future: Future | None = None
         self._delivered = 0
         self.compile_fn = None  # None: matedit.compiler.compile_document (tests slow it down)
-        self.warm_up = True
         self.warm_fn = None  # None: WarmupClient.warm (tests wrap it)
         self.warmed: list[tuple[int, threading.Thread, object]] = []
         self._warmer = None  # a WarmupClient, used from the worker thread only
