@@ -181,5 +181,8 @@ class CompileWorker(QObject):
     def shutdown(self) -> None:
         self.supersede()
         if self._warmer is not None:  # after a running warm-up, on the worker thread
-            self._pool.submit(self._warmer.close)
+            try:
+                self._pool.submit(self._warmer.close)
+            except RuntimeError:  # shut down before
+                pass
         self._pool.shutdown(wait=False)  # the pending compile, if any, was cancelled above
