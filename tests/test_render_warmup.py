@@ -6,6 +6,8 @@ Whether Mesa's shader cache then hits is measured by benchmarks/bench_ui_block.p
 from __future__ import annotations
 
 import os
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -81,3 +83,47 @@ def test_until_the_child_is_ready_a_warm_up_returns_at_once_untried():
     finally:
         c.close()
     assert c.pid is None
+
+
+def test_a_frozen_bundle_serves_the_warm_up_from_its_entry_point(tmp_path, monkeypatch):
+    """In the PyInstaller bundle sys.executable is the bundle's `matedit`: the client starts it
+    with MATEDIT_WARMUP_SERVER=1, and packaging/matedit_entry.py serves instead of the CLI.
+    Here a script standing in for the bundle runs that entry point."""
+    root = Path(__file__).resolve().parent.parent
+    bundle = tmp_path / "matedit"
+    bundle.write_text(f"#!/bin/sh\nPYTHONPATH='{root}' exec '{sys.executable}' "
+                      f"'{root / 'packaging' / 'matedit_entry.py'}' \"$@\"\n")
+    bundle.chmod(0o755)
+    monkeypatch.setattr(sys, "frozen", True, raising=False)
+    monkeypatch.setattr(sys, "executable", str(bundle))
+    c = WarmupClient(timeout_s=300)
+    try:
+        c.start()
+        assert c.wait_ready(300)
+        cm = _compiled("brushed_gold")
+        r = c.warm(cm, ViewportState())
+        assert r.ok, r.error
+        assert r.program == _expected(cm)
+    finally:
+        c.close()
+
+
+def test_a_child_that_cannot_start_is_given_up(tmp_path, monkeypatch):
+    bundle = tmp_path / "matedit"
+    bundle.write_text("#!/bin/sh\nexit 3\n")  # a bundle whose child dies at once
+    bundle.chmod(0o755)
+    monkeypatch.setattr(sys, "frozen", True, raising=False)
+    monkeypatch.setattr(sys, "executable", str(bundle))
+    from matedit.render.warmup import MAX_STARTS
+
+    c = WarmupClient(timeout_s=30)
+    cm = _compiled("brushed_gold")
+    try:
+        for _ in range(3 * MAX_STARTS):
+            c.start()
+            assert not c.wait_ready(30)
+            r = c.warm(cm, ViewportState())
+            assert r.starting and not r.ok
+        assert c.starts == MAX_STARTS
+    finally:
+        c.close()

@@ -132,7 +132,7 @@ class WarmReply:
     pid: int = 0  # the process that did it
     program: str = ""  # the structure hash of the variant drawn ("" when none)
     error: str = ""
-    starting: bool = False  # not tried: the child is not ready yet
+    starting: bool = False  # not tried: the child is not ready yet (or would not start)
 
 
 # --- the pipe: 4-byte big-endian length, then a pickle -----------------------------------------
@@ -151,6 +151,10 @@ def _recv(stream):
     if len(data) < n:
         raise EOFError("warm-up pipe closed")
     return pickle.loads(data)  # noqa: S301 - our own child process, over its own pipe
+
+
+SERVER_ENV = "MATEDIT_WARMUP_SERVER"  # set for a frozen bundle's child: serve, not the CLI
+MAX_STARTS = 5
 
 
 def _end(proc: subprocess.Popen) -> None:
@@ -175,21 +179,32 @@ class WarmupClient:
         self._proc: subprocess.Popen | None = None
         self._ready = False
         self._lock = threading.Lock()
+        self.starts = 0  # children started (a crashed one is replaced, up to MAX_STARTS)
 
     def _start(self) -> subprocess.Popen:
         import matedit
 
         env = dict(os.environ)
-        root = str(Path(matedit.__file__).resolve().parent.parent)
-        env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
-        proc = subprocess.Popen([sys.executable, "-m", "matedit.render.warmup"],
+        if getattr(sys, "frozen", False):  # a PyInstaller bundle: its entry point serves
+            cmd = [sys.executable]  # (packaging/matedit_entry.py)
+            env[SERVER_ENV] = "1"
+        else:
+            cmd = [sys.executable, "-m", "matedit.render.warmup"]
+            root = str(Path(matedit.__file__).resolve().parent.parent)
+            env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
+        self.starts += 1
+        proc = subprocess.Popen(cmd,
                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env,
                                 stderr=subprocess.DEVNULL)
         weakref.finalize(self, _end, proc)  # a client dropped without close(): no orphan
         return proc
 
-    def _ensure(self) -> subprocess.Popen:
+    def _ensure(self) -> subprocess.Popen | None:
+        """The running child, started if need be; None once it has failed to start
+        MAX_STARTS times (no GL for it, say): warm-ups are off for this client then."""
         if self._proc is None or self._proc.poll() is not None:
+            if self.starts >= MAX_STARTS:
+                return None
             self._proc = self._start()
             self._ready = False
         return self._proc
@@ -226,6 +241,9 @@ class WarmupClient:
     def warm(self, compiled, state: ViewportState) -> WarmReply:
         with self._lock:
             proc = self._ensure()
+            if proc is None:
+                return WarmReply(False, error="the warm-up process failed to start",
+                                 starting=True)
             if not self._check_ready(0.0):
                 return WarmReply(False, error="the warm-up process is starting",
                                  starting=True)
@@ -292,9 +310,15 @@ def serve(inp, out) -> None:
     warmer.release()
 
 
+def serve_stdio() -> int:
+    """The child's entry: the pipe is its stdin and stdout (print goes to stderr)."""
+    inp, out = sys.stdin.buffer, sys.stdout.buffer
+    sys.stdout = sys.stderr  # the pipe carries only replies
+    serve(inp, out)
+    return 0
+
+
 if __name__ == "__main__":
     from matedit.render import warmup as _module  # replies pickle as matedit.render.warmup's
 
-    _inp, _out = sys.stdin.buffer, sys.stdout.buffer
-    sys.stdout = sys.stderr  # the pipe carries only replies
-    _module.serve(_inp, _out)
+    sys.exit(_module.serve_stdio())
