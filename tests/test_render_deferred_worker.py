@@ -52,7 +52,7 @@ def _slow_compiles(window, threads: list, warm_up: bool = False):
         c.worker.finished.connect(c._finished)
     c.worker.compile_fn = slow
     c.worker.warm_up = warm_up
-    if warm_up:  # its child takes seconds to start: let it get ready before the edit
+    if warm_up and c.worker.warming:  # its child takes seconds to start: wait for it
         c.worker.prepare_warm_up()
         end = time.monotonic() + 120
         while not c.worker.warm_up_ready(0.5):
@@ -123,9 +123,11 @@ def _viewport_program_hash(renderer) -> str:
     return renderer._compiled.variant(Entry.GBUFFER).structure_hash
 
 
-def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qtbot):
+def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qtbot,
+                                                                      monkeypatch):
     import os
 
+    monkeypatch.setenv("MESA_SHADER_CACHE_DISABLE", "false")  # the warm-up's condition
     from PySide6.QtCore import QTimer
 
     from matedit.render.warmup import WarmupClient
@@ -173,7 +175,8 @@ def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qt
     assert reply.program == _viewport_program_hash(renderer)
 
 
-def test_a_superseded_result_is_not_warmed(window, qtbot):
+def test_a_superseded_result_is_not_warmed(window, qtbot, monkeypatch):
+    monkeypatch.setenv("MESA_SHADER_CACHE_DISABLE", "false")  # the warm-up's condition
     threads: list = []
     _slow_compiles(window, threads, warm_up=True)
     delivered = []
@@ -190,3 +193,16 @@ def test_a_superseded_result_is_not_warmed(window, qtbot):
     assert len(delivered) == 1
     assert "p_fresh_name" in {u.name for u in delivered[0].ir.uniforms}
     assert reply.program == _viewport_program_hash(window.viewport.view.renderer)
+
+
+def test_no_warm_up_while_mesas_shader_cache_is_disabled(window, qtbot, monkeypatch):
+    monkeypatch.setenv("MESA_SHADER_CACHE_DISABLE", "true")
+    threads: list = []
+    _slow_compiles(window, threads, warm_up=True)  # asked for, but useless without the cache
+    delivered = []
+    window.compiler.compiled.connect(delivered.append)
+    _structural_edit(window, "uncached_name")
+    qtbot.waitUntil(lambda: bool(delivered), timeout=60000)
+    assert window.compiler.worker.warmed == []
+    assert not window.compiler.worker.warm_up_started  # no child process either
+    assert "p_uncached_name" in {u.name for u in delivered[0].ir.uniforms}

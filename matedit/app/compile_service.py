@@ -112,7 +112,7 @@ class MaterialCompiler(QObject):
             self.worker = CompileWorker(self)
             self.worker.finished.connect(self._finished)
         state = self.viewport_state() if self.viewport_state is not None else None
-        if state is not None and self.worker.warm_up and not self.worker.warm_up_started:
+        if state is not None and self.worker.warming and not self.worker.warm_up_started:
             self.worker.prepare_warm_up()  # ready for the next edits
         self.worker.submit(doc, self.controller.resolver, VIEWPORT_TARGET, state)
 

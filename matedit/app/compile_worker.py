@@ -63,9 +63,10 @@ def viewport_textures(cm, doc) -> dict:
 class CompileWorker(QObject):
     """One background thread; `finished(CompileResult)` arrives on the UI thread.
 
-    `warm_up` (default on) has the viewport's programs warmed after each compile when `submit`
-    is given the viewport's state (asked from that thread, done in matedit.render.warmup's
-    child process); `warmed` lists (generation, asking thread, WarmReply), for tests."""
+    `warm_up` (default on; nothing is warmed while MESA_SHADER_CACHE_DISABLE is set) has the
+    viewport's programs warmed after each compile when `submit` is given the viewport's state
+    (asked from that thread, done in matedit.render.warmup's child process); `warmed` lists
+    (generation, asking thread, WarmReply), for tests."""
 
     finished = Signal(object)
     _done = Signal(object)  # emitted on the worker thread, delivered queued
@@ -96,7 +97,7 @@ class CompileWorker(QObject):
             self._future.cancel()  # not started yet: never will be
         snapshot = snapshot_document(doc)
         fn = self.compile_fn
-        viewport = viewport if self.warm_up else None
+        viewport = viewport if self.warming else None
         future = self._pool.submit(self._run, gen, snapshot, resolver, target, fn, viewport)
         future.add_done_callback(lambda f: None if f.cancelled() else self._done.emit(f.result()))
         self._future = future
@@ -125,10 +126,17 @@ class CompileWorker(QObject):
         then are not warmed and not held back)."""
         from matedit.render.warmup import WarmupClient
 
-        if self.warm_up:
+        if self.warming:
             if self._warmer is None:
                 self._warmer = WarmupClient()
             self._warmer.start()
+
+    @property
+    def warming(self) -> bool:
+        """`warm_up`, and Mesa's shader cache on (without it a warm-up only delays)."""
+        from matedit.render.warmup import shader_cache_enabled
+
+        return bool(self.warm_up) and shader_cache_enabled()
 
     @property
     def warm_up_started(self) -> bool:

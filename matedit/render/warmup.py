@@ -153,6 +153,14 @@ def _recv(stream):
     return pickle.loads(data)  # noqa: S301 - our own child process, over its own pipe
 
 
+def shader_cache_enabled() -> bool:
+    """Whether Mesa's shader cache is on for processes started now (MESA_SHADER_CACHE_DISABLE
+    as Mesa reads it). Without it a warm-up helps nothing and only delays the edit (measured:
+    benchmarks/bench_ui_block.py), so the editor does none."""
+    value = os.environ.get("MESA_SHADER_CACHE_DISABLE", "").strip().lower()
+    return value not in ("1", "true", "y", "yes")
+
+
 SERVER_ENV = "MATEDIT_WARMUP_SERVER"  # set for a frozen bundle's child: serve, not the CLI
 MAX_STARTS = 5
 
