@@ -3,12 +3,13 @@
 On llvmpipe most of a structural edit's cost is not our compile but the driver's: the GLSL
 link, and above all the JIT of the fragment shader's variant at its first draw. Mesa's shader
 cache (per user, ~/.cache/mesa_shader_cache unless MESA_SHADER_CACHE_DIR says otherwise) hands
-both between GL contexts of one process. So a worker that links and draws the new program once,
+both between GL contexts, EGL or GLX, and processes (it is on disk). So one that links and draws
+the new program once,
 in its own headless context, into a small target set up like the viewport's (the same
 framebuffer formats and sample count, the same texture formats and sampler state, the same entry
 variant and lighting pass), leaves the UI thread's link and first draw about one plain frame.
-With the cache disabled (MESA_SHADER_CACHE_DISABLE=true) the warm-up is wasted work on the worker
-and the UI thread pays what it paid before: nothing breaks.
+With the cache disabled (MESA_SHADER_CACHE_DISABLE=true) a warm-up would only delay the edit, so
+the editor does none (`shader_cache_enabled`) and the UI thread pays what it paid before.
 
 The warm-up runs in a child process (`WarmupClient`, serving `python -m matedit.render.warmup`),
 not on a thread of the editor's: moderngl holds Python's GIL through every GL call, and the link
@@ -22,7 +23,6 @@ moderngl only, no Qt. One `Warmer` per thread: its context is current on the thr
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import pickle
 import select
@@ -36,7 +36,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 # Small: the variant key of llvmpipe's fragment shaders does not depend on the target's size
-# (benchmarks/bench_ui_block.py measures the UI thread's first draw after warming at this size).
+# (measured: warmed at 16², 64² or the viewport's own size, the viewport's first draw of
+# rusty_painted_metal cost one plain frame each time; benchmarks/bench_ui_block.py at 64²).
 WARM_SIZE = (64, 64)
 
 
@@ -74,7 +75,7 @@ class Warmer:
         from matedit.render.renderer import Renderer
 
         if self.thread is not None and self.thread is not threading.current_thread():
-            raise RuntimeError("a Warmer is used on the thread that made it")
+            raise RuntimeError("a Warmer must be used on the thread that made it")
         key = (state.samples, state.deferred)
         if self.renderer is None or self._key != key:
             self.release()
@@ -119,10 +120,6 @@ class Warmer:
             self.ctx.release()
             self.ctx = None
         self._key = None
-
-
-def with_textures(state: ViewportState, textures: dict) -> ViewportState:
-    return dataclasses.replace(state, textures=dict(textures))
 
 
 @dataclass
