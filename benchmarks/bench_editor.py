@@ -78,11 +78,11 @@ def main() -> int:
         paint_ms.append(view.last_frame_time * 1e3)
     relinks = view.renderer.link_count - links0
 
-    # A constant feeding the rust threshold: its value is folded into the code.
+    # A constant feeding the rust edge width (e1.b): its value is folded into the code.
     g = w.controller.document.graph
     w.controller.push_all([AddNode(Node("bench_k", "constant", (-450, 400),
                                         {"type": "float", "value": 0.08})),
-                           Connect(Link("bench_k", "value", "hi", "b"))], "bench")
+                           Connect(Link("bench_k", "value", "e1", "b"))], "bench")
     w.controller.flush()
     wait_frame(app, view, view.frames)
     struct_ms, compile_ms = [], []

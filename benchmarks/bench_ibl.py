@@ -215,12 +215,16 @@ def run_cmgen(cmgen: str, path: Path, tmp: Path, size: int, lut_size: int) -> di
 def lut_error(lut: np.ndarray, model: str) -> tuple[float, str]:
     """Max |error| at a 32 x 32 subset of texel centres; tries the plausible layouts."""
     n = lut.shape[0]
-    idx = np.arange(n // 64, n, max(1, n // 32))[:32]
+    idx = np.arange(max(1, n // 64), n, max(1, n // 32))[:32]  # row 0 of cmgen's is not used
     centres = (idx + 0.5) / n
     ref = brute_lut(centres, centres, model)
+    # cmgen (Filament's CubemapIBL::DFG) gives its row y, top first, the perceptual roughness
+    # saturate((N - y + 0.5) / N): the roughness (j + 0.5) / N is row N - j, one row off a
+    # plain flip (lut[::-1] reads row N - 1 - j, roughness (j + 1.5) / N)
+    down = np.roll(lut[::-1], 1, axis=0)  # down[j] = lut[N - j] (j >= 1)
     candidates = {
         "rows=roughness up, R=A G=B": lut,
-        "rows=roughness down, R=A G=B": lut[::-1],
+        "rows=roughness down, row y at (N-y+0.5)/N (cmgen), R=A G=B": down,
     }
     best = None
     for name, cand in candidates.items():

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every benchmark and writes benchmarks/RESULTS.md.
+# Runs every benchmark and writes benchmarks/RESULTS.md and benchmarks/results.json (keys: benchmarks/README.md).
 #   benchmarks/run.sh            the full run (about 6 minutes on 2 cores with llvmpipe)
 #   benchmarks/run.sh --quick    fewer repetitions and a smaller IBL bake, to try it out
 # Benchmark-only dependencies are set up here and nowhere else: MaterialX, pyinstrument and

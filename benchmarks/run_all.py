@@ -144,66 +144,74 @@ def child_gl(quick: bool) -> dict:
     return out
 
 
-def _variant(cm, fragment_text: str, tag: str):
-    """`cm` with another fragment shader (and structure hash, so that it links anew)."""
-    import dataclasses
-
-    frag = dataclasses.replace(cm.fragment, text=fragment_text)
-    return dataclasses.replace(cm, fragment=frag, structure_hash=cm.structure_hash + tag)
-
-
 def child_jit(quick: bool) -> dict:
-    """Link + first frame of variants of the layered sample's program, under whatever
-    GALLIVM_PERF the parent set: the sample as compiled; the same with the reference-IBL
-    branch removed (what one program per IBL mode would give); the hand-written floor
-    (constant material, same lighting library)."""
+    """Link + first frame of the layered sample's FORWARD entry under whatever GALLIVM_PERF
+    the parent set, with and without the reference-IBL estimator: the variant the forward
+    preview's split-sum mode links (MATEDIT_SPLIT_SUM_ONLY defined, through the compiler's
+    Entry/defines mechanism, no shader text edited here), the variant its reference mode links
+    (no define: both IBL branches), and the hand-written floor (constant material, same
+    lighting library). A forward renderer (deferred=False), so that these are the programs
+    drawn; reference mode at 1 sample a pixel and 1 frame, so that the first frame is the
+    driver's compile plus one cheap frame, as in split-sum mode."""
     import moderngl
-    from bench_render import floor_material, frame_time
+    from bench_render import floor_material
+    from common import median_time
 
     from matedit.compiler import compile_document
+    from matedit.compiler.emit import Entry
     from matedit.io.document import FileResolver, load
     from matedit.render import Renderer
+    from matedit.render.deferred import SPLIT_SUM_ONLY
     from matedit.resources import graphs_dir
 
     ctx = moderngl.create_standalone_context(backend="egl")
-    r = Renderer(ctx, (512, 512))
+    r = Renderer(ctx, (512, 512), deferred=False)
+    r.reference_samples, r.reference_frames = 1, 1
     r.render()
     ctx.finish()
     cm = compile_document(load(graphs_dir() / "materials" / "worn_painted_steel.json"),
                           FileResolver())
-    text = cm.fragment_text
-    guard = "#ifndef MATEDIT_SPLIT_SUM_ONLY"
-    if guard in text:  # the renderer links a split-sum-only program by defining this macro
-        both = _variant(cm, text.replace(guard, "#if 1"), "-both")
-        split = cm
-    else:  # the renderer links one program with both IBL branches
-        both = cm
-        split = _variant(cm, text.replace("if (mode == IBL_MODE_REFERENCE) {", "if (false) {"),
-                         "-splitsum")
-    variants = {"worn_painted_steel, both IBL branches": both,
-                "worn_painted_steel, split-sum branch only": split,
-                "hand-written floor": floor_material()}
+    variants = {"worn_painted_steel, both IBL branches": (cm, "reference"),
+                "worn_painted_steel, split-sum branch only": (cm, "splitsum"),
+                "hand-written floor": (floor_material(), "splitsum")}
     out = {"gallivm_perf": os.environ.get("GALLIVM_PERF", ""), "variants": [],
-           "renderer_specialises": guard in text}
+           "renderer_specialises": True}
+
+    def link_and_draw(material, mode: str) -> tuple[float, float, float]:
+        r.programs.table.clear()  # links anew (not released: no program name is reused)
+        r.mode = mode
+        t0 = time.perf_counter()
+        r.set_material(material)  # the split-sum variant, FORWARD + MATEDIT_SPLIT_SUM_ONLY
+        if mode == "reference":  # and the one reference mode draws, FORWARD without it
+            t0 = time.perf_counter()  # (the split-sum variant's link is not this row's)
+            r.programs.get(material, Entry.FORWARD, ())
+        ctx.finish()
+        t1 = time.perf_counter()
+        r.render()
+        ctx.finish()
+        t2 = time.perf_counter()
+        return t1 - t0, t2 - t1, t2 - t0
+
     runs: dict[str, list] = {name: [] for name in variants}
     for _ in range(1 if quick else 5):  # interleaved, so that load on the machine hits all
-        for name, material in variants.items():
-            r._programs.clear()
-            t0 = time.perf_counter()
-            r.set_material(material)
-            ctx.finish()
-            t1 = time.perf_counter()
-            r.render()
-            ctx.finish()
-            t2 = time.perf_counter()
-            runs[name].append((t1 - t0, t2 - t1, t2 - t0))
-    for name, material in variants.items():
+        for name, (material, mode) in variants.items():
+            runs[name].append(link_and_draw(material, mode))
+    for name, (material, mode) in variants.items():
         rows = sorted(runs[name], key=lambda x: x[2])
         link, first, total = rows[len(rows) // 2]
+        r.mode = mode
         r.set_material(material)
+        variant = material.variant(Entry.FORWARD,
+                                   () if mode == "reference" else (SPLIT_SUM_ONLY,))
+
+        def frame():  # reference mode has converged after its one frame: start it again
+            r.reset_accumulation()
+            r.render()
+            ctx.finish()
+
         out["variants"].append({"name": name, "link": link, "first_frame": first,
-                                "total": total, "frame": frame_time(r, ctx, frames=3),
-                                "fragment_chars": len(material.fragment_text)})
+                                "total": total, "frame": median_time(frame, repeat=3),
+                                "fragment_chars": len(variant.fragment_text)})
     r.release()
     return out
 
@@ -649,6 +657,83 @@ def startup_section(rep: Report, st: dict, goals: list) -> None:
         rep.add()
 
 
+def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
+    rep.add("## 6b. Structural edit in the editor: UI-thread blocking")
+    rep.add()
+    rep.add("benchmarks/bench_ui_block.py: the real MainWindow under Xvfb on the sample layered "
+            "material, compiles off the UI thread (as `matedit edit`), each structural edit "
+            "(add a constant node and wire it into `e1.b`, through the undo stack; a new "
+            "program every time) timed from the push to the first frame drawn with the new "
+            "program. *UI block* is the longest gap between ticks of a 5 ms timer on the UI "
+            "thread over that time. Each row is its own child process with Mesa's shader "
+            "cache enabled in a fresh, empty temporary MESA_SHADER_CACHE_DIR (the only part "
+            "of this report with the cache on): with the compile worker's warm-up "
+            "(matedit.render.warmup) and without it (`CompileWorker.warm_up = False`).")
+    rep.add()
+    rows = []
+    for key, label in (("cold", "no warm-up"), ("warm", "warm-up in a child process")):
+        r = ub.get(key, {})
+        if "error" in r or not r:
+            rows.append([label, r.get("error", "not run"), "", "", "", "", ""])
+            continue
+        rows.append([label, f"**{r['ui_block_max_ms']:.0f}**", f"{r['ui_block_median_ms']:.0f}",
+                     f"{r['latency_median_ms']:.0f}", f"{r['apply_median_ms']:.0f}",
+                     f"{r['first_paint_median_ms']:.0f}", f"{r['plain_paint_median_ms']:.0f}"])
+    rep.table(["", "UI block max (ms)", "UI block median (ms)", "edit → pixels median (ms)",
+               "UI-thread link (ms)", "first frame (ms)", "plain frame (ms)"], "lrrrrrr", rows)
+    w = ub.get("warm", {})
+    if "ui_block_max_ms" in w:
+        rep.add(f"{w['edits']} edits each, viewport {w['viewport'][0]}×{w['viewport'][1]} px. "
+                "With the warm-up the longest block is about one plain frame (the frame is "
+                "drawn on the UI thread).")
+        rep.add()
+        goals.append(["UI thread blocked during a structural edit", "≤ 50 ms",
+                      f"{w['ui_block_max_ms']:.0f} ms (plain frame "
+                      f"{w['plain_paint_median_ms']:.0f} ms)",
+                      verdict(w["ui_block_max_ms"] <= 50.0)])
+
+
+def results_json(results: dict, uiblock: dict, meta: dict) -> dict:
+    """The report's figures under stable keys (benchmarks/README.md); milliseconds as `_ms`,
+    seconds as `_seconds`; a figure not measured in this run is absent."""
+    out: dict = {"meta": dict(meta, cores=os.cpu_count())}
+    gl = results.get("gl", {})
+    out["meta"]["gl_renderer"] = gl.get("gl_renderer")
+    out["meta"]["mesa_shader_cache_disable"] = os.environ.get("MESA_SHADER_CACHE_DISABLE")
+    per = {"structural_edit_ms": {}, "materialx_per_layer_ms": {}, "materialx_mixed_ms": {}}
+    for r in gl.get("structural", []):
+        per["structural_edit_ms"][r["sample"]] = r["total"] * 1e3
+        if "mx_shaders" in r:
+            per["materialx_per_layer_ms"][r["sample"]] = r["mx_shaders"]["total"] * 1e3
+        if "mx_inputs" in r:
+            per["materialx_mixed_ms"][r["sample"]] = r["mx_inputs"]["total"] * 1e3
+    out.update({k: v for k, v in per.items() if v})
+    if "parameter" in gl:
+        p = gl["parameter"]
+        out["param_edit_links"] = p["links"]
+        out["param_edit_ms"] = p["edit_to_frame"] * 1e3
+        out["param_plain_frame_ms"] = p["frame"] * 1e3
+    if "frames" in gl:
+        out["frame_ms"] = {str(f["size"]): f["material"] * 1e3 for f in gl["frames"]}
+        out["floor_ms"] = {str(f["size"]): f["floor"] * 1e3 for f in gl["frames"]}
+    comp = results.get("compile", {})
+    if "scaling" in comp:
+        out["compile_ms"] = {str(s["nodes"]): s["seconds"] * 1e3 for s in comp["scaling"]}
+    tools = results.get("ibl", {}).get("tools", {})
+    if "matedit" in tools:
+        out["ibl_seconds"] = tools["matedit"]["prefilter_s"]
+        out["ibl_lut_error"] = tools["matedit"]["lut_error"]
+    if "cmgen" in tools:
+        out["cmgen_seconds"] = tools["cmgen"]["prefilter_s"]
+        out["cmgen_lut_error"] = tools["cmgen"]["lut_error"]
+    for key, suffix in (("warm", ""), ("cold", "_no_warmup")):
+        r = uiblock.get(key, {})
+        if "ui_block_max_ms" in r:
+            out["ui_block_max_ms" + suffix] = r["ui_block_max_ms"]
+            out["editor_structural_edit_ms" + suffix] = r["latency_median_ms"]
+    return out
+
+
 def optional_section(rep: Report, opt: dict) -> None:
     rep.add("## 7. Node canvas and editor responsiveness (benchmarks written elsewhere)")
     rep.add()
@@ -690,7 +775,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer repetitions, smaller IBL")
     parser.add_argument("--out", default=str(HERE / "RESULTS.md"))
     parser.add_argument("--skip", default="", help="comma-separated sections to skip: "
-                        "gl,jit,compile,ibl,profile,native,startup,optional")
+                        "gl,jit,compile,ibl,profile,native,startup,uiblock,optional")
     args = parser.parse_args(argv)
     if args.child:
         result = CHILDREN[args.child](args.quick)
@@ -738,6 +823,14 @@ def main(argv=None) -> int:
         except (subprocess.SubprocessError, OSError) as exc:
             startup["editor"] = {"skipped": f"failed: {exc}"}
         startup["wall"] = time.perf_counter() - t0
+    uiblock: dict = {}
+    if "uiblock" not in skip:
+        import bench_ui_block
+
+        print("[run_all] ui block …", file=sys.stderr, flush=True)
+        t0 = time.perf_counter()
+        uiblock = bench_ui_block.run(edits=4 if args.quick else 8)
+        uiblock["wall"] = time.perf_counter() - t0
     optional: dict = {}
     if "optional" not in skip:
         for script, _ in OPTIONAL_BENCHES:
@@ -773,6 +866,8 @@ def main(argv=None) -> int:
     ibl_section(rep, results["ibl"], goals)
     if startup:
         startup_section(rep, startup, goals)
+    if uiblock:
+        ui_block_section(rep, uiblock, goals)
     if optional:
         optional_section(rep, optional)
     rep.add("## Goals")
@@ -784,7 +879,12 @@ def main(argv=None) -> int:
         rep.add(notes.read_text().rstrip())
         rep.add()
     Path(args.out).write_text("\n".join(rep.lines).rstrip() + "\n")
-    print(f"[run_all] wrote {args.out} in {total / 60:.1f} min", file=sys.stderr)
+    figures = results_json(results, uiblock, {"date": when.isoformat(timespec="minutes"),
+                                              "command": command, "quick": bool(args.quick)})
+    json_out = Path(args.out).with_name("results.json")
+    json_out.write_text(json.dumps(figures, indent=1, sort_keys=True) + "\n")
+    print(f"[run_all] wrote {args.out} and {json_out.name} in {total / 60:.1f} min",
+          file=sys.stderr)
     return 0
 
 

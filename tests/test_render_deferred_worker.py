@@ -1,6 +1,9 @@
 """Structural edits compile off the UI thread (matedit.app.compile_worker): the event loop keeps
 running during a slow compile, the viewport keeps the last good program until the new one
-arrives, and a newer edit supersedes a pending one. Real widgets and GL under Xvfb."""
+arrives, and a newer edit supersedes a pending one; the viewport's program is warmed in the
+warm-up child process (matedit.render.warmup) before the UI thread gets it, and a superseded
+result is not warmed. Real widgets and GL under Xvfb; nothing here depends on Mesa's shader
+cache (whether it hits is the benchmark's business: benchmarks/bench_ui_block.py)."""
 
 from __future__ import annotations
 
@@ -31,7 +34,9 @@ def window(qtbot, request, monkeypatch):
     return w
 
 
-def _slow_compiles(window, threads: list):
+def _slow_compiles(window, threads: list, warm_up: bool = False):
+    """Each compile sleeps SLOW_S on the worker; the warm-up is off unless asked (the child's
+    start-up would only slow these tests)."""
     from matedit.compiler import compile_document
 
     def slow(doc, resolver, target):
@@ -46,6 +51,12 @@ def _slow_compiles(window, threads: list):
         c.worker = CompileWorker(c)
         c.worker.finished.connect(c._finished)
     c.worker.compile_fn = slow
+    c.worker.warm_up = warm_up
+    if warm_up and c.worker.warming:  # its child takes seconds to start: wait for it
+        c.worker.prepare_warm_up()
+        end = time.monotonic() + 120
+        while not c.worker.warm_up_ready(0.5):
+            assert time.monotonic() < end, "the warm-up process never got ready"
 
 
 def _structural_edit(window, value: str):
@@ -103,3 +114,95 @@ def test_a_newer_edit_supersedes_a_pending_one(window, qtbot):
     assert window.viewport.view.renderer._compiled is delivered[0]
     # reading `current` waits for nothing now, and is the delivered one
     assert window.compiler.current is delivered[0]
+
+
+def _viewport_program_hash(renderer) -> str:
+    from matedit.compiler.emit import Entry
+
+    assert not renderer.is_forward  # the sample is opaque: the deferred GBUFFER entry
+    return renderer._compiled.variant(Entry.GBUFFER).structure_hash
+
+
+def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qtbot,
+                                                                      monkeypatch):
+    import os
+
+    monkeypatch.setenv("MESA_SHADER_CACHE_DISABLE", "false")  # the warm-up's condition
+    from PySide6.QtCore import QTimer
+
+    from matedit.render.warmup import WarmupClient
+
+    view = window.viewport.view
+    renderer = view.renderer
+    old = renderer._compiled
+    threads: list = []
+    _slow_compiles(window, threads, warm_up=True)
+    order: list[str] = []
+    warming = threading.Event()
+
+    def slow_warm(client, compiled, state):
+        warming.set()
+        time.sleep(SLOW_S)  # the viewport must keep the old program meanwhile
+        reply = WarmupClient.warm(client, compiled, state)
+        order.append("warmed")
+        return reply
+
+    window.compiler.worker.warm_fn = slow_warm
+    window.compiler.compiled.connect(lambda cm: order.append("delivered"))
+    ticks: list[float] = []
+    timer = QTimer()
+    timer.setInterval(10)
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start()
+    _structural_edit(window, "warmed_name")
+    qtbot.waitUntil(warming.is_set, timeout=30000)
+    frames = view.frames
+    view.update()
+    qtbot.waitUntil(lambda: view.frames > frames, timeout=10000)
+    assert renderer._compiled is old  # drawn while warming: still the last good program
+    qtbot.waitUntil(lambda: "delivered" in order, timeout=120000)  # the child starts first
+    timer.stop()
+    assert order == ["warmed", "delivered"]  # swapped only once the warm-up was done
+    assert len(ticks) >= 10  # the event loop ran during the compile and the warm-up
+    (gen, asking, reply), = window.compiler.worker.warmed
+    assert gen == window.compiler.worker.generation
+    assert asking is not threading.main_thread()
+    assert reply.ok, reply.error
+    assert reply.pid not in (0, os.getpid())  # another process: no GIL shared with the UI
+    assert renderer._compiled is not old
+    assert any(u.name == "p_warmed_name" for u in renderer._compiled.ir.uniforms)
+    # the child drew the very program the viewport now draws
+    assert reply.program == _viewport_program_hash(renderer)
+
+
+def test_a_superseded_result_is_not_warmed(window, qtbot, monkeypatch):
+    monkeypatch.setenv("MESA_SHADER_CACHE_DISABLE", "false")  # the warm-up's condition
+    threads: list = []
+    _slow_compiles(window, threads, warm_up=True)
+    delivered = []
+    window.compiler.compiled.connect(delivered.append)
+    _structural_edit(window, "stale_name")
+    _structural_edit(window, "fresh_name")  # while the first one compiles
+    worker = window.compiler.worker
+    qtbot.waitUntil(lambda: not worker.pending, timeout=120000)
+    qtbot.wait(2 * int(SLOW_S * 1000))
+    assert len(threads) == 2  # both compiled (the first was running when superseded)
+    assert [g for g, _, _ in worker.warmed] == [worker.generation]  # the first never warmed
+    (_, _, reply), = worker.warmed
+    assert reply.ok, reply.error
+    assert len(delivered) == 1
+    assert "p_fresh_name" in {u.name for u in delivered[0].ir.uniforms}
+    assert reply.program == _viewport_program_hash(window.viewport.view.renderer)
+
+
+def test_no_warm_up_while_mesas_shader_cache_is_disabled(window, qtbot, monkeypatch):
+    monkeypatch.setenv("MESA_SHADER_CACHE_DISABLE", "true")
+    threads: list = []
+    _slow_compiles(window, threads, warm_up=True)  # asked for, but useless without the cache
+    delivered = []
+    window.compiler.compiled.connect(delivered.append)
+    _structural_edit(window, "uncached_name")
+    qtbot.waitUntil(lambda: bool(delivered), timeout=60000)
+    assert window.compiler.worker.warmed == []
+    assert not window.compiler.worker.warm_up_started  # no child process either
+    assert "p_uncached_name" in {u.name for u in delivered[0].ir.uniforms}

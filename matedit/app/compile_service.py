@@ -61,6 +61,9 @@ class MaterialCompiler(QObject):
     failed = Signal(list)  # list[Diagnostic]
     previewChanged = Signal(object)  # PreviewTarget | None: the viewport shows that socket
     asynchronous = False
+    # the viewport's state for the worker's warm-up (ViewportPanel sets it): a callable giving a
+    # matedit.render.warmup.ViewportState, or None while the viewport has no renderer
+    viewport_state = None
 
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
@@ -108,7 +111,10 @@ class MaterialCompiler(QObject):
 
             self.worker = CompileWorker(self)
             self.worker.finished.connect(self._finished)
-        self.worker.submit(doc, self.controller.resolver, VIEWPORT_TARGET)
+        state = self.viewport_state() if self.viewport_state is not None else None
+        if state is not None and self.worker.warming and not self.worker.warm_up_started:
+            self.worker.prepare_warm_up()  # ready for the next edits
+        self.worker.submit(doc, self.controller.resolver, VIEWPORT_TARGET, state)
 
     def _finished(self, result) -> None:
         """A worker's result, on the UI thread: the same outcome as a synchronous compile."""

@@ -3,16 +3,22 @@
 A structural edit hands a snapshot of the document (a deep copy taken on the UI thread, so
 later edits cannot change what is being compiled) to one worker thread, which lowers it to IR,
 optimises it and writes the GLSL of the viewport's entry variants (FORWARD, and GBUFFER for the
-deferred preview). The result comes back to the UI thread as a queued Qt signal; the viewport
-then links the small GBUFFER program there (GL stays on its own thread) and swaps it in, drawing
-the last good program until then. Each request has a generation number: a newer request
-supersedes an older one (a queued one is cancelled, a running one's result is dropped).
+deferred preview). With the viewport's state (matedit.render.warmup.ViewportState) the worker
+then has that program linked and drawn once in a headless context of a helper process
+(matedit.render.warmup: a thread of ours would hold the GIL through those GL calls), so that the
+driver's compiled shaders are in Mesa's shader cache before the UI thread asks for them.
+The result comes back to the UI thread as a queued Qt signal; the viewport then links the program
+there (GL stays on its own thread; with the cache warm that costs about one plain frame) and
+swaps it in, drawing the last good program until then. Each request has a generation number: a
+newer request supersedes an older one (a queued one is cancelled, a running one's result is
+dropped, and a superseded result is not warmed).
 """
 
 from __future__ import annotations
 
 import copy
 import dataclasses
+import threading
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -27,6 +33,7 @@ class CompileResult:
     diagnostics: list = field(default_factory=list)
     error: BaseException | None = None  # a compiler bug, reported as a diagnostic
     ms: float = 0.0
+    warm_ms: float | None = None  # the warm-up's time; None when none was done
 
 
 def compile_snapshot(doc, resolver, target: str, compile_fn=None):
@@ -46,11 +53,24 @@ def snapshot_document(doc):
                                extra=copy.deepcopy(doc.extra), link_extra=dict(doc.link_extra))
 
 
+def viewport_textures(cm, doc) -> dict:
+    """The texture files the viewport will load for `cm` (what its value push names)."""
+    from matedit.app.compile_service import texture_paths
+
+    return {k: (str(v) if v else None) for k, v in texture_paths(cm, doc).items()}
+
+
 class CompileWorker(QObject):
-    """One background thread; `finished(CompileResult)` arrives on the UI thread."""
+    """One background thread; `finished(CompileResult)` arrives on the UI thread.
+
+    `warm_up` (default on; nothing is warmed while MESA_SHADER_CACHE_DISABLE is set) has the
+    viewport's programs warmed after each compile when `submit` is given the viewport's state
+    (asked from that thread, done in matedit.render.warmup's child process); `warmed` lists
+    (generation, asking thread, WarmReply), for tests."""
 
     finished = Signal(object)
     _done = Signal(object)  # emitted on the worker thread, delivered queued
+    warm_up = True  # per instance too (tests, benchmarks/bench_ui_block.py)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -59,38 +79,90 @@ class CompileWorker(QObject):
         self._future: Future | None = None
         self._delivered = 0
         self.compile_fn = None  # None: matedit.compiler.compile_document (tests slow it down)
+        self.warm_fn = None  # None: WarmupClient.warm (tests wrap it)
+        self.warmed: list[tuple[int, threading.Thread, object]] = []
+        self._warmer = None  # a WarmupClient, used from the worker thread only
         self._done.connect(self._deliver)
 
     @property
     def pending(self) -> bool:
         return self._delivered < self.generation
 
-    def submit(self, doc, resolver, target: str) -> int:
-        """Queue a compile of a snapshot of `doc`; returns its generation."""
+    def submit(self, doc, resolver, target: str, viewport=None) -> int:
+        """Queue a compile of a snapshot of `doc`; returns its generation. `viewport` (a
+        matedit.render.warmup.ViewportState, taken now on the UI thread) asks for a warm-up."""
         self.generation += 1
         gen = self.generation
         if self._future is not None:
             self._future.cancel()  # not started yet: never will be
         snapshot = snapshot_document(doc)
         fn = self.compile_fn
-        future = self._pool.submit(self._run, gen, snapshot, resolver, target, fn)
+        viewport = viewport if self.warming else None
+        future = self._pool.submit(self._run, gen, snapshot, resolver, target, fn, viewport)
         future.add_done_callback(lambda f: None if f.cancelled() else self._done.emit(f.result()))
         self._future = future
         return gen
 
-    @staticmethod
-    def _run(gen: int, doc, resolver, target: str, fn) -> CompileResult:
+    def _run(self, gen: int, doc, resolver, target: str, fn, viewport=None) -> CompileResult:
         from matedit.compiler import CompileError
 
         t0 = time.perf_counter()
         try:
             cm = compile_snapshot(doc, resolver, target, fn)
-            return CompileResult(gen, cm, ms=(time.perf_counter() - t0) * 1e3)
         except CompileError as exc:
             return CompileResult(gen, None, list(exc.diagnostics),
                                  ms=(time.perf_counter() - t0) * 1e3)
         except Exception as exc:  # a compiler bug must not take the editor down
             return CompileResult(gen, None, [], exc, ms=(time.perf_counter() - t0) * 1e3)
+        result = CompileResult(gen, cm, ms=(time.perf_counter() - t0) * 1e3)
+        if viewport is not None and gen == self.generation:  # superseded: not worth warming
+            t1 = time.perf_counter()
+            self._warm(gen, cm, doc, viewport)
+            result.warm_ms = (time.perf_counter() - t1) * 1e3
+        return result
+
+    def prepare_warm_up(self) -> None:
+        """Starts the warm-up's child process now (it takes seconds to be ready; edits until
+        then are not warmed and not held back)."""
+        from matedit.render.warmup import WarmupClient
+
+        if self.warming:
+            if self._warmer is None:
+                self._warmer = WarmupClient()
+            self._warmer.start()
+
+    @property
+    def warming(self) -> bool:
+        """`warm_up`, and Mesa's shader cache on (without it a warm-up only delays)."""
+        from matedit.render.warmup import shader_cache_enabled
+
+        return bool(self.warm_up) and shader_cache_enabled()
+
+    @property
+    def warm_up_started(self) -> bool:
+        return self._warmer is not None
+
+    def warm_up_ready(self, timeout: float = 0.0) -> bool:
+        """Whether the warm-up's child is ready (tests; it may wait for a running warm-up)."""
+        return self._warmer is not None and self._warmer.wait_ready(timeout)
+
+    def _warm(self, gen: int, cm, doc, viewport) -> None:
+        """On the worker thread. Any failure here only loses the warm-up: the UI thread links
+        as it would without one (and reports link errors itself)."""
+        import dataclasses as dc
+
+        from matedit.render.warmup import WarmupClient
+
+        try:
+            state = dc.replace(viewport, textures=viewport_textures(cm, doc))
+            if self._warmer is None:
+                self._warmer = WarmupClient()
+            reply = (self.warm_fn or WarmupClient.warm)(self._warmer, cm, state)
+            if reply.starting:
+                return  # no warm-up this time: the UI thread links as it did before
+            self.warmed.append((gen, threading.current_thread(), reply))
+        except Exception:  # noqa: BLE001 - a bad file, a pickling problem: no warm-up
+            pass
 
     def wait(self) -> CompileResult | None:
         """Block until the newest request is done and deliver it now (tests, export, save)."""
@@ -116,4 +188,9 @@ class CompileWorker(QObject):
 
     def shutdown(self) -> None:
         self.supersede()
-        self._pool.shutdown(wait=False, cancel_futures=True)
+        if self._warmer is not None:  # after a running warm-up, on the worker thread
+            try:
+                self._pool.submit(self._warmer.close)
+            except RuntimeError:  # shut down before
+                pass
+        self._pool.shutdown(wait=False)  # the pending compile, if any, was cancelled above

@@ -529,4 +529,6 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.save_layout()
+        if self.compiler.worker is not None:  # its thread, and the warm-up's child process
+            self.compiler.worker.shutdown()
         event.accept()

@@ -180,6 +180,20 @@ class ViewportWidget(QOpenGLWidget):
         p.end()
 
     # --- material and values ---------------------------------------------------------------
+    def viewport_state(self):
+        """What the compile worker needs to warm this view's programs (matedit.render.warmup),
+        or None before the renderer runs."""
+        r = self.renderer
+        if r is None:
+            return None
+        from matedit.render.warmup import ViewportState
+
+        return ViewportState(samples=r.samples, deferred=r.deferred,
+                             environment=getattr(r, "environment_name", self._environment),
+                             mode=r.mode, mesh=r.mesh_name,
+                             energy_compensation=r.energy_compensation,
+                             show_background=r.show_background)
+
     def set_material(self, compiled) -> bool | None:
         """A new program; None while GL is not up yet (applied at initializeGL)."""
         if self.renderer is None:
@@ -476,6 +490,7 @@ class ViewportPanel(QWidget):
         self.view.glErrors.connect(self.glErrors)
         self.view.materialApplied.connect(self.materialApplied)
         compiler.compiled.connect(self.on_compiled)
+        compiler.viewport_state = self.view.viewport_state
         compiler.previewChanged.connect(self._preview_changed)
         self.controller.valuesChanged.connect(self.push_values)
 
