@@ -14,6 +14,7 @@ import numpy as np
 
 from matedit.render.deferred import GBuffer
 from matedit.render.fullscreen import FullscreenQuad, render_program, set_uniform
+from matedit.shading.ibl import IBL_MODE_REFERENCE, IBL_MODE_SPLIT_SUM
 
 HEAT_RANGE = 0.1  # |split sum - reference| shown at full heat, linear HDR
 
@@ -51,8 +52,34 @@ class SceneTargets:
         self.gbuffer = GBuffer(ctx, size, samples, depth) if deferred else None
         self.background = _float_target(ctx, size) if deferred else None
         self.resolved = _float_target(ctx, size)
+        self.ctx, self.size = ctx, size
+
+    def _begin(self, fbo: moderngl.Framebuffer, clear: tuple[float, ...] | None) -> None:
+        fbo.use()
+        fbo.viewport = (0, 0, *self.size)
+        if clear is not None:
+            self.ctx.clear(*clear, depth=1.0)
+
+    def begin_background(self, deferred: bool) -> None:
+        """Binds and clears where the background goes: the HDR target itself (forward), or the
+        one-sample texture that the lighting pass reads where the mesh is not (deferred)."""
+        self._begin(self.background if deferred else self.msaa, (0.0, 0.0, 0.0, 1.0))
+
+    def begin_gbuffer(self) -> None:
+        self._begin(self.gbuffer.fbo, (0.0, 0.0, 0.0, 0.0))
+
+    def begin_lighting(self) -> None:
+        """Binds the HDR target for the lighting pass: no clear, the pass writes every sample,
+        and the depth of the G-buffer pass is kept (for the gizmos)."""
+        self._begin(self.msaa, None)
+
+    def resolve(self) -> None:
+        self.ctx.copy_framebuffer(self.resolved, self.msaa)
 
     def release(self) -> None:
+        """Framebuffer 0 is bound first: moderngl would otherwise bind a released framebuffer
+        again later (GL_INVALID_OPERATION)."""
+        self.ctx.detect_framebuffer(0).use()
         if self.gbuffer is not None:
             self.gbuffer.release()  # before the depth it shares with msaa
         for fbo in (self.msaa, self.background, self.resolved):
@@ -69,6 +96,8 @@ class Accumulator:
         self._accumulate = render_program(ctx, "fullscreen.vert", "accumulate.frag")
         self._display = render_program(ctx, "fullscreen.vert", "display.frag")
         self.frames = 0
+        self.drawn = 0  # frames displayed (keys the difference mean read back)
+        self._difference: tuple[int, float] | None = None
         self.sum: moderngl.Framebuffer | None = None
         self.split: moderngl.Framebuffer | None = None
         self._out: moderngl.Framebuffer | None = None
@@ -80,6 +109,23 @@ class Accumulator:
         self.sum = _float_target(self.ctx, size)
         self.split = _float_target(self.ctx, size)
         self.frames = 0
+
+    def draw(self, mode: str, reference_frames: int, scene, resolved: moderngl.Framebuffer,
+             target: moderngl.Framebuffer | None, exposure: float) -> None:
+        """One frame of `mode` into `target` (None: the internal image). `scene(ibl_mode,
+        offset)` draws and resolves a scene into `resolved`: split sum each frame; reference a
+        new frame added until `reference_frames` are; difference both."""
+        if mode == "splitsum":
+            scene(IBL_MODE_SPLIT_SUM, (0.0, 0.0))
+        else:
+            if self.frames < reference_frames:
+                scene(IBL_MODE_REFERENCE, r2_offset(self.frames))
+                self.add(resolved)
+            if mode == "difference":
+                scene(IBL_MODE_SPLIT_SUM, (0.0, 0.0))
+                self.keep_split_sum(resolved)
+        self.display(target if target is not None else self.output(), mode, resolved, exposure)
+        self.drawn += 1
 
     def add(self, resolved: moderngl.Framebuffer) -> None:
         """Adds a resolved reference frame to the sum."""
@@ -155,6 +201,24 @@ class Accumulator:
         w, h = self._size
         raw = fbo.read(components=4, dtype="f4")
         return np.frombuffer(raw, np.float32).reshape(h, w, 4)[::-1, :, :3] * scale
+
+    def read_linear(self, mode: str, resolved: moderngl.Framebuffer) -> np.ndarray:
+        """The linear radiance of `mode`'s frame: split sum, the reference average, or in
+        difference mode split sum minus reference (signed)."""
+        if mode == "difference":
+            return self.read_hdr("splitsum", mode, resolved) - \
+                self.read_hdr("reference", mode, resolved)
+        return self.read_hdr("splitsum" if mode == "splitsum" else "reference", mode, resolved)
+
+    def difference_mean(self, mode: str, resolved: moderngl.Framebuffer) -> float | None:
+        """Mean |split sum - reference| of the last difference frame (read back once per frame
+        drawn); None in the other modes and before a reference frame."""
+        if mode != "difference" or self.frames == 0:
+            return None
+        if self._difference is None or self._difference[0] != self.drawn:
+            mean = float(np.mean(np.abs(self.read_linear("difference", resolved))))
+            self._difference = (self.drawn, mean)
+        return self._difference[1]
 
     def release_targets(self) -> None:
         for fbo in (self.sum, self.split, self._out):
