@@ -221,6 +221,8 @@ class Accumulator:
         return self._difference[1]
 
     def release_targets(self) -> None:
+        if self.sum is not None:  # framebuffer 0 first, as in SceneTargets.release
+            self.ctx.detect_framebuffer(0).use()
         for fbo in (self.sum, self.split, self._out):
             _release_fbo(fbo)
         self.sum = self.split = self._out = None
