@@ -195,7 +195,7 @@ def frames_forward_deferred(ctx, material: CompiledMaterial, sizes=(512, 1024),
                             times.setdefault(key, []).append(time.perf_counter() - t)
                     r.lighting.edges_once = False
         row = {"size": size, **{k: statistics.median(v) for k, v in times.items()}}
-        g = rs["deferred"]._gbuffer
+        g = rs["deferred"].targets.gbuffer
         if g is not None:  # the share of edge pixels (samples that disagree), for the cost
             t3 = np.frombuffer(_resolve_coverage(ctx, g, size), np.float32)
             row["edge_pixel_share"] = float(((t3 > 0) & (t3 < 1)).mean())

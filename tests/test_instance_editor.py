@@ -68,7 +68,7 @@ def test_create_override_reset_switch_save_reopen(window, qtbot, tmp_path):
     row.field.edited.emit(0.9, None)
     assert editor.doc.parameters == {"wear_amount": 0.9}
     assert row.check.isChecked() and editor.panel.is_marked("wear_amount")
-    assert renderer._values["p_wear_amount"] == pytest.approx(0.9)
+    assert renderer.material.values["p_wear_amount"] == pytest.approx(0.9)
     _frame(qtbot, editor)
     assert (renderer.link_count, editor.compile_count) == (links, compiles)
 
@@ -76,7 +76,7 @@ def test_create_override_reset_switch_save_reopen(window, qtbot, tmp_path):
     qtbot.mouseClick(row.reset, Qt.MouseButton.LeftButton)
     assert editor.doc.parameters == {} and not editor.panel.is_marked("wear_amount")
     assert row.field.value() == pytest.approx(WEAR)
-    assert renderer._values["p_wear_amount"] == pytest.approx(WEAR)
+    assert renderer.material.values["p_wear_amount"] == pytest.approx(WEAR)
 
     # the override checkbox overrides with the inherited value
     colour = editor.panel.rows["paint_color"]
@@ -89,12 +89,12 @@ def test_create_override_reset_switch_save_reopen(window, qtbot, tmp_path):
     switch.setChecked(False)
     _frame(qtbot, editor)
     assert editor.compile_count == compiles + 1 and renderer.link_count == links + 1
-    assert "p_rust_amount" not in renderer._values
+    assert "p_rust_amount" not in renderer.material.values
     assert not editor.panel.rows["rust_amount"].field.isEnabled()
     switch.setChecked(True)
     _frame(qtbot, editor)
     assert editor.compile_count == compiles + 2 and renderer.link_count == links + 1
-    assert "p_rust_amount" in renderer._values
+    assert "p_rust_amount" in renderer.material.values
     switch.setChecked(False)
     _frame(qtbot, editor)
     assert renderer.link_count == links + 1

@@ -37,12 +37,12 @@ def test_the_same_file_again_reads_nothing(gl_ctx, textured):
         r.set_texture(name, str(path))
         r.render()
         r.render()
-        tex = r._textures[name]
+        tex = r.material.textures[name]
         reads = T.READS["count"]
         for _ in range(20):  # a slider drag: set_values names every texture at every step
             r.set_texture(name, str(path))
         assert T.READS["count"] == reads
-        assert r._textures[name] is tex
+        assert r.material.textures[name] is tex
         # another colour space: that texture again
         r.set_texture(name, str(path), "linear")
         assert T.READS["count"] == reads + 1

@@ -13,9 +13,8 @@ arguments shadeSurface gets in the FORWARD entry.
 from __future__ import annotations
 
 import moderngl
-import numpy as np
 
-from matedit.glsl.include import assemble
+from matedit.render.fullscreen import FullscreenQuad, render_program
 from matedit.resources import shaders_dir
 
 GBUFFER_TARGETS = 4
@@ -95,39 +94,37 @@ class LightingPass:
     """The lighting programs, keyed by (split sum only, energy compensation), each linked on
     first use and then kept for the renderer's lifetime."""
 
-    def __init__(self, ctx: moderngl.Context, samples: int, bind) -> None:
+    def __init__(self, ctx: moderngl.Context, samples: int, bind, quad: FullscreenQuad) -> None:
         self.ctx = ctx
         self.samples = max(1, samples)
         self._bind = bind
-        self._quad = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
-        self._programs: dict[tuple[bool, bool, bool], tuple] = {}
+        self._quad = quad
+        self._programs: dict[tuple[bool, bool, bool], moderngl.Program] = {}
         self.link_count = 0
         self.edges_once = False  # benchmarks only (see program)
 
-    def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False):
+    def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False
+                ) -> moderngl.Program:
         """`edges_once` (benchmarks only) shades every pixel once, edges too: no anti-aliasing
         of the lighting, to measure what lighting edges per sample costs."""
         key = (bool(split_sum_only), bool(compensation), bool(edges_once))
-        hit = self._programs.get(key)
-        if hit is None:
+        prog = self._programs.get(key)
+        if prog is None:
             defines = ([SPLIT_SUM_ONLY] if split_sum_only else []) + \
                       ([ENERGY_COMPENSATION] if compensation else []) + \
                       (["MATEDIT_EDGES_ONCE"] if edges_once else [])
             lines = [f"#define {d} 1" for d in defines]
             lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")
-            root = shaders_dir() / "render"
-            v = assemble((root / "fullscreen.vert").read_text(), "330 core", [], "<vertex>")
-            f = assemble((root / "lighting.frag").read_text(), "330 core", [], "<lighting>",
-                         roots=[root, shaders_dir()], prelude="\n".join(lines))
-            prog = self.ctx.program(vertex_shader=v.text, fragment_shader=f.text)
+            prog = render_program(self.ctx, "fullscreen.vert", "lighting.frag",
+                                  "\n".join(lines), [shaders_dir() / "render", shaders_dir()],
+                                  vertex_prelude=False)
             self._bind(prog)
             for i in range(GBUFFER_TARGETS):
                 prog[f"uGBuffer{i}"].value = GBUFFER_FIRST_UNIT + i
             prog["uBackground"].value = GBUFFER_FIRST_UNIT + GBUFFER_TARGETS
             self.link_count += 1
-            hit = (prog, self.ctx.vertex_array(prog, [(self._quad, "2f", "a_pos")]))
-            self._programs[key] = hit
-        return hit
+            self._programs[key] = prog
+        return prog
 
     def draw(self, gbuffer: GBuffer, background: moderngl.Texture, eye,
              split_sum_only: bool, compensation: bool) -> None:
@@ -135,13 +132,11 @@ class LightingPass:
         for i, t in enumerate(gbuffer.textures):
             t.use(location=GBUFFER_FIRST_UNIT + i)
         background.use(location=GBUFFER_FIRST_UNIT + GBUFFER_TARGETS)
-        prog, vao = self.program(split_sum_only, compensation, self.edges_once)
+        prog = self.program(split_sum_only, compensation, self.edges_once)
         prog["uCameraPosition"].value = tuple(float(x) for x in eye)
-        vao.render(vertices=3)
+        self._quad.draw(prog)
 
     def release(self) -> None:
-        for prog, vao in self._programs.values():
-            vao.release()
+        for prog in self._programs.values():
             prog.release()
         self._programs.clear()
-        self._quad.release()

@@ -1,8 +1,10 @@
-"""The renderer's program cache: (structure hash of an entry variant) -> linked program, and
-the location of a failed link on the graph's nodes.
+"""The renderer's program cache: (structure hash of an entry variant) -> linked program, which
+variant a material draws with, and the location of a failed link on the graph's nodes.
 
 A material is linked through one of its entry variants (matedit.compiler.emit.Entry, with the
 preview's extra defines); the variant's structure hash covers its whole text, so it is the key.
+Deferred, a material draws its GBUFFER entry; forward, its FORWARD entry with split sum only
+(the reference estimator is a third of llvmpipe's work) and, in reference mode, the full one.
 """
 
 from __future__ import annotations
@@ -13,6 +15,15 @@ import moderngl
 
 from matedit.compiler.api import CompiledMaterial
 from matedit.compiler.emit import Entry
+from matedit.glsl.layout import BINDINGS
+from matedit.render.deferred import ENERGY_COMPENSATION, SPLIT_SUM_ONLY
+from matedit.render.fullscreen import set_uniform
+
+# uniform blocks and samplers a program may declare -> their binding (matedit/glsl/layout.py)
+_BLOCKS = (("LightsBlock", "LIGHTS"), ("IblBlock", "IBL"), ("FrameBlock", "FRAME"),
+           ("MaterialParams", "MATERIAL"))
+_SAMPLERS = (("uPrefilteredEnv", "PREFILTERED_ENV"), ("uBrdfLut", "BRDF_LUT"),
+             ("uEnvironment", "ENVIRONMENT"))
 
 
 @dataclass
@@ -33,10 +44,25 @@ def failure(compiled: CompiledMaterial, exc: Exception) -> MaterialStatus:
     return MaterialStatus(False, errors, log)
 
 
+def bind_program(prog: moderngl.Program) -> None:
+    """Assigns a new program's uniform blocks and environment samplers their bindings."""
+    for block, key in _BLOCKS:
+        if block in prog:
+            prog[block].binding = BINDINGS[key]
+    for sampler, key in _SAMPLERS:
+        set_uniform(prog, sampler, BINDINGS[key])
+
+
+def forward_defines(split_sum_only: bool, compensation: bool) -> tuple[str, ...]:
+    """The preview's defines of a FORWARD variant."""
+    return ((SPLIT_SUM_ONLY,) if split_sum_only else ()) + \
+        ((ENERGY_COMPENSATION,) if compensation else ())
+
+
 class ProgramCache:
     """Linked material programs; `bind` assigns a new program's block bindings and units."""
 
-    def __init__(self, ctx: moderngl.Context, bind) -> None:
+    def __init__(self, ctx: moderngl.Context, bind=bind_program) -> None:
         self.ctx = ctx
         self.table: dict[str, moderngl.Program] = {}
         self.link_count = 0
@@ -55,6 +81,35 @@ class ProgramCache:
             self._bind(prog)
             self.table[variant.structure_hash] = prog
         return prog, variant
+
+    def material(self, compiled: CompiledMaterial, forward: bool, compensation: bool = False
+                 ) -> moderngl.Program:
+        """The program a material draws with (raises moderngl.Error): its GBUFFER entry, or
+        forward its split-sum FORWARD variant (with the preview's compensation option)."""
+        return self.get(compiled, *self._variant(forward, compensation))[0]
+
+    def reference(self, compiled: CompiledMaterial, compensation: bool = False,
+                  fallback: moderngl.Program | None = None) -> moderngl.Program | None:
+        """The FORWARD variant with the reference estimator (reference mode, forward path), or
+        `fallback` if it fails to link (which the split-sum variant linking rules out)."""
+        try:
+            return self.get(compiled, Entry.FORWARD, forward_defines(False, compensation))[0]
+        except moderngl.Error:
+            return fallback
+
+    def link(self, compiled: CompiledMaterial, forward: bool, compensation: bool = False
+             ) -> moderngl.Program | MaterialStatus:
+        """`material`, or the failed status located in the variant that failed."""
+        try:
+            return self.material(compiled, forward, compensation)
+        except moderngl.Error as exc:
+            return failure(compiled.variant(*self._variant(forward, compensation)), exc)
+
+    @staticmethod
+    def _variant(forward: bool, compensation: bool) -> tuple[Entry, tuple[str, ...]]:
+        if forward:
+            return Entry.FORWARD, forward_defines(True, compensation)
+        return Entry.GBUFFER, ()
 
     def release(self, forget=None) -> None:
         for p in self.table.values():

@@ -58,3 +58,61 @@ def texture_from(ctx: moderngl.Context, path: str | None, space: str = "srgb"
     tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
     tex.repeat_x = tex.repeat_y = True
     return tex
+
+
+class TextureCache:
+    """A material's textures by name, each with the identity (`file_stamp`) of what it holds:
+    naming the same unchanged file in the same space again reads nothing."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self._textures: dict[str, moderngl.Texture] = {}
+        self._keys: dict[str, tuple[str | None, str]] = {}  # name: (path, space)
+        self._stamps: dict[str, tuple] = {}  # name: file_stamp
+
+    def __getitem__(self, name: str) -> moderngl.Texture:
+        return self._textures[name]
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._textures
+
+    def set(self, name: str, path: str | None, space: str) -> bool:
+        """Loads `path` as texture `name` unless it holds that file already; True if loaded."""
+        stamp = file_stamp(path, space)
+        if name in self._textures and self._stamps.get(name) == stamp:
+            return False
+        self._load(name, path, space, stamp)
+        return True
+
+    def sync(self, textures) -> None:
+        """Keeps the textures of a newly compiled material (IR texture infos): drops the
+        others, loads new names, and reloads a kept name whose colour space changed (from the
+        path last set for it, which a value edit may have changed since the compile)."""
+        from matedit.shading.colorspace import effective_space
+
+        wanted = {t.name: t for t in textures}
+        for name in [n for n in self._textures if n not in wanted]:
+            self._textures.pop(name).release()
+            self._keys.pop(name, None)
+            self._stamps.pop(name, None)
+        for name, info in wanted.items():
+            space = effective_space(getattr(info, "color_space", ""), info.srgb)
+            if name in self._textures and self._keys[name][1] == space:
+                continue
+            path = self._keys[name][0] if name in self._keys else info.path
+            self._load(name, path, space, file_stamp(path, space))
+
+    def _load(self, name: str, path: str | None, space: str, stamp: tuple) -> None:
+        old = self._textures.pop(name, None)
+        if old is not None:
+            old.release()
+        self._textures[name] = texture_from(self.ctx, path, space)
+        self._keys[name] = (path, space)
+        self._stamps[name] = stamp
+
+    def release(self) -> None:
+        for t in self._textures.values():
+            t.release()
+        self._textures.clear()
+        self._keys.clear()
+        self._stamps.clear()

@@ -1,0 +1,81 @@
+"""One scene frame into the multisampled HDR target: the environment background, the material
+on the mesh and the light gizmos, then the resolve.
+
+Forward, the mesh's FORWARD program draws (blended) into the target. Deferred, its GBUFFER
+program fills the G-buffer (sharing the target's depth) and the lighting pass shades it into
+the target over the background, which was drawn first into a one-sample texture.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from matedit.render.deferred import ENERGY_COMPENSATION, LightingPass
+from matedit.render.environment import EnvironmentLighting
+from matedit.render.frames import SceneTargets
+from matedit.render.fullscreen import FullscreenQuad
+from matedit.render.gizmos import Gizmos
+from matedit.render.material import MaterialResources
+from matedit.render.mesh import GpuMesh
+from matedit.render.programs import bind_program
+from matedit.render.settings import PreviewSettings
+from matedit.render.uniforms import SceneUniforms
+from matedit.shading.ibl import IBL_MODE_REFERENCE
+
+
+class ScenePass:
+    """The scene's shared inputs (uniform blocks, environment) and passes (lighting, gizmos)."""
+
+    def __init__(self, ctx: moderngl.Context, samples: int, quad: FullscreenQuad,
+                 settings: PreviewSettings, prelink: bool = False) -> None:
+        """`prelink`: the split-sum lighting program now, at start-up (the deferred path)."""
+        self.ctx = ctx
+        self.uniforms = SceneUniforms(ctx, settings.lights)
+        self.environment = EnvironmentLighting(ctx, quad)
+        self.gizmos = Gizmos(ctx)
+        self.lighting = LightingPass(ctx, samples, bind_program, quad)
+        if prelink:
+            self.lighting.program(True, False)
+
+    def draw(self, view: PreviewSettings, targets: SceneTargets, mesh: GpuMesh | None,
+             program: moderngl.Program | None, forward: bool, material: MaterialResources,
+             ibl_mode: int, offset=(0.0, 0.0)) -> None:
+        """The scene as `view` shows it, the mesh drawn with `program` (none: no mesh) on the
+        forward or the deferred path, with IBL mode `ibl_mode` (reference: sample set rotated
+        by `offset`), into `targets` and resolved."""
+        ctx, reference = self.ctx, ibl_mode == IBL_MODE_REFERENCE
+        vp = self.uniforms.write_frame(view.camera, targets.size, view.time, view.exposure)
+        drawn = program is not None and mesh is not None
+        deferred = drawn and not forward
+        targets.begin_background(deferred)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
+        if view.show_background:
+            self.environment.draw_background(vp, view.background_blur,
+                                             view.environment_intensity)
+        if drawn:
+            self.uniforms.bind()
+            self.environment.bind(ibl_mode, view.environment_intensity, view.reference_samples,
+                                  offset, reference and view.reference_lights)
+            material.bind(program)
+            if deferred:
+                targets.begin_gbuffer()
+            ctx.enable(moderngl.DEPTH_TEST | (0 if deferred else moderngl.BLEND))
+            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+            mesh.render(program)
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+            if deferred:
+                targets.begin_lighting()
+                compensation = view.energy_compensation or \
+                    ENERGY_COMPENSATION in material.compiled.ir.defines
+                self.lighting.draw(targets.gbuffer, targets.background.color_attachments[0],
+                                   np.array(view.camera.eye, "f4"), not reference, compensation)
+        if view.show_gizmos:
+            ctx.enable(moderngl.DEPTH_TEST)
+            self.gizmos.draw(vp, view.lights)
+        ctx.disable(moderngl.DEPTH_TEST)
+        targets.resolve()
+
+    def release(self) -> None:
+        for part in (self.lighting, self.gizmos, self.environment, self.uniforms):
+            part.release()
