@@ -64,7 +64,7 @@ class SurfaceUV(Expr):
     type: PortType = PortType.VEC2
 
     def key(self) -> str:
-        return "g_surface.uv"
+        return "surface:uv"  # no `node.port` name has a colon
 
 
 @dataclass(frozen=True)
