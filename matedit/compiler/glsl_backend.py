@@ -41,8 +41,8 @@ def float_literal(x: float) -> str:
 
 
 def expr(e: Expr, names: LocalNames) -> str:
-    if isinstance(e, Var):
-        return names(e.name)
+    if type(e) is Var:
+        return names.taken[e.name]  # the schedule named every variable
     if isinstance(e, (Param, Uni)):
         return e.name
     if isinstance(e, SurfaceUV):
@@ -58,48 +58,40 @@ def expr(e: Expr, names: LocalNames) -> str:
     raise TypeError(f"cannot emit {e!r}")
 
 
-_TEMPLATES: dict[tuple[str, str], list] = {}
+_TEMPLATES: dict[tuple[str, str], tuple[str, bool]] = {}
 
 
-def _parts(template: str, op: Op) -> list:
-    """The template split into text and placeholders (parsed once a kind and template): an int
-    is an operand, ("T",) the result type, ("args",) all operands, ("data", key) op data."""
+def _format(template: str, op: Op) -> tuple[str, bool]:
+    """The template as a str.format string of (operands, type name, all operands, op data), and
+    whether it uses all operands; made once a kind and template. `{k}` is operand k, `{T}` the
+    result type, `{args}` all operands, `{name}` an input of the catalogue kind, else op data."""
     key = (op.kind, template)
-    parts = _TEMPLATES.get(key)
-    if parts is None:
+    hit = _TEMPLATES.get(key)
+    if hit is None:
         d = nodes.REGISTRY.get(op.kind)
         index = {i.name: k for k, i in enumerate(d.inputs)} if d else {}
         pieces = re.split(r"\{(\w+)\}", template)
-        parts = []
+        out = []
         for k, p in enumerate(pieces):
             if k % 2 == 0:
-                parts.append(p)
+                out.append(p.replace("{", "{{").replace("}", "}}"))
             elif p.isdigit():
-                parts.append(int(p))
-            elif p in ("T", "args"):
-                parts.append((p,))
+                out.append(f"{{0[{p}]}}")
+            elif p == "T":
+                out.append("{1}")
+            elif p == "args":
+                out.append("{2}")
             elif p in index:
-                parts.append(index[p])
+                out.append(f"{{0[{index[p]}]}}")
             else:
-                parts.append(("data", p))
-        _TEMPLATES[key] = parts
-    return parts
+                out.append(f"{{3[{p}]}}")
+        hit = _TEMPLATES[key] = ("".join(out), "{2}" in out)
+    return hit
 
 
 def _fill(template: str, op: Op, args: list[str], t: PortType) -> str:
-    out = []
-    for p in _parts(template, op):
-        if isinstance(p, str):
-            out.append(p)
-        elif isinstance(p, int):
-            out.append(args[p])
-        elif p[0] == "T":
-            out.append(TYPE_NAMES[t])
-        elif p[0] == "args":
-            out.append(", ".join(args))
-        else:
-            out.append(str(op.data[p[1]]))
-    return "".join(out)
+    fmt, joined = _format(template, op)
+    return fmt.format(args, TYPE_NAMES[t], ", ".join(args) if joined else "", op.data)
 
 
 def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:

@@ -46,6 +46,9 @@ class Writer:
                 self.map[len(self.lines)] = (node, file)
 
 
+_UNDERSCORES = re.compile(r"_+")
+
+
 class LocalNames:
     """Local variable names: `l_<node>_<port>` (IR names are `node.port`), in a name space of
     their own (no uniform, parameter, function or library name starts with `l_`), made unique
@@ -58,7 +61,7 @@ class LocalNames:
     def __call__(self, raw: str) -> str:
         if raw in self.taken:
             return self.taken[raw]
-        name = "l_" + re.sub(r"_+", "_", raw.replace(".", "_"))
+        name = "l_" + _UNDERSCORES.sub("_", raw.replace(".", "_"))
         base, i = name, 2
         while name in self.used:
             name, i = f"{base}_{i}", i + 1
@@ -67,10 +70,10 @@ class LocalNames:
         return name
 
     def visit(self, e: Expr) -> None:
-        """Name the variables of an operand, in reading order."""
-        while isinstance(e, Splat):
+        """Name the variable of an operand (an operand holds at most one)."""
+        while type(e) is Splat:
             e = e.expr
-        if isinstance(e, Var):
+        if type(e) is Var and e.name not in self.taken:
             self(e.name)
 
 
@@ -93,9 +96,10 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
     for p, _ in scope.params:
         names.used.add(p)
     steps = []
+    visit = names.visit
     for op in scope.ops:
         for a in op.args:
-            names.visit(a)
+            visit(a)
         steps.append((op, [(names(op.out(p).name), t) for p, t in op.outs]))
     for _, _, e in scope.outputs:
         names.visit(e)
