@@ -45,8 +45,8 @@ class OpImpl:
     glsl: str | None = None  # value template (see the module doc); None: the op's data says
     # op.data key of the struct fields that operands 1.. are assigned to, after the value
     assigns: str | None = None
-    # catalogue kinds whose library code the op needs (their shader files are included)
-    needs: tuple[str, ...] = ()
+    # library units the op's code needs (the back-end includes its file of each)
+    units: tuple[str, ...] = ()
 
 
 def _mask(op: Op, args: list, env) -> tuple:
@@ -92,7 +92,7 @@ BUILTINS: dict[str, OpImpl] = {o.kind: o for o in (
     OpImpl(APPEND, _append, glsl="{T}({args})"),
     OpImpl(SET_ATTRIBUTES, _set_attributes, glsl="{0}", assigns="fields"),
     OpImpl(WEIGHT, _weight, glsl="clamp({0} * {1}, 0.0, 1.0)"),
-    OpImpl(BLEND, _blend, glsl="blendMaterialAttributes({args})", needs=("layer_blend",)),
+    OpImpl(BLEND, _blend, glsl="blendMaterialAttributes({args})", units=("nodes/layer_blend",)),
     OpImpl(CALL, _call),  # the back-end's call convention, on op.data["function"]
 )}
 

@@ -167,13 +167,12 @@ def schedule(ir: MaterialIR, mode: str | Entry = Entry.FORWARD,
             raise ValueError(f"not a define name: {d!r}")
     scopes = [plan_scope(s, main=False) for s in ir.functions]
     scopes.append(plan_scope(ir.main, main=True))
-    kinds = set(ir.node_kinds)
+    # the library file of each node kind used, and those the compiler's own ops need
+    needed = {f"nodes/{k}" for k in ir.node_kinds if nodes.REGISTRY[k].glsl}
     for s in [ir.main, *ir.functions]:
         for op in s.ops:
-            kinds.update(ops.implementation(op.kind).needs)
-    units = list(BASE_UNITS)
-    units += [f"nodes/{k}" for k in sorted(kinds) if nodes.REGISTRY[k].glsl]
-    units += ENTRY_UNITS[entry]
+            needed.update(ops.implementation(op.kind).units)
+    units = [*BASE_UNITS, *sorted(needed), *ENTRY_UNITS[entry]]
     extra = [d for d in defines if d not in ir.defines]
     return Schedule(ir, entry, scopes, units, has_defines(ir) + list(ir.defines), extra,
                     ENTRY_OUTPUTS[entry])
