@@ -13,8 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, MaterialIR, Op, Param, Scope, Splat, SurfaceUV, Uni, Var
-from matedit.graph.nodes import ATTRIBUTE_FIELDS, Role, role_of
+from matedit.graph.nodes import ATTRIBUTE_FIELDS
 from matedit.graph.types import PortType
 
 
@@ -72,36 +73,9 @@ def eval_expr(e: Expr, table: dict[str, Any], env: Env | None) -> Any:
 
 
 def eval_op(op: Op, args: list[Any], env: Env | None) -> tuple:
-    from matedit.compiler import cpu_nodes
-
-    k = op.kind
-    if k == "mask":
-        idx = ["xyzw".index(c) for c in op.data["channels"]]
-        a = np.asarray(args[0])
-        a = a.reshape(a.shape[0], -1)
-        r = a[:, idx]
-        return (r[:, 0] if len(idx) == 1 else r,)
-    role = role_of(k)
-    if role == Role.APPEND:
-        parts = [np.asarray(a).reshape(np.asarray(a).shape[0], -1) for a in args]
-        return (np.concatenate(parts, axis=1),)
-    if role == Role.SET_ATTRIBUTES:
-        m = {f: np.array(v, copy=True) for f, v in args[0].items()}
-        for name, v in zip(op.data["fields"], args[1:]):
-            m[name] = np.asarray(v, dtype=np.float64)
-        return (m,)
-    if k == "weight":
-        return (np.clip(np.asarray(args[0]) * np.asarray(args[1]), 0.0, 1.0),)
-    if k == "blend":
-        return (cpu_nodes.blend_material_attributes(args[0], args[1], np.asarray(args[2])),)
-    if k == "call":
-        scope = env.functions[op.data["function"]]
-        return eval_scope(scope, dict(zip((p for p, _ in scope.params), args)), env)
-    impl = cpu_nodes.IMPLS.get(k)
-    if impl is None:
-        raise KeyError(f"no numpy implementation for node kind {k!r}")
-    out = impl(env.surface if env else None, *args)
-    return out if isinstance(out, tuple) else (out,)
+    """The op's outputs from its operand values, by its row in the op table (`ops`); `env`
+    None: constant folding, where ops that read the surface or call a function refuse."""
+    return ops.implementation(op.kind).numpy(op, args, env)
 
 
 def eval_scope(scope: Scope, params: dict[str, Any], env: Env,

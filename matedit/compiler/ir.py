@@ -1,4 +1,4 @@
-"""The typed intermediate representation between a graph and GLSL.
+"""The typed intermediate representation between a graph and the back-ends.
 
 A scope (the material, or one material function) is a list of `Op`s in a
 stable topological order. Operands are `Expr`s: another op's output (`Var`), a
@@ -64,7 +64,7 @@ class SurfaceUV(Expr):
     type: PortType = PortType.VEC2
 
     def key(self) -> str:
-        return "g_surface.uv"
+        return "surface:uv"  # no `node.port` name has a colon
 
 
 @dataclass(frozen=True)
@@ -78,11 +78,11 @@ class Splat(Expr):
 
 @dataclass
 class Op:
-    """One evaluation: a node kind's GLSL function / inline template, or a compiler op.
+    """One evaluation: a catalogue node kind, or one of the compiler's own ops.
 
-    `kind` is a node kind from the registry, or one of the compiler's own:
-    'mask', 'append', 'set_attributes', 'call' (material function), 'blend'
-    (blendMaterialAttributes), 'weight' (saturate(mask * opacity)).
+    `kind` is a node kind from the registry or a compiler op (`matedit.compiler.ops`: mask,
+    append, set_attributes, weight, blend, call); either way its implementations are the row
+    `ops.implementation(kind)`.
     """
 
     var: str  # stem of the output names

@@ -26,23 +26,16 @@ class Target:
     es: bool = False
 
     def prelude(self) -> str:
-        lines = []
-        if self.es:
-            lines += ["precision highp float;", "precision highp int;",
-                      "precision highp sampler2D;", "precision highp samplerCube;"]
-        if self.vulkan:
-            lines += [
-                      "#define MATEDIT_UBO(n) layout(std140, set = 0, binding = n)",
-                      "#define MATEDIT_BINDING(n) layout(set = 0, binding = n)"]
-        else:
-            lines += ["#define MATEDIT_UBO(n) layout(std140)", "#define MATEDIT_BINDING(n)"]
-        return "\n".join(lines)
+        """What follows `#version` in every stage (the GLSL back-end writes it)."""
+        from matedit.compiler.glsl_backend import prelude
+
+        return prelude(self)
 
     def varying(self, direction: str, location: int, decl: str) -> str:
-        """An interface variable between stages; Vulkan needs explicit locations."""
-        if self.vulkan:
-            return f"layout(location = {location}) {direction} {decl};"
-        return f"{direction} {decl};"
+        """An interface variable between stages (the GLSL back-end writes it)."""
+        from matedit.compiler.glsl_backend import varying
+
+        return varying(self, direction, location, decl)
 
 
 TARGETS = {

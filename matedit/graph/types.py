@@ -31,15 +31,9 @@ class PortType(str, Enum):
     def is_numeric(self) -> bool:
         return _COMPONENTS[self._value_] > 0
 
-    @property
-    def glsl(self) -> str:
-        return _GLSL[self._value_]
-
 
 _COMPONENTS = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4, "MaterialAttributes": 0,
                "texture2d": 0}
-_GLSL = {"float": "float", "vec2": "vec2", "vec3": "vec3", "vec4": "vec4",
-         "MaterialAttributes": "MaterialAttributes", "texture2d": "sampler2D"}
 VECTOR_BY_SIZE = {1: PortType.FLOAT, 2: PortType.VEC2, 3: PortType.VEC3, 4: PortType.VEC4}
 NUMERIC = (PortType.FLOAT, PortType.VEC2, PortType.VEC3, PortType.VEC4)
 

@@ -1,0 +1,220 @@
+"""The GLSL back-end: a `Schedule` to vertex and fragment text for one GLSL dialect.
+
+It owns everything that is GLSL: type names, literal syntax, declarations (uniform block,
+samplers, stage interface), the call convention (library functions and material functions
+take `out` parameters), the ops table's `glsl` column, the dialects' preludes, and the library
+files (`shaders/<unit>.glsl`). HLSL and MSL come from the glsl450 text through SPIR-V
+(`matedit.interop.cross`), not from a back-end of their own.
+"""
+
+from __future__ import annotations
+
+import re
+from functools import cache
+
+from matedit.compiler import ops
+from matedit.compiler.ir import Expr, Lit, Op, Param, Splat, SurfaceUV, Uni, Var
+from matedit.compiler.schedule import Entry, LocalNames, Schedule, ScopePlan, SourceMap, Writer
+from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING, Target
+from matedit.glsl import layout as _layout
+from matedit.glsl.include import Assembly, assemble
+from matedit.graph import nodes
+from matedit.graph.types import PortType
+
+# PortType -> GLSL type name
+TYPE_NAMES = {PortType.FLOAT: "float", PortType.VEC2: "vec2", PortType.VEC3: "vec3",
+              PortType.VEC4: "vec4", PortType.MATERIAL: "MaterialAttributes",
+              PortType.TEXTURE: "sampler2D"}
+
+
+def type_name(t: PortType) -> str:
+    return TYPE_NAMES[t]
+
+
+def float_literal(x: float) -> str:
+    s = repr(float(x))
+    if "inf" in s or "nan" in s:
+        raise ValueError(f"cannot write {s} as a GLSL literal")
+    if "e" not in s and "." not in s:
+        s += ".0"
+    return s
+
+
+def expr(e: Expr, names: LocalNames) -> str:
+    if type(e) is Var:
+        return names.taken[e.name]  # the schedule named every variable
+    if isinstance(e, (Param, Uni)):
+        return e.name
+    if isinstance(e, SurfaceUV):
+        return "g_surface.uv"
+    if isinstance(e, Lit):
+        if e.type == PortType.MATERIAL:
+            return "defaultMaterialAttributes()"
+        if e.type == PortType.FLOAT:
+            return float_literal(e.value)
+        return f"{TYPE_NAMES[e.type]}({', '.join(float_literal(v) for v in e.value)})"
+    if isinstance(e, Splat):
+        return f"{TYPE_NAMES[e.type]}({expr(e.expr, names)})"
+    raise TypeError(f"cannot emit {e!r}")
+
+
+_TEMPLATES: dict[tuple[str, str], tuple[str, bool]] = {}
+
+
+def _format(template: str, op: Op) -> tuple[str, bool]:
+    """The template as a str.format string of (operands, type name, all operands, op data), and
+    whether it uses all operands; made once a kind and template. `{k}` is operand k, `{T}` the
+    result type, `{args}` all operands, `{name}` an input of the catalogue kind, else op data."""
+    key = (op.kind, template)
+    hit = _TEMPLATES.get(key)
+    if hit is None:
+        d = nodes.REGISTRY.get(op.kind)
+        index = {i.name: k for k, i in enumerate(d.inputs)} if d else {}
+        pieces = re.split(r"\{(\w+)\}", template)
+        out = []
+        for k, p in enumerate(pieces):
+            if k % 2 == 0:
+                out.append(p.replace("{", "{{").replace("}", "}}"))
+            elif p.isdigit():
+                out.append(f"{{0[{p}]}}")
+            elif p == "T":
+                out.append("{1}")
+            elif p == "args":
+                out.append("{2}")
+            elif p in index:
+                out.append(f"{{0[{index[p]}]}}")
+            else:
+                out.append(f"{{3[{p}]}}")
+        hit = _TEMPLATES[key] = ("".join(out), "{2}" in out)
+    return hit
+
+
+def _fill(template: str, op: Op, args: list[str], t: PortType) -> str:
+    fmt, joined = _format(template, op)
+    return fmt.format(args, TYPE_NAMES[t], ", ".join(args) if joined else "", op.data)
+
+
+def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
+    """One op as one line: a declaration of its value, or declarations and a call that fills
+    them through `out` parameters."""
+    impl = ops.implementation(op.kind)
+    args = [expr(a, names) for a in op.args]
+    template = impl.glsl if impl.glsl is not None else op.data.get("inline")
+    if template is not None:
+        (name, t), = outs
+        line = f"{TYPE_NAMES[t]} {name} = {_fill(template, op, args, t)};"
+        if impl.assigns:
+            sets = " ".join(f"{name}.{f} = {a};" for f, a in zip(op.data[impl.assigns], args[1:]))
+            line += " " + sets
+        return line
+    fn = op.data.get("glsl") or op.data.get("function")
+    decls = " ".join(f"{TYPE_NAMES[t]} {n};" for n, t in outs)
+    return f"{decls} {fn}({', '.join(args + [n for n, _ in outs])});"
+
+
+def _scope(w: Writer, plan: ScopePlan) -> None:
+    scope, names = plan.scope, plan.names
+    if plan.main:
+        w.add("MaterialAttributes evaluateMaterial() {")
+    else:
+        params = [f"{TYPE_NAMES[t]} {n}" for n, t in scope.params]
+        params += [f"out {TYPE_NAMES[t]} out_{n}" for n, t, _ in scope.outputs]
+        w.add(f"void {scope.name}({', '.join(params)}) {{")
+        w.add(f"    // material function {scope.name}")
+    for op, outs in plan.steps:
+        w.add("    " + op_line(op, outs, names), op.node, scope.source)
+    if plan.main:
+        w.add(f"    return {expr(scope.outputs[0][2], names)};" if scope.outputs
+              else "    return defaultMaterialAttributes();")
+    else:
+        for n, _, e in scope.outputs:
+            w.add(f"    out_{n} = {expr(e, names)};")
+    w.add("}")
+
+
+# --- the dialects -----------------------------------------------------------------------------
+def prelude(target: Target) -> str:
+    """What follows `#version`: ES precisions, and the binding macros (Vulkan: set 0)."""
+    lines = []
+    if target.es:
+        lines += ["precision highp float;", "precision highp int;",
+                  "precision highp sampler2D;", "precision highp samplerCube;"]
+    if target.vulkan:
+        lines += [
+                  "#define MATEDIT_UBO(n) layout(std140, set = 0, binding = n)",
+                  "#define MATEDIT_BINDING(n) layout(set = 0, binding = n)"]
+    else:
+        lines += ["#define MATEDIT_UBO(n) layout(std140)", "#define MATEDIT_BINDING(n)"]
+    return "\n".join(lines)
+
+
+def varying(target: Target, direction: str, location: int, decl: str) -> str:
+    """An interface variable between stages; Vulkan needs explicit locations."""
+    if target.vulkan:
+        return f"layout(location = {location}) {direction} {decl};"
+    return f"{direction} {decl};"
+
+
+# The FrameBlock declaration, a str.format template of {binding} (matedit/glsl/layout.py)
+FRAME_BLOCK = (_layout.FRAME_BLOCK.declaration("@B@").replace("{", "{{").replace("}", "}}")
+               .replace("@B@", "{binding}"))
+
+_VARYINGS = ["vec3 v_position", "vec3 v_normal", "vec4 v_tangent", "vec2 v_uv"]
+
+
+def vertex_source(target: Target) -> Assembly:
+    body = "\n".join([
+        FRAME_BLOCK.format(binding=FRAME_BINDING),
+        "layout(location = 0) in vec3 a_position;",
+        "layout(location = 1) in vec3 a_normal;",
+        "layout(location = 2) in vec4 a_tangent;",
+        "layout(location = 3) in vec2 a_uv;",
+        *(varying(target, "out", i, d) for i, d in enumerate(_VARYINGS)),
+        "void main() {",
+        "    vec4 world = uFrame.model * vec4(a_position, 1.0);",
+        "    v_position = world.xyz;",
+        "    v_normal = mat3(uFrame.normalMatrix) * a_normal;",
+        "    v_tangent = vec4(mat3(uFrame.model) * a_tangent.xyz, a_tangent.w);",
+        "    v_uv = a_uv;",
+        "    gl_Position = uFrame.viewProjection * world;",
+        "}",
+    ])
+    return assemble(body, target.version, [], "<vertex>", prelude=prelude(target))
+
+
+@cache
+def entry_text(entry: Entry) -> str:
+    """The entry file's `main`, without its leading comment lines (the file's documentation)."""
+    from matedit.resources import shaders_dir
+
+    lines = (shaders_dir() / "entry" / f"{entry.value}.frag.glsl").read_text().split("\n")
+    while lines and lines[0].startswith("//"):
+        lines.pop(0)
+    return "\n".join(lines).rstrip("\n")
+
+
+def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap]:
+    ir = plan.ir
+    w = Writer()
+    w.add(FRAME_BLOCK.format(binding=FRAME_BINDING))
+    if ir.uniforms:
+        w.add(f"MATEDIT_UBO({MATERIAL_BINDING}) uniform MaterialParams {{")
+        for u in ir.uniforms:
+            w.add(f"    {TYPE_NAMES[u.type]} {u.name};", u.node, ir.main.source)
+        w.add("};")
+    for i, t in enumerate(ir.textures):
+        w.add(f"MATEDIT_BINDING({FIRST_TEXTURE_BINDING + i}) uniform "
+              f"{TYPE_NAMES[PortType.TEXTURE]} {t.name};", t.node, ir.main.source)
+    for i, decl in enumerate(_VARYINGS):
+        w.add(varying(target, "in", i, decl))
+    for i, name in enumerate(plan.outputs):
+        w.add(f"layout(location = {i}) out vec4 {name};")
+    for scope in plan.scopes:
+        _scope(w, scope)
+    w.add(entry_text(plan.entry))
+    includes = [f"{unit}.glsl" for unit in plan.units]
+    lines = "\n".join(f"#define {d} 1" for d in plan.defines)
+    lines += "".join(f"\n#define {d} 1" for d in plan.extra_defines)
+    asm = assemble("\n".join(w.lines), target.version, includes, "<material>",
+                   prelude=prelude(target) + "\n" + lines)
+    return asm, SourceMap(w.map, len(asm.sources) - 1)

@@ -1,0 +1,194 @@
+"""The target-neutral half of emission: what a back-end writes, and in which order.
+
+A `Schedule` is the optimised IR laid out for one entry point: the scopes in emission order
+(material functions callees first, then the material), each op's local variable names, the
+library units to include, the feature defines, the entry's outputs, and the uniform block's
+layout. It holds no text of any shading language; a back-end (`glsl_backend`) turns it into
+source, and records each line's node in a `SourceMap` as it writes.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from enum import Enum
+
+from matedit.compiler import ops
+from matedit.compiler.ir import Expr, MaterialIR, Op, Scope, Splat, Var
+from matedit.graph import nodes
+from matedit.graph.types import PortType
+
+
+@dataclass
+class SourceMap:
+    """Line numbers of the generated source string -> (node id, file of that node)."""
+
+    lines: dict[int, tuple[str, str]] = field(default_factory=dict)
+    source_number: int = -1  # the generated text's source-string number in the assembly
+
+    def node_at(self, source: int, line: int) -> tuple[str, str] | None:
+        if source != self.source_number:
+            return None
+        return self.lines.get(line)
+
+
+class Writer:
+    """Generated lines and the node each came from (the source map under construction)."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.map: dict[int, tuple[str, str]] = {}
+
+    def add(self, text: str, node: str | None = None, file: str = "") -> None:
+        for line in text.split("\n"):
+            self.lines.append(line)
+            if node is not None:
+                self.map[len(self.lines)] = (node, file)
+
+
+_UNDERSCORES = re.compile(r"_+")
+
+
+class LocalNames:
+    """Local variable names: `l_<node>_<port>` (IR names are `node.port`), in a name space of
+    their own (no uniform, parameter, function or library name starts with `l_`), made unique
+    within the function deterministically, in the order the scope first uses them."""
+
+    def __init__(self) -> None:
+        self.taken: dict[str, str] = {}
+        self.used: set[str] = set()
+
+    def __call__(self, raw: str) -> str:
+        if raw in self.taken:
+            return self.taken[raw]
+        name = "l_" + _UNDERSCORES.sub("_", raw.replace(".", "_"))
+        base, i = name, 2
+        while name in self.used:
+            name, i = f"{base}_{i}", i + 1
+        self.used.add(name)
+        self.taken[raw] = name
+        return name
+
+    def visit(self, e: Expr) -> None:
+        """Name the variable of an operand (an operand holds at most one)."""
+        while type(e) is Splat:
+            e = e.expr
+        if type(e) is Var and e.name not in self.taken:
+            self(e.name)
+
+
+@dataclass
+class ScopePlan:
+    """One scope in emission order, its local names fixed."""
+
+    scope: Scope
+    main: bool
+    names: LocalNames
+    steps: list[tuple[Op, list[tuple[str, PortType]]]]  # each op, its outputs' local names
+
+    @property
+    def source(self) -> str:
+        return self.scope.source
+
+
+def plan_scope(scope: Scope, main: bool) -> ScopePlan:
+    names = LocalNames()
+    for p, _ in scope.params:
+        names.used.add(p)
+    steps = []
+    visit = names.visit
+    for op in scope.ops:
+        for a in op.args:
+            visit(a)
+        steps.append((op, [(names(op.out(p).name), t) for p, t in op.outs]))
+    for _, _, e in scope.outputs:
+        names.visit(e)
+    return ScopePlan(scope, main, names, steps)
+
+
+class Entry(Enum):
+    """The fragment entry points; each back-end has one file per entry (GLSL:
+    `shaders/entry/<value>.frag.glsl`).
+
+    FORWARD: attributes and `shadeSurface` in one shader (what `compile` exports).
+    GBUFFER: the attributes and the world-space shading normal into four float targets, for the
+    preview's deferred lighting pass (shaders/render/lighting.frag).
+    ATTRIBUTES: the raw MaterialAttributes into four float targets (tests, `bake`).
+    """
+
+    FORWARD = "forward"
+    GBUFFER = "gbuffer"
+    ATTRIBUTES = "attributes"
+
+    @classmethod
+    def of(cls, mode: str | Entry) -> Entry:
+        """An Entry from itself or an older mode name ("shade" is FORWARD)."""
+        if isinstance(mode, Entry):
+            return mode
+        return {"shade": cls.FORWARD}.get(mode) or cls(mode)
+
+
+# Output variables of each entry (location order); the entry file writes them.
+ENTRY_OUTPUTS = {
+    Entry.FORWARD: ("fragColor",),
+    Entry.GBUFFER: ("gbuffer0", "gbuffer1", "gbuffer2", "gbuffer3"),
+    Entry.ATTRIBUTES: ("out0", "out1", "out2", "out3"),
+}
+# Library units every material needs, and those an entry needs beyond the material's own.
+BASE_UNITS = ("common", "material", "nodes/context")
+ENTRY_UNITS = {Entry.FORWARD: ("surface",), Entry.GBUFFER: (), Entry.ATTRIBUTES: ()}
+
+_DEFINE = re.compile(r"MATEDIT_[A-Z0-9_]+")
+
+
+def has_defines(ir: MaterialIR) -> list[str]:
+    """`MATERIAL_HAS_BASE_COLOR` and friends, for the attributes the graph writes."""
+    return ["MATERIAL_HAS_" + re.sub(r"(?<!^)([A-Z])", r"_\1", f).upper() for f in ir.attributes]
+
+
+@dataclass
+class Schedule:
+    ir: MaterialIR
+    entry: Entry
+    scopes: list[ScopePlan]  # material functions (callees first), then the material
+    units: list[str]  # library units to include, in order
+    defines: list[str]  # the material's feature defines, in order
+    extra_defines: list[str]  # the caller's, after them
+    outputs: tuple[str, ...]  # the entry's output variables, in location order
+
+
+def schedule(ir: MaterialIR, mode: str | Entry = Entry.FORWARD,
+             defines: tuple[str, ...] | list[str] = ()) -> Schedule:
+    """The emission plan of one entry; `defines` are extra feature defines after the
+    material's own (the preview's MATEDIT_SPLIT_SUM_ONLY, MATEDIT_ENERGY_COMPENSATION)."""
+    entry = Entry.of(mode)
+    for d in defines:
+        if not _DEFINE.fullmatch(d):
+            raise ValueError(f"not a define name: {d!r}")
+    scopes = [plan_scope(s, main=False) for s in ir.functions]
+    scopes.append(plan_scope(ir.main, main=True))
+    # the library file of each node kind used, and those the compiler's own ops need
+    needed = {f"nodes/{k}" for k in ir.node_kinds if nodes.REGISTRY[k].glsl}
+    for s in [ir.main, *ir.functions]:
+        for op in s.ops:
+            needed.update(ops.implementation(op.kind).units)
+    units = [*BASE_UNITS, *sorted(needed), *ENTRY_UNITS[entry]]
+    extra = [d for d in defines if d not in ir.defines]
+    return Schedule(ir, entry, scopes, units, has_defines(ir) + list(ir.defines), extra,
+                    ENTRY_OUTPUTS[entry])
+
+
+_STD140 = {PortType.FLOAT: (4, 4), PortType.VEC2: (8, 8), PortType.VEC3: (16, 12),
+           PortType.VEC4: (16, 16)}
+
+
+def std140_layout(ir: MaterialIR) -> tuple[dict[str, int], int]:
+    """Byte offsets of the MaterialParams members (in name order) and the block size, by the
+    std140 rules."""
+    offsets, off = {}, 0
+    for u in ir.uniforms:
+        align, size = _STD140[u.type]
+        off = (off + align - 1) // align * align
+        offsets[u.name] = off
+        off += size
+    return offsets, (off + 15) // 16 * 16
