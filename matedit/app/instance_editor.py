@@ -285,9 +285,11 @@ def install(window) -> None:
             return None
 
     window.parameters_panel = MaterialParameters(window.controller)
-    window.parameters_dock = window._dock("Parameters", "parametersDock",
-                                          window.parameters_panel,
-                                          Qt.DockWidgetArea.RightDockWidgetArea)
+    from matedit.app.docks import add_dock
+
+    window.parameters_dock = add_dock(window, "Parameters", "parametersDock",
+                                      window.parameters_panel,
+                                      Qt.DockWidgetArea.RightDockWidgetArea)
     window.tabifyDockWidget(window.inspector_dock, window.parameters_dock)
     window.inspector_dock.raise_()
     window.open_instance = open_path
