@@ -23,7 +23,7 @@ LIGHTS_TITLE = "Lights & Environment"
 # Default sizes at the default window size (1480x900): the viewport keeps a useful square,
 # the inspector's first fields and the Lights panel's light properties show unscrolled.
 SIDE_WIDTHS = (270, 430)  # left column (library, layers), right column (viewport, inspector)
-RIGHT_HEIGHTS = (400, 420)  # viewport, inspector/lights
+RIGHT_HEIGHTS = (300, 520)  # viewport, inspector/lights
 LEFT_HEIGHTS = (330, 420)  # library, layers
 BOTTOM_HEIGHT = 170  # diagnostics, code, history
 
@@ -63,6 +63,10 @@ def build_docks(w) -> None:
     ``w.controller`` and ``w.undo_group``)."""
     L, R, B = (Qt.DockWidgetArea.LeftDockWidgetArea, Qt.DockWidgetArea.RightDockWidgetArea,
                Qt.DockWidgetArea.BottomDockWidgetArea)
+    # The side columns run the window's full height; the bottom docks sit under the canvas
+    # alone, so the inspector and the lights get that height.
+    w.setCorner(Qt.Corner.BottomLeftCorner, L)
+    w.setCorner(Qt.Corner.BottomRightCorner, R)
     w.viewport = ViewportPanel(w.compiler)
     w.inspector = InspectorPanel(w.controller)
     w.layers = LayersPanel(w.controller)
