@@ -72,6 +72,7 @@ class CanvasTabs(QWidget):
         self.snap_to_grid = False
         # One action table for every tab: its commands apply to the active tab's canvas.
         self.canvas_actions = CanvasActions(self, lambda: self.active.canvas)
+        self.tabs.currentChanged.connect(lambda _i: self.canvas_actions.refresh())
         self.material = self._add(material, material_actions, None)
         bar = self.tabs.tabBar()
         bar.setTabButton(0, bar.ButtonPosition.RightSide, None)

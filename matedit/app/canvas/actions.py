@@ -120,9 +120,11 @@ class CanvasActions(QObject):
     def all(self) -> list[QAction]:
         return list(self._actions.values())
 
-    def attach(self, canvas: QWidget) -> None:
-        """The canvas is where the actions' shortcuts apply."""
+    def attach(self, canvas: NodeCanvasView) -> None:
+        """The canvas is where the actions' shortcuts apply; its selection changes what is
+        enabled (menus refresh again as they open: a wire's selection has no signal)."""
         canvas.addActions(self.all())
+        canvas.selectionChangedIds.connect(lambda _ids: self.refresh())
 
     def run(self, command_id: str, canvas: NodeCanvasView) -> bool:
         """Runs the command on `canvas` if it applies there now; whether it ran."""
