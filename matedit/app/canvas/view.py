@@ -636,6 +636,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             self._scene.clear_wire_selection()
             item.setSelected(True)
         menu = QMenu(self)
+        menu.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)  # a new one each time
         # Add node and Paste land where the menu was opened: both read `_last_pos`.
         menu.addAction(self.actions["add_node"])
         if wire is not None:
