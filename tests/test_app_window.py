@@ -190,8 +190,12 @@ def test_the_file_dialog_name_column_fits_the_longest_name(qtbot, tmp_path):
     model = tree.model()
     qtbot.waitUntil(lambda: model.rowCount(tree.rootIndex()) == len(names), timeout=10000)
     qtbot.wait(50)
-    widest = max(tree.fontMetrics().horizontalAdvance(n) for n in names)
+    fm, root = tree.fontMetrics(), tree.rootIndex()
+    widest = max(fm.horizontalAdvance(n) for n in names)
     assert tree.header().sectionSize(0) >= widest
+    for col in (1, 2):  # size and type are not elided either
+        texts = [str(model.index(r, col, root).data()) for r in range(len(names))]
+        assert tree.header().sectionSize(col) >= max(fm.horizontalAdvance(t) for t in texts)
 
     save = make_dialog(None, "Save", str(tmp_path / "viewport.png"), "PNG (*.png)",
                        mode="save")

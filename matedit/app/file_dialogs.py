@@ -8,9 +8,10 @@ width truncates names like ``rusty_painted_metal.instance.json``).
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QFileDialog, QHeaderView, QTreeView, QWidget
+from PySide6.QtWidgets import QFileDialog, QHeaderView, QSplitter, QTreeView, QWidget
 
 SIZE = (900, 560)
+SIDEBAR = 170  # the places list's width: names like 'Computer' unclipped
 
 
 def make_dialog(parent: QWidget | None, caption: str, directory: str = "",
@@ -28,10 +29,14 @@ def make_dialog(parent: QWidget | None, caption: str, directory: str = "",
         dlg.setFileMode(QFileDialog.FileMode.ExistingFile)
     dlg.setViewMode(QFileDialog.ViewMode.Detail)
     dlg.resize(*SIZE)
-    for view in dlg.findChildren(QTreeView):
+    for view in dlg.findChildren(QTreeView):  # Name, Size, Type as wide as they need
         head = view.header()
-        head.setSectionResizeMode(0, QHeaderView.ResizeMode.ResizeToContents)
+        for section in range(max(head.count() - 1, 0)):
+            head.setSectionResizeMode(section, QHeaderView.ResizeMode.ResizeToContents)
         head.setStretchLastSection(True)
+    splitter = dlg.findChild(QSplitter, "splitter")  # the places sidebar | the files
+    if splitter is not None and splitter.count() == 2:
+        splitter.setSizes([SIDEBAR, SIZE[0] - SIDEBAR])
     return dlg
 
 
