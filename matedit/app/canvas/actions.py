@@ -4,8 +4,9 @@ context menu and its keys all use the QActions built here from `TABLE`.
 A `CanvasActions` is built once per window (or once per stand-alone canvas) over a
 function that returns the canvas its actions apply to (the active tab's). Keys: the canvas
 looks a key press up in its table (`action_for_key`) and runs that entry on itself, so the
-shortcuts work wherever the canvas has focus and never while another widget has it (the
-QActions' own shortcut context is the canvas, `WidgetWithChildrenShortcut`).
+shortcuts work wherever the canvas has focus and never while another widget has it: the
+QActions' own shortcut context is the canvas alone (`WidgetShortcut`), not its children,
+so F1, Tab or Ctrl+D typed in the palette's search or a node's rename field stay theirs.
 """
 
 from __future__ import annotations
@@ -107,7 +108,7 @@ class CanvasActions(QObject):
             a = QAction(icon(c.icon or "none"), c.text, self)
             a.setObjectName(f"canvas_{c.id}")
             a.setShortcuts([QKeySequence(k) for k in c.keys])
-            a.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+            a.setShortcutContext(Qt.ShortcutContext.WidgetShortcut)
             if c.tip:
                 a.setToolTip(c.tip)
                 a.setStatusTip(c.tip)
