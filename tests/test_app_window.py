@@ -201,3 +201,43 @@ def test_the_file_dialog_name_column_fits_the_longest_name(qtbot, tmp_path):
                        mode="save")
     qtbot.addWidget(save)
     assert save.findChild(QLineEdit, "fileNameEdit").text() == "viewport.png"
+
+
+def test_canvas_keys_stay_out_of_other_widgets_of_an_active_window(qtbot):
+    """With the window active (Qt's shortcut map live), the canvas's keys act only while the
+    canvas itself has focus: not in the inspector, not in the palette's search."""
+    from PySide6.QtCore import QPointF
+    from PySide6.QtWidgets import QApplication
+
+    from matedit.app.fields import FloatField
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    w.activateWindow()
+    qtbot.waitUntil(lambda: QApplication.activeWindow() is w, timeout=5000)
+    canvas, g = w.tabs.material.canvas, w.controller.document.graph
+    canvas.select_nodes(["stack"])
+    w.inspector.show_node("stack")
+    qtbot.wait(20)
+    spin = next(f for f in w.inspector.findChildren(FloatField) if f.isVisible()).spin
+    spin.setFocus()
+    qtbot.waitUntil(lambda: QApplication.focusWidget() is spin, timeout=2000)
+    n, m = len(g.nodes), len(g.comments)
+    for key, mods in ((Qt.Key.Key_D, Qt.KeyboardModifier.ControlModifier),
+                      (Qt.Key.Key_Delete, Qt.KeyboardModifier.NoModifier),
+                      (Qt.Key.Key_C, Qt.KeyboardModifier.NoModifier)):
+        qtbot.keyClick(spin, key, mods)
+    assert len(g.nodes) == n and len(g.comments) == m
+    docs: list[str] = []
+    canvas.docsRequested.connect(docs.append)
+    canvas.setFocus()
+    canvas.open_palette(QPointF(0, 0))
+    search = canvas.node_palette.search
+    search.setText("checker")
+    qtbot.waitUntil(lambda: QApplication.focusWidget() is search, timeout=2000)
+    qtbot.keyClick(search, Qt.Key.Key_F1)  # the palette's kind, not the selected node's
+    assert docs == ["checker"] and w._docs.kind == "checker"  # not "layer_stack"
+    canvas.node_palette.close_palette()
+    canvas.setFocus()
+    qtbot.waitUntil(lambda: QApplication.focusWidget() is canvas, timeout=2000)
+    qtbot.keyClick(canvas, Qt.Key.Key_D, Qt.KeyboardModifier.ControlModifier)
+    assert len(g.nodes) == n + 1  # and on the canvas they act
