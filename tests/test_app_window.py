@@ -205,7 +205,8 @@ def test_the_file_dialog_name_column_fits_the_longest_name(qtbot, tmp_path):
 
 def test_canvas_keys_stay_out_of_other_widgets_of_an_active_window(qtbot):
     """With the window active (Qt's shortcut map live), the canvas's keys act only while the
-    canvas itself has focus: not in the inspector, not in the palette's search."""
+    canvas itself has focus: not in the inspector (a window-wide shortcut context fails
+    here), and F1 in the palette's search still documents the palette's kind."""
     from PySide6.QtCore import QPointF
     from PySide6.QtWidgets import QApplication
 
