@@ -106,7 +106,7 @@ def test_recent_files_and_new_document(qtbot, sample_copy):
 
     w = make_window(qtbot, sample_copy)
     assert DocumentActions.recent_files()[0] == str(sample_copy.resolve())
-    w._fill_recent()
+    w.recent_menu.fill()
     assert any(a.text() == sample_copy.name for a in w.recent_menu.actions())
     assert w.actions.new()
     nodes = w.controller.document.graph.nodes  # a new material starts with its output

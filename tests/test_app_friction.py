@@ -14,6 +14,13 @@ pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 SAMPLE = EDITOR_SAMPLE
 
 
+def short_inspector(qtbot, w) -> None:
+    """A window whose inspector is short enough to scroll (the default layout gives it the
+    height to show a layer stack whole)."""
+    w.resizeDocks([w.viewport_dock, w.inspector_dock], [620, 160], Qt.Orientation.Vertical)
+    qtbot.wait(10)
+
+
 def test_a_new_material_starts_with_an_output_and_the_palette_ranks_it_first(qtbot):
     w = make_window(qtbot, SAMPLE)
     assert w.actions.new()
@@ -61,6 +68,7 @@ def test_the_wheel_never_changes_an_unfocused_slider_it_scrolls_the_panel(qtbot)
     from matedit.app.fields import FloatField
 
     w = make_window(qtbot, SAMPLE, show=True)
+    short_inspector(qtbot, w)
     w.inspector.show_node("stack")
     qtbot.wait(10)
     field = next(f for f in w.inspector._fields.values() if isinstance(f, FloatField))
@@ -82,6 +90,7 @@ def test_the_inspector_keeps_its_scroll_position_across_edits(qtbot):
     from matedit.graph.commands import SetSetting
 
     w = make_window(qtbot, SAMPLE, show=True)
+    short_inspector(qtbot, w)
     w.inspector.show_node("stack")
     qtbot.wait(10)
     bar = w.inspector.verticalScrollBar()

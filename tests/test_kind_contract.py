@@ -35,7 +35,7 @@ BINDING = ("compiler/cpu_nodes.py", "_impl")
 ALLOWED = {
     ("app/layers_panel.py", "add"): "icon name",
     ("app/lights_panel.py", "add"): "icon name",
-    ("app/main_window.py", "add"): "icon name",
+    ("app/canvas/actions.py", "add"): "icon name",
     ("app/lights_panel.py", "length"): "a tube light's length field",
     ("io/rig.py", "length"): "a tube light's length field in the rig file",
     ("app/recovery.py", "time"): "the recovery file's timestamp key",

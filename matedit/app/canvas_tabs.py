@@ -15,6 +15,7 @@ from PySide6.QtGui import QUndoGroup
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QTabWidget, QVBoxLayout, QWidget
 
 from matedit.app.canvas import NodeCanvasView
+from matedit.app.canvas.actions import CanvasActions
 from matedit.app.controller import DocumentController
 from matedit.app.document_actions import DocumentActions, display_name, no_mnemonic
 from matedit.app.previews import NodePreviews
@@ -69,6 +70,9 @@ class CanvasTabs(QWidget):
         lay.addWidget(self.tabs, 1)
         self._tabs: list[CanvasTab] = []
         self.snap_to_grid = False
+        # One action table for every tab: its commands apply to the active tab's canvas.
+        self.canvas_actions = CanvasActions(self, lambda: self.active.canvas)
+        self.tabs.currentChanged.connect(lambda _i: self.canvas_actions.refresh())
         self.material = self._add(material, material_actions, None)
         bar = self.tabs.tabBar()
         bar.setTabButton(0, bar.ButtonPosition.RightSide, None)
@@ -79,7 +83,7 @@ class CanvasTabs(QWidget):
     # --- tabs ------------------------------------------------------------------------------
     def _add(self, controller: DocumentController, actions: DocumentActions,
              parent: CanvasTab | None) -> CanvasTab:
-        canvas = NodeCanvasView(controller, self)
+        canvas = NodeCanvasView(controller, self, self.canvas_actions)
         canvas.scene().snap_to_grid = self.snap_to_grid
         tab = CanvasTab(controller, canvas, actions, parent)
         if not controller.document.is_function:

@@ -18,8 +18,9 @@ from pathlib import Path
 
 import shiboken6
 from PySide6.QtCore import QObject, QSettings, QTimer, Signal
-from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
+from PySide6.QtWidgets import QMessageBox, QWidget
 
+from matedit.app import file_dialogs
 from matedit.app.controller import DocumentController
 from matedit.app.paths import relativise_references
 from matedit.app.recovery import DISCARD as REC_DISCARD
@@ -145,13 +146,13 @@ class DocumentActions(QObject):
 
     def _ask_open_path(self) -> str:
         start = str(Path(self.controller.path).parent) if self.controller.path else ""
-        path, _ = QFileDialog.getOpenFileName(self.window, "Open a material", start,
-                                              FILE_FILTER)
+        path, _ = file_dialogs.open_file(self.window, "Open a material", start,
+                                         FILE_FILTER)
         return path
 
     def _ask_save_path(self, suggestion: str) -> str:
-        path, _ = QFileDialog.getSaveFileName(self.window, "Save the material as", suggestion,
-                                              FILE_FILTER)
+        path, _ = file_dialogs.save_file(self.window, "Save the material as", suggestion,
+                                         FILE_FILTER)
         if path and not path.endswith(".json"):
             path += ".json"
         return path

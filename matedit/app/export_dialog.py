@@ -15,7 +15,6 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QDialog,
     QDialogButtonBox,
-    QFileDialog,
     QHBoxLayout,
     QLabel,
     QLineEdit,
@@ -24,6 +23,7 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
 )
 
+from matedit.app import file_dialogs
 from matedit.compiler import TARGETS, CompileError
 from matedit.compiler.export import export_shaders
 from matedit.compiler.targets import CROSS_TARGETS
@@ -97,7 +97,7 @@ class ExportDialog(QDialog):
         return [t for t, b in self.boxes.items() if b.isChecked() and b.isEnabled()]
 
     def _browse(self) -> None:
-        folder = QFileDialog.getExistingDirectory(self, "Export into", self.folder.text())
+        folder = file_dialogs.existing_folder(self, "Export into", self.folder.text())
         if folder:
             self.folder.setText(folder)
 

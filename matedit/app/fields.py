@@ -19,7 +19,6 @@ from PySide6.QtWidgets import (
     QApplication,
     QColorDialog,
     QDoubleSpinBox,
-    QFileDialog,
     QHBoxLayout,
     QLabel,
     QLineEdit,
@@ -31,6 +30,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app import file_dialogs
 from matedit.app.controller import new_merge_id
 from matedit.app.theme import icon
 
@@ -383,7 +383,7 @@ class TextureField(QWidget):
         col.addLayout(row)
         lay.addWidget(self.thumb)
         lay.addLayout(col, 1)
-        self.file_dialog = QFileDialog.getOpenFileName  # tests replace it
+        self.file_dialog = file_dialogs.open_file  # tests replace it
         self.set_value(stored, absolute)
 
     def set_value(self, stored: str, absolute: Path | None) -> None:

@@ -22,26 +22,23 @@ from PySide6.QtWidgets import (
 
 from matedit.graph import nodes
 
-# (keys, what it does, where): the one list the reference shows.
-SHORTCUTS: tuple[tuple[str, str, str], ...] = (
-    ("Tab", "Add a node (the palette), wherever the pointer is over the canvas", "Canvas"),
+# (keys, what it does, where): what is not a canvas command. The canvas's commands come from
+# its action table (`canvas_rows`), so the reference shows the keys the canvas answers to.
+POINTER = (
+    ("Tab over the canvas", "Add a node (the palette), wherever the keyboard focus is",
+     "Canvas"),
     ("Right-click", "Node, wire and canvas menu: preview in viewport, insert reroute, …",
      "Canvas"),
     ("Drag from a port", "Connect; drop on nothing to add a connected node", "Canvas"),
     ("Double-click a wire", "Insert a reroute", "Canvas"),
+    ("Double-click a node's title", "Rename the node", "Canvas"),
     ("Double-click a function call", "Open the function in a tab", "Canvas"),
-    ("F2", "Rename the selected node", "Canvas"),
-    ("F1", "Documentation of the selected node", "Canvas, palette"),
-    ("Delete / Backspace", "Delete the selection", "Canvas"),
-    ("Ctrl+C / Ctrl+X / Ctrl+V", "Copy, cut, paste nodes", "Canvas"),
-    ("Ctrl+D", "Duplicate the selection", "Canvas"),
-    ("C", "Frame the selection in a comment", "Canvas"),
-    ("F", "Frame the selection", "Canvas"),
-    ("Home / A", "Frame the whole graph", "Canvas"),
-    ("M", "Show or hide the minimap", "Canvas"),
     ("Middle drag, Alt+drag, Space+drag", "Pan", "Canvas"),
     ("Wheel", "Zoom about the pointer", "Canvas"),
     ("Esc", "Cancel a wire, clear the selection", "Canvas"),
+    ("F1 in the palette", "Documentation of the highlighted kind", "Palette"),
+)
+WINDOW = (
     ("Left drag", "Orbit the camera", "Viewport"),
     ("Shift+drag, middle drag", "Pan the camera", "Viewport"),
     ("Wheel", "Dolly the camera", "Viewport"),
@@ -54,6 +51,19 @@ SHORTCUTS: tuple[tuple[str, str, str], ...] = (
     ("Ctrl+Z / Ctrl+Shift+Z", "Undo, redo (the active tab)", "Edit"),
     ("Ctrl+/", "This reference", "Help"),
 )
+
+
+def canvas_rows() -> list[tuple[str, str, str]]:
+    """The canvas action table's commands with their keys (needs a QGuiApplication: standard
+    keys are the platform's)."""
+    from matedit.app.canvas.actions import TABLE, key_text
+
+    return [(key_text(c), c.tip or c.text.replace("&", ""), "Canvas") for c in TABLE if c.keys]
+
+
+def shortcut_rows() -> list[tuple[str, str, str]]:
+    """Every row of the reference."""
+    return [*canvas_rows(), *POINTER, *WINDOW]
 
 
 class ShortcutReference(QDialog):
@@ -87,7 +97,7 @@ class ShortcutReference(QDialog):
 
     def fill(self, query: str) -> None:
         words = query.lower().split()
-        rows = [r for r in SHORTCUTS if all(w in " ".join(r).lower() for w in words)]
+        rows = [r for r in shortcut_rows() if all(w in " ".join(r).lower() for w in words)]
         self.table.setRowCount(len(rows))
         for i, row in enumerate(rows):
             for j, text in enumerate(row):

@@ -13,7 +13,6 @@ from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
-    QFileDialog,
     QFormLayout,
     QHBoxLayout,
     QLabel,
@@ -26,6 +25,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app import file_dialogs
 from matedit.app.controller import DocumentController
 from matedit.app.fields import (
     ColorField,
@@ -320,8 +320,8 @@ class InspectorPanel(QScrollArea):
         browse.setToolTip("Choose a material function file")
 
         def pick() -> None:
-            path, _ = QFileDialog.getOpenFileName(self, "Choose a material function", "",
-                                                  "Material functions (*.json)")
+            path, _ = file_dialogs.open_file(self, "Choose a material function", "",
+                                             "Material functions (*.json)")
             if path:
                 self._set_setting(s.name, reference_for(self.controller.document, path))
         browse.clicked.connect(pick)

@@ -20,7 +20,6 @@ from typing import Any
 
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
-    QFileDialog,
     QHBoxLayout,
     QLabel,
     QMessageBox,
@@ -31,6 +30,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app import file_dialogs
 from matedit.app.parameter_panel import ParameterPanel
 from matedit.app.viewport import ViewportWidget
 from matedit.compiler import CompileError, compile_document
@@ -221,7 +221,7 @@ class InstanceEditor(QWidget):
 
     def save_as(self, path: str | Path | None = None) -> bool:
         if path is None:
-            path, _ = QFileDialog.getSaveFileName(self, "Save instance as", "", INSTANCE_FILTER)
+            path, _ = file_dialogs.save_file(self, "Save instance as", "", INSTANCE_FILTER)
             if not path:
                 return False
         save_instance(self.doc, path, resolved=self.resolved)
@@ -285,9 +285,11 @@ def install(window) -> None:
             return None
 
     window.parameters_panel = MaterialParameters(window.controller)
-    window.parameters_dock = window._dock("Parameters", "parametersDock",
-                                          window.parameters_panel,
-                                          Qt.DockWidgetArea.RightDockWidgetArea)
+    from matedit.app.docks import add_dock
+
+    window.parameters_dock = add_dock(window, "Parameters", "parametersDock",
+                                      window.parameters_panel,
+                                      Qt.DockWidgetArea.RightDockWidgetArea)
     window.tabifyDockWidget(window.inspector_dock, window.parameters_dock)
     window.inspector_dock.raise_()
     window.open_instance = open_path
@@ -301,14 +303,14 @@ def _new_instance_dialog(window, parent_file: str | None = None) -> None:
         doc = window.actions.document if hasattr(window, "actions") else None
         parent_file = str(doc.path) if doc is not None and doc.path else None
     if parent_file is None:
-        parent_file, _ = QFileDialog.getOpenFileName(window, "Instance of which material?",
-                                                     "", INSTANCE_FILTER)
+        parent_file, _ = file_dialogs.open_file(window, "Instance of which material?",
+                                                "", INSTANCE_FILTER)
         if not parent_file:
             return
     stem = Path(parent_file).stem
-    path, _ = QFileDialog.getSaveFileName(window, "Save the new instance as",
-                                          str(Path(parent_file).with_name(f"{stem}_inst.json")),
-                                          INSTANCE_FILTER)
+    path, _ = file_dialogs.save_file(window, "Save the new instance as",
+                                     str(Path(parent_file).with_name(f"{stem}_inst.json")),
+                                     INSTANCE_FILTER)
     if path:
         try:
             window.create_instance(parent_file, path)

@@ -14,7 +14,9 @@ from pathlib import Path
 
 from PySide6.QtCore import QSettings, Qt
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QApplication, QFileDialog, QInputDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QInputDialog, QMessageBox
+
+from matedit.app import file_dialogs
 
 FOLDER_KEY = "interop/folder"
 
@@ -97,16 +99,16 @@ class InteropActions:
         return str(Path(self.doc.path).parent) if self.doc.path else ""
 
     def _ask_save(self, title: str, suffix_filter: str, default_name: str) -> Path | None:
-        path, _ = QFileDialog.getSaveFileName(self.window, title,
-                                              str(Path(self._start_dir()) / default_name),
-                                              suffix_filter)
+        path, _ = file_dialogs.save_file(self.window, title,
+                                         str(Path(self._start_dir()) / default_name),
+                                         suffix_filter)
         if not path:
             return None
         QSettings().setValue(FOLDER_KEY, str(Path(path).parent))
         return Path(path)
 
     def _ask_folder(self, title: str) -> Path | None:
-        folder = QFileDialog.getExistingDirectory(self.window, title, self._start_dir())
+        folder = file_dialogs.existing_folder(self.window, title, self._start_dir())
         if not folder:
             return None
         QSettings().setValue(FOLDER_KEY, folder)
@@ -240,8 +242,8 @@ class InteropActions:
         artist picks) and open it."""
         title = "Import MaterialX"
         if src is None:
-            path, _ = QFileDialog.getOpenFileName(self.window, title, self._start_dir(),
-                                                  "MaterialX (*.mtlx)")
+            path, _ = file_dialogs.open_file(self.window, title, self._start_dir(),
+                                             "MaterialX (*.mtlx)")
             if not path:
                 return False
             src = Path(path)

@@ -27,6 +27,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app import file_dialogs
 from matedit.app.controller import DocumentController
 from matedit.app.fields import FloatField
 from matedit.app.paths import reference_for
@@ -490,10 +491,8 @@ class LayersPanel(QWidget):
         other.triggered.connect(self._add_other)
 
     def _add_other(self) -> None:
-        from PySide6.QtWidgets import QFileDialog
-
-        path, _ = QFileDialog.getOpenFileName(self, "Add a material layer",
-                                              str(graphs_dir() / "layers"),
-                                              "Material layers (*.json)")
+        path, _ = file_dialogs.open_file(self, "Add a material layer",
+                                         str(graphs_dir() / "layers"),
+                                         "Material layers (*.json)")
         if path:
             self.add_layer_file(Path(path))

@@ -12,7 +12,6 @@ from pathlib import Path
 from PySide6.QtCore import QMimeData, QSettings, Qt, Signal
 from PySide6.QtWidgets import (
     QAbstractItemView,
-    QFileDialog,
     QHBoxLayout,
     QLineEdit,
     QToolButton,
@@ -22,6 +21,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app import file_dialogs
 from matedit.app.layers_panel import LAYER_MIME
 from matedit.app.theme import icon
 from matedit.io.document import FormatError, load
@@ -100,7 +100,7 @@ class LibraryPanel(QWidget):
         lay.addWidget(self.tree, 1)
         self.tree.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
         self.tree.customContextMenuRequested.connect(self._context_menu)
-        self.folder_dialog = QFileDialog.getExistingDirectory  # tests replace it
+        self.folder_dialog = file_dialogs.existing_folder  # tests replace it
         self.refresh()
 
     # --- folders ---------------------------------------------------------------------------

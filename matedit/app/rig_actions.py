@@ -8,8 +8,9 @@ naming the file, the light and the field) and leaves the panel's lights as they 
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QFileDialog, QMessageBox, QToolButton
+from PySide6.QtWidgets import QMessageBox, QToolButton
 
+from matedit.app import file_dialogs
 from matedit.app.theme import icon
 from matedit.io import rig as rigio
 
@@ -44,12 +45,12 @@ def install_rig_actions(panel, bar) -> None:
             QMessageBox.warning(panel, "Light rig", message)
 
     def load() -> None:
-        path, _ = QFileDialog.getOpenFileName(panel, "Load a light rig", "", FILTER)
+        path, _ = file_dialogs.open_file(panel, "Load a light rig", "", FILTER)
         if path:
             report(load_rig_into(panel, path))
 
     def save() -> None:
-        path, _ = QFileDialog.getSaveFileName(panel, "Save the light rig", "rig.json", FILTER)
+        path, _ = file_dialogs.save_file(panel, "Save the light rig", "rig.json", FILTER)
         if path:
             report(save_rig_from(panel, path))
 

@@ -22,7 +22,6 @@ from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
     QDoubleSpinBox,
-    QFileDialog,
     QHBoxLayout,
     QLabel,
     QMessageBox,
@@ -33,6 +32,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from matedit.app import file_dialogs
 from matedit.app.compile_service import MaterialCompiler, texture_paths, uniform_values
 from matedit.app.theme import icon
 
@@ -474,8 +474,8 @@ class ViewportPanel(QWidget):
         lay.addWidget(self.view, 1)
         self._env_index = 0
         self._custom_envs: list[str] = []
-        self.env_dialog = QFileDialog.getOpenFileName  # tests replace it
-        self.save_dialog = QFileDialog.getSaveFileName  # tests replace it
+        self.env_dialog = file_dialogs.open_file  # tests replace it
+        self.save_dialog = file_dialogs.save_file  # tests replace it
         self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment
         self.mesh_combo.currentTextChanged.connect(self.view.set_mesh)
         self.mode_combo.currentTextChanged.connect(self._mode_changed)

@@ -2,7 +2,7 @@
 
 Public API (what the main window uses; kept stable):
 
-``NodeCanvasView(controller, parent=None)``
+``NodeCanvasView(controller, parent=None, actions=None)``
     A QGraphicsView over ``controller`` (a ``DocumentController``). It follows the
     controller's document, including ``documentReplaced``.
 
@@ -28,9 +28,12 @@ Methods on the view:
     ``paste(scene_pos=None)``, ``duplicate_selection()``, ``comment_selection()``,
     ``selected_ids()``, ``set_minimap_visible(bool)``.
 
-Keys (while the canvas has focus): Tab palette; Delete/Backspace delete; Ctrl+C/X/V/D
+Commands (menus, context menu, keys) are the action table's (``canvas.actions``, see
+``matedit.app.canvas.actions``). Keys (while the canvas has focus): Tab palette;
+Delete/Backspace delete; Ctrl+C/X/V/D
 copy, cut, paste, duplicate (clipboard: ``application/x-matedit-nodes`` and text JSON);
-F frame selection; Home or A frame all; C comment around selection; M minimap;
+F frame selection; Home or A frame all; C comment around selection; F2 rename;
+F1 node documentation; M minimap;
 wheel zoom; middle drag, Alt+drag or Space+drag pan.
 """
 

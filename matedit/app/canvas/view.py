@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
 
 from matedit.app.canvas import clipboard
 from matedit.app.canvas import constants as C
+from matedit.app.canvas.actions import CONTEXT_MENU, CanvasActions
 from matedit.app.canvas.comment_item import CommentItem
 from matedit.app.canvas.drops import CanvasDrops
 from matedit.app.canvas.interaction import WireDrag, compatible_port, kind_ports, port_at
@@ -71,9 +72,13 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
     materialOpenRequested = Signal(str)  # a material file dropped on the canvas
     docsRequested = Signal(str)  # a node kind whose documentation to show (F1)
 
-    def __init__(self, controller: DocumentController, parent: QWidget | None = None) -> None:
+    def __init__(self, controller: DocumentController, parent: QWidget | None = None,
+                 actions: CanvasActions | None = None) -> None:
         super().__init__(parent)
         self.controller = controller
+        # The window's action table (menus and keys), or one of its own when stand-alone.
+        self.actions = actions if actions is not None else CanvasActions(self, lambda: self)
+        self.actions.attach(self)
         self._scene = NodeScene(controller, self)
         self.setScene(self._scene)
         # Node caches are pixmaps; the default 10 MB cache thrashes on a big graph.
@@ -201,6 +206,22 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
 
     def set_minimap_visible(self, visible: bool) -> None:
         self.minimap.setVisible(visible)
+
+    def toggle_minimap(self) -> None:
+        self.minimap.setVisible(not self.minimap.isVisible())
+
+    def rename_selected(self) -> QLineEdit | None:
+        """The inline title editor over the one selected node (None otherwise)."""
+        ids = self.selected_ids()
+        return self.start_rename(ids[0]) if len(ids) == 1 else None
+
+    def request_docs(self) -> bool:
+        """Asks for the selected node kind's documentation (`docsRequested`)."""
+        ids = self.selected_ids()
+        node = self.controller.document.graph.nodes.get(ids[0]) if ids else None
+        if node is not None:
+            self.docsRequested.emit(node.kind)
+        return node is not None
 
     # --- edits -------------------------------------------------------------------------------
     def delete_selection(self) -> bool:
@@ -617,7 +638,9 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             self._scene.clear_wire_selection()
             item.setSelected(True)
         menu = QMenu(self)
-        menu.addAction("Add node…\tTab", lambda: self.open_palette(sp))
+        menu.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)  # a new one each time
+        # Add node and Paste land where the menu was opened: both read `_last_pos`.
+        menu.addAction(self.actions["add_node"])
         if wire is not None:
             menu.addAction("Insert reroute\tdouble-click",
                            lambda: self.insert_reroute(wire, sp))
@@ -630,79 +653,36 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
                                  lambda n=item.node_id, p=name: self.preview_node(n, p))
             act.setEnabled(bool(name))
             menu.addSeparator()
-        has_sel = bool(self._scene.selectedItems() or self._scene.selected_wires)
-        for text, slot, key, enabled in (
-                ("Copy", self.copy_selection, "Ctrl+C", has_sel),
-                ("Cut", self.cut_selection, "Ctrl+X", has_sel),
-                ("Paste", lambda: self.paste(sp), "Ctrl+V", True),
-                ("Duplicate", self.duplicate_selection, "Ctrl+D", has_sel),
-                ("Delete", self.delete_selection, "Del", has_sel),
-                ("Comment around selection", self.comment_selection, "C", has_sel),
-                ("Frame all", self.frame_all, "Home", True)):
-            action = menu.addAction(f"{text}\t{key}", slot)
-            action.setEnabled(enabled)
+        self.actions.fill(menu, CONTEXT_MENU)
+        self.actions.refresh(self)
         self.run_menu(menu, event.globalPos())
 
     # --- keys --------------------------------------------------------------------------------
-    _OWN_KEYS = (QKeySequence.StandardKey.Copy, QKeySequence.StandardKey.Paste,
-                 QKeySequence.StandardKey.Cut, QKeySequence.StandardKey.Delete)
-
-    def _is_own_key(self, event) -> bool:
-        if any(event.matches(k) for k in self._OWN_KEYS):
-            return True
-        key, mods = event.key(), event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
-        if mods == Qt.KeyboardModifier.ControlModifier and key == Qt.Key.Key_D:
-            return True
-        return mods == Qt.KeyboardModifier.NoModifier and key in (
-            Qt.Key.Key_Tab, Qt.Key.Key_Delete, Qt.Key.Key_Backspace, Qt.Key.Key_F,
-            Qt.Key.Key_A, Qt.Key.Key_Home, Qt.Key.Key_C, Qt.Key.Key_M, Qt.Key.Key_Space,
-            Qt.Key.Key_Escape, Qt.Key.Key_F1, Qt.Key.Key_F2)
+    # Commands come from the action table (`self.actions`); what is left here is state, not a
+    # command: Space held down pans with the left button, Esc cancels a wire being dragged.
+    def _is_state_key(self, event) -> bool:
+        mods = event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        return event.key() == Qt.Key.Key_Escape or (
+            mods == Qt.KeyboardModifier.NoModifier and event.key() == Qt.Key.Key_Space)
 
     def event(self, event) -> bool:
         t = event.type()
-        if t == QEvent.Type.ShortcutOverride and self._is_own_key(event):
+        if t == QEvent.Type.ShortcutOverride and (self.actions.action_for_key(event)
+                                                  or self._is_state_key(event)):
             event.accept()  # the canvas's keys win over window shortcuts while it has focus
             return True
-        if t == QEvent.Type.KeyPress and event.key() == Qt.Key.Key_Tab and not (
-                event.modifiers() & (Qt.KeyboardModifier.ControlModifier
-                                     | Qt.KeyboardModifier.AltModifier
-                                     | Qt.KeyboardModifier.ShiftModifier)):
-            self.open_palette()
-            return True
+        if t == QEvent.Type.KeyPress:  # before QWidget's Tab focus chain sees Tab
+            command = self.actions.action_for_key(event)
+            if command:
+                self.actions.run(command, self)
+                event.accept()
+                return True
         return super().event(event)
 
     def keyPressEvent(self, event) -> None:
-        key, mods = event.key(), event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
-        ctrl = mods == Qt.KeyboardModifier.ControlModifier
-        plain = mods == Qt.KeyboardModifier.NoModifier
-        if event.matches(QKeySequence.StandardKey.Copy):
-            self.copy_selection()
-        elif event.matches(QKeySequence.StandardKey.Cut):
-            self.cut_selection()
-        elif event.matches(QKeySequence.StandardKey.Paste):
-            self.paste()
-        elif ctrl and key == Qt.Key.Key_D:
-            self.duplicate_selection()
-        elif plain and key in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):
-            self.delete_selection()
-        elif plain and key == Qt.Key.Key_F:
-            self.frame_selection()
-        elif plain and key in (Qt.Key.Key_A, Qt.Key.Key_Home):
-            self.frame_all()
-        elif plain and key == Qt.Key.Key_C:
-            self.comment_selection()
-        elif plain and key == Qt.Key.Key_F2:
-            ids = self.selected_ids()
-            if len(ids) == 1:
-                self.start_rename(ids[0])
-        elif plain and key == Qt.Key.Key_F1:
-            ids = self.selected_ids()
-            node = self.controller.document.graph.nodes.get(ids[0]) if ids else None
-            if node is not None:
-                self.docsRequested.emit(node.kind)
-        elif plain and key == Qt.Key.Key_M:
-            self.minimap.setVisible(not self.minimap.isVisible())
-        elif plain and key == Qt.Key.Key_Space:
+        mods = event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        key = event.key()
+        if mods == Qt.KeyboardModifier.NoModifier and key == Qt.Key.Key_Space:
             if not event.isAutoRepeat():
                 self._space = True
                 self.viewport().setCursor(Qt.CursorShape.OpenHandCursor)
