@@ -151,7 +151,39 @@ def main() -> int:
     save(dlg, "export.png")
     dlg.close()
 
-    # 8. A broken link: the Diagnostics panel names the node.
+    # 8. Preview in viewport: a noise node's value on the mesh, with the banner.
+    from matedit.app.node_preview import PreviewTarget
+
+    graph = w.controller.document.graph
+    from matedit.graph.nodes import definition
+
+    noise = next(nid for nid, n in sorted(graph.nodes.items()) if nid == "mask")
+    port = definition(graph.nodes[noise].kind).outputs[0].name
+    before = w.compiler.current
+    assert w.compiler.set_preview(PreviewTarget(noise, port)), (noise, port)
+    wait(lambda: w.compiler.current is not before, what="the node preview to compile")
+    pump(1.5)
+    save(w.viewport_dock, "viewport-node-preview.png")
+    w.compiler.set_preview(None)
+    pump(1.0)
+
+    # 9. Zoomed out: titles stay readable, port labels hide.
+    canvas.frame_all()
+    canvas.resetTransform()
+    canvas.scale(0.33, 0.33)
+    canvas.centerOn(canvas.scene().itemsBoundingRect().center())
+    pump(0.5)
+    save(w.tabs, "canvas-overview.png")
+    canvas.frame_all()
+
+    # 10. Help > Keyboard Shortcuts, searchable.
+    ref = w.show_shortcuts()
+    ref.resize(560, 640)
+    pump(0.5)
+    save(ref, "shortcuts.png")
+    ref.close()
+
+    # 11. A broken link: the Diagnostics panel names the node.
     from matedit.graph.commands import Disconnect
 
     link = next(l for l in w.controller.document.graph.links if l.dst == "out")

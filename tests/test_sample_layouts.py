@@ -20,7 +20,8 @@ from PySide6.QtGui import QColor, QImage  # noqa: E402
 
 from matedit.app.canvas import NodeCanvasView  # noqa: E402
 from matedit.app.controller import DocumentController  # noqa: E402
-from matedit.app.previews import ALWAYS, SIZE  # noqa: E402
+from matedit.app.previews import SIZE  # noqa: E402
+from matedit.graph.nodes import Thumbnail, definition  # noqa: E402
 from matedit.io.document import load  # noqa: E402
 
 pytestmark = pytest.mark.gui
@@ -40,7 +41,7 @@ def with_thumbnails(scene):
     image = QImage(SIZE, SIZE, QImage.Format.Format_RGB32)
     image.fill(QColor(90, 90, 90))
     for nid, item in scene.node_items.items():
-        if item.kind in ALWAYS:
+        if definition(item.kind).thumbnail == Thumbnail.ALWAYS:
             scene.set_node_preview(nid, image)
     return scene
 
