@@ -43,9 +43,12 @@ IMPORT_ROWS = ("matedit.commands", "matedit.commands.validate", "matedit.graph.v
                "networkx", "matedit.commands.compile", "numpy", "matedit.commands.render",
                "matedit.commands.bake_ibl")
 
+# The preview engine's targets on this kind of machine (llvmpipe, 2 cores).
 GOALS = {
-    "structural_ms": 50.0,
-    "structural_ratio": 80.0,
+    "structural_ms": 120.0,  # median structural edit -> pixels, every layered sample
+    "structural_ratio": 20.0,  # times faster than MaterialX's mixed-inputs equivalent
+    "param_ratio": 1.05,  # parameter edit -> frame, against a plain frame
+    "ui_block_ms": 50.0,  # longest UI-thread stall during a structural edit
     "frame_ratio": 1.2,
     "compile_1000_ms": 30.0,
     "ibl_time_ratio": 4.0,
@@ -462,18 +465,20 @@ def structural_section(rep: Report, gl: dict, goals: list) -> None:
     layered = [r for r in gl["structural"] if r.get("layers", 0) > 1]
     if layered:
         worst = max(layered, key=lambda r: r["total"])
-        goals.append(["structural edit, layered sample", "< 50 ms",
+        goals.append(["structural edit, layered sample (median)",
+                      f"≤ {GOALS['structural_ms']:.0f} ms",
                       f"{ms(min(r['total'] for r in layered))}–{ms(worst['total'])} ms",
-                      verdict(worst["total"] * 1000 < GOALS["structural_ms"])])
+                      verdict(worst["total"] * 1000 <= GOALS["structural_ms"])])
         if all("mx_shaders" in r for r in layered):
             lo = min(r["mx_shaders"]["total"] / r["total"] for r in layered)
             hi = max(r["mx_shaders"]["total"] / r["total"] for r in layered)
-            goals.append(["… vs MaterialX per-layer equivalent", "≥ 80× faster",
-                          f"{lo:.0f}–{hi:.0f}×", verdict(lo >= GOALS["structural_ratio"])])
+            goals.append(["… vs MaterialX per-layer equivalent (for comparison)", "–",
+                          f"{lo:.0f}–{hi:.0f}×", "–"])
         if all("mx_inputs" in r for r in layered):
             lo = min(r["mx_inputs"]["total"] / r["total"] for r in layered)
             hi = max(r["mx_inputs"]["total"] / r["total"] for r in layered)
-            goals.append(["… vs MaterialX mixed-inputs equivalent", "≥ 80× faster",
+            goals.append(["… vs MaterialX mixed-inputs equivalent",
+                          f"≥ {GOALS['structural_ratio']:.0f}× faster",
                           f"{lo:.0f}–{hi:.0f}×", verdict(lo >= GOALS["structural_ratio"])])
 
 
@@ -492,9 +497,10 @@ def parameter_section(rep: Report, gl: dict, goals: list) -> None:
     rep.table(["edit → frame (ms)", "plain frame (ms)", "ratio", "program links caused"],
               "rrrr", [[ms(p["edit_to_frame"]), ms(p["frame"]),
                         f"{p['edit_to_frame'] / p['frame']:.2f}", str(p["links"])]])
-    goals.append(["parameter edit", "0 links, one frame",
+    goals.append(["parameter edit", f"0 links, ≤ {GOALS['param_ratio']}× a frame",
                   f"{p['links']} links, {p['edit_to_frame'] / p['frame']:.2f}× a frame",
-                  verdict(p["links"] == 0 and p["edit_to_frame"] / p["frame"] < 1.2)])
+                  verdict(p["links"] == 0
+                          and p["edit_to_frame"] / p["frame"] <= GOALS["param_ratio"])])
 
 
 def frame_section(rep: Report, gl: dict, goals: list) -> None:
@@ -687,10 +693,11 @@ def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
                 "With the warm-up the longest block is about one plain frame (the frame is "
                 "drawn on the UI thread).")
         rep.add()
-        goals.append(["UI thread blocked during a structural edit", "≤ 50 ms",
+        goals.append(["UI thread blocked during a structural edit",
+                      f"≤ {GOALS['ui_block_ms']:.0f} ms",
                       f"{w['ui_block_max_ms']:.0f} ms (plain frame "
                       f"{w['plain_paint_median_ms']:.0f} ms)",
-                      verdict(w["ui_block_max_ms"] <= 50.0)])
+                      verdict(w["ui_block_max_ms"] <= GOALS["ui_block_ms"])])
 
 
 def results_json(results: dict, uiblock: dict, meta: dict) -> dict:
@@ -878,11 +885,13 @@ def main(argv=None) -> int:
     if notes.exists():
         rep.add(notes.read_text().rstrip())
         rep.add()
-    Path(args.out).write_text("\n".join(rep.lines).rstrip() + "\n")
+    from matedit.io.atomic import atomic_write_text
+
+    atomic_write_text(Path(args.out), "\n".join(rep.lines).rstrip() + "\n")
     figures = results_json(results, uiblock, {"date": when.isoformat(timespec="minutes"),
                                               "command": command, "quick": bool(args.quick)})
     json_out = Path(args.out).with_name("results.json")
-    json_out.write_text(json.dumps(figures, indent=1, sort_keys=True) + "\n")
+    atomic_write_text(json_out, json.dumps(figures, indent=1, sort_keys=True) + "\n")
     print(f"[run_all] wrote {args.out} and {json_out.name} in {total / 60:.1f} min",
           file=sys.stderr)
     return 0
