@@ -4,9 +4,10 @@ and masks. Registered into `matedit.graph.nodes.REGISTRY` when that module is im
 Every kind here has a GLSL function in `shaders/nodes/<kind>.glsl` or an inline template,
 a numpy twin in `matedit.compiler.cpu_nodes`, port ranges, and the facts of
 `matedit.graph.nodes.NodeDef`: patterns show a thumbnail always, kinds that read the
-surface's geometry or time are impure. Their MaterialX mapping is the default, BAKE: the
-MaterialX exporter bakes them (a stdlib node is mapped only once MaterialX's own shader
-generator is shown to agree with our CPU evaluator, tests/test_interop_mtlx.py).
+surface's geometry or time are impure. Their MaterialX mapping is the default, BAKE (the
+MaterialX exporter bakes them), except where a stdlib node computes the same values: a
+stdlib node is mapped only once MaterialX's own shader generator is shown to agree with our
+CPU evaluator (tests/test_interop_mtlx.py, every mapped kind in one material).
 
 Pattern edges are band-limited: kinds with a `filter_width` input box-filter their edges
 over `filter_width` pixels of screen-space footprint (`fwidth`); the numpy twins take the
@@ -15,16 +16,22 @@ same footprint from the evaluator's pixel grid (`SurfaceArrays.grid`).
 
 from __future__ import annotations
 
+import math
+
 from matedit.graph.nodes import (
     GENERIC,
     MESH_UV,
     REGISTRY,
+    MxNode,
+    MxRecipe,
     NodeDef,
     Role,
     Thumbnail,
+    _bin,
     _i,
     _o,
     _op,
+    _un,
     register,
 )
 
@@ -44,30 +51,37 @@ def _fn(kind, title, category, description, inputs, outputs, **facts):
 
 # --- maths -----------------------------------------------------------------------------------
 _op("atan2", "Atan2", "atan({y}, {x})", [_i("y", T), _i("x", T, 1.0)],
-    "Angle of the point (x, y) in radians, in (−π, π].")
-_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.")
+    "Angle of the point (x, y) in radians, in (−π, π].",
+    mtlx=MxNode("atan2", (("y", "iny"), ("x", "inx"))))
+_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.", mtlx=_un("exp"))
 _op("log", "Log", "log(max({value}, 1e-30))", [_i("value", T, 1.0)],
     "Natural logarithm; values at or below 0 read as 1e-30.")
 _op("mod", "Modulo", "mod({a}, {b})", [_i("a", T), _i("b", T, 1.0)],
-    "a − b floor(a / b): the remainder with the sign of b.")
-_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.")
+    "a − b floor(a / b): the remainder with the sign of b.", mtlx=_bin("modulo"))
+_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.", mtlx=_un("sign"))
 _op("round", "Round", "floor({value} + 0.5)", [_i("value", T)],
     "Nearest integer; halves round up.")
-_op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.")
+_op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.",
+    mtlx=_un("ceil"))
 _op("trunc", "Truncate", "trunc({value})", [_i("value", T)],
     "Integer part, rounding towards zero.")
-_op("negate", "Negate", "(-{value})", [_i("value", T)], "−value.")
+_op("negate", "Negate", "(-{value})", [_i("value", T)], "−value.",
+    mtlx=MxNode("multiply", (("value", "in1"),), (("in2", -1.0),)))
 _op("reciprocal", "Reciprocal", "(1.0 / {value})", [_i("value", T, 1.0)],
-    "1 ÷ value (zero gives the GPU's infinity).")
-_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.")
+    "1 ÷ value (zero gives the GPU's infinity).",
+    mtlx=MxNode("divide", (("value", "in2"),), (("in1", 1.0),)))
+_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.", mtlx=_un("tan"))
 _op("asin", "Arcsine", "asin(clamp({value}, -1.0, 1.0))", [_i("value", T)],
     "Arcsine in radians; input clamped to [−1, 1].")
 _op("acos", "Arccosine", "acos(clamp({value}, -1.0, 1.0))", [_i("value", T)],
     "Arccosine in radians; input clamped to [−1, 1].")
-_op("radians", "To Radians", "radians({value})", [_i("value", T)], "Degrees to radians.")
-_op("degrees", "To Degrees", "degrees({value})", [_i("value", T)], "Radians to degrees.")
+_op("radians", "To Radians", "radians({value})", [_i("value", T)], "Degrees to radians.",
+    mtlx=MxNode("multiply", (("value", "in1"),), (("in2", math.pi / 180.0),)))
+_op("degrees", "To Degrees", "degrees({value})", [_i("value", T)], "Radians to degrees.",
+    mtlx=MxNode("multiply", (("value", "in1"),), (("in2", 180.0 / math.pi),)))
 _op("multiply_add", "Multiply Add", "({a} * {b} + {c})",
-    [_i("a", T), _i("b", T, 1.0), _i("c", T)], "a × b + c.")
+    [_i("a", T), _i("b", T, 1.0), _i("c", T)], "a × b + c.",
+    mtlx=MxRecipe("multiply_then_add"))
 _op("posterize", "Posterize", "(floor({value} * max({steps}, 1.0)) / max({steps}, 1.0))",
     [_i("value", T), _i("steps", T, 4.0, "levels per unit (at least 1)", (1.0, 64.0))],
     "Quantises value into steps levels per unit.")
@@ -79,16 +93,20 @@ _op("distance", "Distance", "distance({a}, {b})", [_i("a", T), _i("b", T)],
     "Euclidean distance between a and b.", out_type="float", category="Vector")
 _op("reflect", "Reflect", "reflect({incident}, {normal})",
     [_i("incident", "vec3", [0.0, 0.0, -1.0]), _i("normal", "vec3", [0.0, 0.0, 1.0], "unit")],
-    "Mirror direction of incident about normal.", out_type="vec3", category="Vector")
+    "Mirror direction of incident about normal.", out_type="vec3", category="Vector",
+    mtlx=MxNode("reflect", (("incident", "in"), ("normal", "normal"))))
 _op("refract", "Refract", "refract({incident}, {normal}, {eta})",
     [_i("incident", "vec3", [0.0, 0.0, -1.0], "unit"),
      _i("normal", "vec3", [0.0, 0.0, 1.0], "unit"),
      _i("eta", "float", 0.67, "ratio of indices of refraction", (0.0, 3.0))],
     "Refracted direction (zero on total internal reflection).", out_type="vec3",
-    category="Vector")
+    category="Vector",
+    mtlx=MxNode("refract", (("incident", "in"), ("normal", "normal"), ("eta", "ior"))))
 _op("if_greater", "If Greater", "({a} > {b} ? {if_true} : {if_false})",
     [_i("a", "float"), _i("b", "float"), _i("if_true", T, 1.0), _i("if_false", T, 0.0)],
-    "if_true where a > b, else if_false.", category="Logic")
+    "if_true where a > b, else if_false.", category="Logic",
+    mtlx=MxNode("ifgreater", (("a", "value1"), ("b", "value2"), ("if_true", "in1"),
+                              ("if_false", "in2"))))
 _op("if_equal", "If Equal", "(abs({a} - {b}) <= {tolerance} ? {if_true} : {if_false})",
     [_i("a", "float"), _i("b", "float"), _i("tolerance", "float", 1e-4, "", (0.0, 1.0)),
      _i("if_true", T, 1.0), _i("if_false", T, 0.0)],

@@ -318,6 +318,11 @@ class _Exporter:
                 ("in1", self.node("max", mt, f"{hint}_max", [
                     ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt),
                 ("in2", *arg(1))]))
+        if name == "multiply_then_add":
+            return one(lambda: self.node("add", mt, hint, [
+                ("in1", self.node("multiply", mt, f"{hint}_mul",
+                                  [("in1", *arg(0)), ("in2", *arg(1))]), mt),
+                ("in2", *arg(2))]))
         if name == "positive_sqrt":
             return one(lambda: self.node("sqrt", mt, hint, [
                 ("in", self.node("max", mt, f"{hint}_max", [

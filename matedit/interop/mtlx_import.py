@@ -284,26 +284,6 @@ class _Importer:
                 self.connect(self.input_src(node, mxin, depth), nid, ours)
             self._defaults(node, nid, ports)
             return Src(nid, "result", width=width)
-        if cat == "modulo":
-            in1 = self.input_src(node, "in1", depth) or Src(value=[0.0] * max(width, 1))
-            in2 = self.input_src(node, "in2", depth)
-            if in2 is None or (in2.node is None and all(v == 1.0 for v in in2.value)):
-                nid = self.add(name, _kind("modulo"), depth=depth)
-                self.connect(in1, nid, "value")
-                return Src(nid, "result", width=width)
-            # MaterialX's modulo is GLSL mod: a - b floor(a / b)
-            q = self.add(f"{name}_q", _kind("divide"), depth=depth)
-            self.connect(in1, q, "a")
-            self.connect(in2, q, "b")
-            f = self.add(f"{name}_floor", _kind("floor"), depth=depth)
-            self.connect(Src(q, "result"), f, "value")
-            m = self.add(f"{name}_m", _kind("multiply"), depth=depth)
-            self.connect(Src(f, "result"), m, "a")
-            self.connect(in2, m, "b")
-            nid = self.add(name, _kind("subtract"), depth=depth)
-            self.connect(in1, nid, "a")
-            self.connect(Src(m, "result"), nid, "b")
-            return Src(nid, "result", width=width)
         if cat == "extract":
             idx_in = node.getInput("index")
             idx = int(_floats(idx_in.getValueString(), where)[0]) if idx_in is not None else 0
