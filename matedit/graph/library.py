@@ -55,16 +55,19 @@ _op("atan2", "Atan2", "atan({y}, {x})", [_i("y", T), _i("x", T, 1.0)],
     mtlx=MxNode("atan2", (("y", "iny"), ("x", "inx"))))
 _op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.", mtlx=_un("exp"))
 _op("log", "Log", "log(max({value}, 1e-30))", [_i("value", T, 1.0)],
-    "Natural logarithm; values at or below 0 read as 1e-30.")
+    "Natural logarithm; values at or below 0 read as 1e-30.",
+    mtlx=MxRecipe("floored_log"), reads=_un("ln"))  # ln(max(value, 1e-30))
 _op("mod", "Modulo", "mod({a}, {b})", [_i("a", T), _i("b", T, 1.0)],
     "a − b floor(a / b): the remainder with the sign of b.", mtlx=_bin("modulo"))
 _op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.", mtlx=_un("sign"))
 _op("round", "Round", "floor({value} + 0.5)", [_i("value", T)],
-    "Nearest integer; halves round up.")
+    "Nearest integer; halves round up.",
+    mtlx=MxRecipe("floor_of_half_up"))  # floor(value + 0.5): GLSL's round may go either way
 _op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.",
     mtlx=_un("ceil"))
 _op("trunc", "Truncate", "trunc({value})", [_i("value", T)],
-    "Integer part, rounding towards zero.")
+    "Integer part, rounding towards zero.",
+    mtlx=MxRecipe("signed_floor_of_abs"))  # sign(value) floor(|value|): no stdlib trunc
 _op("negate", "Negate", "(-{value})", [_i("value", T)], "−value.",
     mtlx=MxNode("multiply", (("value", "in1"),), (("in2", -1.0),)))
 _op("reciprocal", "Reciprocal", "(1.0 / {value})", [_i("value", T, 1.0)],
@@ -72,9 +75,11 @@ _op("reciprocal", "Reciprocal", "(1.0 / {value})", [_i("value", T, 1.0)],
     mtlx=MxNode("divide", (("value", "in2"),), (("in1", 1.0),)))
 _op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.", mtlx=_un("tan"))
 _op("asin", "Arcsine", "asin(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arcsine in radians; input clamped to [−1, 1].")
+    "Arcsine in radians; input clamped to [−1, 1].",
+    mtlx=MxRecipe("clamped_asin"), reads=_un("asin"))
 _op("acos", "Arccosine", "acos(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arccosine in radians; input clamped to [−1, 1].")
+    "Arccosine in radians; input clamped to [−1, 1].",
+    mtlx=MxRecipe("clamped_acos"), reads=_un("acos"))
 _op("radians", "To Radians", "radians({value})", [_i("value", T)], "Degrees to radians.",
     mtlx=MxNode("multiply", (("value", "in1"),), (("in2", math.pi / 180.0),)))
 _op("degrees", "To Degrees", "degrees({value})", [_i("value", T)], "Radians to degrees.",
@@ -90,7 +95,8 @@ _op("smooth_min", "Soft Minimum", None,
     "The smaller of a and b with a rounded join (polynomial smooth minimum).",
     glsl="node_smooth_min")
 _op("distance", "Distance", "distance({a}, {b})", [_i("a", T), _i("b", T)],
-    "Euclidean distance between a and b.", out_type="float", category="Vector")
+    "Euclidean distance between a and b.", out_type="float", category="Vector",
+    mtlx=MxRecipe("distance_or_absval"), reads=_bin("distance"))  # |a - b| for floats
 _op("reflect", "Reflect", "reflect({incident}, {normal})",
     [_i("incident", "vec3", [0.0, 0.0, -1.0]), _i("normal", "vec3", [0.0, 0.0, 1.0], "unit")],
     "Mirror direction of incident about normal.", out_type="vec3", category="Vector",
@@ -110,7 +116,8 @@ _op("if_greater", "If Greater", "({a} > {b} ? {if_true} : {if_false})",
 _op("if_equal", "If Equal", "(abs({a} - {b}) <= {tolerance} ? {if_true} : {if_false})",
     [_i("a", "float"), _i("b", "float"), _i("tolerance", "float", 1e-4, "", (0.0, 1.0)),
      _i("if_true", T, 1.0), _i("if_false", T, 0.0)],
-    "if_true where |a − b| ≤ tolerance, else if_false.", category="Logic")
+    "if_true where |a − b| ≤ tolerance, else if_false.", category="Logic",
+    mtlx=MxRecipe("within_tolerance"))  # ifgreater(|a - b|, tolerance, if_false, if_true)
 _op("fwidth", "Pixel Footprint", "fwidth({value})", [_i("value", T)],
     "How much value changes across one pixel (|d/dx| + |d/dy|): the width to filter "
     "an edge of value over.", category="Utility")
@@ -118,7 +125,7 @@ _op("fwidth", "Pixel Footprint", "fwidth({value})", [_i("value", T)],
 # --- colour ----------------------------------------------------------------------------------
 _C = ("color", "vec3", [0.5, 0.5, 0.5], "linear RGB")
 _fn("luminance", "Luminance", "Colour", "Rec. 709 luminance of a linear colour.",
-    [_i(*_C)], [_o("value", "float")])
+    [_i(*_C)], [_o("value", "float")], mtlx=MxRecipe("rec709_dot"))
 _fn("rgb_to_hsv", "RGB to HSV", "Colour", "Hue (turns), saturation and value of a colour.",
     [_i(*_C)], [_o("hsv", "vec3")])
 _fn("hsv_to_rgb", "HSV to RGB", "Colour", "The colour of a hue (turns), saturation, value.",
@@ -134,7 +141,8 @@ _fn("brightness_contrast", "Brightness / Contrast", "Colour",
     [_i(*_C), _i("brightness", "float", 0.0, "", (-1.0, 1.0)),
      _i("contrast", "float", 0.0, "", (-1.0, 1.0))], [_o("result", "vec3")])
 _fn("gamma", "Gamma", "Colour", "color raised to gamma (negative components read 0).",
-    [_i(*_C), _i("gamma", "float", 1.0, "", (0.01, 10.0))], [_o("result", "vec3")])
+    [_i(*_C), _i("gamma", "float", 1.0, "", (0.01, 10.0))], [_o("result", "vec3")],
+    mtlx=MxRecipe("positive_power"))  # power(max(color, 0), gamma)
 _fn("invert", "Invert", "Colour", "1 − color, by amount.",
     [_i(*_C), _i("amount", "float", 1.0, "", UNIT)], [_o("result", "vec3")])
 _fn("levels", "Levels", "Colour",
@@ -294,10 +302,11 @@ _fn("filtered_smoothstep", "Filtered Smooth Step", "Procedural",
 # --- UV and space ----------------------------------------------------------------------------
 _fn("tiling_offset", "Tiling and Offset", "Coordinates", "uv × tiling + offset.",
     [_i(*_UV), _i("tiling", "vec2", [1.0, 1.0]), _i("offset", "vec2", [0.0, 0.0])],
-    [_o("uv", "vec2")])
+    [_o("uv", "vec2")], mtlx=MxRecipe("multiply_then_add"))
 _fn("rotate_uv", "Rotate UV", "Coordinates", "Rotates uv about a pivot, counter-clockwise.",
     [_i(*_UV), _i("angle", "float", 0.0, "degrees", (0.0, 360.0)),
-     _i("pivot", "vec2", [0.5, 0.5])], [_o("uv", "vec2")])
+     _i("pivot", "vec2", [0.5, 0.5])], [_o("uv", "vec2")],
+    mtlx=MxRecipe("rotate_about_pivot"))  # rotate2d turns clockwise: by −angle about 0
 _fn("panner", "Panner", "Coordinates", "Scrolls uv over time: uv + speed × seconds.",
     [_i(*_UV), _i("speed", "vec2", [0.1, 0.0], "UV units per second")], [_o("uv", "vec2")],
     impure=True, geometry=True)

@@ -323,6 +323,59 @@ class _Exporter:
                 ("in1", self.node("multiply", mt, f"{hint}_mul",
                                   [("in1", *arg(0)), ("in2", *arg(1))]), mt),
                 ("in2", *arg(2))]))
+        if name == "floored_log":
+            return one(lambda: self.node("ln", mt, hint, [
+                ("in", self.node("max", mt, f"{hint}_max", [
+                    ("in1", *arg(0)), ("in2", _const(1e-30, outs_t[0]), mt)]), mt)]))
+        if name in ("clamped_asin", "clamped_acos"):
+            return one(lambda: self.node(name[len("clamped_"):], mt, hint, [
+                ("in", self.node("clamp", mt, f"{hint}_clamp", [
+                    ("in", *arg(0)), ("low", _const(-1.0, outs_t[0]), mt),
+                    ("high", _const(1.0, outs_t[0]), mt)]), mt)]))
+        if name == "floor_of_half_up":
+            return one(lambda: self.node("floor", mt, hint, [
+                ("in", self.node("add", mt, f"{hint}_half", [
+                    ("in1", *arg(0)), ("in2", _const(0.5, outs_t[0]), mt)]), mt)]))
+        if name == "signed_floor_of_abs":
+            return one(lambda: self.node("multiply", mt, hint, [
+                ("in1", self.node("sign", mt, f"{hint}_sign", [("in", *arg(0))]), mt),
+                ("in2", self.node("floor", mt, f"{hint}_floor", [
+                    ("in", self.node("absval", mt, f"{hint}_abs", [("in", *arg(0))]), mt)]),
+                 mt)]))
+        if name == "distance_or_absval":
+            if args[0].type == PortType.FLOAT:
+                return one(lambda: self.node("absval", "float", hint, [
+                    ("in", self.node("subtract", "float", f"{hint}_d",
+                                     [("in1", *arg(0)), ("in2", *arg(1))]), "float")]))
+            return one(lambda: self.node("distance", "float", hint,
+                                         [("in1", *arg(0)), ("in2", *arg(1))]))
+        if name == "within_tolerance":
+            def make_equal():
+                diff = self.node("absval", "float", f"{hint}_diff", [
+                    ("in", self.node("subtract", "float", f"{hint}_d",
+                                     [("in1", *arg(0)), ("in2", *arg(1))]), "float")])
+                # |a - b| > tolerance picks if_false: the same as |a - b| <= tolerance
+                # picking if_true
+                return self.node("ifgreater", mt, hint, [
+                    ("value1", diff, "float"), ("value2", *arg(2)), ("in1", *arg(4)),
+                    ("in2", *arg(3))])
+            return one(make_equal)
+        if name == "rec709_dot":
+            from matedit.compiler.cpu_nodes import LUMA_REC709
+
+            return one(lambda: self.node("dotproduct", "float", hint, [
+                ("in1", *arg(0)), ("in2", ("value", tuple(LUMA_REC709)), "vector3")]))
+        if name == "rotate_about_pivot":
+            def make_rotate():
+                d = self.node("subtract", "vector2", f"{hint}_centred",
+                              [("in1", *arg(0)), ("in2", *arg(2))])
+                turn = self.node("multiply", "float", f"{hint}_cw",
+                                 [("in1", *arg(1)), ("in2", ("value", -1.0), "float")])
+                r = self.node("rotate2d", "vector2", f"{hint}_rotate",
+                              [("in", d, "vector2"), ("amount", turn, "float")])
+                return self.node("add", "vector2", hint, [("in1", r, "vector2"),
+                                                          ("in2", *arg(2))])
+            return one(make_rotate)
         if name == "positive_sqrt":
             return one(lambda: self.node("sqrt", mt, hint, [
                 ("in", self.node("max", mt, f"{hint}_max", [

@@ -346,6 +346,16 @@ class _Importer:
                 return None
             nid = self.add(name, _kind(cat), depth=depth)
             return Src(nid, "position" if cat == "position" else "normal", width=3)
+        if cat == "rotate2d":
+            # rotate2d turns clockwise by amount degrees about 0: ours by -amount
+            amount = self.input_src(node, "amount", depth) or Src(value=[0.0])
+            neg = self.add(f"{name}_ccw", _kind("multiply"), values={"b": -1.0}, depth=depth)
+            self.connect(amount, neg, "a")
+            nid = self.add(name, _kind("rotate_about_pivot"), values={"pivot": [0.0, 0.0]},
+                           depth=depth)
+            self.connect(self.input_src(node, "in", depth) or Src(value=[0.0, 0.0]), nid, "uv")
+            self.connect(Src(neg, "result"), nid, "angle")
+            return Src(nid, "uv", width=2)
         if cat == "viewdirection":
             v = self.add(f"{name}_eye", _kind("negated_viewdirection"), depth=depth)
             nid = self.add(name, _kind("multiply"), values={"b": [-1.0, -1.0, -1.0]}, depth=depth)
