@@ -129,7 +129,10 @@ _fn("luminance", "Luminance", "Colour", "Rec. 709 luminance of a linear colour."
 _fn("rgb_to_hsv", "RGB to HSV", "Colour", "Hue (turns), saturation and value of a colour.",
     [_i(*_C)], [_o("hsv", "vec3")])
 _fn("hsv_to_rgb", "HSV to RGB", "Colour", "The colour of a hue (turns), saturation, value.",
-    [_i("hsv", "vec3", [0.0, 1.0, 1.0])], [_o("color", "vec3")])
+    [_i("hsv", "vec3", [0.0, 1.0, 1.0])], [_o("color", "vec3")],
+    # hsvtorgb on color3: the same sectors; below saturation 1e-4 it returns grey (v, v, v),
+    # ours v mix(1, c, s): they differ there by at most 1e-4 v
+    mtlx=MxRecipe("hsvtorgb_on_color3"), mtlx_reads=MxNode("hsvtorgb", (("hsv", "in"),)))
 _fn("hsv_adjust", "HSV Adjust", "Colour",
     "Rotates hue, scales saturation and value (in HSV space).",
     [_i(*_C), _i("hue", "float", 0.0, "hue shift in turns", (-0.5, 0.5)),

@@ -360,6 +360,11 @@ class _Exporter:
                     ("value1", diff, "float"), ("value2", *arg(2)), ("in1", *arg(4)),
                     ("in2", *arg(3))])
             return one(make_equal)
+        if name == "hsvtorgb_on_color3":
+            return one(lambda: self.node("convert", "vector3", hint, [
+                ("in", self.node("hsvtorgb", "color3", f"{hint}_rgb", [
+                    ("in", self.node("convert", "color3", f"{hint}_hsv", [("in", *arg(0))]),
+                     "color3")]), "color3")]))
         if name == "rec709_dot":
             from matedit.compiler.cpu_nodes import LUMA_REC709
 

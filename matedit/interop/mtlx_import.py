@@ -24,7 +24,7 @@ from typing import Any
 
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.names import identifier_problem, mangle
-from matedit.graph.nodes import Role, kind_for
+from matedit.graph.nodes import Role, definition, kind_for
 from matedit.interop import mtlx_map
 from matedit.interop.mtlx_colorspace import from_materialx
 from matedit.io.atomic import read_bounded
@@ -283,7 +283,7 @@ class _Importer:
             for mxin, ours in ports.items():
                 self.connect(self.input_src(node, mxin, depth), nid, ours)
             self._defaults(node, nid, ports)
-            return Src(nid, "result", width=width)
+            return Src(nid, definition(kind).outputs[0].name, width=width)
         if cat == "extract":
             idx_in = node.getInput("index")
             idx = int(_floats(idx_in.getValueString(), where)[0]) if idx_in is not None else 0
