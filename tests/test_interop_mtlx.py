@@ -249,6 +249,34 @@ def test_import_other_surfaces(tmp_path, surface, inputs, expect):
         np.testing.assert_allclose(a[k][0, 0], v, atol=1e-9, err_msg=k)
 
 
+def test_import_reads_an_unset_geometric_default_from_the_surface(tmp_path):
+    """MaterialX's reflect reads the world normal where its normal input is unset
+    (defaultgeomprop Nworld): the import connects our world normal there, so on a tilted
+    surface the result is I − 2 (N·I) N with the surface's N, not +Z."""
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.compiler.cpu_eval import evaluate
+    from matedit.compiler.cpu_nodes import SurfaceArrays
+    from matedit.io.document import FileResolver, load
+
+    text = _doc('<nodegraph name="NG"><reflect name="r" type="vector3">'
+                '<input name="in" type="vector3" value="0, 0, -1"/></reflect>'
+                '<convert name="c" type="color3"><input name="in" type="vector3" '
+                'nodename="r"/></convert><output name="o" type="color3" nodename="c"/>'
+                '</nodegraph><standard_surface name="S" type="surfaceshader">'
+                '<input name="base_color" type="color3" nodegraph="NG" output="o"/>'
+                '</standard_surface><surfacematerial name="M" type="material">'
+                '<input name="surfaceshader" type="surfaceshader" nodename="S"/>'
+                '</surfacematerial>')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 0, r.stderr
+    n = np.array([0.0, 0.6, 0.8])
+    incident = np.array([0.0, 0.0, -1.0])
+    surface = SurfaceArrays(np.zeros((1, 2)), np.zeros((1, 3)), n[None], n[None])
+    got = evaluate(lower_and_optimise(load(out), FileResolver()), surface)["baseColor"]
+    want = incident - 2.0 * n.dot(incident) * n  # (0, 0.96, 0.28)
+    np.testing.assert_allclose(got[0], want, atol=1e-6)
+
+
 @pytest.mark.parametrize("text, needle", [
     ("<materialx version='1.39'><bad", "not a MaterialX document"),
     (_doc('<disney_brdf_2012 name="S" type="surfaceshader"/><surfacematerial name="M" '

@@ -387,6 +387,9 @@ class _Importer:
             if ours in values or ours in linked or node.getInput(mxin) is not None:
                 continue
             d = nd.getActiveInput(mxin)
+            if d is not None and d.getDefaultGeomPropString():
+                self._geometry_default(node, nid, ours, d.getDefaultGeomPropString())
+                continue
             if d is None or not d.getValueString():
                 continue
             try:
@@ -394,6 +397,20 @@ class _Importer:
             except ValueError:
                 continue
             values[ours] = vals[0] if len(vals) == 1 else vals
+
+    def _geometry_default(self, node, nid: str, ours: str, geomprop: str) -> None:
+        """An unset input that MaterialX reads from the geometry (reflect's normal is the
+        world normal): the same geometry node of ours, or an error naming it."""
+        name = node.getName()
+        if geomprop == "Nworld":
+            src = Src(self.add(f"{name}_{ours}", _kind("normal")), "normal", width=3)
+        elif geomprop == "UV0":
+            src = Src(self.add(f"{name}_{ours}", _kind("tiled_texcoord")), "uv", width=2)
+        else:
+            self.err(f"node {self.name_of(node)}: input {ours!r} defaults to the geometric "
+                     f"property {geomprop!r}, which is not supported: connect it")
+            return
+        self.connect(src, nid, ours)
 
     def image(self, node, depth: int, where: str, width: int) -> Src | None:
         file_in = node.getInput("file")
