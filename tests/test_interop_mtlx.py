@@ -492,11 +492,20 @@ def _all_kinds_material(folder: Path) -> Path:
     link(d, "ac", "result", "ie", "if_false")
     node(d, "lu", "luminance")
     link(d, "v3", "result", "lu", "color")
+    node(d, "ps", "posterize", values={"steps": 5.0})  # 5 exp(sin u) stays 0.04 off integers
+    link(d, "ex", "result", "ps", "value")
+    node(d, "tb", "triplanar_blend")
+    link(d, "ps", "result", "tb", "x")
+    link(d, "cs", "result", "tb", "y")
+    link(d, "ex", "result", "tb", "z")
+    link(d, "h2r", "color", "tb", "weights")
+    node(d, "sph", "spherical_gradient", values={"center": [0.5, 0.5], "radius": 2.0})
+    link(d, "ro", "uv", "sph", "uv")
     total = "f3"
-    for k, term in enumerate(("lg", "rn", "tr", "ds", "ds3", "ie", "lu")):
+    for k, term in enumerate(("lg", "rn", "tr", "ds", "ds3", "ie", "lu", "tb", "sph")):
         node(d, f"g{k}", "add")
         link(d, total, "result", f"g{k}", "a")
-        link(d, term, "value" if term == "lu" else "result", f"g{k}", "b")
+        link(d, term, "value" if term in ("lu", "sph") else "result", f"g{k}", "b")
         total = f"g{k}"
     node(d, "cav", "multiply_add", values={"b": 0.05})
     link(d, total, "result", "cav", "a")
@@ -528,8 +537,14 @@ def _all_kinds_material(folder: Path) -> Path:
     node(d, "v4", "add")
     link(d, "v3", "result", "v4", "a")
     link(d, "h2r", "color", "v4", "b")
+    node(d, "iv", "invert", values={"amount": 0.3})
+    link(d, "v4", "result", "iv", "color")
+    node(d, "sa", "saturation", values={"amount": 1.4})
+    link(d, "iv", "result", "sa", "color")
+    node(d, "bcn", "brightness_contrast", values={"brightness": 0.1, "contrast": 0.2})
+    link(d, "sa", "result", "bcn", "color")
     node(d, "gm", "gamma", values={"gamma": 2.2})
-    link(d, "v4", "result", "gm", "color")
+    link(d, "bcn", "result", "gm", "color")
     node(d, "bc2", "multiply_add", values={"b": 0.1})
     link(d, "gm", "result", "bc2", "a")
     link(d, "bc", "result", "bc2", "c")

@@ -89,7 +89,8 @@ _op("multiply_add", "Multiply Add", "({a} * {b} + {c})",
     mtlx=MxRecipe("multiply_then_add"))
 _op("posterize", "Posterize", "(floor({value} * max({steps}, 1.0)) / max({steps}, 1.0))",
     [_i("value", T), _i("steps", T, 4.0, "levels per unit (at least 1)", (1.0, 64.0))],
-    "Quantises value into steps levels per unit.")
+    "Quantises value into steps levels per unit.",
+    mtlx=MxRecipe("floor_in_steps"))  # floor(value s) / s, s = max(steps, 1)
 _op("smooth_min", "Soft Minimum", None,
     [_i("a", T), _i("b", T), _i("smoothness", T, 0.1, "blend radius", (0.0, 1.0))],
     "The smaller of a and b with a rounded join (polynomial smooth minimum).",
@@ -142,12 +143,14 @@ _fn("hsv_adjust", "HSV Adjust", "Colour",
 _fn("brightness_contrast", "Brightness / Contrast", "Colour",
     "Adds brightness and scales contrast about mid grey; never below 0.",
     [_i(*_C), _i("brightness", "float", 0.0, "", (-1.0, 1.0)),
-     _i("contrast", "float", 0.0, "", (-1.0, 1.0))], [_o("result", "vec3")])
+     _i("contrast", "float", 0.0, "", (-1.0, 1.0))], [_o("result", "vec3")],
+    mtlx=MxRecipe("scale_about_mid_grey"))  # max((1 + c) color + b − c / 2, 0)
 _fn("gamma", "Gamma", "Colour", "color raised to gamma (negative components read 0).",
     [_i(*_C), _i("gamma", "float", 1.0, "", (0.01, 10.0))], [_o("result", "vec3")],
     mtlx=MxRecipe("positive_power"))  # power(max(color, 0), gamma)
 _fn("invert", "Invert", "Colour", "1 − color, by amount.",
-    [_i(*_C), _i("amount", "float", 1.0, "", UNIT)], [_o("result", "vec3")])
+    [_i(*_C), _i("amount", "float", 1.0, "", UNIT)], [_o("result", "vec3")],
+    mtlx=MxRecipe("mix_towards_inverse"))  # mix(color, 1 − color, amount)
 _fn("levels", "Levels", "Colour",
     "Input black/white points, midtone gamma and output range, like an image editor's.",
     [_i(*_C), _i("in_black", "float", 0.0, "", UNIT), _i("in_white", "float", 1.0, "", UNIT),
@@ -155,7 +158,8 @@ _fn("levels", "Levels", "Colour",
      _i("out_black", "float", 0.0, "", UNIT), _i("out_white", "float", 1.0, "", UNIT)],
     [_o("result", "vec3")])
 _fn("saturation", "Saturation", "Colour", "Mixes between grey (0) and the colour (1) and past.",
-    [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")])
+    [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")],
+    mtlx=MxRecipe("mix_from_grey"))  # mix(rec709 luminance, color, amount)
 _fn("srgb_to_linear", "sRGB to Linear", "Colour", "Decodes sRGB-encoded values (IEC 61966-2-1).",
     [_i("color", "vec3", [0.5, 0.5, 0.5], "sRGB-encoded")], [_o("result", "vec3")])
 _fn("linear_to_srgb", "Linear to sRGB", "Colour", "Encodes linear values as sRGB.",
@@ -291,7 +295,8 @@ _fn("spherical_gradient", "Spherical Gradient", "Procedural",
     "1 at the centre falling to 0 at radius.",
     [_i(*_UV), _i("center", "vec2", [0.5, 0.5]),
      _i("radius", "float", 0.5, "UV units", (0.0, 2.0))], [_o("value", "float")],
-    thumbnail=Thumbnail.ALWAYS)
+    thumbnail=Thumbnail.ALWAYS,
+    mtlx=MxRecipe("falloff_from_centre"))  # clamp(1 − |uv − c| / max(radius, 1e-6), 0, 1)
 _fn("filtered_step", "Filtered Step", "Procedural",
     "step(edge, value) with the edge blurred over the pixel footprint of value: an "
     "anti-aliased threshold for any pattern.",
@@ -341,7 +346,8 @@ _fn("triplanar_mapping", "Triplanar Mapping", "Coordinates",
 _op("triplanar_blend", "Triplanar Blend",
     "({x} * {weights}.x + {y} * {weights}.y + {z} * {weights}.z)",
     [_i("x", T), _i("y", T), _i("z", T), _i("weights", "vec3", [1 / 3] * 3, "", UNIT)],
-    "Blends three projections by the Triplanar Mapping weights.", category="Coordinates")
+    "Blends three projections by the Triplanar Mapping weights.", category="Coordinates",
+    mtlx=MxRecipe("weighted_sum"))  # x w.x + y w.y + z w.z
 _fn("triplanar_texture", "Triplanar Texture", "Texture",
     "Samples a texture by triplanar projection of world position, no UVs needed.",
     [_i("texture", "texture2d", None, "from a Texture Parameter", required=True),

@@ -365,6 +365,72 @@ class _Exporter:
                 ("in", self.node("hsvtorgb", "color3", f"{hint}_rgb", [
                     ("in", self.node("convert", "color3", f"{hint}_hsv", [("in", *arg(0))]),
                      "color3")]), "color3")]))
+        if name == "floor_in_steps":
+            def make_steps():
+                st = self.node("max", mt, f"{hint}_steps",
+                               [("in1", *arg(1)), ("in2", _const(1.0, outs_t[0]), mt)])
+                f = self.node("floor", mt, f"{hint}_floor", [
+                    ("in", self.node("multiply", mt, f"{hint}_scaled",
+                                     [("in1", *arg(0)), ("in2", st, mt)]), mt)])
+                return self.node("divide", mt, hint, [("in1", f, mt), ("in2", st, mt)])
+            return one(make_steps)
+        if name == "weighted_sum":
+            def make_sum():
+                w = args[3].ref()
+                terms = [self.node("multiply", mt, f"{hint}_{c}", [
+                    ("in1", *arg(i)), ("in2", self._extract(w, PortType.VEC3, i, hint),
+                                       "float")]) for i, c in enumerate("xyz")]
+                s = self.node("add", mt, f"{hint}_xy", [("in1", terms[0], mt),
+                                                        ("in2", terms[1], mt)])
+                return self.node("add", mt, hint, [("in1", s, mt), ("in2", terms[2], mt)])
+            return one(make_sum)
+        if name == "mix_towards_inverse":
+            return one(lambda: self.node("mix", "vector3", hint, [
+                ("bg", *arg(0)),
+                ("fg", self.node("subtract", "vector3", f"{hint}_inverse", [
+                    ("in1", ("value", (1.0, 1.0, 1.0)), "vector3"), ("in2", *arg(0))]),
+                 "vector3"),
+                ("mix", *arg(1))]))
+        if name == "mix_from_grey":
+            from matedit.compiler.cpu_nodes import LUMA_REC709
+
+            def make_saturation():
+                y = self.node("dotproduct", "float", f"{hint}_luma", [
+                    ("in1", *arg(0)), ("in2", ("value", tuple(LUMA_REC709)), "vector3")])
+                grey = self.node("convert", "vector3", f"{hint}_grey", [("in", y, "float")])
+                return self.node("mix", "vector3", hint, [("bg", grey, "vector3"),
+                                                          ("fg", *arg(0)), ("mix", *arg(1))])
+            return one(make_saturation)
+        if name == "scale_about_mid_grey":
+            def make_bc():
+                gain = self.node("add", "float", f"{hint}_gain",
+                                 [("in1", ("value", 1.0), "float"), ("in2", *arg(2))])
+                lift = self.node("subtract", "float", f"{hint}_lift", [
+                    ("in1", *arg(1)),
+                    ("in2", self.node("multiply", "float", f"{hint}_half", [
+                        ("in1", *arg(2)), ("in2", ("value", 0.5), "float")]), "float")])
+                y = self.node("add", "vector3", f"{hint}_lifted", [
+                    ("in1", self.node("multiply", "vector3", f"{hint}_scaled", [
+                        ("in1", *arg(0)), ("in2", gain, "float")]), "vector3"),
+                    ("in2", lift, "float")])
+                return self.node("max", "vector3", hint, [("in1", y, "vector3"),
+                                                          ("in2", ("value", 0.0), "float")])
+            return one(make_bc)
+        if name == "falloff_from_centre":
+            def make_falloff():
+                r = self.node("magnitude", "float", f"{hint}_r", [
+                    ("in", self.node("subtract", "vector2", f"{hint}_d",
+                                     [("in1", *arg(0)), ("in2", *arg(1))]), "vector2")])
+                rad = self.node("max", "float", f"{hint}_radius",
+                                [("in1", *arg(2)), ("in2", ("value", 1e-6), "float")])
+                f = self.node("subtract", "float", f"{hint}_falloff", [
+                    ("in1", ("value", 1.0), "float"),
+                    ("in2", self.node("divide", "float", f"{hint}_ratio",
+                                      [("in1", r, "float"), ("in2", rad, "float")]), "float")])
+                return self.node("clamp", "float", hint, [("in", f, "float"),
+                                                          ("low", ("value", 0.0), "float"),
+                                                          ("high", ("value", 1.0), "float")])
+            return one(make_falloff)
         if name == "rec709_dot":
             from matedit.compiler.cpu_nodes import LUMA_REC709
 
