@@ -543,8 +543,14 @@ def _all_kinds_material(folder: Path) -> Path:
     link(d, "iv", "result", "sa", "color")
     node(d, "bcn", "brightness_contrast", values={"brightness": 0.1, "contrast": 0.2})
     link(d, "sa", "result", "bcn", "color")
+    last = "bcn"
+    for mode in ("multiply", "screen", "add", "subtract", "difference", "lighten", "darken"):
+        node(d, f"bl_{mode}", f"blend_{mode}", values={"opacity": 0.7})
+        link(d, last, "result", f"bl_{mode}", "base")
+        link(d, "h2r", "color", f"bl_{mode}", "blend")
+        last = f"bl_{mode}"
     node(d, "gm", "gamma", values={"gamma": 2.2})
-    link(d, "bcn", "result", "gm", "color")
+    link(d, last, "result", "gm", "color")
     node(d, "bc2", "multiply_add", values={"b": 0.1})
     link(d, "gm", "result", "bc2", "a")
     link(d, "bc", "result", "bc2", "c")

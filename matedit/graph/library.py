@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 from matedit.graph.nodes import (
+    BAKE,
     GENERIC,
     MESH_UV,
     REGISTRY,
@@ -177,11 +178,15 @@ _BLENDS = {
     "lighten": ("Lighten", "The larger of base and blend."),
     "darken": ("Darken", "The smaller of base and blend."),
 }
+# The modes that are a stdlib node or two before the mix by opacity; overlay, soft light,
+# dodge and burn bake (their branches and guards differ from MaterialX's).
+_COMPOSITED = ("multiply", "screen", "add", "subtract", "difference", "lighten", "darken")
 for _name, (_title, _doc) in _BLENDS.items():
     _fn(f"blend_{_name}", f"Blend: {_title}", "Colour",
         f"{_doc} Mixed over base by opacity.",
         [_i("base", "vec3", [0.5, 0.5, 0.5]), _i("blend", "vec3", [0.5, 0.5, 0.5]),
-         _i("opacity", "float", 1.0, "", UNIT)], [_o("result", "vec3")])
+         _i("opacity", "float", 1.0, "", UNIT)], [_o("result", "vec3")],
+        mtlx=MxRecipe(f"composite_{_name}") if _name in _COMPOSITED else BAKE)
 RAMP_STOPS = 6
 _GREYS = (0.0, 1.0, 1.0, 1.0, 1.0, 1.0)
 register(NodeDef(

@@ -431,6 +431,29 @@ class _Exporter:
                                                           ("low", ("value", 0.0), "float"),
                                                           ("high", ("value", 1.0), "float")])
             return one(make_falloff)
+        if name.startswith("composite_"):
+            mode = name.removeprefix("composite_")
+
+            def make_composite():
+                def v3(cat, suffix, *ins):
+                    names = ("in1", "in2") if len(ins) == 2 else ("in",)
+                    return self.node(cat, "vector3", f"{hint}_{suffix}",
+                                     [(k, r, t) for k, (r, t) in zip(names, ins)])
+                base, blend = arg(0), arg(1)
+                one3 = (("value", (1.0, 1.0, 1.0)), "vector3")
+                if mode == "screen":
+                    r = v3("subtract", "screen", one3, (v3(
+                        "multiply", "darks", (v3("subtract", "base_inv", one3, base), "vector3"),
+                        (v3("subtract", "blend_inv", one3, blend), "vector3")), "vector3"))
+                elif mode == "difference":
+                    r = v3("absval", "difference",
+                           (v3("subtract", "d", base, blend), "vector3"))
+                else:
+                    cat = {"lighten": "max", "darken": "min"}.get(mode, mode)
+                    r = v3(cat, mode, base, blend)
+                return self.node("mix", "vector3", hint, [("bg", *base), ("fg", r, "vector3"),
+                                                          ("mix", *arg(2))])
+            return one(make_composite)
         if name == "rec709_dot":
             from matedit.compiler.cpu_nodes import LUMA_REC709
 

@@ -107,7 +107,7 @@ class _Importer:
         self.errors: list[str] = []
         self.mat = MaterialDocument(kind=DocumentKind.MATERIAL, path=out)
         self.ids: set[str] = set()
-        self.done: dict[tuple[int, str], Src] = {}
+        self.done: dict[tuple[str, str], Src] = {}
         self.params: dict[str, Src] = {}
         self.count = 0
 
@@ -261,7 +261,9 @@ class _Importer:
 
     # --- nodes -----------------------------------------------------------------------------
     def node_src(self, node, output: str, depth: int) -> Src | None:
-        key = (id(node), node.getNamePath(), output)
+        # by name path: MaterialX hands out a new Python wrapper for each look-up, so a
+        # node read twice (a shared subgraph) is converted once
+        key = (node.getNamePath(), output)
         if key in self.done:
             return self.done[key]
         if depth > 2000:
