@@ -162,9 +162,10 @@ _fn("saturation", "Saturation", "Colour", "Mixes between grey (0) and the colour
     [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")],
     mtlx=MxRecipe("mix_from_grey"))  # mix(rec709 luminance, color, amount)
 _fn("srgb_to_linear", "sRGB to Linear", "Colour", "Decodes sRGB-encoded values (IEC 61966-2-1).",
-    [_i("color", "vec3", [0.5, 0.5, 0.5], "sRGB-encoded")], [_o("result", "vec3")])
+    [_i("color", "vec3", [0.5, 0.5, 0.5], "sRGB-encoded")], [_o("result", "vec3")],
+    mtlx=MxRecipe("srgb_decode_per_component"))  # ifgreater per component on max(c, 0)
 _fn("linear_to_srgb", "Linear to sRGB", "Colour", "Encodes linear values as sRGB.",
-    [_i(*_C)], [_o("result", "vec3")])
+    [_i(*_C)], [_o("result", "vec3")], mtlx=MxRecipe("srgb_encode_per_component"))
 _BLENDS = {
     "multiply": ("Multiply", "base × blend: darkens."),
     "screen": ("Screen", "1 − (1 − base)(1 − blend): lightens."),

@@ -454,6 +454,40 @@ class _Exporter:
                 return self.node("mix", "vector3", hint, [("bg", *base), ("fg", r, "vector3"),
                                                           ("mix", *arg(2))])
             return one(make_composite)
+        if name in ("srgb_decode_per_component", "srgb_encode_per_component"):
+            decode = name.startswith("srgb_decode")
+
+            def make_srgb():
+                def v3(cat, suffix, *ins):
+                    return self.node(cat, "vector3", f"{hint}_{suffix}",
+                                     [(k, r, t) for k, (r, t) in zip(("in1", "in2"), ins)])
+
+                def f(x):
+                    return (("value", x), "float")
+                c = v3("max", "positive", arg(0), f(0.0))
+                cv = (c, "vector3")
+                if decode:  # IEC 61966-2-1
+                    edge = 0.04045
+                    linear = v3("divide", "linear", cv, f(12.92))
+                    curve = v3("power", "curve", (v3("divide", "scaled", (v3(
+                        "add", "offset", cv, f(0.055)), "vector3"), f(1.055)), "vector3"),
+                        f(2.4))
+                else:
+                    edge = 0.0031308
+                    linear = v3("multiply", "linear", cv, f(12.92))
+                    curve = v3("subtract", "curve", (v3("multiply", "scaled", (v3(
+                        "power", "root", cv, f(1.0 / 2.4)), "vector3"), f(1.055)), "vector3"),
+                        f(0.055))
+                parts = []
+                for i in range(3):
+                    # c <= edge is the linear segment: c > edge picks the curve
+                    parts.append(self.node("ifgreater", "float", f"{hint}_{'xyz'[i]}", [
+                        ("value1", self._extract(c, PortType.VEC3, i, hint), "float"),
+                        ("value2", ("value", edge), "float"),
+                        ("in1", self._extract(curve, PortType.VEC3, i, hint), "float"),
+                        ("in2", self._extract(linear, PortType.VEC3, i, hint), "float")]))
+                return combine(parts, PortType.VEC3)
+            return one(make_srgb)
         if name == "rec709_dot":
             from matedit.compiler.cpu_nodes import LUMA_REC709
 
