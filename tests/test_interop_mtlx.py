@@ -249,6 +249,34 @@ def test_import_other_surfaces(tmp_path, surface, inputs, expect):
         np.testing.assert_allclose(a[k][0, 0], v, atol=1e-9, err_msg=k)
 
 
+def test_import_reads_an_unset_geometric_default_from_the_surface(tmp_path):
+    """MaterialX's reflect reads the world normal where its normal input is unset
+    (defaultgeomprop Nworld): the import connects our world normal there, so on a tilted
+    surface the result is I − 2 (N·I) N with the surface's N, not +Z."""
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.compiler.cpu_eval import evaluate
+    from matedit.compiler.cpu_nodes import SurfaceArrays
+    from matedit.io.document import FileResolver, load
+
+    text = _doc('<nodegraph name="NG"><reflect name="r" type="vector3">'
+                '<input name="in" type="vector3" value="0, 0, -1"/></reflect>'
+                '<convert name="c" type="color3"><input name="in" type="vector3" '
+                'nodename="r"/></convert><output name="o" type="color3" nodename="c"/>'
+                '</nodegraph><standard_surface name="S" type="surfaceshader">'
+                '<input name="base_color" type="color3" nodegraph="NG" output="o"/>'
+                '</standard_surface><surfacematerial name="M" type="material">'
+                '<input name="surfaceshader" type="surfaceshader" nodename="S"/>'
+                '</surfacematerial>')
+    r, out = _import(tmp_path, text)
+    assert r.returncode == 0, r.stderr
+    n = np.array([0.0, 0.6, 0.8])
+    incident = np.array([0.0, 0.0, -1.0])
+    surface = SurfaceArrays(np.zeros((1, 2)), np.zeros((1, 3)), n[None], n[None])
+    got = evaluate(lower_and_optimise(load(out), FileResolver()), surface)["baseColor"]
+    want = incident - 2.0 * n.dot(incident) * n  # (0, 0.96, 0.28)
+    np.testing.assert_allclose(got[0], want, atol=1e-6)
+
+
 @pytest.mark.parametrize("text, needle", [
     ("<materialx version='1.39'><bad", "not a MaterialX document"),
     (_doc('<disney_brdf_2012 name="S" type="surfaceshader"/><surfacematerial name="M" '
@@ -387,8 +415,12 @@ def _all_kinds_material(folder: Path) -> Path:
     node(d, "em", "multiply")
     link(d, "smp", "rgb", "em", "a")
     link(d, "fl", "result", "em", "b")
+    node(d, "to", "tiling_offset", values={"tiling": [1.5, 0.5], "offset": [-0.2, 0.3]})
+    link(d, "uv", "uv", "to", "uv")
+    node(d, "ro", "rotate_uv", values={"angle": 40.0, "pivot": [0.3, 0.6]})
+    link(d, "to", "uv", "ro", "uv")
     node(d, "gr", "gradient", values={"angle": 30.0})
-    link(d, "uv", "uv", "gr", "uv")
+    link(d, "ro", "uv", "gr", "uv")
     # filter_width 0: MaterialX's checkerboard has hard edges (ours band-limits by default)
     node(d, "ck", "checker", values={"scale": 3.0, "color_a": [0.9, 0.2, 0.1],
                                      "color_b": [0.1, 0.3, 0.8], "filter_width": 0.0})
@@ -407,14 +439,139 @@ def _all_kinds_material(folder: Path) -> Path:
     node(d, "bc", "add")
     link(d, "lp", "result", "bc", "a")
     link(d, "ckm", "result", "bc", "b")
+    # maths with a stdlib twin: u in [0.1, 2.1] keeps sin(u) > 0, off atan2's branch cut
+    node(d, "at", "atan2")
+    link(d, "sn", "result", "at", "y")
+    link(d, "cs", "result", "at", "x")
+    node(d, "ex", "exp")
+    link(d, "sn", "result", "ex", "value")
+    node(d, "tn", "tan")
+    link(d, "sn", "result", "tn", "value")
+    node(d, "sg", "sign")
+    link(d, "cs", "result", "sg", "value")
+    node(d, "ig", "if_greater", values={"b": 0.5})  # sin(u) stays 0.03 off 0.5 on the grid
+    link(d, "sn", "result", "ig", "a")
+    link(d, "ex", "result", "ig", "if_true")
+    link(d, "at", "result", "ig", "if_false")
+    node(d, "rad", "radians")
+    link(d, "tn", "result", "rad", "value")
+    node(d, "deg", "degrees")
+    link(d, "sg", "result", "deg", "value")
+    node(d, "ng", "negate")
+    link(d, "rad", "result", "ng", "value")
+    node(d, "rc", "reciprocal")
+    link(d, "ex", "result", "rc", "value")
+    node(d, "f1", "multiply_add", values={"b": 0.002})
+    link(d, "deg", "result", "f1", "a")
+    link(d, "ig", "result", "f1", "c")
+    node(d, "f2", "add")
+    link(d, "ng", "result", "f2", "a")
+    link(d, "rc", "result", "f2", "b")
+    node(d, "f3", "add")
+    link(d, "f1", "result", "f3", "a")
+    link(d, "f2", "result", "f3", "b")
+    node(d, "lg", "log")
+    link(d, "ex", "result", "lg", "value")
+    node(d, "as", "asin")
+    link(d, "sn", "result", "as", "value")
+    node(d, "ac", "acos")
+    link(d, "cs", "result", "ac", "value")
+    node(d, "rn", "round")
+    link(d, "tn", "result", "rn", "value")
+    node(d, "tr", "trunc")
+    link(d, "ng", "result", "tr", "value")  # −radians(tan(sin u)), in [−0.03, 0)
+    node(d, "ds", "distance")
+    link(d, "sn", "result", "ds", "a")
+    link(d, "cs", "result", "ds", "b")
+    node(d, "ds3", "distance")
+    link(d, "nr", "result", "ds3", "a")
+    link(d, "wn", "normal", "ds3", "b")
+    node(d, "ie", "if_equal", values={"b": 0.0, "tolerance": 0.5})  # |cos v| off 0.5
+    link(d, "cs", "result", "ie", "a")
+    link(d, "as", "result", "ie", "if_true")
+    link(d, "ac", "result", "ie", "if_false")
+    node(d, "lu", "luminance")
+    link(d, "v3", "result", "lu", "color")
+    node(d, "ps", "posterize", values={"steps": 5.0})  # 5 exp(sin u) stays 0.04 off integers
+    link(d, "ex", "result", "ps", "value")
+    node(d, "tb", "triplanar_blend")
+    link(d, "ps", "result", "tb", "x")
+    link(d, "cs", "result", "tb", "y")
+    link(d, "ex", "result", "tb", "z")
+    link(d, "h2r", "color", "tb", "weights")
+    node(d, "sph", "spherical_gradient", values={"center": [0.5, 0.5], "radius": 2.0})
+    link(d, "ro", "uv", "sph", "uv")
+    total = "f3"
+    for k, term in enumerate(("lg", "rn", "tr", "ds", "ds3", "ie", "lu", "tb", "sph")):
+        node(d, f"g{k}", "add")
+        link(d, total, "result", f"g{k}", "a")
+        link(d, term, "value" if term in ("lu", "sph") else "result", f"g{k}", "b")
+        total = f"g{k}"
+    node(d, "cav", "multiply_add", values={"b": 0.05})
+    link(d, total, "result", "cav", "a")
+    link(d, "rm", "result", "cav", "c")
+    node(d, "md", "mod", values={"b": 0.7})
+    link(d, "m3", "result", "md", "a")
+    node(d, "ce", "ceil")
+    link(d, "m3", "result", "ce", "value")
+    node(d, "rf", "reflect")
+    link(d, "nr", "result", "rf", "incident")
+    link(d, "wn", "normal", "rf", "normal")
+    node(d, "rr", "refract", values={"eta": 0.67})
+    link(d, "nr", "result", "rr", "incident")
+    link(d, "wn", "normal", "rr", "normal")
+    node(d, "v1", "add")
+    link(d, "md", "result", "v1", "a")
+    link(d, "ce", "result", "v1", "b")
+    node(d, "v2", "add")
+    link(d, "rf", "result", "v2", "a")
+    link(d, "rr", "result", "v2", "b")
+    node(d, "v3", "add")
+    link(d, "v1", "result", "v3", "a")
+    link(d, "v2", "result", "v3", "b")
+    node(d, "hsv", "combine", values={"z": 0.8})
+    link(d, "sp", "y", "hsv", "x")  # hue wraps: v runs over [0.2, 3.2] turns
+    link(d, "cl", "result", "hsv", "y")
+    node(d, "h2r", "hsv_to_rgb")
+    link(d, "hsv", "xyz", "h2r", "hsv")
+    node(d, "v4", "add")
+    link(d, "v3", "result", "v4", "a")
+    link(d, "h2r", "color", "v4", "b")
+    node(d, "s2l", "srgb_to_linear")
+    link(d, "h2r", "color", "s2l", "color")
+    node(d, "l2s", "linear_to_srgb")
+    link(d, "v4", "result", "l2s", "color")
+    node(d, "v5", "add")
+    link(d, "s2l", "result", "v5", "a")
+    link(d, "l2s", "result", "v5", "b")
+    node(d, "iv", "invert", values={"amount": 0.3})
+    link(d, "v5", "result", "iv", "color")
+    node(d, "sa", "saturation", values={"amount": 1.4})
+    link(d, "iv", "result", "sa", "color")
+    node(d, "bcn", "brightness_contrast", values={"brightness": 0.1, "contrast": 0.2})
+    link(d, "sa", "result", "bcn", "color")
+    last = "bcn"
+    for mode in ("multiply", "screen", "add", "subtract", "difference", "lighten", "darken"):
+        node(d, f"bl_{mode}", f"blend_{mode}", values={"opacity": 0.7})
+        link(d, last, "result", f"bl_{mode}", "base")
+        link(d, "h2r", "color", f"bl_{mode}", "blend")
+        last = f"bl_{mode}"
+    node(d, "gm", "gamma", values={"gamma": 2.2})
+    link(d, last, "result", "gm", "color")
+    node(d, "bc2", "multiply_add", values={"b": 0.5})
+    link(d, "gm", "result", "bc2", "a")
+    link(d, "bc", "result", "bc2", "c")
     node(d, "make", "make_attributes")
     node(d, "out", "material_output")
-    link(d, "bc", "result", "make", "baseColor")
+    link(d, "bc2", "result", "make", "baseColor")
     link(d, "ad", "result", "make", "metallic")
     link(d, "sb", "result", "make", "roughness")
-    link(d, "rm", "result", "make", "cavity")
+    link(d, "cav", "result", "make", "cavity")
     link(d, "fn", "normal", "make", "normal")
-    link(d, "em", "result", "make", "emissive")
+    node(d, "em2", "multiply_add", values={"b": 0.5})  # the sRGB curves, seen unmixed
+    link(d, "v5", "result", "em2", "a")
+    link(d, "em", "result", "em2", "c")
+    link(d, "em2", "result", "make", "emissive")
     link(d, "sat", "result", "make", "opacity")
     link(d, "make", "attributes", "out", "attributes")
     return save(d, folder / "all_kinds.json")

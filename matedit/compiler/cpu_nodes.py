@@ -463,11 +463,11 @@ def _if_equal(ctx, a, b, tolerance, if_true, if_false):
 
 
 # --- colour -----------------------------------------------------------------------------------
-_LUMA = (0.2126, 0.7152, 0.0722)
+LUMA_REC709 = (0.2126, 0.7152, 0.0722)
 
 
 def _luminance(c):
-    w = np.asarray(_LUMA, dtype=np.float32).astype(c.dtype)
+    w = np.asarray(LUMA_REC709, dtype=np.float32).astype(c.dtype)
     return c[:, 0] * w[0] + c[:, 1] * w[1] + c[:, 2] * w[2]
 
 

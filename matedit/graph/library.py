@@ -4,9 +4,10 @@ and masks. Registered into `matedit.graph.nodes.REGISTRY` when that module is im
 Every kind here has a GLSL function in `shaders/nodes/<kind>.glsl` or an inline template,
 a numpy twin in `matedit.compiler.cpu_nodes`, port ranges, and the facts of
 `matedit.graph.nodes.NodeDef`: patterns show a thumbnail always, kinds that read the
-surface's geometry or time are impure. Their MaterialX mapping is the default, BAKE: the
-MaterialX exporter bakes them (a stdlib node is mapped only once MaterialX's own shader
-generator is shown to agree with our CPU evaluator, tests/test_interop_mtlx.py).
+surface's geometry or time are impure. Their MaterialX mapping is the default, BAKE (the
+MaterialX exporter bakes them), except where a stdlib node computes the same values: a
+stdlib node is mapped only once MaterialX's own shader generator is shown to agree with our
+CPU evaluator (tests/test_interop_mtlx.py, every mapped kind in one material).
 
 Pattern edges are band-limited: kinds with a `filter_width` input box-filter their edges
 over `filter_width` pixels of screen-space footprint (`fwidth`); the numpy twins take the
@@ -15,16 +16,23 @@ same footprint from the evaluator's pixel grid (`SurfaceArrays.grid`).
 
 from __future__ import annotations
 
+import math
+
 from matedit.graph.nodes import (
+    BAKE,
     GENERIC,
     MESH_UV,
     REGISTRY,
+    MxNode,
+    MxRecipe,
     NodeDef,
     Role,
     Thumbnail,
+    _bin,
     _i,
     _o,
     _op,
+    _un,
     register,
 )
 
@@ -44,55 +52,74 @@ def _fn(kind, title, category, description, inputs, outputs, **facts):
 
 # --- maths -----------------------------------------------------------------------------------
 _op("atan2", "Atan2", "atan({y}, {x})", [_i("y", T), _i("x", T, 1.0)],
-    "Angle of the point (x, y) in radians, in (−π, π].")
-_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.")
+    "Angle of the point (x, y) in radians, in (−π, π].",
+    mtlx=MxNode("atan2", (("y", "iny"), ("x", "inx"))))
+_op("exp", "Exp", "exp({value})", [_i("value", T)], "e raised to value.", mtlx=_un("exp"))
 _op("log", "Log", "log(max({value}, 1e-30))", [_i("value", T, 1.0)],
-    "Natural logarithm; values at or below 0 read as 1e-30.")
+    "Natural logarithm; values at or below 0 read as 1e-30.",
+    mtlx=MxRecipe("floored_log"), reads=_un("ln"))  # ln(max(value, 1e-30))
 _op("mod", "Modulo", "mod({a}, {b})", [_i("a", T), _i("b", T, 1.0)],
-    "a − b floor(a / b): the remainder with the sign of b.")
-_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.")
+    "a − b floor(a / b): the remainder with the sign of b.", mtlx=_bin("modulo"))
+_op("sign", "Sign", "sign({value})", [_i("value", T)], "−1, 0 or 1.", mtlx=_un("sign"))
 _op("round", "Round", "floor({value} + 0.5)", [_i("value", T)],
-    "Nearest integer; halves round up.")
-_op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.")
+    "Nearest integer; halves round up.",
+    mtlx=MxRecipe("floor_of_half_up"))  # floor(value + 0.5): GLSL's round may go either way
+_op("ceil", "Ceil", "ceil({value})", [_i("value", T)], "Smallest integer not below value.",
+    mtlx=_un("ceil"))
 _op("trunc", "Truncate", "trunc({value})", [_i("value", T)],
-    "Integer part, rounding towards zero.")
-_op("negate", "Negate", "(-{value})", [_i("value", T)], "−value.")
+    "Integer part, rounding towards zero.",
+    mtlx=MxRecipe("signed_floor_of_abs"))  # sign(value) floor(|value|): no stdlib trunc
+_op("negate", "Negate", "(-{value})", [_i("value", T)], "−value.",
+    mtlx=MxNode("multiply", (("value", "in1"),), (("in2", -1.0),)))
 _op("reciprocal", "Reciprocal", "(1.0 / {value})", [_i("value", T, 1.0)],
-    "1 ÷ value (zero gives the GPU's infinity).")
-_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.")
+    "1 ÷ value (zero gives the GPU's infinity).",
+    mtlx=MxNode("divide", (("value", "in2"),), (("in1", 1.0),)))
+_op("tan", "Tangent", "tan({value})", [_i("value", T)], "Tangent of radians.", mtlx=_un("tan"))
 _op("asin", "Arcsine", "asin(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arcsine in radians; input clamped to [−1, 1].")
+    "Arcsine in radians; input clamped to [−1, 1].",
+    mtlx=MxRecipe("clamped_asin"), reads=_un("asin"))
 _op("acos", "Arccosine", "acos(clamp({value}, -1.0, 1.0))", [_i("value", T)],
-    "Arccosine in radians; input clamped to [−1, 1].")
-_op("radians", "To Radians", "radians({value})", [_i("value", T)], "Degrees to radians.")
-_op("degrees", "To Degrees", "degrees({value})", [_i("value", T)], "Radians to degrees.")
+    "Arccosine in radians; input clamped to [−1, 1].",
+    mtlx=MxRecipe("clamped_acos"), reads=_un("acos"))
+_op("radians", "To Radians", "radians({value})", [_i("value", T)], "Degrees to radians.",
+    mtlx=MxNode("multiply", (("value", "in1"),), (("in2", math.pi / 180.0),)))
+_op("degrees", "To Degrees", "degrees({value})", [_i("value", T)], "Radians to degrees.",
+    mtlx=MxNode("multiply", (("value", "in1"),), (("in2", 180.0 / math.pi),)))
 _op("multiply_add", "Multiply Add", "({a} * {b} + {c})",
-    [_i("a", T), _i("b", T, 1.0), _i("c", T)], "a × b + c.")
+    [_i("a", T), _i("b", T, 1.0), _i("c", T)], "a × b + c.",
+    mtlx=MxRecipe("multiply_then_add"))
 _op("posterize", "Posterize", "(floor({value} * max({steps}, 1.0)) / max({steps}, 1.0))",
     [_i("value", T), _i("steps", T, 4.0, "levels per unit (at least 1)", (1.0, 64.0))],
-    "Quantises value into steps levels per unit.")
+    "Quantises value into steps levels per unit.",
+    mtlx=MxRecipe("floor_in_steps"))  # floor(value s) / s, s = max(steps, 1)
 _op("smooth_min", "Soft Minimum", None,
     [_i("a", T), _i("b", T), _i("smoothness", T, 0.1, "blend radius", (0.0, 1.0))],
     "The smaller of a and b with a rounded join (polynomial smooth minimum).",
     glsl="node_smooth_min")
 _op("distance", "Distance", "distance({a}, {b})", [_i("a", T), _i("b", T)],
-    "Euclidean distance between a and b.", out_type="float", category="Vector")
+    "Euclidean distance between a and b.", out_type="float", category="Vector",
+    mtlx=MxRecipe("distance_or_absval"), reads=_bin("distance"))  # |a - b| for floats
 _op("reflect", "Reflect", "reflect({incident}, {normal})",
     [_i("incident", "vec3", [0.0, 0.0, -1.0]), _i("normal", "vec3", [0.0, 0.0, 1.0], "unit")],
-    "Mirror direction of incident about normal.", out_type="vec3", category="Vector")
+    "Mirror direction of incident about normal.", out_type="vec3", category="Vector",
+    mtlx=MxNode("reflect", (("incident", "in"), ("normal", "normal"))))
 _op("refract", "Refract", "refract({incident}, {normal}, {eta})",
     [_i("incident", "vec3", [0.0, 0.0, -1.0], "unit"),
      _i("normal", "vec3", [0.0, 0.0, 1.0], "unit"),
      _i("eta", "float", 0.67, "ratio of indices of refraction", (0.0, 3.0))],
     "Refracted direction (zero on total internal reflection).", out_type="vec3",
-    category="Vector")
+    category="Vector",
+    mtlx=MxNode("refract", (("incident", "in"), ("normal", "normal"), ("eta", "ior"))))
 _op("if_greater", "If Greater", "({a} > {b} ? {if_true} : {if_false})",
     [_i("a", "float"), _i("b", "float"), _i("if_true", T, 1.0), _i("if_false", T, 0.0)],
-    "if_true where a > b, else if_false.", category="Logic")
+    "if_true where a > b, else if_false.", category="Logic",
+    mtlx=MxNode("ifgreater", (("a", "value1"), ("b", "value2"), ("if_true", "in1"),
+                              ("if_false", "in2"))))
 _op("if_equal", "If Equal", "(abs({a} - {b}) <= {tolerance} ? {if_true} : {if_false})",
     [_i("a", "float"), _i("b", "float"), _i("tolerance", "float", 1e-4, "", (0.0, 1.0)),
      _i("if_true", T, 1.0), _i("if_false", T, 0.0)],
-    "if_true where |a − b| ≤ tolerance, else if_false.", category="Logic")
+    "if_true where |a − b| ≤ tolerance, else if_false.", category="Logic",
+    mtlx=MxRecipe("within_tolerance"))  # ifgreater(|a - b|, tolerance, if_false, if_true)
 _op("fwidth", "Pixel Footprint", "fwidth({value})", [_i("value", T)],
     "How much value changes across one pixel (|d/dx| + |d/dy|): the width to filter "
     "an edge of value over.", category="Utility")
@@ -100,11 +127,14 @@ _op("fwidth", "Pixel Footprint", "fwidth({value})", [_i("value", T)],
 # --- colour ----------------------------------------------------------------------------------
 _C = ("color", "vec3", [0.5, 0.5, 0.5], "linear RGB")
 _fn("luminance", "Luminance", "Colour", "Rec. 709 luminance of a linear colour.",
-    [_i(*_C)], [_o("value", "float")])
+    [_i(*_C)], [_o("value", "float")], mtlx=MxRecipe("rec709_dot"))
 _fn("rgb_to_hsv", "RGB to HSV", "Colour", "Hue (turns), saturation and value of a colour.",
     [_i(*_C)], [_o("hsv", "vec3")])
 _fn("hsv_to_rgb", "HSV to RGB", "Colour", "The colour of a hue (turns), saturation, value.",
-    [_i("hsv", "vec3", [0.0, 1.0, 1.0])], [_o("color", "vec3")])
+    [_i("hsv", "vec3", [0.0, 1.0, 1.0])], [_o("color", "vec3")],
+    # hsvtorgb on color3: the same sectors; below saturation 1e-4 it returns grey (v, v, v),
+    # ours v mix(1, c, s): they differ there by at most 1e-4 v
+    mtlx=MxRecipe("hsvtorgb_on_color3"), mtlx_reads=MxNode("hsvtorgb", (("hsv", "in"),)))
 _fn("hsv_adjust", "HSV Adjust", "Colour",
     "Rotates hue, scales saturation and value (in HSV space).",
     [_i(*_C), _i("hue", "float", 0.0, "hue shift in turns", (-0.5, 0.5)),
@@ -114,11 +144,14 @@ _fn("hsv_adjust", "HSV Adjust", "Colour",
 _fn("brightness_contrast", "Brightness / Contrast", "Colour",
     "Adds brightness and scales contrast about mid grey; never below 0.",
     [_i(*_C), _i("brightness", "float", 0.0, "", (-1.0, 1.0)),
-     _i("contrast", "float", 0.0, "", (-1.0, 1.0))], [_o("result", "vec3")])
+     _i("contrast", "float", 0.0, "", (-1.0, 1.0))], [_o("result", "vec3")],
+    mtlx=MxRecipe("scale_about_mid_grey"))  # max((1 + c) color + b − c / 2, 0)
 _fn("gamma", "Gamma", "Colour", "color raised to gamma (negative components read 0).",
-    [_i(*_C), _i("gamma", "float", 1.0, "", (0.01, 10.0))], [_o("result", "vec3")])
+    [_i(*_C), _i("gamma", "float", 1.0, "", (0.01, 10.0))], [_o("result", "vec3")],
+    mtlx=MxRecipe("positive_power"))  # power(max(color, 0), gamma)
 _fn("invert", "Invert", "Colour", "1 − color, by amount.",
-    [_i(*_C), _i("amount", "float", 1.0, "", UNIT)], [_o("result", "vec3")])
+    [_i(*_C), _i("amount", "float", 1.0, "", UNIT)], [_o("result", "vec3")],
+    mtlx=MxRecipe("mix_towards_inverse"))  # mix(color, 1 − color, amount)
 _fn("levels", "Levels", "Colour",
     "Input black/white points, midtone gamma and output range, like an image editor's.",
     [_i(*_C), _i("in_black", "float", 0.0, "", UNIT), _i("in_white", "float", 1.0, "", UNIT),
@@ -126,11 +159,13 @@ _fn("levels", "Levels", "Colour",
      _i("out_black", "float", 0.0, "", UNIT), _i("out_white", "float", 1.0, "", UNIT)],
     [_o("result", "vec3")])
 _fn("saturation", "Saturation", "Colour", "Mixes between grey (0) and the colour (1) and past.",
-    [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")])
+    [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")],
+    mtlx=MxRecipe("mix_from_grey"))  # mix(rec709 luminance, color, amount)
 _fn("srgb_to_linear", "sRGB to Linear", "Colour", "Decodes sRGB-encoded values (IEC 61966-2-1).",
-    [_i("color", "vec3", [0.5, 0.5, 0.5], "sRGB-encoded")], [_o("result", "vec3")])
+    [_i("color", "vec3", [0.5, 0.5, 0.5], "sRGB-encoded")], [_o("result", "vec3")],
+    mtlx=MxRecipe("srgb_decode_per_component"))  # ifgreater per component on max(c, 0)
 _fn("linear_to_srgb", "Linear to sRGB", "Colour", "Encodes linear values as sRGB.",
-    [_i(*_C)], [_o("result", "vec3")])
+    [_i(*_C)], [_o("result", "vec3")], mtlx=MxRecipe("srgb_encode_per_component"))
 _BLENDS = {
     "multiply": ("Multiply", "base × blend: darkens."),
     "screen": ("Screen", "1 − (1 − base)(1 − blend): lightens."),
@@ -144,11 +179,15 @@ _BLENDS = {
     "lighten": ("Lighten", "The larger of base and blend."),
     "darken": ("Darken", "The smaller of base and blend."),
 }
+# The modes that are a stdlib node or two before the mix by opacity; overlay, soft light,
+# dodge and burn bake (their branches and guards differ from MaterialX's).
+_COMPOSITED = ("multiply", "screen", "add", "subtract", "difference", "lighten", "darken")
 for _name, (_title, _doc) in _BLENDS.items():
     _fn(f"blend_{_name}", f"Blend: {_title}", "Colour",
         f"{_doc} Mixed over base by opacity.",
         [_i("base", "vec3", [0.5, 0.5, 0.5]), _i("blend", "vec3", [0.5, 0.5, 0.5]),
-         _i("opacity", "float", 1.0, "", UNIT)], [_o("result", "vec3")])
+         _i("opacity", "float", 1.0, "", UNIT)], [_o("result", "vec3")],
+        mtlx=MxRecipe(f"composite_{_name}") if _name in _COMPOSITED else BAKE)
 RAMP_STOPS = 6
 _GREYS = (0.0, 1.0, 1.0, 1.0, 1.0, 1.0)
 register(NodeDef(
@@ -262,7 +301,8 @@ _fn("spherical_gradient", "Spherical Gradient", "Procedural",
     "1 at the centre falling to 0 at radius.",
     [_i(*_UV), _i("center", "vec2", [0.5, 0.5]),
      _i("radius", "float", 0.5, "UV units", (0.0, 2.0))], [_o("value", "float")],
-    thumbnail=Thumbnail.ALWAYS)
+    thumbnail=Thumbnail.ALWAYS,
+    mtlx=MxRecipe("falloff_from_centre"))  # clamp(1 − |uv − c| / max(radius, 1e-6), 0, 1)
 _fn("filtered_step", "Filtered Step", "Procedural",
     "step(edge, value) with the edge blurred over the pixel footprint of value: an "
     "anti-aliased threshold for any pattern.",
@@ -276,10 +316,11 @@ _fn("filtered_smoothstep", "Filtered Smooth Step", "Procedural",
 # --- UV and space ----------------------------------------------------------------------------
 _fn("tiling_offset", "Tiling and Offset", "Coordinates", "uv × tiling + offset.",
     [_i(*_UV), _i("tiling", "vec2", [1.0, 1.0]), _i("offset", "vec2", [0.0, 0.0])],
-    [_o("uv", "vec2")])
+    [_o("uv", "vec2")], mtlx=MxRecipe("multiply_then_add"))
 _fn("rotate_uv", "Rotate UV", "Coordinates", "Rotates uv about a pivot, counter-clockwise.",
     [_i(*_UV), _i("angle", "float", 0.0, "degrees", (0.0, 360.0)),
-     _i("pivot", "vec2", [0.5, 0.5])], [_o("uv", "vec2")])
+     _i("pivot", "vec2", [0.5, 0.5])], [_o("uv", "vec2")],
+    mtlx=MxRecipe("rotate_about_pivot"))  # rotate2d turns clockwise: by −angle about 0
 _fn("panner", "Panner", "Coordinates", "Scrolls uv over time: uv + speed × seconds.",
     [_i(*_UV), _i("speed", "vec2", [0.1, 0.0], "UV units per second")], [_o("uv", "vec2")],
     impure=True, geometry=True)
@@ -311,7 +352,8 @@ _fn("triplanar_mapping", "Triplanar Mapping", "Coordinates",
 _op("triplanar_blend", "Triplanar Blend",
     "({x} * {weights}.x + {y} * {weights}.y + {z} * {weights}.z)",
     [_i("x", T), _i("y", T), _i("z", T), _i("weights", "vec3", [1 / 3] * 3, "", UNIT)],
-    "Blends three projections by the Triplanar Mapping weights.", category="Coordinates")
+    "Blends three projections by the Triplanar Mapping weights.", category="Coordinates",
+    mtlx=MxRecipe("weighted_sum"))  # x w.x + y w.y + z w.z
 _fn("triplanar_texture", "Triplanar Texture", "Texture",
     "Samples a texture by triplanar projection of world position, no UVs needed.",
     [_i("texture", "texture2d", None, "from a Texture Parameter", required=True),

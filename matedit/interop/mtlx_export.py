@@ -318,6 +318,192 @@ class _Exporter:
                 ("in1", self.node("max", mt, f"{hint}_max", [
                     ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt),
                 ("in2", *arg(1))]))
+        if name == "multiply_then_add":
+            return one(lambda: self.node("add", mt, hint, [
+                ("in1", self.node("multiply", mt, f"{hint}_mul",
+                                  [("in1", *arg(0)), ("in2", *arg(1))]), mt),
+                ("in2", *arg(2))]))
+        if name == "floored_log":
+            return one(lambda: self.node("ln", mt, hint, [
+                ("in", self.node("max", mt, f"{hint}_max", [
+                    ("in1", *arg(0)), ("in2", _const(1e-30, outs_t[0]), mt)]), mt)]))
+        if name in ("clamped_asin", "clamped_acos"):
+            return one(lambda: self.node(name[len("clamped_"):], mt, hint, [
+                ("in", self.node("clamp", mt, f"{hint}_clamp", [
+                    ("in", *arg(0)), ("low", _const(-1.0, outs_t[0]), mt),
+                    ("high", _const(1.0, outs_t[0]), mt)]), mt)]))
+        if name == "floor_of_half_up":
+            return one(lambda: self.node("floor", mt, hint, [
+                ("in", self.node("add", mt, f"{hint}_half", [
+                    ("in1", *arg(0)), ("in2", _const(0.5, outs_t[0]), mt)]), mt)]))
+        if name == "signed_floor_of_abs":
+            return one(lambda: self.node("multiply", mt, hint, [
+                ("in1", self.node("sign", mt, f"{hint}_sign", [("in", *arg(0))]), mt),
+                ("in2", self.node("floor", mt, f"{hint}_floor", [
+                    ("in", self.node("absval", mt, f"{hint}_abs", [("in", *arg(0))]), mt)]),
+                 mt)]))
+        if name == "distance_or_absval":
+            if args[0].type == PortType.FLOAT:
+                return one(lambda: self.node("absval", "float", hint, [
+                    ("in", self.node("subtract", "float", f"{hint}_d",
+                                     [("in1", *arg(0)), ("in2", *arg(1))]), "float")]))
+            return one(lambda: self.node("distance", "float", hint,
+                                         [("in1", *arg(0)), ("in2", *arg(1))]))
+        if name == "within_tolerance":
+            def make_equal():
+                diff = self.node("absval", "float", f"{hint}_diff", [
+                    ("in", self.node("subtract", "float", f"{hint}_d",
+                                     [("in1", *arg(0)), ("in2", *arg(1))]), "float")])
+                # |a - b| > tolerance picks if_false: the same as |a - b| <= tolerance
+                # picking if_true
+                return self.node("ifgreater", mt, hint, [
+                    ("value1", diff, "float"), ("value2", *arg(2)), ("in1", *arg(4)),
+                    ("in2", *arg(3))])
+            return one(make_equal)
+        if name == "hsvtorgb_on_color3":
+            return one(lambda: self.node("convert", "vector3", hint, [
+                ("in", self.node("hsvtorgb", "color3", f"{hint}_rgb", [
+                    ("in", self.node("convert", "color3", f"{hint}_hsv", [("in", *arg(0))]),
+                     "color3")]), "color3")]))
+        if name == "floor_in_steps":
+            def make_steps():
+                st = self.node("max", mt, f"{hint}_steps",
+                               [("in1", *arg(1)), ("in2", _const(1.0, outs_t[0]), mt)])
+                f = self.node("floor", mt, f"{hint}_floor", [
+                    ("in", self.node("multiply", mt, f"{hint}_scaled",
+                                     [("in1", *arg(0)), ("in2", st, mt)]), mt)])
+                return self.node("divide", mt, hint, [("in1", f, mt), ("in2", st, mt)])
+            return one(make_steps)
+        if name == "weighted_sum":
+            def make_sum():
+                w = args[3].ref()
+                terms = [self.node("multiply", mt, f"{hint}_{c}", [
+                    ("in1", *arg(i)), ("in2", self._extract(w, PortType.VEC3, i, hint),
+                                       "float")]) for i, c in enumerate("xyz")]
+                s = self.node("add", mt, f"{hint}_xy", [("in1", terms[0], mt),
+                                                        ("in2", terms[1], mt)])
+                return self.node("add", mt, hint, [("in1", s, mt), ("in2", terms[2], mt)])
+            return one(make_sum)
+        if name == "mix_towards_inverse":
+            return one(lambda: self.node("mix", "vector3", hint, [
+                ("bg", *arg(0)),
+                ("fg", self.node("subtract", "vector3", f"{hint}_inverse", [
+                    ("in1", ("value", (1.0, 1.0, 1.0)), "vector3"), ("in2", *arg(0))]),
+                 "vector3"),
+                ("mix", *arg(1))]))
+        if name == "mix_from_grey":
+            from matedit.compiler.cpu_nodes import LUMA_REC709
+
+            def make_saturation():
+                y = self.node("dotproduct", "float", f"{hint}_luma", [
+                    ("in1", *arg(0)), ("in2", ("value", tuple(LUMA_REC709)), "vector3")])
+                grey = self.node("convert", "vector3", f"{hint}_grey", [("in", y, "float")])
+                return self.node("mix", "vector3", hint, [("bg", grey, "vector3"),
+                                                          ("fg", *arg(0)), ("mix", *arg(1))])
+            return one(make_saturation)
+        if name == "scale_about_mid_grey":
+            def make_bc():
+                gain = self.node("add", "float", f"{hint}_gain",
+                                 [("in1", ("value", 1.0), "float"), ("in2", *arg(2))])
+                lift = self.node("subtract", "float", f"{hint}_lift", [
+                    ("in1", *arg(1)),
+                    ("in2", self.node("multiply", "float", f"{hint}_half", [
+                        ("in1", *arg(2)), ("in2", ("value", 0.5), "float")]), "float")])
+                y = self.node("add", "vector3", f"{hint}_lifted", [
+                    ("in1", self.node("multiply", "vector3", f"{hint}_scaled", [
+                        ("in1", *arg(0)), ("in2", gain, "float")]), "vector3"),
+                    ("in2", lift, "float")])
+                return self.node("max", "vector3", hint, [("in1", y, "vector3"),
+                                                          ("in2", ("value", 0.0), "float")])
+            return one(make_bc)
+        if name == "falloff_from_centre":
+            def make_falloff():
+                r = self.node("magnitude", "float", f"{hint}_r", [
+                    ("in", self.node("subtract", "vector2", f"{hint}_d",
+                                     [("in1", *arg(0)), ("in2", *arg(1))]), "vector2")])
+                rad = self.node("max", "float", f"{hint}_radius",
+                                [("in1", *arg(2)), ("in2", ("value", 1e-6), "float")])
+                f = self.node("subtract", "float", f"{hint}_falloff", [
+                    ("in1", ("value", 1.0), "float"),
+                    ("in2", self.node("divide", "float", f"{hint}_ratio",
+                                      [("in1", r, "float"), ("in2", rad, "float")]), "float")])
+                return self.node("clamp", "float", hint, [("in", f, "float"),
+                                                          ("low", ("value", 0.0), "float"),
+                                                          ("high", ("value", 1.0), "float")])
+            return one(make_falloff)
+        if name.startswith("composite_"):
+            mode = name.removeprefix("composite_")
+
+            def make_composite():
+                def v3(cat, suffix, *ins):
+                    names = ("in1", "in2") if len(ins) == 2 else ("in",)
+                    return self.node(cat, "vector3", f"{hint}_{suffix}",
+                                     [(k, r, t) for k, (r, t) in zip(names, ins)])
+                base, blend = arg(0), arg(1)
+                one3 = (("value", (1.0, 1.0, 1.0)), "vector3")
+                if mode == "screen":
+                    r = v3("subtract", "screen", one3, (v3(
+                        "multiply", "darks", (v3("subtract", "base_inv", one3, base), "vector3"),
+                        (v3("subtract", "blend_inv", one3, blend), "vector3")), "vector3"))
+                elif mode == "difference":
+                    r = v3("absval", "difference",
+                           (v3("subtract", "d", base, blend), "vector3"))
+                else:
+                    cat = {"lighten": "max", "darken": "min"}.get(mode, mode)
+                    r = v3(cat, mode, base, blend)
+                return self.node("mix", "vector3", hint, [("bg", *base), ("fg", r, "vector3"),
+                                                          ("mix", *arg(2))])
+            return one(make_composite)
+        if name in ("srgb_decode_per_component", "srgb_encode_per_component"):
+            decode = name.startswith("srgb_decode")
+
+            def make_srgb():
+                def v3(cat, suffix, *ins):
+                    return self.node(cat, "vector3", f"{hint}_{suffix}",
+                                     [(k, r, t) for k, (r, t) in zip(("in1", "in2"), ins)])
+
+                def f(x):
+                    return (("value", x), "float")
+                c = v3("max", "positive", arg(0), f(0.0))
+                cv = (c, "vector3")
+                if decode:  # IEC 61966-2-1
+                    edge = 0.04045
+                    linear = v3("divide", "linear", cv, f(12.92))
+                    curve = v3("power", "curve", (v3("divide", "scaled", (v3(
+                        "add", "offset", cv, f(0.055)), "vector3"), f(1.055)), "vector3"),
+                        f(2.4))
+                else:
+                    edge = 0.0031308
+                    linear = v3("multiply", "linear", cv, f(12.92))
+                    curve = v3("subtract", "curve", (v3("multiply", "scaled", (v3(
+                        "power", "root", cv, f(1.0 / 2.4)), "vector3"), f(1.055)), "vector3"),
+                        f(0.055))
+                parts = []
+                for i in range(3):
+                    # c <= edge is the linear segment: c > edge picks the curve
+                    parts.append(self.node("ifgreater", "float", f"{hint}_{'xyz'[i]}", [
+                        ("value1", self._extract(c, PortType.VEC3, i, hint), "float"),
+                        ("value2", ("value", edge), "float"),
+                        ("in1", self._extract(curve, PortType.VEC3, i, hint), "float"),
+                        ("in2", self._extract(linear, PortType.VEC3, i, hint), "float")]))
+                return combine(parts, PortType.VEC3)
+            return one(make_srgb)
+        if name == "rec709_dot":
+            from matedit.compiler.cpu_nodes import LUMA_REC709
+
+            return one(lambda: self.node("dotproduct", "float", hint, [
+                ("in1", *arg(0)), ("in2", ("value", tuple(LUMA_REC709)), "vector3")]))
+        if name == "rotate_about_pivot":
+            def make_rotate():
+                d = self.node("subtract", "vector2", f"{hint}_centred",
+                              [("in1", *arg(0)), ("in2", *arg(2))])
+                turn = self.node("multiply", "float", f"{hint}_cw",
+                                 [("in1", *arg(1)), ("in2", ("value", -1.0), "float")])
+                r = self.node("rotate2d", "vector2", f"{hint}_rotate",
+                              [("in", d, "vector2"), ("amount", turn, "float")])
+                return self.node("add", "vector2", hint, [("in1", r, "vector2"),
+                                                          ("in2", *arg(2))])
+            return one(make_rotate)
         if name == "positive_sqrt":
             return one(lambda: self.node("sqrt", mt, hint, [
                 ("in", self.node("max", mt, f"{hint}_max", [

@@ -24,7 +24,7 @@ from typing import Any
 
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.names import identifier_problem, mangle
-from matedit.graph.nodes import Role, kind_for
+from matedit.graph.nodes import Role, definition, kind_for
 from matedit.interop import mtlx_map
 from matedit.interop.mtlx_colorspace import from_materialx
 from matedit.io.atomic import read_bounded
@@ -107,7 +107,7 @@ class _Importer:
         self.errors: list[str] = []
         self.mat = MaterialDocument(kind=DocumentKind.MATERIAL, path=out)
         self.ids: set[str] = set()
-        self.done: dict[tuple[int, str], Src] = {}
+        self.done: dict[tuple[str, str], Src] = {}
         self.params: dict[str, Src] = {}
         self.count = 0
 
@@ -261,7 +261,9 @@ class _Importer:
 
     # --- nodes -----------------------------------------------------------------------------
     def node_src(self, node, output: str, depth: int) -> Src | None:
-        key = (id(node), node.getNamePath(), output)
+        # by name path: MaterialX hands out a new Python wrapper for each look-up, so a
+        # node read twice (a shared subgraph) is converted once
+        key = (node.getNamePath(), output)
         if key in self.done:
             return self.done[key]
         if depth > 2000:
@@ -283,27 +285,7 @@ class _Importer:
             for mxin, ours in ports.items():
                 self.connect(self.input_src(node, mxin, depth), nid, ours)
             self._defaults(node, nid, ports)
-            return Src(nid, "result", width=width)
-        if cat == "modulo":
-            in1 = self.input_src(node, "in1", depth) or Src(value=[0.0] * max(width, 1))
-            in2 = self.input_src(node, "in2", depth)
-            if in2 is None or (in2.node is None and all(v == 1.0 for v in in2.value)):
-                nid = self.add(name, _kind("modulo"), depth=depth)
-                self.connect(in1, nid, "value")
-                return Src(nid, "result", width=width)
-            # MaterialX's modulo is GLSL mod: a - b floor(a / b)
-            q = self.add(f"{name}_q", _kind("divide"), depth=depth)
-            self.connect(in1, q, "a")
-            self.connect(in2, q, "b")
-            f = self.add(f"{name}_floor", _kind("floor"), depth=depth)
-            self.connect(Src(q, "result"), f, "value")
-            m = self.add(f"{name}_m", _kind("multiply"), depth=depth)
-            self.connect(Src(f, "result"), m, "a")
-            self.connect(in2, m, "b")
-            nid = self.add(name, _kind("subtract"), depth=depth)
-            self.connect(in1, nid, "a")
-            self.connect(Src(m, "result"), nid, "b")
-            return Src(nid, "result", width=width)
+            return Src(nid, definition(kind).outputs[0].name, width=width)
         if cat == "extract":
             idx_in = node.getInput("index")
             idx = int(_floats(idx_in.getValueString(), where)[0]) if idx_in is not None else 0
@@ -366,6 +348,16 @@ class _Importer:
                 return None
             nid = self.add(name, _kind(cat), depth=depth)
             return Src(nid, "position" if cat == "position" else "normal", width=3)
+        if cat == "rotate2d":
+            # rotate2d turns clockwise by amount degrees about 0: ours by -amount
+            amount = self.input_src(node, "amount", depth) or Src(value=[0.0])
+            neg = self.add(f"{name}_ccw", _kind("multiply"), values={"b": -1.0}, depth=depth)
+            self.connect(amount, neg, "a")
+            nid = self.add(name, _kind("rotate_about_pivot"), values={"pivot": [0.0, 0.0]},
+                           depth=depth)
+            self.connect(self.input_src(node, "in", depth) or Src(value=[0.0, 0.0]), nid, "uv")
+            self.connect(Src(neg, "result"), nid, "angle")
+            return Src(nid, "uv", width=2)
         if cat == "viewdirection":
             v = self.add(f"{name}_eye", _kind("negated_viewdirection"), depth=depth)
             nid = self.add(name, _kind("multiply"), values={"b": [-1.0, -1.0, -1.0]}, depth=depth)
@@ -397,6 +389,9 @@ class _Importer:
             if ours in values or ours in linked or node.getInput(mxin) is not None:
                 continue
             d = nd.getActiveInput(mxin)
+            if d is not None and d.getDefaultGeomPropString():
+                self._geometry_default(node, nid, ours, d.getDefaultGeomPropString())
+                continue
             if d is None or not d.getValueString():
                 continue
             try:
@@ -404,6 +399,20 @@ class _Importer:
             except ValueError:
                 continue
             values[ours] = vals[0] if len(vals) == 1 else vals
+
+    def _geometry_default(self, node, nid: str, ours: str, geomprop: str) -> None:
+        """An unset input that MaterialX reads from the geometry (reflect's normal is the
+        world normal): the same geometry node of ours, or an error naming it."""
+        name = node.getName()
+        if geomprop == "Nworld":
+            src = Src(self.add(f"{name}_{ours}", _kind("normal")), "normal", width=3)
+        elif geomprop == "UV0":
+            src = Src(self.add(f"{name}_{ours}", _kind("tiled_texcoord")), "uv", width=2)
+        else:
+            self.err(f"node {self.name_of(node)}: input {ours!r} defaults to the geometric "
+                     f"property {geomprop!r}, which is not supported: connect it")
+            return
+        self.connect(src, nid, ours)
 
     def image(self, node, depth: int, where: str, width: int) -> Src | None:
         file_in = node.getInput("file")

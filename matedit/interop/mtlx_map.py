@@ -60,12 +60,16 @@ def direct() -> dict[str, tuple[str, dict[str, str]]]:
 def kind_mapped_to(name: str) -> str:
     """The catalogue kind that exports as the stdlib node `name` (an MxNode category, first
     registered wins) or as the recipe `name`: what the importer builds when it reads one
-    back."""
-    for kind, d in nodes.REGISTRY.items():
-        m = d.mtlx
-        if (isinstance(m, MxNode) and m.category == name) or \
-                (isinstance(m, MxRecipe) and m.name == name):
-            return kind
+    back. A kind that maps to the node with no fixed inputs wins over one that fixes some
+    (MaterialX's modulo reads back as our mod, not as frac's modulo by 1)."""
+    for one_for_one in (True, False):
+        for kind, d in nodes.REGISTRY.items():
+            m = d.mtlx
+            if isinstance(m, MxNode) and m.category == name and \
+                    (not m.fixed or not one_for_one):
+                return kind
+            if isinstance(m, MxRecipe) and m.name == name:
+                return kind
     raise LookupError(f"no catalogue kind exports as MaterialX {name!r}")
 
 
