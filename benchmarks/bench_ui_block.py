@@ -37,7 +37,7 @@ TICK_MS = 5
 def child(warm: bool, edits: int) -> dict:
     os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
     sys.path.insert(0, str(HERE))
-    from bench_editor import start_display
+    from bench_editor import open_editor, start_display
 
     display = start_display()
     from PySide6.QtCore import QEventLoop, QStandardPaths, Qt, QTimer
@@ -48,18 +48,12 @@ def child(warm: bool, edits: int) -> dict:
     app = make_application()
     from matedit.app.compile_service import MaterialCompiler
     from matedit.app.compile_worker import CompileWorker
-    from matedit.app.main_window import MainWindow
     from matedit.graph.commands import AddNode, Connect
     from matedit.graph.model import Link, Node
 
     MaterialCompiler.asynchronous = True  # as matedit.app.app.run
     CompileWorker.warm_up = warm  # off: no child process at all
-    w = MainWindow(restore_layout=False)
-    w.resize(1600, 1000)
-    w.show()
-    view = w.viewport.view
-    while view.renderer is None and not view.problem:
-        app.processEvents()
+    w, view = open_editor(app)
     if view.renderer is None:
         return {"error": f"no renderer: {view.problem}"}
 

@@ -65,58 +65,11 @@ def open_editor(argv: list[str]) -> int:
             raise UsageError(str(exc)) from None
         if doc.is_function:
             raise UsageError(f"{path}: is a material function; open a material that uses it")
-    from matedit.app.app import run
+    from matedit.app.app import quit_after_first_frame, run
 
     if os.environ.get(QUIT_AFTER_FIRST_FRAME):
-        _quit_after_first_frame(os.environ[QUIT_AFTER_FIRST_FRAME])
+        quit_after_first_frame(os.environ[QUIT_AFTER_FIRST_FRAME])
     return run(path)
-
-
-def _quit_after_first_frame(setting: str) -> None:
-    """MATEDIT_QUIT_AFTER_FIRST_FRAME=SECONDS: the editor exits with status 0 once its
-    viewport has drawn a frame with the material's program, or with status 1 and an
-    `error:` line when it has not within SECONDS (a non-number means 120). For smoke tests
-    of an installed build; it changes nothing else."""
-    from PySide6.QtCore import QTimer
-
-    from matedit.app.app import make_application
-    from matedit.app.viewport import ViewportWidget
-
-    try:
-        limit = float(setting)
-    except ValueError:
-        limit = 120.0
-    if not limit > 1:
-        limit = 120.0
-    app = make_application()  # run() reuses this instance
-
-    def arm() -> None:
-        views = [v for w in app.topLevelWidgets() for v in w.findChildren(ViewportWidget)]
-        if not views:
-            QTimer.singleShot(20, arm)
-            return
-        view = views[0]
-        compiler = getattr(view.window(), "compiler", None)
-
-        def on_frame() -> None:
-            # A compiled material reaches the renderer before the frame after it is drawn.
-            if view.renderer is not None and getattr(compiler, "current", None) is not None:
-                print(f"matedit: viewport frame drawn, {view.width()}x{view.height()}",
-                      file=sys.stderr)
-                app.exit(0)
-
-        view.frameDrawn.connect(on_frame)
-        view.update()  # the first frame may already be on screen: ask for one more
-
-    def give_up() -> None:
-        view = next((v for w in app.topLevelWidgets() for v in w.findChildren(ViewportWidget)),
-                    None)
-        why = (view.problem if view is not None else "") or "no viewport frame"
-        print(f"error: no first frame within {limit:g} s: {why}", file=sys.stderr)
-        app.exit(1)
-
-    QTimer.singleShot(0, arm)
-    QTimer.singleShot(int(limit * 1000), give_up)
 
 
 def main(argv: list[str] | None = None) -> int:
