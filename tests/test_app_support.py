@@ -1,7 +1,7 @@
 """Shared set-up for the editor's GUI tests (pytest-qt under Xvfb; imported, holds no tests).
 
 Importing this module before the QApplication exists asks for OpenGL 3.3 core
-contexts (what the viewport's renderer needs) and isolates QSettings and the
+contexts (what the viewport's renderer needs) and isolates the
 autosave folder in Qt's test locations, emptied for each test.
 """
 
@@ -32,12 +32,7 @@ QStandardPaths.setTestModeEnabled(True)
 if "MATEDIT_RECOVERY_DIR" not in os.environ:
     os.environ["MATEDIT_RECOVERY_DIR"] = tempfile.mkdtemp(prefix="matedit-recovery-")
     atexit.register(shutil.rmtree, os.environ["MATEDIT_RECOVERY_DIR"], True)
-# QSettings of this test run only: test mode alone puts every run on the machine in one
-# ~/.qttest file, where one run's clear() wipes what another just saved.
-_SETTINGS_DIR = tempfile.mkdtemp(prefix="matedit-settings-")
-atexit.register(shutil.rmtree, _SETTINGS_DIR, True)
-for _format in (QSettings.Format.NativeFormat, QSettings.Format.IniFormat):
-    QSettings.setPath(_format, QSettings.Scope.UserScope, _SETTINGS_DIR)
+# QSettings of this test run only: tests/conftest.py points them at a folder per run.
 
 
 @pytest.fixture
