@@ -283,8 +283,19 @@ def builtin_mesh(name: str) -> MeshData:
 
 
 def mesh_from_spec(spec: str | Path) -> MeshData:
-    s = str(spec)
-    return builtin_mesh(s) if s in BUILTIN_MESHES else load_obj(s)
+    """`builtin:NAME` or a bare built-in name (text only), else an OBJ file
+    (`matedit.io.inputs.builtin_name`: `./sphere` is a file)."""
+    from matedit.io.inputs import BuiltinNameError, builtin_name, spellings
+
+    try:
+        name = builtin_name(spec, "mesh")
+    except BuiltinNameError as exc:
+        raise MeshError(str(exc)) from None
+    if name is not None:
+        return builtin_mesh(name)
+    if not Path(spec).exists():
+        raise MeshError(f"{spec}: no such file (a mesh is {spellings('mesh')})")
+    return load_obj(spec)
 
 
 class GpuMesh:
