@@ -145,9 +145,9 @@ def load_environment(spec: str | os.PathLike, size: int = 256) -> Environment:
         return builtin(name, size)
     text = os.fspath(spec)
     path = Path(text)
-    if path.is_dir():
+    if os.path.isdir(path):  # isdir and exists are False, not errors, for over-long names
         return load_cube_faces(path)
-    if not path.exists():
+    if not os.path.exists(path):
         raise EnvironmentMapError(f"{text}: no such file or folder (an environment is "
                                   f"{spellings('environment')})")
     try:

@@ -103,7 +103,7 @@ def cube_face_files(folder: str | os.PathLike) -> list[tuple[str, Path]]:
     except OSError:
         return []
     for p in entries:
-        if p.suffix.lower() in FACE_EXTENSIONS and p.is_file():
+        if p.suffix.lower() in FACE_EXTENSIONS and os.path.isfile(p):
             key = face_key(p.stem)
             if key is not None:
                 out.append((key, p))
@@ -113,7 +113,7 @@ def cube_face_files(folder: str | os.PathLike) -> list[tuple[str, Path]]:
 def environment_files(path: str | os.PathLike) -> list[Path]:
     """The files an environment at `path` reads: its cube faces for a folder, else itself."""
     p = Path(path)
-    return [f for _, f in cube_face_files(p)] if p.is_dir() else [p]
+    return [f for _, f in cube_face_files(p)] if os.path.isdir(p) else [p]
 
 
 def preview_file(doc, key: str) -> Path | None:
@@ -218,7 +218,7 @@ def command_inputs(args, documents: Iterable = (), resolver=None,
             if not isinstance(v, str) or not v:
                 continue
             if kind in ("document", "documents"):  # read in full through `documents`
-                if not Path(v).is_dir():
+                if not os.path.isdir(v):  # False, not an error, for an over-long name
                     found.setdefault(_real(v), "the document")
                 continue
             if kind == "rig" and v in ("default", "none"):

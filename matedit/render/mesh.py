@@ -7,6 +7,7 @@ UVs, triangle indices); `GpuMesh` uploads it to a moderngl context.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -293,7 +294,7 @@ def mesh_from_spec(spec: str | Path) -> MeshData:
         raise MeshError(str(exc)) from None
     if name is not None:
         return builtin_mesh(name)
-    if not Path(spec).exists():
+    if not os.path.lexists(spec):  # False for a name no file can have
         raise MeshError(f"{spec}: no such file (a mesh is {spellings('mesh')})")
     return load_obj(spec)
 
