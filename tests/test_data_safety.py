@@ -582,6 +582,39 @@ def test_no_command_writes_over_any_input(tmp_path, command, kind, how):
     assert victim.read_bytes() == before
 
 
+MULTI_FILE_OUTPUTS = {  # command -> its arguments, the input planted, each of its file names
+    "compile": (lambda p, o: ["compile", p["document"], "-o", o, "--target", "glsl330"],
+                ["m.glsl330.vert", "m.glsl330.frag", "m.reflection.json"]),
+    "bake": (lambda p, o: ["bake", p["document"], "-o", o, "--size", "8"],
+             [f"m_{n}.png" for n in ("base_color", "normal", "orm", "emissive", "opacity")]),
+    "bake-ibl": (lambda p, o: ["bake-ibl", p["preview_face"].parent, "-o", o, "--size", "16",
+                               "--samples", "16"],
+                 ["prefiltered_mip0.exr", "prefiltered_mip4.exr", "brdf_lut.exr", "sh.json",
+                  "ibl.json"]),
+    "export": (lambda p, o: ["export", p["document"], "-o", o / "m.gltf", "--size", "8"],
+               ["m.gltf", "m.bin"]),
+}
+
+
+@pytest.mark.parametrize("command, file", [(c, f) for c, (_, files) in
+                                           MULTI_FILE_OUTPUTS.items() for f in files])
+def test_every_file_of_a_multi_file_output_is_checked(tmp_path, command, file):
+    """Each file name of a multi-file output, planted as a link to a cube face of the
+    material's preview environment (for bake-ibl: of the folder it bakes)."""
+    argv, _ = MULTI_FILE_OUTPUTS[command]
+    p = _input_tree(tmp_path)
+    face = p["preview_face"]
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / file).symlink_to(face)
+    before = face.read_bytes()
+    rc, _, err = cli(*argv(p, out))
+    assert_clean_failure(rc, err)
+    assert len(err.strip().splitlines()) == 1 and "refusing to write over" in err, err
+    assert str(face) in err and face.read_bytes() == before
+    assert sorted(x.name for x in out.iterdir()) == [file]
+
+
 # --- import -o DIR never replaces a material silently ---------------------------------------
 
 def test_import_into_a_folder_refuses_an_existing_material_without_overwrite(tmp_path):

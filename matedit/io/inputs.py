@@ -21,10 +21,10 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-BUILTIN_MESHES = frozenset({"sphere", "cube", "plane", "cylinder"})
-BUILTIN_ENVIRONMENTS = frozenset({"studio", "sky"})
+BUILTIN_MESHES = ("sphere", "cube", "plane", "cylinder")
+BUILTIN_ENVIRONMENTS = ("studio", "sky")
 BUILTIN_PREFIX = "builtin:"
-_BUILTINS = {"mesh": ("sphere", "cube", "plane", "cylinder"), "environment": ("studio", "sky")}
+_BUILTINS = {"mesh": BUILTIN_MESHES, "environment": BUILTIN_ENVIRONMENTS}
 
 # The kinds of input a command argument may name (see `declare_inputs`).
 INPUT_KINDS = ("document", "documents", "mesh", "environment", "rig", "mtlx")
@@ -185,7 +185,7 @@ def declare_inputs(parser, **kinds: str) -> None:
     """Record on a command's parser which arguments name inputs, and of which kind:
     'document' (a loaded material or instance, passed to `command_inputs`), 'documents'
     (the files or folders of several), 'mesh', 'environment', 'rig' (a light-rig file, or
-    default/none) or 'mtlx' (a MaterialX document). A command that reads nothing declares nothing,
+    default/none) or 'mtlx' (a MaterialX document). A command that reads nothing says so
     explicitly: `declare_inputs(p)`."""
     bad = [k for k in kinds.values() if k not in INPUT_KINDS]
     if bad:
