@@ -710,17 +710,18 @@ def builtin_lookalikes(tmp_path, monkeypatch):
 
 @pytest.mark.gl
 @pytest.mark.parametrize("options, error", [
-    ([], None),  # the defaults are built-ins too
-    (["--env", "studio"], None),
-    (["--env", "builtin:studio"], None),
-    (["--env", "sky", "--mesh", "builtin:cube"], None),
-    (["--mesh", "sphere"], None),
-    (["--env", "./studio"], "studio: a folder environment needs six cube-face files"),
-    (["--mesh", "./sphere"], "is a folder"),
-    (["--env", "builtin:studi0"], "builtin:studio, builtin:sky"),
-    (["--mesh", "builtin:ball"], "builtin:sphere, builtin:cube"),
-    (["--env", "stuido"], "builtin:studio, builtin:sky"),
-    (["--mesh", "spehre"], "builtin:sphere, builtin:cube"),
+    pytest.param([], None, id="defaults"),  # the defaults are built-ins too
+    pytest.param(["--env", "studio"], None, id="studio"),
+    pytest.param(["--env", "builtin:studio"], None, id="builtin:studio"),
+    pytest.param(["--env", "sky", "--mesh", "builtin:cube"], None, id="sky-builtin:cube"),
+    pytest.param(["--mesh", "sphere"], None, id="sphere"),
+    pytest.param(["--env", "./studio"], "studio: a folder environment needs six cube-face "
+                 "files", id="./studio"),
+    pytest.param(["--mesh", "./sphere"], "is a folder", id="./sphere"),
+    pytest.param(["--env", "builtin:studi0"], "builtin:studio, builtin:sky", id="builtin:typo"),
+    pytest.param(["--mesh", "builtin:ball"], "builtin:sphere, builtin:cube", id="builtin:ball"),
+    pytest.param(["--env", "stuido"], "builtin:studio, builtin:sky", id="env-typo"),
+    pytest.param(["--mesh", "spehre"], "builtin:sphere, builtin:cube", id="mesh-typo"),
 ])
 def test_render_built_in_names_beside_folders_of_those_names(builtin_lookalikes, options,
                                                             error):
