@@ -367,3 +367,386 @@ def test_a_file_that_loads_also_saves(tmp_path):
     assert loads(dumps(doc), "m.json").graph.nodes["r"].values["value"] == 10**300
     with pytest.raises(FormatError, match="64-bit float"):
         loads(json.dumps(raw).replace(str(10**300), "1" + "0" * 400), "m.json")
+
+
+# === Every command's inputs, built-in names, import -o DIR (issue 22) =========================
+#
+# One tree holds every kind of input a command reads; each case plants one of them at one of
+# a command's output names, directly (the input is read at that very name), through a
+# symbolic link or a hard link, or is read through a link whose target is the output name.
+# The command must exit 2 with one `error:` line naming the input and leave it unchanged.
+
+_FACES = ("px", "nx", "py", "ny", "pz", "nz")
+_TRIANGLE_OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+
+
+def _mtlx_text(image: str) -> str:
+    return ('<?xml version="1.0"?>\n<materialx version="1.39">\n'
+            '<nodegraph name="NG"><image name="img" type="color3"><input name="file" '
+            f'type="filename" value="{image}"/></image>'
+            '<output name="o" type="color3" nodename="img"/></nodegraph>'
+            '<standard_surface name="S" type="surfaceshader"><input name="base_color" '
+            'type="color3" nodegraph="NG" output="o"/></standard_surface>'
+            '<surfacematerial name="mat" type="material"><input name="surfaceshader" '
+            'type="surfaceshader" nodename="S"/></surfacematerial>\n</materialx>\n')
+
+
+def _rel(path, start) -> str:
+    return os.path.relpath(path, start).replace(os.sep, "/")
+
+
+def _faces(px_path) -> list:
+    """The six face files of a folder environment whose +X face is `px_path` (NAME_px.EXT)."""
+    stem, ext = px_path.name.rsplit(".", 1)
+    prefix = stem[:-2]
+    return [px_path.with_name(f"{prefix}{f}.{ext}") for f in _FACES]
+
+
+def _input_tree(tmp, at=None):
+    """Every kind of input under tmp/src, the one in `at` (kind -> path) placed there
+    instead; returns kind -> the file of that kind (for faces: the +X face)."""
+    import numpy as np
+
+    from matedit.io.images import write_image
+
+    at = at or {}
+    src = tmp / "src"
+    src.mkdir(exist_ok=True)
+    defaults = {"texture": "albedo.png", "function": "f.json", "preview_mesh": "pm.obj",
+                "preview_face": "penv/sky_px.hdr", "mesh": "mesh.obj",
+                "env_face": "env/sky_px.hdr", "env_file": "env.hdr", "rig": "rig.json",
+                "mtlx": "a.mtlx", "mtlx_image": "mx.png"}
+    p = {k: at.get(k, src / v) for k, v in defaults.items()}
+    for f in p.values():
+        f.parent.mkdir(parents=True, exist_ok=True)
+    pixels = np.full((4, 4, 3), 0.5, np.float32)
+    write_image(p["texture"], pixels) if p["texture"].suffix == ".png" else \
+        p["texture"].write_bytes(b"texture")
+    p["mtlx_image"].write_bytes(p["texture"].read_bytes())
+    write(p["function"], function_doc())
+    for k in ("preview_mesh", "mesh"):
+        p[k].write_text(_TRIANGLE_OBJ)
+    for k in ("preview_face", "env_face"):
+        for f in _faces(p[k]):
+            if not f.exists():
+                f.write_bytes(b"face " + f.name.encode())
+    write_image(p["env_file"], np.ones((8, 16, 3), np.float32)) \
+        if p["env_file"].suffix == ".hdr" else p["env_file"].write_bytes(b"environment")
+    write(p["rig"], {"format": "matedit.lightrig", "version": 1, "lights": []})
+    p["mtlx"].write_text(_mtlx_text(_rel(p["mtlx_image"], p["mtlx"].parent)))
+    raw = base_material()
+    raw["nodes"] += [
+        {"id": "tex", "kind": "texture_parameter", "position": [0, 300],
+         "settings": {"name": "albedo", "path": _rel(p["texture"], src)}},
+        {"id": "samp", "kind": "texture_sample", "position": [200, 300]},
+        {"id": "fn", "kind": "function_call", "position": [200, 500],
+         "settings": {"function": _rel(p["function"], src)}},
+    ]
+    raw["links"] = [l for l in raw["links"] if l["to"] != ["make", "baseColor"]]
+    raw["links"] += [{"from": ["tex", "texture"], "to": ["samp", "texture"]},
+                     {"from": ["samp", "rgb"], "to": ["make", "baseColor"]},
+                     {"from": ["r", "value"], "to": ["fn", "a"]},
+                     {"from": ["fn", "result"], "to": ["make", "metallic"]}]
+    raw["preview"] = {"mesh": _rel(p["preview_mesh"], src),
+                      "environment": _rel(p["preview_face"].parent, src)}
+    p["document"] = write(src / "m.json", raw)
+    p["parent"] = p["document"]
+    p["instance"] = write(src / "inst.json", {"format": "matedit.instance", "version": 2,
+                                              "parent": "m.json", "parameters": {}})
+    return p
+
+
+# command -> (the kinds of input it reads, the output file a case plants, its arguments).
+# `o` is the output folder; `p` the tree; `kind` the case's. A name None: no direct case.
+def _compile(p, o, kind):
+    return ["compile", p["instance"] if kind == "parent" else p["document"], "-o", o]
+
+
+def _render(p, o, kind):
+    extra = {"mesh": ["--mesh", p["mesh"]], "env_face": ["--env", p["env_face"].parent],
+             "env_file": ["--env", p["env_file"]], "rig": ["--lights", p["rig"]]}
+    out = o / ("r_px.exr" if kind.endswith("face") else "r.exr")
+    return ["render", p["instance"] if kind == "parent" else p["document"], "-o", out,
+            "--size", "16x16", *extra.get(kind, [])]
+
+
+def _sheet(p, o, kind):
+    out = o / ("s_px.png" if kind.endswith("face") else "s.png")
+    return ["contact-sheet", p["document"], "-o", out, "--size", "32",
+            *(["--mesh", p["mesh"]] if kind == "mesh" else [])]
+
+
+def _export(suffix):
+    def argv(p, o, kind):
+        return ["export", p["document"], "-o", o / f"m.{suffix}", "--size", "8",
+                *(["--mesh", p["mesh"]] if kind == "mesh" else [])]
+    return argv
+
+
+_DOC_KINDS = ("document", "texture", "function", "preview_mesh", "preview_face")
+COMMAND_CASES = {
+    "compile": (_DOC_KINDS + ("parent",), lambda kind: "inst.reflection.json"
+                if kind == "parent" else "m.reflection.json", _compile),
+    "render": (_DOC_KINDS + ("parent", "mesh", "env_face", "env_file", "rig"),
+               lambda kind: "r_px.exr" if kind.endswith("face") else "r.exr", _render),
+    "bake-ibl": (("env_face", "env_file"), lambda kind: "ibl.json",
+                 lambda p, o, kind: ["bake-ibl", p[kind].parent if kind == "env_face"
+                                     else p[kind], "-o", o, "--size", "16", "--samples", "16"]),
+    "contact-sheet": (_DOC_KINDS + ("mesh",),
+                      lambda kind: "s_px.png" if kind.endswith("face") else "s.png", _sheet),
+    "bake": (_DOC_KINDS, lambda kind: "m_orm.png",
+             lambda p, o, kind: ["bake", p["document"], "-o", o, "--size", "8"]),
+    "export": (("document", "texture", "function", "preview_mesh", "mesh"),
+               lambda kind: "m.bin", _export("gltf")),
+    "export .mtlx": (("document", "texture", "function"), lambda kind: "m.mtlx",
+                     _export("mtlx")),
+    "import": (("mtlx", "mtlx_image"), lambda kind: "mat.json",
+               lambda p, o, kind: ["import", p["mtlx"], "-o", o]),
+    "import .json": (("mtlx", "mtlx_image"), lambda kind: "mat.json",
+                     lambda p, o, kind: ["import", p["mtlx"], "-o", o / "mat.json"]),
+}
+# Commands that write no file: their declaration must say they read nothing to protect, or
+# only documents (validate).
+NO_OUTPUT = {"validate", "nodes", "brdf-lut"}
+
+
+def _direct_ok(command, kind, name) -> bool:
+    """Whether the input can itself sit at the output name and still be read as that kind."""
+    if kind in ("document", "parent"):
+        return False  # a document's outputs are named after it
+    if kind.endswith("face"):
+        return name.rsplit(".", 1)[0].endswith("_px")
+    return True
+
+
+def _cases():
+    for command, (kinds, name, _) in COMMAND_CASES.items():
+        for kind in kinds:
+            for how in ("direct", "symlink", "hardlink", "read through a link"):
+                if how == "direct" and not _direct_ok(command, kind, name(kind)):
+                    continue
+                if how == "read through a link" and kind == "parent":
+                    continue  # an instance reads its parent's references from the real file
+                yield pytest.param(command, kind, how, id=f"{command}-{kind}-{how}")
+
+
+def test_every_command_declares_its_inputs():
+    """Every command of the parser declares its inputs; a new command without a declaration,
+    or one writing files that this section has no cases for, fails here."""
+    from matedit.cli import build_parser, subcommand_names
+
+    parser = build_parser()
+    names = subcommand_names(parser)
+    sub = next(a for a in parser._actions if a.dest == "command")
+    covered = {c.split(" ")[0] for c in COMMAND_CASES}
+    assert names == covered | NO_OUTPUT, "a command with no input cases here"
+    for name in names:
+        declared = sub.choices[name].get_default("inputs")
+        assert isinstance(declared, dict), f"{name} declares no inputs (declare_inputs)"
+        if name in COMMAND_CASES:
+            assert declared, name
+    from matedit.io.inputs import command_inputs
+
+    with pytest.raises(LookupError, match="declares no inputs"):
+        import argparse
+
+        command_inputs(argparse.Namespace(command="new"))
+
+
+@pytest.mark.parametrize("command, kind, how", list(_cases()))
+def test_no_command_writes_over_any_input(tmp_path, command, kind, how):
+    _, name, argv = COMMAND_CASES[command]
+    out = tmp_path / "out"
+    out.mkdir()
+    planted = out / name(kind)
+    if how == "direct":
+        p = _input_tree(tmp_path, {kind: planted})
+        victim = planted
+    else:
+        p = _input_tree(tmp_path)
+        victim = p[kind]
+        if how == "symlink":
+            planted.symlink_to(victim)
+        elif how == "hardlink":
+            os.link(victim, planted)
+        else:  # the command reads the input through a link to the output name
+            os.replace(victim, planted)
+            victim.symlink_to(planted)
+            victim = planted
+    before = victim.read_bytes()
+    rc, _, err = cli(*argv(p, out, kind))
+    assert_clean_failure(rc, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "refusing to write over" in lines[0], err
+    assert str(os.path.realpath(victim)) in lines[0], err
+    assert victim.read_bytes() == before
+
+
+MULTI_FILE_OUTPUTS = {  # command -> its arguments, the input planted, each of its file names
+    "compile": (lambda p, o: ["compile", p["document"], "-o", o, "--target", "glsl330"],
+                ["m.glsl330.vert", "m.glsl330.frag", "m.reflection.json"]),
+    "bake": (lambda p, o: ["bake", p["document"], "-o", o, "--size", "8"],
+             [f"m_{n}.png" for n in ("base_color", "normal", "orm", "emissive", "opacity")]),
+    "bake-ibl": (lambda p, o: ["bake-ibl", p["preview_face"].parent, "-o", o, "--size", "16",
+                               "--samples", "16"],
+                 ["prefiltered_mip0.exr", "prefiltered_mip4.exr", "brdf_lut.exr", "sh.json",
+                  "ibl.json"]),
+    "export": (lambda p, o: ["export", p["document"], "-o", o / "m.gltf", "--size", "8"],
+               ["m.gltf", "m.bin"]),
+}
+
+
+@pytest.mark.parametrize("command, file", [(c, f) for c, (_, files) in
+                                           MULTI_FILE_OUTPUTS.items() for f in files])
+def test_every_file_of_a_multi_file_output_is_checked(tmp_path, command, file):
+    """Each file name of a multi-file output, planted as a link to a cube face of the
+    material's preview environment (for bake-ibl: of the folder it bakes)."""
+    argv, _ = MULTI_FILE_OUTPUTS[command]
+    p = _input_tree(tmp_path)
+    face = p["preview_face"]
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / file).symlink_to(face)
+    before = face.read_bytes()
+    rc, _, err = cli(*argv(p, out))
+    assert_clean_failure(rc, err)
+    assert len(err.strip().splitlines()) == 1 and "refusing to write over" in err, err
+    assert str(face) in err and face.read_bytes() == before
+    assert sorted(x.name for x in out.iterdir()) == [file]
+
+
+# --- import -o DIR never replaces a material silently ---------------------------------------
+
+def test_import_into_a_folder_refuses_an_existing_material_without_overwrite(tmp_path):
+    p = _input_tree(tmp_path)
+    out = tmp_path / "mats"
+    assert cli("import", p["mtlx"], "-o", out)[0] == 0
+    target = out / "mat.json"
+    target.write_text("my edits")
+    decoy = tmp_path / "decoy.txt"
+    decoy.write_text("precious")
+    rc, _, err = cli("import", p["mtlx"], "-o", out)
+    assert_clean_failure(rc, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and str(target) in lines[0] and "--overwrite" in lines[0], err
+    assert target.read_text() == "my edits"
+    target.unlink()
+    target.symlink_to(decoy)  # anything at the name, a link too, is refused
+    rc, _, err = cli("import", p["mtlx"], "-o", out, "--material", "mat")
+    assert_clean_failure(rc, err)
+    assert str(target) in err and decoy.read_text() == "precious"
+    target.unlink()
+    target.write_text("my edits")
+    rc, _, err = cli("import", p["mtlx"], "-o", out, "--overwrite")
+    assert rc == 0, err
+    assert json.loads(target.read_text())["format"] == "matedit.material"
+
+
+# --- built-in names against files and folders of the same name ------------------------------
+
+def test_builtin_names_and_paths_are_told_apart(tmp_path):
+    from matedit.io.inputs import BuiltinNameError, as_reference, builtin_name
+
+    assert builtin_name("studio", "environment") == "studio"
+    assert builtin_name("builtin:sky", "environment") == "sky"
+    assert builtin_name("builtin:cube", "mesh") == "cube"
+    for path in ("./studio", "studio/", str(tmp_path / "studio"), "a/studio", "Studio"):
+        assert builtin_name(path, "environment") is None, path
+    assert builtin_name(tmp_path / "sphere", "mesh") is None  # a Path is always a file
+    assert builtin_name("sphere", "environment") is None  # a mesh's name, not an environment's
+    with pytest.raises(BuiltinNameError, match="builtin:studio, builtin:sky"):
+        builtin_name("builtin:nope", "environment")
+    assert as_reference("studio", "environment") == "./studio"
+    assert as_reference("builtin:x", "mesh") == "./builtin:x"
+    assert as_reference("studio", "mesh") == "studio"
+
+
+def test_a_preview_built_in_is_no_file_and_a_path_is(tmp_path):
+    from matedit.io.inputs import document_inputs, preview_file
+
+    (tmp_path / "studio").mkdir()
+    for f in _FACES:
+        (tmp_path / "studio" / f"{f}.hdr").write_bytes(b"face")
+    (tmp_path / "sphere").write_text(_TRIANGLE_OBJ)
+    for preview, files in [({"environment": "studio", "mesh": "sphere"}, set()),
+                           ({"environment": "builtin:studio", "mesh": "builtin:sphere"}, set()),
+                           ({"environment": "./studio", "mesh": "./sphere"},
+                            {f"studio/{f}.hdr" for f in _FACES} | {"sphere"})]:
+        raw = base_material()
+        raw["preview"] = preview
+        doc = load(write(tmp_path / "m.json", raw))
+        assert (preview_file(doc, "environment") is None) == (not files)
+        found = {_rel(p, tmp_path) for p in document_inputs(doc)} - {"m.json"}
+        assert found == files, preview
+
+
+def test_an_instance_moved_beside_its_preview_folder_keeps_it_a_path(tmp_path):
+    from matedit.io.instance import load_instance, save_instance
+
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b" / "studio").mkdir(parents=True)
+    write(tmp_path / "m.json", base_material())
+    write(tmp_path / "a" / "inst.json", {"format": "matedit.instance", "version": 2,
+                                         "parent": "../m.json", "parameters": {},
+                                         "preview": {"environment": "../b/studio",
+                                                     "mesh": "cube"}})
+    doc = load_instance(tmp_path / "a" / "inst.json")
+    save_instance(doc, tmp_path / "b" / "inst.json")
+    saved = json.loads((tmp_path / "b" / "inst.json").read_text())
+    assert saved["preview"] == {"environment": "./studio", "mesh": "cube"}
+
+
+@pytest.fixture
+def builtin_lookalikes(tmp_path, monkeypatch):
+    """A working folder holding a folder `studio`, a folder `sphere` and a file `sky`."""
+    (tmp_path / "studio").mkdir()
+    (tmp_path / "studio" / "notes.txt").write_text("not an environment")
+    (tmp_path / "sphere").mkdir()
+    (tmp_path / "sky").write_text("not an image")
+    write(tmp_path / "m.json", base_material())
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("options, error", [
+    pytest.param([], None, id="defaults"),  # the defaults are built-ins too
+    pytest.param(["--env", "studio"], None, id="studio"),
+    pytest.param(["--env", "builtin:studio"], None, id="builtin:studio"),
+    pytest.param(["--env", "sky", "--mesh", "builtin:cube"], None, id="sky-builtin:cube"),
+    pytest.param(["--mesh", "sphere"], None, id="sphere"),
+    pytest.param(["--env", "./studio"], "studio: a folder environment needs six cube-face "
+                 "files", id="./studio"),
+    pytest.param(["--mesh", "./sphere"], "is a folder", id="./sphere"),
+    pytest.param(["--env", "builtin:studi0"], "builtin:studio, builtin:sky", id="builtin:typo"),
+    pytest.param(["--mesh", "builtin:ball"], "builtin:sphere, builtin:cube", id="builtin:ball"),
+    pytest.param(["--env", "stuido"], "builtin:studio, builtin:sky", id="env-typo"),
+    pytest.param(["--mesh", "spehre"], "builtin:sphere, builtin:cube", id="mesh-typo"),
+])
+def test_render_built_in_names_beside_folders_of_those_names(builtin_lookalikes, options,
+                                                            error):
+    rc, _, err = cli("render", "m.json", "-o", "out.png", "--size", "16x16", *options)
+    if error is None:
+        assert rc == 0, err
+        assert (builtin_lookalikes / "out.png").is_file()
+    else:
+        assert_clean_failure(rc, err)
+        assert len(err.strip().splitlines()) == 1 and error in err, err
+
+
+@pytest.mark.gl
+def test_other_commands_read_built_in_names_beside_folders(builtin_lookalikes):
+    rc, _, err = cli("bake-ibl", "studio", "-o", "ibl", "--size", "16", "--samples", "16")
+    assert rc == 0, err
+    rc, _, err = cli("bake-ibl", "./studio", "-o", "ibl2", "--size", "16", "--samples", "16")
+    assert_clean_failure(rc, err)
+    assert "six cube-face files" in err and not (builtin_lookalikes / "ibl2").exists()
+    rc, _, err = cli("export", "m.json", "-o", "m.gltf", "--size", "8", "--mesh", "sphere")
+    assert rc == 0, err
+    rc, _, err = cli("export", "m.json", "-o", "n.gltf", "--size", "8", "--mesh", "./sphere")
+    assert_clean_failure(rc, err)
+    raw = base_material()
+    raw["preview"] = {"environment": "builtin:sky", "mesh": "sphere"}
+    write(builtin_lookalikes / "p.json", raw)
+    rc, _, err = cli("render", "p.json", "-o", "p.png", "--size", "16x16")
+    assert rc == 0, err

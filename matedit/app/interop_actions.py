@@ -147,13 +147,11 @@ class InteropActions:
             out = out.with_suffix(".glb")
         from matedit.interop import gltf
         from matedit.interop.bake import bake_attributes, maps_from
-        from matedit.io.inputs import BUILTIN_MESHES, preview_file, refuse_overwrite
+        from matedit.io.inputs import preview_spec, refuse_overwrite
         from matedit.render.mesh import mesh_from_spec
 
         try:
-            named = self.doc.preview.get("mesh") if isinstance(self.doc.preview, dict) else None
-            mesh_spec = preview_file(self.doc, "mesh") or (
-                named if named in BUILTIN_MESHES else "sphere")
+            mesh_spec = preview_spec(self.doc, "mesh", "sphere")  # builtin:cube, cube or a file
             outs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
             refuse_overwrite(outs, self._inputs())
             attrs, ir = _in_worker(lambda ctx: bake_attributes(ctx, self.doc, self.resolver,

@@ -678,24 +678,30 @@ class ViewportPanel(QWidget):
         as a path relative to the document, like every reference it holds."""
         import os
 
+        from matedit.io.inputs import as_reference
+
         env = self.view._environment
         if env not in ENVIRONMENTS.values():
-            try:
-                env = Path(os.path.relpath(Path(env).resolve(),
-                                           Path(saved_as).resolve().parent)).as_posix()
+            try:  # a file named like a built-in is written as ./studio
+                env = as_reference(Path(os.path.relpath(Path(env).resolve(), Path(
+                    saved_as).resolve().parent)).as_posix(), "environment")
             except ValueError:  # another drive
                 env = Path(env).resolve().as_posix()
         return {"mesh": self.mesh_combo.currentText(), "environment": env}
 
     def set_preview(self, preview: dict, doc_path: Path | None = None) -> None:
         """Mesh and environment stored with a document (a file relative to `doc_path`)."""
-        mesh = preview.get("mesh")
-        if isinstance(mesh, str) and mesh in MESHES:
-            self.mesh_combo.setCurrentText(mesh)
+        from matedit.io.inputs import BUILTIN_PREFIX
+
+        mesh = preview.get("mesh")  # `cube` or `builtin:cube`
+        if isinstance(mesh, str) and mesh.removeprefix(BUILTIN_PREFIX) in MESHES:
+            self.mesh_combo.setCurrentText(mesh.removeprefix(BUILTIN_PREFIX))
         env = preview.get("environment")
         if not isinstance(env, str) or not env:
             return
-        if env not in ENVIRONMENTS.values():
+        if env.removeprefix(BUILTIN_PREFIX) in ENVIRONMENTS.values():
+            env = env.removeprefix(BUILTIN_PREFIX)
+        else:
             p = Path(env)
             if not p.is_absolute() and doc_path is not None:
                 p = Path(doc_path).resolve().parent / p

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli import UsageError
+from matedit.io.inputs import declare_inputs
 
 MAX_SIZE = 8192
 
@@ -23,6 +24,7 @@ def register(sub) -> None:
                    help=f"map width and height in texels, 1..{MAX_SIZE} (default 1024)")
     p.add_argument("--format", default="png", choices=["png", "exr"],
                    help="8-bit PNG or float EXR (default png)")
+    declare_inputs(p, file="document")
     p.set_defaults(run=run)
 
 
@@ -66,7 +68,7 @@ def run(args) -> int:
     from matedit.interop.bake import bake_document, encode_file, map_paths
     from matedit.io.document import FileResolver
     from matedit.io.images import ImageError
-    from matedit.io.inputs import OverwriteError, document_inputs, refuse_overwrite
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
     from matedit.render.context import headless
 
     size = parse_size(args.size)
@@ -77,7 +79,7 @@ def run(args) -> int:
     doc = load_material(path)
     resolver = FileResolver()
     stem = stem_of(doc)
-    inputs = document_inputs(doc, resolver)
+    inputs = command_inputs(args, [doc], resolver)
     try:
         from matedit.interop.bake import MAP_NAMES
 

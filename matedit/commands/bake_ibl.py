@@ -7,11 +7,11 @@ name (studio, sky). The files written are described in matedit/ibl/output.py.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
 from matedit.cli import UsageError, report
+from matedit.io.inputs import declare_inputs
 
 
 def register(subparsers) -> None:
@@ -20,13 +20,16 @@ def register(subparsers) -> None:
         help="bake an environment: prefiltered cube mips, BRDF LUT, SH irradiance",
         description=__doc__.splitlines()[0].split(": ", 1)[1],
     )
-    p.add_argument("env", metavar="ENV", help="environment image, or a built-in: studio, sky")
+    p.add_argument("env", metavar="ENV", help="environment image, a folder of six cube-face "
+                   "files, or a built-in: studio, sky (or builtin:studio, builtin:sky; "
+                   "./studio is a file or folder of that name)")
     p.add_argument("-o", "--output", metavar="DIR", required=True, help="output folder")
     p.add_argument("--size", type=int, default=256, help="face size of mip 0 (default 256)")
     p.add_argument(
         "--samples", type=int, default=256, help="GGX samples per texel of mip 1 (default 256)"
     )
     p.add_argument("--no-cache", action="store_true", help="bake even if a cached bake exists")
+    declare_inputs(p, env="environment")
     p.set_defaults(run=run)
 
 
@@ -56,16 +59,14 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise UsageError(f"{out}: exists and is not a folder")
-    if args.env not in ("studio", "sky"):
-        from matedit.io.inputs import OverwriteError, refuse_overwrite
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
-        names = ["brdf_lut.exr", "sh.json", "ibl.json"]
-        names += [f"prefiltered_mip{m}.exr" for m in range(16)]
-        try:
-            refuse_overwrite([out / n for n in names],
-                             {Path(os.path.realpath(args.env)): "the environment"})
-        except OverwriteError as exc:
-            raise UsageError(str(exc)) from None
+    names = ["brdf_lut.exr", "sh.json", "ibl.json"]
+    names += [f"prefiltered_mip{m}.exr" for m in range(16)]
+    try:
+        refuse_overwrite([out / n for n in names], command_inputs(args))
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
     try:
         env = load_environment(args.env, settings.size)
     except EnvironmentMapError as exc:

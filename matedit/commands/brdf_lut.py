@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli import UsageError
+from matedit.io.inputs import declare_inputs
 
 
 def register(subparsers) -> None:
@@ -28,6 +29,7 @@ def register(subparsers) -> None:
         help="integrand evaluations per texel (default 1024; see matedit/ibl/lut.py)",
     )
     p.add_argument("--no-cache", action="store_true", help="compute even if cached")
+    declare_inputs(p)  # computed, not read
     p.set_defaults(run=run)
 
 
@@ -42,6 +44,12 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"{out}: is a folder")
     if not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
+
+    try:
+        refuse_overwrite([out], command_inputs(args))
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
     from matedit.render.context import headless_context
 
     ctx = headless_context()

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from matedit.cli import UsageError, report
 from matedit.compiler.targets import CROSS_TARGETS, TARGETS
+from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
@@ -21,16 +22,17 @@ def register(sub) -> None:
     p.add_argument("--target", default="glsl330", choices=[*TARGETS, *CROSS_TARGETS, "all"],
                    help="GLSL dialect, HLSL/MSL (via SPIR-V and spirv-cross), or all (HLSL and "
                    "MSL only when spirv-cross is installed)")
+    declare_inputs(p, file="document")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
     # Imported here, not at the top, so that other subcommands start without the compiler.
     from matedit.compiler import CompileError
-    from matedit.compiler.export import compile_targets, export_shaders
+    from matedit.compiler.export import compile_targets, export_shaders, shader_files
     from matedit.interop.cross import CrossCompileError, available
     from matedit.io.document import FileResolver, FormatError
-    from matedit.io.inputs import OverwriteError
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
     from matedit.io.instance import InstanceError, load_effective
 
     path = Path(args.file)
@@ -57,6 +59,7 @@ def run(args) -> int:
             from None
     out = Path(args.output)
     try:
+        refuse_overwrite(shader_files(doc, compiled, out), command_inputs(args, [doc], resolver))
         export_shaders(doc, resolver, targets, out, compiled)
     except (OverwriteError, NotADirectoryError) as exc:
         raise UsageError(str(exc)) from None

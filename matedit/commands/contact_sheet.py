@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli import UsageError
+from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
@@ -23,6 +24,7 @@ def register(sub) -> None:
     p.add_argument("--size", type=int, default=256, metavar="N", help="tile size in pixels")
     p.add_argument("--columns", type=int, default=4, metavar="N")
     p.add_argument("--mesh", default=None, help="override every file's preview mesh")
+    declare_inputs(p, files="documents", mesh="mesh")
     p.set_defaults(run=run)
 
 
@@ -64,6 +66,7 @@ def run(args) -> int:
     from matedit.commands.render import write_png
     from matedit.compiler import CompileError, compile_document
     from matedit.io.document import FileResolver, FormatError, load
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
     out = Path(args.output)
     if out.suffix.lower() != ".png":
@@ -75,14 +78,18 @@ def run(args) -> int:
     if args.columns < 1:
         raise UsageError(f"--columns must be at least 1, got {args.columns}")
     paths = materials(args.files)
-    if out.resolve() in {p.resolve() for p in paths}:
-        raise UsageError(f"{out}: would overwrite an input")
-    docs = []
+    loaded = []
     for path in paths:
         try:
-            doc = load(path)
+            loaded.append((path, load(path)))
         except FormatError as exc:
             raise UsageError(str(exc)) from None
+    try:  # every sheet file, and every texture, function, mesh and environment they read
+        refuse_overwrite([out], command_inputs(args, [d for _, d in loaded], FileResolver()))
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    docs = []
+    for path, doc in loaded:
         if doc.is_function:
             continue
         try:

@@ -7,12 +7,12 @@ express are baked to EXR images beside the document, and reported."""
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
 from matedit.cli import UsageError, report
 from matedit.commands.bake import compile_error, load_material, parse_size, progress_printer
+from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
@@ -26,8 +26,10 @@ def register(sub) -> None:
                    help="baked map size in texels (default 1024 for glTF, 512 for the "
                    "MaterialX bakes)")
     p.add_argument("--mesh", default=None,
-                   help="glTF only: sphere, cube, plane, cylinder or an OBJ file (default: "
-                   "the file's preview mesh, else sphere)")
+                   help="glTF only: sphere, cube, plane, cylinder (or builtin:sphere, ...) or "
+                   "an OBJ file (./sphere for a file of that name) (default: the file's "
+                   "preview mesh, else sphere)")
+    declare_inputs(p, file="document", mesh="mesh")
     p.set_defaults(run=run)
 
 
@@ -45,15 +47,6 @@ def run(args) -> int:
     return _gltf(args, out)
 
 
-def _inputs(doc, resolver, extra=()):
-    from matedit.io.inputs import document_inputs
-
-    inputs = document_inputs(doc, resolver)
-    for given in extra:
-        inputs.setdefault(Path(os.path.realpath(given)), "an input file")
-    return inputs
-
-
 def _gltf(args, out: Path) -> int:
     import numpy as np
 
@@ -62,7 +55,7 @@ def _gltf(args, out: Path) -> int:
     from matedit.interop import gltf
     from matedit.interop.bake import bake_attributes, maps_from
     from matedit.io.document import FileResolver
-    from matedit.io.inputs import BUILTIN_MESHES, OverwriteError, preview_file, refuse_overwrite
+    from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
     from matedit.render.context import headless
     from matedit.render.mesh import MeshError, mesh_from_spec
 
@@ -70,9 +63,8 @@ def _gltf(args, out: Path) -> int:
     path = Path(args.file)
     doc = load_material(path)
     resolver = FileResolver()
-    mesh_spec = args.mesh or preview_file(doc, "mesh") or "sphere"
-    extra = [] if str(mesh_spec) in BUILTIN_MESHES else [mesh_spec]
-    inputs = _inputs(doc, resolver, extra)
+    mesh_spec = args.mesh or preview_spec(doc, "mesh", "sphere")
+    inputs = command_inputs(args, [doc], resolver)
     outputs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
     try:
         refuse_overwrite(outputs, inputs)
@@ -106,13 +98,13 @@ def _mtlx(args, out: Path) -> int:
     from matedit.compiler import CompileError
     from matedit.interop import mtlx_export
     from matedit.io.document import FileResolver
-    from matedit.io.inputs import OverwriteError, refuse_overwrite
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
     size = parse_size(args.size or "512")
     path = Path(args.file)
     doc = load_material(path)
     resolver = FileResolver()
-    inputs = _inputs(doc, resolver)
+    inputs = command_inputs(args, [doc], resolver)
     try:
         result = mtlx_export.export(doc, resolver, out, size)
         refuse_overwrite(result.files, inputs)

@@ -4,8 +4,10 @@ matedit materials.
 `-o OUT.json` writes one material: the document's only one, or the one `--material` names.
 `-o DIR` (any output not ending in .json; created if missing) writes every material, or the
 one named, as DIR/NAME.json, NAME the material's name as a checked identifier
-(matedit.interop.mtlx_import.output_paths). A document with several materials, written to
-OUT.json without `--material`, is an `error:` listing their names (exit 2).
+(matedit.interop.mtlx_import.output_paths); a DIR/NAME.json that exists already is an
+`error:` naming it (exit 2, nothing written) unless `--overwrite` is given. A document with
+several materials, written to OUT.json without `--material`, is an `error:` listing their
+names (exit 2).
 
 Every unsupported node or input is an `error:` line naming it (exit 2); nothing is written
 then (with -o DIR: nothing at all, every material is read before the first file is written).
@@ -14,10 +16,12 @@ matedit.interop.mtlx_import for what is read."""
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
 from matedit.cli import UsageError, report
+from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
@@ -32,6 +36,10 @@ def register(sub) -> None:
     p.add_argument("--material", metavar="NAME",
                    help="the surfacematerial to import (required for OUT.json when the "
                    "document holds several)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="with -o DIR: replace DIR/NAME.json files that exist already "
+                   "(without it they are an error and nothing is written)")
+    declare_inputs(p, file="mtlx")
     p.set_defaults(run=run)
 
 
@@ -41,13 +49,22 @@ def _fail(exc) -> UsageError:
     return UsageError(exc.messages[0])
 
 
-def run(args) -> int:
-    import os
+def refuse_existing(targets, overwrite: bool) -> None:
+    """`import -o DIR` never replaces a material file silently: an existing DIR/NAME.json (or
+    anything at that name, a link included) is refused unless --overwrite is given."""
+    if overwrite:
+        return
+    for target in targets:
+        if os.path.lexists(target):
+            raise UsageError(f"{target}: exists already; pass --overwrite to replace it, or "
+                             "import into another folder")
 
+
+def run(args) -> int:
     from matedit.interop.mtlx_import import MtlxImportError, import_all, import_mtlx, output_paths
     from matedit.io.atomic import atomic_write_text
-    from matedit.io.document import dumps, reference_fields
-    from matedit.io.inputs import OverwriteError, refuse_overwrite
+    from matedit.io.document import dumps
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
     path = Path(args.file)
     out = Path(args.output)
@@ -58,10 +75,9 @@ def run(args) -> int:
                              "must end in .json)")
     elif not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
-    source = {Path(os.path.realpath(path)): "the MaterialX document"}
     if not to_folder:
         try:
-            refuse_overwrite([out], source)
+            refuse_overwrite([out], command_inputs(args))
         except OverwriteError as exc:
             raise UsageError(str(exc)) from None
     try:
@@ -74,14 +90,10 @@ def run(args) -> int:
             docs = {target: import_mtlx(path, target, args.material)}
     except MtlxImportError as exc:
         raise _fail(exc) from None
-    inputs = dict(source)
-    for target, doc in docs.items():
-        for container, key in reference_fields(doc):
-            inputs[Path(os.path.realpath(target.parent / container[key]))] = \
-                "an image a material reads"
-    try:
-        refuse_overwrite(list(docs), inputs)
+    try:  # the MaterialX document, and every image an imported material reads
+        refuse_overwrite(list(docs), command_inputs(args, written=docs.values()))
         if to_folder:
+            refuse_existing(docs, args.overwrite)
             out.mkdir(parents=True, exist_ok=True)
         for target, doc in docs.items():
             atomic_write_text(target, dumps(doc))

@@ -12,6 +12,7 @@ import sys
 from typing import Any
 
 from matedit.cli import UsageError
+from matedit.io.inputs import declare_inputs
 
 GLSL_TARGETS = ("glsl330", "glsl450", "essl300")
 SCHEMA_VERSION = 1
@@ -180,6 +181,7 @@ def register(sub) -> None:
                        "defaults and ranges, description, and the targets implemented.")
     p.add_argument("--json", action="store_true", help="print the catalogue as JSON")
     p.add_argument("--category", metavar="NAME", help="only this palette category")
+    declare_inputs(p)  # reads only the built-in catalogue, writes stdout
     p.set_defaults(run=run)
 
 

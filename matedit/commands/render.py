@@ -5,12 +5,12 @@ holds the scene-referred linear radiance of the same frame, before exposure and 
 
 from __future__ import annotations
 
-import os
 import re
 import sys
 from pathlib import Path
 
 from matedit.cli import UsageError
+from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
@@ -23,11 +23,13 @@ def register(sub) -> None:
                    "radiance (RGBA float, A = 1), before exposure and the display transform")
     p.add_argument("--size", default="512x512", metavar="WxH")
     p.add_argument("--mesh", default=None,
-                   help="sphere, cube, plane, cylinder or an OBJ file (default: the file's "
-                   "preview mesh, else sphere)")
+                   help="sphere, cube, plane, cylinder (or builtin:sphere, ...) or an OBJ file "
+                   "(./sphere for a file of that name) (default: the file's preview mesh, "
+                   "else sphere)")
     p.add_argument("--env", default=None, metavar="PATH|studio|sky",
-                   help="built-in environment, an HDR/EXR file, or a folder of six cube-face "
-                   "files (px nx py ny pz nz) (default: studio)")
+                   help="built-in environment (studio, sky, or builtin:studio, builtin:sky), "
+                   "an HDR/EXR file, or a folder of six cube-face files (px nx py ny pz nz); "
+                   "./studio is a file or folder of that name (default: studio)")
     p.add_argument("--ibl", default="splitsum", choices=["splitsum", "reference", "difference"],
                    help="split-sum approximation, converged importance-sampled reference, "
                    "or a heat map of their difference")
@@ -42,6 +44,7 @@ def register(sub) -> None:
                    help="multiple-scattering specular compensation (Fdez-Aguera 2019), beyond "
                    "the talk; a material can also ask for it (preview "
                    "\"energy_compensation\": true)")
+    declare_inputs(p, file="document", mesh="mesh", env="environment", lights="rig")
     p.set_defaults(run=run)
 
 
@@ -133,22 +136,10 @@ def _check_texture_spaces(compiled, path: Path) -> None:
             raise UsageError(f"{path}: node {t.node}: field color_space: {exc}") from None
 
 
-def _builtin(doc, key: str, fallback: str) -> str:
-    value = doc.preview.get(key) if isinstance(doc.preview, dict) else None
-    return value if isinstance(value, str) and value else fallback
-
-
 def run(args) -> int:
     from matedit.compiler import CompileError, compile_document
     from matedit.io.document import FileResolver, FormatError
-    from matedit.io.inputs import (
-        BUILTIN_ENVIRONMENTS,
-        BUILTIN_MESHES,
-        OverwriteError,
-        document_inputs,
-        preview_file,
-        refuse_overwrite,
-    )
+    from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
 
     size = _size(args.size)
     path = Path(args.file)
@@ -171,12 +162,8 @@ def run(args) -> int:
     if doc.is_function:
         raise UsageError(f"{path}: is a material function; render a material that uses it")
     resolver = FileResolver()
-    inputs = document_inputs(doc, resolver)
-    for given in (args.mesh, args.env, args.lights):
-        if given and given not in BUILTIN_MESHES | BUILTIN_ENVIRONMENTS | {"default", "none"}:
-            inputs.setdefault(Path(os.path.realpath(given)), "an input file")
     try:
-        refuse_overwrite([out], inputs)
+        refuse_overwrite([out], command_inputs(args, [doc], resolver))
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
     try:
@@ -191,8 +178,8 @@ def run(args) -> int:
     from matedit.render.context import headless_context
 
     ctx = headless_context()
-    env = args.env or preview_file(doc, "environment") or _builtin(doc, "environment", "studio")
-    mesh = args.mesh or preview_file(doc, "mesh") or _builtin(doc, "mesh", "sphere")
+    env = args.env or preview_spec(doc, "environment", "studio")
+    mesh = args.mesh or preview_spec(doc, "mesh", "sphere")
     tty = sys.stderr.isatty()
     try:
         renderer = _renderer(ctx, size, Renderer)

@@ -7,6 +7,7 @@ from pathlib import Path
 from matedit.cli import report
 from matedit.graph.validate import Severity, analyse
 from matedit.io.document import FileResolver, FormatError, load
+from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
@@ -14,6 +15,7 @@ def register(sub) -> None:
                        description="Check material, material-function and material-instance "
                        "files (folders are searched for *.json).")
     p.add_argument("files", nargs="+", metavar="FILE")
+    declare_inputs(p, files="documents")  # read only: validate writes no file
     p.set_defaults(run=run)
 
 

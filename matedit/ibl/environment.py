@@ -15,9 +15,15 @@ from pathlib import Path
 
 import numpy as np
 
-from matedit.ibl.builtin import BUILTIN_NAMES, builtin_environment
+from matedit.ibl.builtin import builtin_environment
 from matedit.ibl.cubemap import cross_to_faces
 from matedit.io.images import ImageError, read_image
+from matedit.io.inputs import (
+    BuiltinNameError,
+    builtin_name,
+    cube_face_files,
+    spellings,
+)
 
 DEFAULT_ENVIRONMENT = "studio"
 
@@ -64,35 +70,15 @@ def builtin(name: str, size: int = 256) -> Environment:
     return Environment(name=name, equirect=builtin_environment(name, width))
 
 
-FACE_ALIASES = {"px": ("px", "posx", "right"), "nx": ("nx", "negx", "left"),
-                "py": ("py", "posy", "top", "up"), "ny": ("ny", "negy", "bottom", "down"),
-                "pz": ("pz", "posz", "front"), "nz": ("nz", "negz", "back")}
-_FACE_EXTENSIONS = {".exr", ".hdr", ".png", ".jpg", ".jpeg", ".tif", ".tiff"}
-
-
-def _face_key(stem: str) -> str | None:
-    s = stem.lower()
-    for face, names in FACE_ALIASES.items():
-        for n in names:
-            if s == n or s.endswith(("_" + n, "-" + n, "." + n)):
-                return face
-    return None
-
-
 def load_cube_faces(folder: str | os.PathLike) -> Environment:
     """Six square face images in one folder, named by face: px nx py ny pz nz (or posx/negx...,
     or right/left/top/bottom/front/back), optionally after a prefix and "_" or "-", e.g.
     sky_px.hdr. Faces are in the OpenGL cube-map orientation, the same as the faces of a
     cube cross (matedit.ibl.cubemap). LDR faces are read as sRGB, as for other files."""
+    name = os.fspath(folder)  # as the user wrote it (`./studio`)
     folder = Path(folder)
-    name = str(folder)
     found: dict[str, Path] = {}
-    for p in sorted(folder.iterdir()):
-        if p.suffix.lower() not in _FACE_EXTENSIONS or not p.is_file():
-            continue
-        key = _face_key(p.stem)
-        if key is None:
-            continue
+    for key, p in cube_face_files(folder):  # the same files `matedit.io.inputs` protects
         if key in found:
             raise EnvironmentMapError(f"{name}: two files for cube face {key}: "
                                       f"{found[key].name} and {p.name}")
@@ -142,23 +128,28 @@ def load_environment_file(path: Path, square: bool = False) -> Environment:
 
 
 def load_environment(spec: str | os.PathLike, size: int = 256) -> Environment:
-    """Load an environment from a file, or draw a built-in ('studio', 'sky').
+    """Load an environment from a file or folder, or draw a built-in.
 
-    A path that exists is always read as a file; otherwise a built-in name is accepted.
+    `builtin:studio` and a bare `studio` are the built-in (`sky` likewise), even where a file
+    or folder of that name exists; `./studio` is that file or folder
+    (`matedit.io.inputs.builtin_name`).
     Layout comes from the aspect ratio: 2:1 is equirectangular, 4:3 or 3:4 a cube cross.
     A folder holds six cube-face files (see `load_cube_faces`). `size` only sets the
     resolution the built-ins are drawn at.
     """
+    try:
+        name = builtin_name(spec, "environment")
+    except BuiltinNameError as exc:
+        raise EnvironmentMapError(str(exc)) from None
+    if name is not None:
+        return builtin(name, size)
     text = os.fspath(spec)
     path = Path(text)
-    if not path.exists() and text in BUILTIN_NAMES:
-        return builtin(text, size)
-    if path.is_dir():
+    if os.path.isdir(path):  # isdir and exists are False, not errors, for over-long names
         return load_cube_faces(path)
-    if not path.exists():
-        raise EnvironmentMapError(
-            f"{text}: no such file (built-in environments: {', '.join(BUILTIN_NAMES)})"
-        )
+    if not os.path.exists(path):
+        raise EnvironmentMapError(f"{text}: no such file or folder (an environment is "
+                                  f"{spellings('environment')})")
     try:
         image = read_image(path)
     except ImageError as exc:

@@ -286,14 +286,22 @@ def rebase(doc: InstanceDocument, new_path: Path, parameters: dict[str, Paramete
     for key in PREVIEW_FILES:
         v = doc.preview.get(key)
         if isinstance(v, str) and _is_file_ref(key, v) and not Path(v).is_absolute():
-            doc.preview[key] = _relative(old_dir / v, new_dir)
+            doc.preview[key] = _preview_relative(old_dir / v, new_dir, key)
 
 
 def _is_file_ref(key: str, value: str) -> bool:
-    from matedit.io.inputs import BUILTIN_ENVIRONMENTS, BUILTIN_MESHES
+    """A preview mesh or environment naming a file, not a built-in (bare or `builtin:`)."""
+    from matedit.io.inputs import BUILTIN_PREFIX, builtin_name
 
-    return bool(value) and value not in (BUILTIN_MESHES if key == "mesh"
-                                         else BUILTIN_ENVIRONMENTS)
+    return bool(value) and not value.startswith(BUILTIN_PREFIX) and \
+        builtin_name(value, key) is None
+
+
+def _preview_relative(target: Path, new_dir: Path, key: str) -> str:
+    """`_relative` for a preview file, spelled so that it cannot read as a built-in."""
+    from matedit.io.inputs import as_reference
+
+    return as_reference(_relative(target, new_dir), key)
 
 
 def save_instance(doc: InstanceDocument, path: str | os.PathLike | None = None,
@@ -487,7 +495,7 @@ def _preview_at(preview: dict, owner: Path | None, anchor: Path) -> dict:
     for key in PREVIEW_FILES:
         v = out.get(key)
         if isinstance(v, str) and _is_file_ref(key, v) and not Path(v).is_absolute():
-            out[key] = _relative(base / v, anchor.parent)
+            out[key] = _preview_relative(base / v, anchor.parent, key)
     return out
 
 

@@ -7,6 +7,7 @@ UVs, triangle indices); `GpuMesh` uploads it to a moderngl context.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -283,8 +284,19 @@ def builtin_mesh(name: str) -> MeshData:
 
 
 def mesh_from_spec(spec: str | Path) -> MeshData:
-    s = str(spec)
-    return builtin_mesh(s) if s in BUILTIN_MESHES else load_obj(s)
+    """`builtin:NAME` or a bare built-in name (text only), else an OBJ file
+    (`matedit.io.inputs.builtin_name`: `./sphere` is a file)."""
+    from matedit.io.inputs import BuiltinNameError, builtin_name, spellings
+
+    try:
+        name = builtin_name(spec, "mesh")
+    except BuiltinNameError as exc:
+        raise MeshError(str(exc)) from None
+    if name is not None:
+        return builtin_mesh(name)
+    if not os.path.lexists(spec):  # False for a name no file can have
+        raise MeshError(f"{spec}: no such file (a mesh is {spellings('mesh')})")
+    return load_obj(spec)
 
 
 class GpuMesh:
