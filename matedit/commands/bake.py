@@ -91,10 +91,12 @@ def run(args) -> int:
     except CompileError as exc:
         raise compile_error(exc, path) from None
     paths = map_paths(out, stem, [m.name for m in maps], args.format)
+    from matedit.io.atomic import staged_outputs
+
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        for m in maps:
-            encode_file(paths[m.name], m)
+        with staged_outputs(out) as stage:  # every map, or none
+            for m in maps:
+                encode_file(stage.path(paths[m.name]), m)
     except ImageError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:

@@ -45,7 +45,7 @@ def run(args) -> int:
     import os
 
     from matedit.interop.mtlx_import import MtlxImportError, import_all, import_mtlx, output_paths
-    from matedit.io.atomic import atomic_write_text
+    from matedit.io.atomic import atomic_write_text, staged_outputs
     from matedit.io.document import dumps, reference_fields
     from matedit.io.inputs import OverwriteError, refuse_overwrite
 
@@ -81,10 +81,13 @@ def run(args) -> int:
                 "an image a material reads"
     try:
         refuse_overwrite(list(docs), inputs)
-        if to_folder:
-            out.mkdir(parents=True, exist_ok=True)
-        for target, doc in docs.items():
-            atomic_write_text(target, dumps(doc))
+        if to_folder:  # every material, or none
+            with staged_outputs(out) as stage:
+                for target, doc in docs.items():
+                    stage.write_text(target, dumps(doc))
+        else:
+            for target, doc in docs.items():
+                atomic_write_text(target, dumps(doc))
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:
