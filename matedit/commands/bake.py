@@ -63,7 +63,7 @@ def compile_error(exc, path: Path) -> UsageError:
 def run(args) -> int:
     from matedit.compiler import CompileError
     from matedit.compiler.export import stem_of
-    from matedit.interop.bake import bake_document, encode_file, map_paths
+    from matedit.interop.bake import bake_document, map_paths, write_maps
     from matedit.io.document import FileResolver
     from matedit.io.images import ImageError
     from matedit.io.inputs import OverwriteError, document_inputs, refuse_overwrite
@@ -90,13 +90,8 @@ def run(args) -> int:
                                     args.format)
     except CompileError as exc:
         raise compile_error(exc, path) from None
-    paths = map_paths(out, stem, [m.name for m in maps], args.format)
-    from matedit.io.atomic import staged_outputs
-
     try:
-        with staged_outputs(out) as stage:  # every map, or none
-            for m in maps:
-                encode_file(stage.path(paths[m.name]), m)
+        paths = write_maps(out, stem, maps, args.format)  # every map, or none
     except ImageError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:
