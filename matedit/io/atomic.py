@@ -166,6 +166,13 @@ def remove_leftovers(folder: str | os.PathLike) -> list[str]:
     return removed
 
 
+def _renamed(exc: OSError, path: Path) -> OSError:
+    """`exc` naming `path` (the same errno, so the same OSError subclass)."""
+    if exc.errno is None:
+        return exc
+    return OSError(exc.errno, exc.strerror, str(path))
+
+
 def _exclusive_temp(folder: Path, name: str) -> tuple[int, Path]:
     for _ in range(100):
         tmp = folder / temporary_name(name)
@@ -173,6 +180,8 @@ def _exclusive_temp(folder: Path, name: str) -> tuple[int, Path]:
             fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, 0o666)
         except FileExistsError:
             continue
+        except OSError as exc:  # named by the file asked for, not its temporary
+            raise _renamed(exc, folder / name) from None
         return fd, tmp
     raise FileExistsError(f"{folder}: cannot create a temporary file")
 
@@ -185,6 +194,8 @@ def _private_folder(folder: Path, name: str) -> Path:
             os.mkdir(private, 0o700)
         except FileExistsError:
             continue
+        except OSError as exc:  # a read-only or full folder: named as the user knows it
+            raise _renamed(exc, folder) from None
         return private
     raise FileExistsError(f"{folder}: cannot create a temporary folder")
 
@@ -284,6 +295,23 @@ class OutputSet:
     def write_text(self, final: str | os.PathLike, text: str) -> Path:
         return atomic_write_text(self.path(final), text)
 
+    def _name_finals(self, exc: BaseException) -> None:
+        """Make an error raised while writing name the output, not its staged temporary."""
+        pairs = [(str(s), str(self.folder / n)) for n, s in self._staged.items()]
+        pairs.append((str(self.private), str(self.folder)))
+
+        def fix(text):
+            if isinstance(text, str):
+                for staged, final in pairs:
+                    text = text.replace(staged, final)
+            return text
+
+        if isinstance(exc, OSError):
+            exc.filename = fix(exc.filename)
+            exc.filename2 = fix(exc.filename2)
+        else:
+            exc.args = tuple(fix(a) for a in exc.args)
+
     def _commit(self) -> list[Path]:
         """Rename every staged file into place; if one rename fails, the files already moved
         are put back as they were (the old file, or none) and the error is raised."""
@@ -344,8 +372,12 @@ def staged_outputs(folder: str | os.PathLike) -> Iterator[OutputSet]:
         private = _private_folder(folder, "output")
         try:
             outputs = OutputSet(folder, private)
-            yield outputs
-            outputs.written = outputs._commit()
+            try:
+                yield outputs
+                outputs.written = outputs._commit()
+            except BaseException as exc:
+                outputs._name_finals(exc)
+                raise
         finally:
             shutil.rmtree(private, ignore_errors=True)
     except BaseException:
