@@ -49,8 +49,8 @@ _DIRECTORY = getattr(os, "O_DIRECTORY", 0)
 # The part of a file name kept in a temporary name: enough to recognise it, short enough
 # that the temporary name stays within the 255 bytes a name may have.
 _NAME_KEPT = 96
-_LEFTOVER = re.compile(r"\.(?P<pid>[1-9][0-9]{0,9})-(?P<host>[0-9a-f]{8})\.[0-9a-f]{16}"
-                       r"\.(?P<kind>tmp|tmpdir)")
+_LEFTOVER = re.compile(r"\..+\.(?P<pid>[1-9][0-9]{0,9})-(?P<host>[0-9a-f]{8})\.[0-9a-f]{16}"
+                       r"\.(?P<kind>tmp|tmpdir)", re.DOTALL)  # the whole name (fullmatch)
 
 
 class UnsafeFileError(OSError):
@@ -141,11 +141,8 @@ def remove_leftovers(folder: str | os.PathLike) -> list[str]:
     except OSError:
         return removed
     for entry in entries:
-        name = entry.name
-        if not name.startswith("."):
-            continue
-        m = _LEFTOVER.search(name)
-        if m is None or m.end() != len(name) or m.start() < 2 or m["host"] != host:
+        m = _LEFTOVER.fullmatch(entry.name)
+        if m is None or m["host"] != host:
             continue
         try:
             st = entry.stat(follow_symlinks=False)
@@ -162,7 +159,7 @@ def remove_leftovers(folder: str | os.PathLike) -> list[str]:
                 continue
         except OSError:
             continue
-        removed.append(name)
+        removed.append(entry.name)
     return removed
 
 
