@@ -689,6 +689,35 @@ def test_outputs_of_several_files_into_a_read_only_folder_fail_cleanly(
     _assert_old_set(dest, names)
 
 
+
+@pytest.mark.parametrize("failing", [0, 1, 2])
+def test_staged_outputs_put_every_old_file_back_when_a_move_fails(tmp_path, monkeypatch,
+                                                                 failing):
+    """The moves into place are the last step: if one fails (here the `failing`-th), those
+    already made are undone, so the folder holds the old set (and no new file) again."""
+    import errno
+
+    names = ["a.bin", "b.txt", "c.gltf"]
+    _old_set(tmp_path, names[:2])  # c.gltf is new
+    real = os.replace
+
+    def replace(src, dst):
+        if os.fspath(dst) == os.fspath(tmp_path / names[failing]):  # a move into place
+            raise OSError(errno.EIO, "Input/output error")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(OSError, match="Input/output"):
+        with atomic.staged_outputs(tmp_path) as stage:
+            for name in names:
+                stage.write_text(tmp_path / name, "new")
+    monkeypatch.undo()
+    _assert_old_set(tmp_path, names[:2])
+    with pytest.raises(ValueError, match="not in the output folder"):
+        with atomic.staged_outputs(tmp_path) as stage:
+            stage.path(tmp_path / "sub" / "x")
+    assert sorted(p.name for p in tmp_path.iterdir()) == names[:2]
+
 # --- leftovers and signals --------------------------------------------------------------------
 
 def _dead_pid() -> int:

@@ -112,8 +112,12 @@ def _host_tag() -> str:
 
 
 def temporary_name(name: str, kind: str = "tmp") -> str:
-    """A fresh temporary name for `name`: `.<name>.<pid>-<host>.<random>.<kind>`."""
-    return f".{name[:_NAME_KEPT]}.{os.getpid()}-{_host_tag()}.{secrets.token_hex(8)}.{kind}"
+    """A fresh temporary name for `name`: `.<name>.<pid>-<host>.<random>.<kind>`, with at
+    most `_NAME_KEPT` bytes of `name` (whole characters)."""
+    kept = name[:_NAME_KEPT]
+    while len(kept.encode("utf-8", "surrogateescape")) > _NAME_KEPT:
+        kept = kept[:-1]
+    return f".{kept}.{os.getpid()}-{_host_tag()}.{secrets.token_hex(8)}.{kind}"
 
 
 def _process_gone(pid: int) -> bool:
@@ -135,6 +139,8 @@ def remove_leftovers(folder: str | os.PathLike) -> list[str]:
     names of the exact temporary pattern, owned by this user, made on this host by a pid
     that no longer runs; a link is never followed, nor removed. Returns the names removed."""
     removed: list[str] = []
+    if os.name != "posix":  # pids are judged with kill(pid, 0)
+        return removed
     host, uid = _host_tag(), os.geteuid()
     try:
         entries = list(os.scandir(folder))
@@ -324,29 +330,29 @@ class OutputSet:
             if mode is not None:
                 os.chmod(staged, mode)
             _fsync_file(staged)
-            backup = None
-            if _lstat(final) is not None:  # kept (a hard link) to be put back on failure
+            existed, backup = _lstat(final) is not None, None
+            if existed:  # kept (a hard link) to be put back on failure
                 backup = self.private / f".old.{i}"
                 try:
                     os.link(final, backup, follow_symlinks=False)
                 except OSError:
                     backup = None
-            moves.append((staged, final, backup))
+            moves.append((staged, final, existed, backup))
         done = []
         try:
-            for staged, final, backup in moves:
+            for staged, final, existed, backup in moves:
                 os.replace(staged, final)
-                done.append((final, backup))
+                done.append((final, existed, backup))
         except BaseException:
-            for final, backup in reversed(done):
+            for final, existed, backup in reversed(done):
                 with contextlib.suppress(OSError):
                     if backup is not None:
                         os.replace(backup, final)
-                    else:
+                    elif not existed:
                         os.unlink(final)
             raise
         _fsync_dir(self.folder)
-        return [final for _, final, _ in moves]
+        return [final for _, final, _, _ in moves]
 
 
 @contextlib.contextmanager
