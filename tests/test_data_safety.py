@@ -718,6 +718,25 @@ def test_staged_outputs_put_every_old_file_back_when_a_move_fails(tmp_path, monk
             stage.path(tmp_path / "sub" / "x")
     assert sorted(p.name for p in tmp_path.iterdir()) == names[:2]
 
+
+def test_staged_outputs_respect_the_umask_and_keep_modes(tmp_path):
+    """A new output folder and new files get the umask; a replaced file keeps its mode."""
+    _old_set(tmp_path, ["kept.txt"])
+    os.chmod(tmp_path / "kept.txt", 0o604)
+    old = os.umask(0o027)
+    try:
+        with atomic.staged_outputs(tmp_path / "new" / "out") as stage:
+            stage.write_bytes(tmp_path / "new" / "out" / "a.bin", b"a")
+        with atomic.staged_outputs(tmp_path) as stage:
+            stage.write_text(tmp_path / "kept.txt", "new")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(os.stat(tmp_path / "new" / "out").st_mode) == 0o750
+    assert stat.S_IMODE(os.stat(tmp_path / "new" / "out" / "a.bin").st_mode) == 0o640
+    assert stat.S_IMODE(os.stat(tmp_path / "kept.txt").st_mode) == 0o604
+    assert (tmp_path / "kept.txt").read_text() == "new" and stage.written == [
+        tmp_path / "kept.txt"]
+
 # --- leftovers and signals --------------------------------------------------------------------
 
 def _dead_pid() -> int:
@@ -845,7 +864,9 @@ def test_a_bake_killed_mid_write_leaves_a_leftover_the_next_run_removes(tmp_path
     assert proc.returncode == -signal.SIGKILL
     left = sorted(p.name for p in dest.iterdir())
     assert left and all(n.startswith(".") and n.endswith(".tmpdir") for n in left), left
+    handler = signal.getsignal(signal.SIGTERM)
     rc, _, err = cli("bake", doc, "-o", dest, "--size", "8")
     assert rc == 0, err
     assert sorted(p.name for p in dest.iterdir()) == ["m_base_color.png", "m_normal.png",
                                                       "m_orm.png"]
+    assert signal.getsignal(signal.SIGTERM) == handler  # a command leaves it as it was
