@@ -412,6 +412,20 @@ def _sources(tmp_path_factory):
     return src
 
 
+def _replacing(command) -> list[str]:
+    """`--overwrite` where the command has it: it would otherwise refuse, before writing, the
+    old file or planted link these cases put at an output's name on purpose."""
+    import argparse
+
+    from matedit.cli import build_parser
+
+    for action in build_parser()._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            options = action.choices[command]._option_string_actions
+            return ["--overwrite"] if "--overwrite" in options else []
+    return []
+
+
 def _ibl_cache_case(src, dest, monkeypatch):
     """bake-ibl, seen from its cache: `dest` is the cache's ibl folder."""
     monkeypatch.setenv("MATEDIT_CACHE_DIR", str(dest.parent))
@@ -435,9 +449,10 @@ OUTPUT_CASES = {
                                                "--size", "8")),
     "export-mtlx": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "x.mtlx",
                                                 "--size", "8")),
-    "import-dir": (True, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d)),
+    "import-dir": (True, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d,
+                                              *_replacing("import"))),
     "import-json": (False, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d / "one.json",
-                                                "--material", "M_b")),
+                                                "--material", "M_b", *_replacing("import"))),
     "contact-sheet": (False, lambda s, d, mp: cli("contact-sheet", s / "m.json", "-o",
                                                   d / "sheet.png", "--size", "32")),
     "ibl-cache": (True, _ibl_cache_case),
