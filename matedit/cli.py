@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 
 QUIT_AFTER_FIRST_FRAME = "MATEDIT_QUIT_AFTER_FIRST_FRAME"
@@ -22,6 +23,30 @@ def report(severity: str, message: object) -> None:
 
 class UsageError(Exception):
     """Bad input: reported as one `error: ...` line and exit status 2."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is so that every write in progress cleans up."""
+
+
+def _on_sigterm(signum, frame) -> None:
+    raise Terminated
+
+
+def _catch_sigterm() -> tuple:
+    """Turn SIGTERM into `Terminated` while a command runs (not the editor, whose event loop
+    would defer it); returns what `_restore_sigterm` needs."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return ()
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    return (signal.SIG_DFL if previous is None else previous,)
+
+
+def _restore_sigterm(saved: tuple) -> None:
+    if saved:
+        signal.signal(signal.SIGTERM, saved[0])
 
 
 class _Parser(argparse.ArgumentParser):
@@ -74,6 +99,7 @@ def open_editor(argv: list[str]) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    saved_sigterm: tuple = ()
     try:
         parser = build_parser()
         if not argv or (not argv[0].startswith("-") and argv[0] not in
@@ -88,18 +114,21 @@ def main(argv: list[str] | None = None) -> int:
         if not getattr(args, "run", None):
             parser.print_help()
             return 0
+        saved_sigterm = _catch_sigterm()
         return int(args.run(args) or 0)
     except UsageError as exc:
         report("error", exc)
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (Terminated): temporaries removed
         print("error: interrupted", file=sys.stderr)
-        return 130
+        return 143 if isinstance(exc, Terminated) else 130
     except Exception as exc:  # internal failure: still one line, status 1
         report("error", f"internal: {type(exc).__name__}: {exc}")
         if "MATEDIT_DEBUG" in __import__("os").environ:
             raise
         return 1
+    finally:
+        _restore_sigterm(saved_sigterm)
 
 
 if __name__ == "__main__":

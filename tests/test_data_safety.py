@@ -750,3 +750,521 @@ def test_other_commands_read_built_in_names_beside_folders(builtin_lookalikes):
     write(builtin_lookalikes / "p.json", raw)
     rc, _, err = cli("render", "p.json", "-o", "p.png", "--size", "16x16")
     assert rc == 0, err
+
+
+# --- issue 22: no output writes through a planted link; outputs of several files whole or ----
+# --- not at all (full disk, read-only folder); SIGTERM/SIGINT/SIGKILL leave nothing behind ----
+#
+# Every command case below writes its outputs into one folder, `dest`. A first, clean run of
+# the case (cached per case) says which names it writes; the tests then plant links at every
+# one of those names, fill the disk while one of them is written, or make `dest` read-only.
+
+_TWO_MATERIALS = """<?xml version="1.0"?>
+<materialx version="1.38">
+  <standard_surface name="SR_a" type="surfaceshader">
+    <input name="base_color" type="color3" value="0.8, 0.2, 0.1" />
+  </standard_surface>
+  <surfacematerial name="M_a" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR_a" />
+  </surfacematerial>
+  <standard_surface name="SR_b" type="surfaceshader">
+    <input name="specular_roughness" type="float" value="0.3" />
+  </standard_surface>
+  <surfacematerial name="M_b" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR_b" />
+  </surfacematerial>
+</materialx>
+"""
+
+
+def _baking_material() -> dict:
+    """`base_material` with a radial gradient, which a MaterialX export bakes to an EXR."""
+    raw = base_material()
+    raw["nodes"].append({"id": "rg", "kind": "radial_gradient", "position": [0, 200]})
+    raw["links"] = [l for l in raw["links"] if l["to"] != ["m", "a"]]
+    raw["links"].append({"from": ["rg", "value"], "to": ["m", "a"]})
+    return raw
+
+
+@pytest.fixture(scope="module")
+def _sources(tmp_path_factory):
+    """The inputs every case reads: a material, and a MaterialX document of two materials."""
+    src = tmp_path_factory.mktemp("sources")
+    write(src / "m.json", _baking_material())
+    (src / "two.mtlx").write_text(_TWO_MATERIALS)
+    return src
+
+
+def _replacing(command) -> list[str]:
+    """`--overwrite` where the command has it: it would otherwise refuse, before writing, the
+    old file or planted link these cases put at an output's name on purpose."""
+    import argparse
+
+    from matedit.cli import build_parser
+
+    for action in build_parser()._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            options = action.choices[command]._option_string_actions
+            return ["--overwrite"] if "--overwrite" in options else []
+    return []
+
+
+def _ibl_cache_case(src, dest, monkeypatch):
+    """bake-ibl, seen from its cache: `dest` is the cache's ibl folder."""
+    monkeypatch.setenv("MATEDIT_CACHE_DIR", str(dest.parent))
+    return cli("bake-ibl", "studio", "-o", dest.parent / "bake", "--size", "16",
+               "--samples", "16")
+
+
+# name -> (writes a folder it may create, run(src, dest, monkeypatch) -> cli's result)
+OUTPUT_CASES = {
+    "compile": (True, lambda s, d, mp: cli("compile", s / "m.json", "-o", d, "--target", "all")),
+    "render": (False, lambda s, d, mp: cli("render", s / "m.json", "-o", d / "r.png",
+                                           "--size", "16x16")),
+    "bake": (True, lambda s, d, mp: cli("bake", s / "m.json", "-o", d, "--size", "8")),
+    "bake-ibl": (True, lambda s, d, mp: cli("bake-ibl", "studio", "-o", d, "--size", "16",
+                                            "--samples", "16", "--no-cache")),
+    "brdf-lut": (False, lambda s, d, mp: cli("brdf-lut", "-o", d / "lut.exr", "--size", "16",
+                                             "--samples", "64", "--no-cache")),
+    "export-gltf": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "e.gltf",
+                                                "--size", "8")),
+    "export-glb": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "e.glb",
+                                               "--size", "8")),
+    "export-mtlx": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "x.mtlx",
+                                                "--size", "8")),
+    "import-dir": (True, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d,
+                                              *_replacing("import"))),
+    "import-json": (False, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d / "one.json",
+                                                "--material", "M_b", *_replacing("import"))),
+    "contact-sheet": (False, lambda s, d, mp: cli("contact-sheet", s / "m.json", "-o",
+                                                  d / "sheet.png", "--size", "32")),
+    "ibl-cache": (True, _ibl_cache_case),
+}
+MULTI_FILE_CASES = ["compile", "bake", "bake-ibl", "export-gltf", "export-mtlx", "import-dir"]
+GL_CASES = {"render", "bake", "bake-ibl", "brdf-lut", "export-gltf", "export-glb",
+            "contact-sheet", "ibl-cache"}
+_LEARNED: dict[str, list[str]] = {}
+
+
+def _case_params(names):
+    return [pytest.param(n, marks=pytest.mark.gl) if n in GL_CASES else n for n in names]
+
+
+def _run_case(case, src, dest, monkeypatch):
+    creates_folder, run = OUTPUT_CASES[case]
+    if not creates_folder:
+        dest.mkdir(parents=True, exist_ok=True)
+    with monkeypatch.context() as mp:
+        return run(src, dest, mp)
+
+
+def _output_names(case, src, root, monkeypatch) -> list[str]:
+    """The names a clean run of `case` writes into its folder (learned once per case)."""
+    if case not in _LEARNED:
+        dest = root / "learn" / ("ibl" if case == "ibl-cache" else "out")
+        rc, _, err = _run_case(case, src, dest, monkeypatch)
+        assert rc == 0, err
+        _LEARNED[case] = sorted(p.name for p in dest.iterdir())
+        assert _LEARNED[case] and _leftovers(dest) == []
+    return _LEARNED[case]
+
+
+def _decoy(folder, kind, i):
+    """A file a link may point at: a precious file, a FIFO standing in for a device such as
+    /dev/zero, or a name that does not exist (a write through the link would create it)."""
+    folder.mkdir(exist_ok=True)
+    path = folder / f"{kind}{i}"
+    if kind == "file":
+        path.write_text(f"precious {i}")
+    elif kind == "fifo":
+        os.mkfifo(path)
+    return path
+
+
+def _decoy_intact(path, kind, i) -> bool:
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return kind == "dangling"
+    if kind == "file":
+        return stat.S_ISREG(st.st_mode) and path.read_text() == f"precious {i}"
+    return kind == "fifo" and stat.S_ISFIFO(st.st_mode)
+
+
+@pytest.mark.parametrize("kind", ["file", "fifo", "dangling"])
+@pytest.mark.parametrize("case", _case_params(OUTPUT_CASES))
+def test_outputs_replace_a_link_planted_at_their_name(tmp_path, monkeypatch, _sources, case,
+                                                      kind):
+    """A link planted at an output's name (in a shared or downloaded folder) is replaced by
+    the output; what it pointed at is untouched. Run as root, `bake-ibl` once replaced
+    /dev/zero through a planted cache entry."""
+    if case == "ibl-cache" and kind == "fifo":
+        pytest.skip("a FIFO cache entry is refused when read (the cache's own validation)")
+    names = _output_names(case, _sources, tmp_path, monkeypatch)
+    dest = tmp_path / "planted" / ("ibl" if case == "ibl-cache" else "out")
+    dest.mkdir(parents=True)
+    decoys = {}
+    for i, name in enumerate(names):
+        decoys[name] = _decoy(tmp_path / "decoys", kind, i)
+        (dest / name).symlink_to(decoys[name])
+    rc, _, err = _run_case(case, _sources, dest, monkeypatch)
+    assert rc == 0, err
+    for i, name in enumerate(names):
+        assert _decoy_intact(decoys[name], kind, i), f"{case} wrote through the link {name}"
+        assert stat.S_ISREG(os.lstat(dest / name).st_mode), f"{name} is not a regular file"
+    assert _leftovers(dest) == []
+
+
+def test_document_formats_follow_a_link_only_when_saved_where_they_were_opened(tmp_path):
+    """A document opened through a link is saved through it (the artist's file); saved as
+    any other name that is a planted link, the link is replaced. The same for instances and
+    light rigs (whose save follows a link only when asked to)."""
+    from matedit.io import instance as inst_io
+    from matedit.io import rig as rigio
+    from matedit.render.lights import default_rig
+
+    (tmp_path / "real").mkdir()
+    real = write(tmp_path / "real" / "m.json", base_material())
+    opened = tmp_path / "opened.json"
+    opened.symlink_to(real)
+    decoy = _decoy(tmp_path / "decoys", "file", 0)
+    planted = tmp_path / "planted.json"
+    planted.symlink_to(decoy)
+    doc = load(opened)
+    doc.name = "through the link"
+    save(doc)  # the document's own name: through the link
+    assert opened.is_symlink() and load(real).name == "through the link"
+    save(doc, planted)  # Save As onto a planted link
+    assert _decoy_intact(decoy, "file", 0) and not planted.is_symlink()
+    assert load(planted).name == "through the link"
+
+    inst = write(tmp_path / "real" / "i.json", {"format": "matedit.instance", "version": 2,
+                                                "parent": "m.json", "parameters": {}})
+    (tmp_path / "i.json").symlink_to(inst)
+    idoc = inst_io.load_instance(tmp_path / "i.json")
+    inst_io.save_instance(idoc)
+    assert (tmp_path / "i.json").is_symlink()
+    (tmp_path / "planted_i.json").symlink_to(_decoy(tmp_path / "decoys", "file", 1))
+    inst_io.save_instance(idoc, tmp_path / "planted_i.json")
+    assert _decoy_intact(tmp_path / "decoys" / "file1", "file", 1)
+    assert not (tmp_path / "planted_i.json").is_symlink()
+
+    rig_real = tmp_path / "real" / "rig.json"
+    rigio.save(default_rig(), rig_real)
+    (tmp_path / "rig.json").symlink_to(rig_real)
+    before = rig_real.read_text()
+    rigio.save(default_rig()[:1], tmp_path / "rig.json", follow_link=True)
+    assert (tmp_path / "rig.json").is_symlink() and rig_real.read_text() != before
+    (tmp_path / "planted_rig.json").symlink_to(_decoy(tmp_path / "decoys", "file", 2))
+    rigio.save(default_rig(), tmp_path / "planted_rig.json")
+    assert _decoy_intact(tmp_path / "decoys" / "file2", "file", 2)
+    assert not (tmp_path / "planted_rig.json").is_symlink()
+
+
+def _full_disk_while_writing(monkeypatch, folder, victim):
+    """ENOSPC from write(2) or fsync(2) on any file whose path below `folder` names
+    `victim` (the output itself, its temporary, or its staged copy)."""
+    import errno
+
+    real_write, real_fsync = os.write, os.fsync
+
+    def hit(fd):
+        try:
+            p = os.readlink(f"/proc/self/fd/{fd}")
+        except OSError:
+            return False
+        return p.startswith(str(folder) + os.sep) and victim in p[len(str(folder)):]
+
+    def write_(fd, data):
+        if hit(fd):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_write(fd, data)
+
+    def fsync_(fd):
+        if hit(fd):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_fsync(fd)
+
+    monkeypatch.setattr(os, "write", write_)
+    monkeypatch.setattr(os, "fsync", fsync_)
+
+
+def _old_set(dest, names):
+    dest.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        (dest / name).write_text(f"old {name}")
+
+
+def _assert_old_set(dest, names):
+    assert sorted(p.name for p in dest.iterdir()) == sorted(names), "files added or removed"
+    for name in names:
+        assert (dest / name).read_text() == f"old {name}", f"{name} was replaced"
+
+
+@pytest.mark.parametrize("victim, before", [("last", "nothing"), ("first", "an old set")])
+@pytest.mark.parametrize("case", _case_params(MULTI_FILE_CASES))
+def test_outputs_of_several_files_are_whole_or_absent_on_a_full_disk(
+        tmp_path, monkeypatch, _sources, case, victim, before):
+    """The disk fills up while one file of the output is written: the command fails cleanly
+    and the folder holds exactly what it held before (no half pair: never a new .gltf beside
+    an old .bin), with no temporary left."""
+    names = _output_names(case, _sources, tmp_path, monkeypatch)
+    creates_folder = OUTPUT_CASES[case][0]
+    dest = tmp_path / "full" / "out"
+    dest.parent.mkdir()
+    if before == "an old set":
+        _old_set(dest, names)
+    elif not creates_folder:
+        dest.mkdir(parents=True)
+    _full_disk_while_writing(monkeypatch, tmp_path / "full",
+                             names[-1] if victim == "last" else names[0])
+    rc, _, err = _run_case(case, _sources, dest, monkeypatch)
+    monkeypatch.undo()
+    assert_clean_failure(rc, err)
+    assert "No space left on device" in err and ".tmp" not in err, err
+    if before == "an old set":
+        _assert_old_set(dest, names)
+    elif creates_folder:
+        assert not dest.exists(), sorted(p.name for p in dest.iterdir())
+    else:
+        assert list(dest.iterdir()) == []
+    assert list((tmp_path / "full").iterdir()) == (
+        [dest] if dest.exists() else []), "something was left beside the output folder"
+
+
+def _read_only(monkeypatch, folder):
+    """`folder` made read-only; as root, who writes anyway, by refusing the calls that would
+    add, replace or remove an entry of it."""
+    import errno
+
+    os.chmod(folder, 0o555)
+    if os.geteuid() != 0:
+        return
+
+    def inside(path):
+        return os.path.dirname(os.path.abspath(os.fspath(path))) == str(folder)
+
+    def refuse(path):
+        raise PermissionError(errno.EACCES, "Permission denied", os.fspath(path))
+
+    real = {n: getattr(os, n) for n in ("open", "mkdir", "replace", "rename", "link",
+                                        "unlink", "rmdir", "symlink")}
+    creating = os.O_CREAT | os.O_WRONLY | os.O_RDWR | os.O_TRUNC
+
+    def open_(path, flags, *a, **k):
+        if flags & creating and inside(path):
+            refuse(path)
+        return real["open"](path, flags, *a, **k)
+
+    def entry(name, which):
+        def call(*args, **kw):
+            for p in args[:2] if name in ("replace", "rename", "link", "symlink") else args[:1]:
+                if which(p):
+                    refuse(p)
+            return real[name](*args, **kw)
+        return call
+
+    monkeypatch.setattr(os, "open", open_)
+    for name in real:
+        if name != "open":
+            monkeypatch.setattr(os, name, entry(name, inside))
+
+
+@pytest.mark.parametrize("case", _case_params(MULTI_FILE_CASES))
+def test_outputs_of_several_files_into_a_read_only_folder_fail_cleanly(
+        tmp_path, monkeypatch, _sources, case):
+    names = _output_names(case, _sources, tmp_path, monkeypatch)
+    dest = tmp_path / "ro" / "out"
+    _old_set(dest, names)
+    try:
+        _read_only(monkeypatch, dest)
+        rc, _, err = _run_case(case, _sources, dest, monkeypatch)
+        monkeypatch.undo()
+    finally:
+        os.chmod(dest, 0o755)
+    assert_clean_failure(rc, err)
+    assert len(err.splitlines()) == 1 and ".tmp" not in err, err
+    _assert_old_set(dest, names)
+
+
+
+@pytest.mark.parametrize("failing", [0, 1, 2])
+def test_staged_outputs_put_every_old_file_back_when_a_move_fails(tmp_path, monkeypatch,
+                                                                 failing):
+    """The moves into place are the last step: if one fails (here the `failing`-th), those
+    already made are undone, so the folder holds the old set (and no new file) again."""
+    import errno
+
+    names = ["a.bin", "b.txt", "c.gltf"]
+    _old_set(tmp_path, names[:2])  # c.gltf is new
+    real = os.replace
+
+    def replace(src, dst):
+        if os.fspath(dst) == os.fspath(tmp_path / names[failing]):  # a move into place
+            raise OSError(errno.EIO, "Input/output error")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(OSError, match="Input/output"):
+        with atomic.staged_outputs(tmp_path) as stage:
+            for name in names:
+                stage.write_text(tmp_path / name, "new")
+    monkeypatch.undo()
+    _assert_old_set(tmp_path, names[:2])
+    with pytest.raises(ValueError, match="not in the output folder"):
+        with atomic.staged_outputs(tmp_path) as stage:
+            stage.path(tmp_path / "sub" / "x")
+    assert sorted(p.name for p in tmp_path.iterdir()) == names[:2]
+
+
+def test_staged_outputs_respect_the_umask_and_keep_modes(tmp_path):
+    """A new output folder and new files get the umask; a replaced file keeps its mode."""
+    _old_set(tmp_path, ["kept.txt"])
+    os.chmod(tmp_path / "kept.txt", 0o604)
+    old = os.umask(0o027)
+    try:
+        with atomic.staged_outputs(tmp_path / "new" / "out") as stage:
+            stage.write_bytes(tmp_path / "new" / "out" / "a.bin", b"a")
+        with atomic.staged_outputs(tmp_path) as stage:
+            stage.write_text(tmp_path / "kept.txt", "new")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(os.stat(tmp_path / "new" / "out").st_mode) == 0o750
+    assert stat.S_IMODE(os.stat(tmp_path / "new" / "out" / "a.bin").st_mode) == 0o640
+    assert stat.S_IMODE(os.stat(tmp_path / "kept.txt").st_mode) == 0o604
+    assert (tmp_path / "kept.txt").read_text() == "new" and stage.written == [
+        tmp_path / "kept.txt"]
+
+# --- leftovers and signals --------------------------------------------------------------------
+
+def _dead_pid() -> int:
+    import subprocess
+    import sys
+
+    p = subprocess.Popen([sys.executable, "-c", "pass"])
+    p.wait()
+    return p.pid
+
+
+def test_leftovers_of_dead_processes_are_removed_and_nothing_else(tmp_path):
+    """A folder written into loses the temporaries of this user's dead processes on this host,
+    matched by their exact pattern, and keeps everything else; links are never followed."""
+    dead, host, rand = _dead_pid(), atomic._host_tag(), "0123456789abcdef"
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "keep.txt").write_text("keep")
+    work = tmp_path / "work"
+    work.mkdir()
+    gone = work / f".m.png.{dead}-{host}.{rand}.tmpdir"
+    gone.mkdir()
+    (gone / "out.png").write_text("half")
+    (gone / "link").symlink_to(outside)
+    (work / f".m.json.{dead}-{host}.{rand}.tmp").write_text("half")
+    kept = [
+        f".m.png.{os.getpid()}-{host}.{rand}.tmpdir",  # a live process (this one)
+        f".m.png.{dead}-{'f' * 8 if host != 'f' * 8 else '0' * 8}.{rand}.tmpdir",  # elsewhere
+        f".m.png.{dead}-{host}.{rand[:-1]}.tmpdir",  # near misses of the pattern
+        f"m.png.{dead}-{host}.{rand}.tmpdir",
+        f".m.png.{dead}-{host}.{rand}.tmpdir.bak",
+        f".m.png.{dead}-{host}.{rand}.TMPDIR",
+        f".m.png.{dead}.{rand}.tmpdir",
+    ]
+    for name in kept:
+        (work / name).mkdir()
+    odd = [f".a.{dead}-{host}.{rand}.tmpdir", f".b.{dead}-{host}.{rand}.tmp"]
+    (work / odd[0]).symlink_to(outside)  # the pattern, but a link: never followed
+    (work / odd[1]).mkdir()  # the pattern of a file, but a folder
+    atomic_write_bytes(work / "new.txt", b"x")
+    assert sorted(p.name for p in work.iterdir()) == sorted([*kept, *odd, "new.txt"])
+    assert (outside / "keep.txt").read_text() == "keep" and (work / odd[0]).is_symlink()
+    names = {atomic.temporary_name("out.png", "tmpdir") for _ in range(3)}
+    assert len(names) == 3 and all(
+        n.startswith(f".out.png.{os.getpid()}-{host}.") for n in names)
+    assert len(atomic.temporary_name("x" * 255)) < 255
+
+
+_SLOW_BAKE = r"""
+import sys, time
+from pathlib import Path
+import matedit.io.images as images
+
+marker, real, calls = Path(sys.argv[1]), images.write_oiio, []
+
+
+def slow(path, spec, pixels):  # the second map waits, with the first one written
+    calls.append(path)
+    if len(calls) == 2:
+        marker.write_text("writing")
+        time.sleep(120)
+    return real(path, spec, pixels)
+
+
+images.write_oiio = slow
+from matedit.cli import main
+
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _bake_until_mid_write(tmp_path, doc, dest):
+    """`matedit bake` in a child process, returned once it is writing its second map."""
+    import subprocess
+    import sys
+    import time
+
+    import matedit
+
+    root = os.path.dirname(os.path.dirname(matedit.__file__))
+    env = {**os.environ, "PYTHONPATH": root}
+    marker = tmp_path / "marker"
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_BAKE, str(marker), "bake", str(doc),
+                             "-o", str(dest), "--size", "8"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not marker.exists():
+        if proc.poll() is not None or time.monotonic() > deadline:
+            proc.kill()
+            out, err = proc.communicate()
+            pytest.fail(f"the bake ended before its second map ({proc.returncode}): {err}")
+        time.sleep(0.02)
+    return proc
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("sig, status", [("SIGTERM", 143), ("SIGINT", 130)])
+def test_a_signal_mid_bake_cleans_up(tmp_path, sig, status):
+    """SIGTERM or SIGINT while a bake writes its maps: one `error: interrupted` line, and
+    neither a map nor a temporary is left (the folder it created is gone too)."""
+    import signal
+
+    doc = write(tmp_path / "m.json", base_material())
+    dest = tmp_path / "maps"
+    proc = _bake_until_mid_write(tmp_path, doc, dest)
+    proc.send_signal(getattr(signal, sig))
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == status, err
+    assert err.splitlines() == ["error: interrupted"], err
+    assert not dest.exists(), sorted(p.name for p in dest.iterdir())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.json", "marker"]
+
+
+@pytest.mark.gl
+def test_a_bake_killed_mid_write_leaves_a_leftover_the_next_run_removes(tmp_path):
+    """SIGKILL cannot be caught: the half-written bake stays in its temporary folder (no map
+    under its real name), named so that the next run into the folder removes it."""
+    import signal
+
+    doc = write(tmp_path / "m.json", base_material())
+    dest = tmp_path / "maps"
+    proc = _bake_until_mid_write(tmp_path, doc, dest)
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate(timeout=60)
+    assert proc.returncode == -signal.SIGKILL
+    left = sorted(p.name for p in dest.iterdir())
+    assert left and all(n.startswith(".") and n.endswith(".tmpdir") for n in left), left
+    handler = signal.getsignal(signal.SIGTERM)
+    rc, _, err = cli("bake", doc, "-o", dest, "--size", "8")
+    assert rc == 0, err
+    assert sorted(p.name for p in dest.iterdir()) == ["m_base_color.png", "m_normal.png",
+                                                      "m_orm.png"]
+    assert signal.getsignal(signal.SIGTERM) == handler  # a command leaves it as it was

@@ -190,16 +190,14 @@ class InteropActions:
         folder = folder or self._ask_folder(title)
         if folder is None:
             return False
-        from matedit.interop.bake import MAP_NAMES, bake_document, encode_file, map_paths
+        from matedit.interop.bake import MAP_NAMES, bake_document, map_paths, write_maps
         from matedit.io.inputs import refuse_overwrite
 
         try:
             refuse_overwrite(map_paths(folder, self._stem(), MAP_NAMES, "png").values(),
                              self._inputs())
             maps, _ = _in_worker(lambda ctx: bake_document(ctx, self.doc, self.resolver, size))
-            paths = map_paths(folder, self._stem(), [m.name for m in maps], "png")
-            for m in maps:
-                encode_file(paths[m.name], m)
+            paths = write_maps(folder, self._stem(), maps, "png")  # all, or none
         except Exception as exc:
             return self._fail(title, exc)
         return self._done(f"baked {len(paths)} maps into {folder}")

@@ -65,7 +65,7 @@ def compile_error(exc, path: Path) -> UsageError:
 def run(args) -> int:
     from matedit.compiler import CompileError
     from matedit.compiler.export import stem_of
-    from matedit.interop.bake import bake_document, encode_file, map_paths
+    from matedit.interop.bake import bake_document, map_paths, write_maps
     from matedit.io.document import FileResolver
     from matedit.io.images import ImageError
     from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
@@ -92,11 +92,8 @@ def run(args) -> int:
                                     args.format)
     except CompileError as exc:
         raise compile_error(exc, path) from None
-    paths = map_paths(out, stem, [m.name for m in maps], args.format)
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        for m in maps:
-            encode_file(paths[m.name], m)
+        paths = write_maps(out, stem, maps, args.format)  # every map, or none
     except ImageError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:

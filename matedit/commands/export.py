@@ -98,6 +98,7 @@ def _mtlx(args, out: Path) -> int:
     from matedit.compiler import CompileError
     from matedit.interop import mtlx_export
     from matedit.io.document import FileResolver
+    from matedit.io.images import ImageError
     from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
     size = parse_size(args.size or "512")
@@ -115,6 +116,8 @@ def _mtlx(args, out: Path) -> int:
         msg = str(exc)  # a node's problem is named in the document it belongs to
         raise UsageError(f"{path}: {msg}" if msg.startswith("node ") else msg) from None
     except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    except ImageError as exc:  # a baked image that could not be written
         raise UsageError(str(exc)) from None
     except OSError as exc:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None

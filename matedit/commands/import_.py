@@ -62,7 +62,7 @@ def refuse_existing(targets, overwrite: bool) -> None:
 
 def run(args) -> int:
     from matedit.interop.mtlx_import import MtlxImportError, import_all, import_mtlx, output_paths
-    from matedit.io.atomic import atomic_write_text
+    from matedit.io.atomic import atomic_write_text, staged_outputs
     from matedit.io.document import dumps
     from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
@@ -92,11 +92,14 @@ def run(args) -> int:
         raise _fail(exc) from None
     try:  # the MaterialX document, and every image an imported material reads
         refuse_overwrite(list(docs), command_inputs(args, written=docs.values()))
-        if to_folder:
+        if to_folder:  # every material, or none
             refuse_existing(docs, args.overwrite)
-            out.mkdir(parents=True, exist_ok=True)
-        for target, doc in docs.items():
-            atomic_write_text(target, dumps(doc))
+            with staged_outputs(out) as stage:
+                for target, doc in docs.items():
+                    stage.write_text(target, dumps(doc))
+        else:
+            for target, doc in docs.items():
+                atomic_write_text(target, dumps(doc))
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:

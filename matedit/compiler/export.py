@@ -13,7 +13,7 @@ from pathlib import Path
 
 from matedit.compiler.api import CompiledMaterial, compile_all
 from matedit.graph.model import MaterialDocument
-from matedit.io.atomic import atomic_write_text
+from matedit.io.atomic import staged_outputs
 from matedit.io.inputs import document_inputs, refuse_overwrite
 
 
@@ -46,7 +46,8 @@ def shader_files(doc: MaterialDocument, compiled: dict[str, CompiledMaterial],
 def export_shaders(doc: MaterialDocument, resolver, targets: list[str], folder: Path,
                    compiled: dict[str, CompiledMaterial] | None = None) -> list[Path]:
     """Compile (unless given) and write; raises CompileError, OverwriteError or OSError.
-    Every output is checked against the inputs before the first file is written."""
+    Every output is checked against the inputs before the first file is written, and the
+    files appear together or not at all (`staged_outputs`)."""
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
         raise NotADirectoryError(f"{folder}: exists and is not a folder")
@@ -54,8 +55,9 @@ def export_shaders(doc: MaterialDocument, resolver, targets: list[str], folder: 
         compiled = compile_targets(doc, resolver, targets)
     files = shader_files(doc, compiled, folder)
     refuse_overwrite(files, document_inputs(doc, resolver))
-    for path, text in files.items():
-        atomic_write_text(path, text)
+    with staged_outputs(folder) as stage:
+        for path, text in files.items():  # the reflection last
+            stage.write_text(path, text)
     return list(files)
 
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from matedit.ibl.bake import IBLBake
 from matedit.ibl.cubemap import faces_to_cross
-from matedit.io.atomic import atomic_write_text
+from matedit.io.atomic import atomic_write_text, staged_outputs
 from matedit.io.images import write_image
 
 SH_BASIS_NAMES = (
@@ -54,18 +54,20 @@ def _write_json(path: Path, data: dict) -> None:
 
 
 def write_bake(result: IBLBake, folder: str | os.PathLike) -> list[Path]:
-    """Write every file of the layout above into `folder` (created); returns the paths."""
+    """Write every file of the layout above into `folder` (created), together or not at all
+    (`staged_outputs`, the manifest moved into place last); returns the paths."""
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = []
+    with staged_outputs(folder) as stage:
+        _write_bake(result, folder, stage.path)
+    return stage.written
+
+
+def _write_bake(result: IBLBake, folder: Path, to) -> None:
     for m, mip in enumerate(result.mips):
-        path = folder / f"prefiltered_mip{m}.exr"
-        write_image(path, faces_to_cross(mip))
-        written.append(path)
-    written.append(write_lut(folder / "brdf_lut.exr", result.lut))
-    sh_path = folder / "sh.json"
+        write_image(to(folder / f"prefiltered_mip{m}.exr"), faces_to_cross(mip))
+    write_lut(to(folder / "brdf_lut.exr"), result.lut)
     _write_json(
-        sh_path,
+        to(folder / "sh.json"),
         {
             "format": "matedit.sh-irradiance",
             "version": 1,
@@ -75,10 +77,8 @@ def write_bake(result: IBLBake, folder: str | os.PathLike) -> list[Path]:
             "coefficients": [[float(v) for v in row] for row in np.asarray(result.sh)],
         },
     )
-    written.append(sh_path)
-    manifest = folder / "ibl.json"
     _write_json(
-        manifest,
+        to(folder / "ibl.json"),
         {
             "format": "matedit.ibl",
             "version": 1,
@@ -97,5 +97,4 @@ def write_bake(result: IBLBake, folder: str | os.PathLike) -> list[Path]:
             "settings": asdict(result.settings),
         },
     )
-    written.append(manifest)
-    return written
+

@@ -224,6 +224,18 @@ def map_paths(folder: Path, stem: str, names, fmt: str) -> dict[str, Path]:
     return {n: Path(folder) / f"{stem}_{n}.{fmt}" for n in names}
 
 
+def write_maps(folder: Path, stem: str, maps: list[BakedMap], fmt: str) -> dict[str, Path]:
+    """Write every map into `folder` (created), all of them or none (staged_outputs);
+    returns map name -> path."""
+    from matedit.io.atomic import staged_outputs
+
+    paths = map_paths(folder, stem, [m.name for m in maps], fmt)
+    with staged_outputs(folder) as stage:
+        for m in maps:
+            encode_file(stage.path(paths[m.name]), m)
+    return paths
+
+
 def bake_document(ctx, doc, resolver, size: int,
                   progress: Callable[[float], None] | None = None, fmt: str = "png"):
     """Compile `doc` in attribute mode and bake it on the GL context `ctx`.

@@ -17,7 +17,7 @@ import numpy as np
 import pygltflib as g
 
 from matedit.interop.bake import BakedMap, encode_file
-from matedit.io.atomic import atomic_write_bytes, atomic_write_text, read_bounded
+from matedit.io.atomic import atomic_write_bytes, read_bounded, staged_outputs
 
 
 @dataclass
@@ -142,8 +142,13 @@ def files_for(out: Path, maps: list[BakedMap], mesh, name: str,
 
 
 def write(files: dict[Path, bytes]) -> None:
-    for p, data in files.items():
-        if p.suffix.lower() == ".gltf":
-            atomic_write_text(p, data.decode("utf-8"))
-        else:
-            atomic_write_bytes(p, data)
+    """Write the asset: OUT.glb alone, or OUT.bin and OUT.gltf together or not at all (the
+    .gltf moved into place last), so a new .gltf never sits beside an old .bin."""
+    if len(files) == 1:
+        ((p, data),) = files.items()
+        atomic_write_bytes(p, data)
+        return
+    order = sorted(files, key=lambda p: p.suffix.lower() == ".gltf")
+    with staged_outputs(order[0].parent) as stage:
+        for p in order:
+            stage.write_bytes(p, files[p])

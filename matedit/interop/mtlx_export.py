@@ -869,9 +869,14 @@ def export(doc, resolver, out: Path, size: int = 512) -> MtlxExport:
 
 
 def write(result: MtlxExport) -> None:
+    """The document and its baked images, together or not at all (the document last)."""
     from matedit.interop.bake import BakedMap, encode_file
-    from matedit.io.atomic import atomic_write_text
+    from matedit.io.atomic import atomic_write_text, staged_outputs
 
-    for path, arr in result.images.items():
-        encode_file(path, BakedMap(path.stem, arr, False))
-    atomic_write_text(result.out, result.text)
+    if not result.images:
+        atomic_write_text(result.out, result.text)
+        return
+    with staged_outputs(result.out.parent) as stage:
+        for path, arr in result.images.items():
+            encode_file(stage.path(path), BakedMap(path.stem, arr, False))
+        stage.write_text(result.out, result.text)

@@ -350,12 +350,16 @@ def rebase_references(doc: MaterialDocument, new_path: Path) -> None:
 
 
 def save(doc: MaterialDocument, path: str | os.PathLike | None = None) -> Path:
-    """Atomic save; with a new path, relative references are rebased first."""
+    """Atomic save; with a new path, relative references are rebased first. Saved to the
+    name it was opened from, a link there is followed; any other link is replaced."""
     target = Path(path) if path is not None else doc.path
     if target is None:
         raise ValueError("no path to save to")
+    from matedit.io.atomic import saves_to_opened_path
+
+    follow = saves_to_opened_path(target, doc.path)
     rebase_references(doc, target)
-    atomic_write_text(target, dumps(doc))
+    atomic_write_text(target, dumps(doc), follow_link=follow)
     doc.path = Path(target)
     return Path(target)
 

@@ -312,6 +312,9 @@ def save_instance(doc: InstanceDocument, path: str | os.PathLike | None = None,
     target = Path(path) if path is not None else doc.path
     if target is None:
         raise ValueError("no path to save to")
+    from matedit.io.atomic import saves_to_opened_path
+
+    follow = saves_to_opened_path(target, doc.path)  # a link is followed only there
     rebase(doc, target, resolved.parameters if resolved else None)
     if resolved is not None:
         known = {n: p.type for n, p in resolved.parameters.items()}
@@ -319,7 +322,7 @@ def save_instance(doc: InstanceDocument, path: str | os.PathLike | None = None,
             if name not in known and name in doc.parent_parameters:
                 known[name] = doc.parent_parameters[name]
         doc.parent_parameters = dict(sorted(known.items()))
-    atomic_write_text(target, dumps(doc))
+    atomic_write_text(target, dumps(doc), follow_link=follow)
     doc.path = target
     return target
 

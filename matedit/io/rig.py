@@ -187,8 +187,9 @@ def dumps(lights: list[Light]) -> str:
                        "lights": [light_to_dict(x) for x in lights]}, indent=2) + "\n"
 
 
-def save(lights: list[Light], path: str | os.PathLike) -> Path:
-    """Writes the rig atomically (matedit.io.atomic)."""
+def save(lights: list[Light], path: str | os.PathLike, *, follow_link: bool = False) -> Path:
+    """Writes the rig atomically (matedit.io.atomic); a link at `path` is replaced, unless
+    `follow_link` (the rig saved back to the name it was loaded from)."""
     if len(lights) > MAX_LIGHTS:
         raise RigError(str(path), f"{len(lights)} lights; at most {MAX_LIGHTS}", field="lights")
-    return atomic_write_text(path, dumps(lights))
+    return atomic_write_text(path, dumps(lights), follow_link=follow_link)
