@@ -319,9 +319,8 @@ def _no_writer_left(path):
 def test_special_files_as_document(tmp_path, kind):
     target = SPECIAL[kind](tmp_path)
     commands = [["compile", target, "-o", tmp_path / "o"], ["render", target, "-o",
-                                                             tmp_path / "r.png"]]
-    if kind != "folder":  # validate FOLDER checks every *.json in it: none here is fine
-        commands.append(["validate", target])
+                                                             tmp_path / "r.png"],
+                ["validate", target]]  # a folder with no *.json in it is an error too
     for command in commands:
         rc, _, err = cli(*command)
         assert_clean_failure(rc, err)
@@ -771,9 +770,10 @@ def _obj_limit_case(tmp_path, monkeypatch, case):
     if case == "triangles":
         text = tri + "f 1 2 3\n" * 101
         return write(tmp_path / "f.obj", text), ["f.obj:104:", "more than 100 triangles"]
-    # distinct corners: 60 positions x 2 UVs drawn as 120 vertices
-    text = "v 0 0 0\n" * 60 + "vt 0 0\nvt 1 1\n" + "".join(
-        f"f {i}/1 {i + 1}/2 {i + 2}/1\nf {i}/2 {i + 1}/1 {i + 2}/2\n" for i in range(1, 49))
+    # distinct corners: 40 triangles of 60 positions and 3 UVs, 120 different pairs
+    text = "v 0 0 0\n" * 60 + "vt 0 0\nvt 1 0\nvt 0 1\n" + "".join(
+        "f " + " ".join(f"{c % 60 + 1}/{c // 60 + 1}" for c in range(3 * k, 3 * k + 3)) + "\n"
+        for k in range(40))
     return write(tmp_path / "c.obj", text), ["c.obj:", "distinct vertices"]
 
 
