@@ -95,10 +95,7 @@ def _hold_standard_fds() -> None:
         if new != fd:
             os.dup2(new, fd)
             os.close(new)
-        if fd == 1 and sys.stdout is None:
-            sys.stdout = open(1, "w", encoding="utf-8", errors="surrogateescape",
-                              closefd=False)
-        elif fd == 2 and sys.stderr is None:
+        if fd == 2 and sys.stderr is None:
             sys.stderr = open(2, "w", encoding="utf-8", errors="backslashreplace",
                               closefd=False)
 
@@ -108,8 +105,12 @@ def _command_stdout():
     """sys.stdout guarded for the command's run; file names that are not UTF-8 are written
     as their own bytes (surrogateescape), as the shell passed them."""
     saved = sys.stdout
-    if saved is None:  # no descriptor 1 could be held: nothing printed is kept
-        saved = sys.stdout = open(os.devnull, "w", encoding="utf-8")
+    if saved is None:  # started with stdout closed: writes go to the descriptor held on 1
+        try:
+            saved = open(1, "w", encoding="utf-8", errors="surrogateescape", closefd=False)
+        except OSError:
+            saved = open(os.devnull, "w", encoding="utf-8")
+        sys.stdout = saved
     errors = getattr(saved, "errors", None)
     with contextlib.suppress(AttributeError, ValueError, OSError, TypeError):
         saved.reconfigure(errors="surrogateescape")
