@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
 import os
 import signal
 import sys
@@ -10,15 +12,30 @@ import sys
 QUIT_AFTER_FIRST_FRAME = "MATEDIT_QUIT_AFTER_FIRST_FRAME"
 
 
+def _escaped(c: str) -> str:
+    if "\udc80" <= c <= "\udcff":  # a byte of a file name that is not UTF-8 (PEP 383)
+        return f"\\x{ord(c) - 0xdc00:02x}"
+    return c.encode("unicode_escape", errors="backslashreplace").decode("ascii")
+
+
 def one_line(text: object) -> str:
     """Text for one line of a terminal report: line breaks and other control characters from
-    file names or fields are shown escaped, so a message is always exactly one line."""
-    return "".join(c if c.isprintable() or c == " " else
-                   c.encode("unicode_escape").decode("ascii") for c in str(text))
+    file names or fields are shown escaped (a non-UTF-8 byte of a name as \\xNN), so a message
+    is always exactly one printable line."""
+    return "".join(c if c.isprintable() or c == " " else _escaped(c) for c in str(text))
 
 
 def report(severity: str, message: object) -> None:
-    print(f"{severity}: {one_line(message)}", file=sys.stderr)
+    """One `severity: message` line on stderr; a stderr that cannot be written is ignored
+    (there is nowhere left to say so)."""
+    stream = sys.stderr
+    if stream is None:
+        return
+    try:
+        stream.write(f"{severity}: {one_line(message)}\n")
+        stream.flush()
+    except (OSError, ValueError):
+        pass
 
 
 class UsageError(Exception):
@@ -47,6 +64,103 @@ def _catch_sigterm() -> tuple:
 def _restore_sigterm(saved: tuple) -> None:
     if saved:
         signal.signal(signal.SIGTERM, saved[0])
+
+
+class StdoutError(Exception):
+    """Standard output could not be written (closed, full, or a reader that went away)."""
+
+    def __init__(self, cause: OSError) -> None:
+        self.cause = cause
+        super().__init__(cause.strerror or str(cause))
+
+
+class _GuardedStdout:
+    """sys.stdout while a command runs: a failed write or flush becomes a StdoutError, so it
+    is told apart from the command's own file errors. Everything else is the stream's."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except OSError as exc:
+            raise StdoutError(exc) from None
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except OSError as exc:
+            raise StdoutError(exc) from None
+
+    def isatty(self) -> bool:
+        try:
+            return self._stream.isatty()
+        except (OSError, ValueError):
+            return False
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+def _hold_standard_fds() -> None:
+    """Put /dev/null on stdin, stdout or stderr where the caller closed them, so files the
+    command opens never take descriptors 0-2. Stdout gets it read-only: a write fails (EBADF)
+    and is reported, rather than vanishing; stderr gets it writable: messages are dropped."""
+    for fd, flags in ((0, os.O_RDONLY), (1, os.O_RDONLY), (2, os.O_WRONLY)):
+        try:
+            os.fstat(fd)
+            continue
+        except OSError:
+            pass
+        try:
+            new = os.open(os.devnull, flags)
+        except OSError:
+            continue
+        if new != fd:
+            os.dup2(new, fd)
+            os.close(new)
+        if fd == 2 and sys.stderr is None:
+            sys.stderr = open(2, "w", encoding="utf-8", errors="backslashreplace",
+                              closefd=False)
+
+
+@contextlib.contextmanager
+def _command_stdout():
+    """sys.stdout guarded for the command's run; file names that are not UTF-8 are written
+    as their own bytes (surrogateescape), as the shell passed them."""
+    saved = sys.stdout
+    if saved is None:  # started with stdout closed: writes go to the descriptor held on 1
+        try:
+            saved = open(1, "w", encoding="utf-8", errors="surrogateescape", closefd=False)
+        except OSError:
+            saved = open(os.devnull, "w", encoding="utf-8")
+        sys.stdout = saved
+    errors = getattr(saved, "errors", None)
+    with contextlib.suppress(AttributeError, ValueError, OSError, TypeError):
+        saved.reconfigure(errors="surrogateescape")
+    sys.stdout = _GuardedStdout(saved)
+    try:
+        yield
+    finally:
+        sys.stdout = saved
+        if errors:
+            with contextlib.suppress(AttributeError, ValueError, OSError, TypeError):
+                saved.reconfigure(errors=errors)
+
+
+def _stdout_failed(exc: StdoutError) -> int:
+    """A broken pipe ends quietly with status 141 (128 + SIGPIPE, what `yes | head -1`
+    reports); any other write failure is one error line and status 2. Either way fd 1 then
+    points at /dev/null, so the interpreter's flush at exit finds nothing to fail on."""
+    with contextlib.suppress(OSError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.close(devnull)
+    if isinstance(exc.cause, BrokenPipeError) or exc.cause.errno == errno.EPIPE:
+        return 141
+    report("error", f"cannot write to standard output: {exc}")
+    return 2
 
 
 class _Parser(argparse.ArgumentParser):
@@ -99,11 +213,32 @@ def open_editor(argv: list[str]) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    saved_sigterm: tuple = ()
+    _hold_standard_fds()
     try:
         parser = build_parser()
-        if not argv or (not argv[0].startswith("-") and argv[0] not in
-                        subcommand_names(parser)):
+        editor = not argv or (not argv[0].startswith("-") and argv[0] not in
+                              subcommand_names(parser))
+    except Exception as exc:  # pragma: no cover - a broken command registry
+        report("error", f"internal: {type(exc).__name__}: {exc}")
+        return 1
+    if editor:
+        return _run(argv, parser, editor)
+    with _command_stdout():
+        try:
+            try:
+                rc = _run(argv, parser, editor)
+            except SystemExit as exc:  # argparse's --help: its text is flushed here too
+                rc = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
+            sys.stdout.flush()
+            return rc
+        except StdoutError as exc:
+            return _stdout_failed(exc)
+
+
+def _run(argv: list[str], parser: argparse.ArgumentParser, editor: bool) -> int:
+    saved_sigterm: tuple = ()
+    try:
+        if editor:
             return open_editor(argv)
         args = parser.parse_args(argv)
         if args.version and not args.command:
@@ -119,8 +254,10 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as exc:
         report("error", exc)
         return 2
+    except StdoutError:
+        raise
     except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (Terminated): temporaries removed
-        print("error: interrupted", file=sys.stderr)
+        report("error", "interrupted")
         return 143 if isinstance(exc, Terminated) else 130
     except Exception as exc:  # internal failure: still one line, status 1
         report("error", f"internal: {type(exc).__name__}: {exc}")

@@ -319,9 +319,8 @@ def _no_writer_left(path):
 def test_special_files_as_document(tmp_path, kind):
     target = SPECIAL[kind](tmp_path)
     commands = [["compile", target, "-o", tmp_path / "o"], ["render", target, "-o",
-                                                             tmp_path / "r.png"]]
-    if kind != "folder":  # validate FOLDER checks every *.json in it: none here is fine
-        commands.append(["validate", target])
+                                                             tmp_path / "r.png"],
+                ["validate", target]]  # a folder with no *.json in it is an error too
     for command in commands:
         rc, _, err = cli(*command)
         assert_clean_failure(rc, err)
@@ -483,3 +482,466 @@ def test_loader_never_raises_anything_but_format_errors(mutation):
 
     again = loads(dumps(doc), "m.json")  # a file that loads also saves, and loads again
     assert dumps(again) == dumps(doc)
+
+
+# === Numbers, names and streams (issue 22): streams, non-UTF-8 names, synthetic image ======
+# === readers, OBJ bounds, degenerate meshes, contact sheets, glTF URIs, empty folders ======
+#
+# Helpers of this section only. Subprocess cases run `python -m matedit` with the matedit
+# this test imported (so the same tree is under test), argv given as bytes where a name is
+# not UTF-8.
+
+STREAM_COMMANDS = {"nodes --json": ["nodes", "--json"], "nodes": ["nodes"],
+                   "--version": ["--version"], "--help": ["--help"]}
+
+
+def _matedit_argv(*args) -> list[bytes]:
+    import sys
+
+    return [os.fsencode(sys.executable), b"-m", b"matedit",
+            *[a if isinstance(a, bytes) else os.fsencode(str(a)) for a in args]]
+
+
+def _matedit_env() -> dict:
+    import matedit
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(matedit.__file__)))
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([root, env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    env.pop("MATEDIT_DEBUG", None)
+    return env
+
+
+def _run_matedit(*args, cwd=None, timeout=18, **kw):
+    import subprocess
+
+    return subprocess.run(_matedit_argv(*args), env=_matedit_env(), cwd=cwd, timeout=timeout,
+                          **kw)
+
+
+def _close_fd(fd: int):
+    return lambda: os.close(fd)
+
+
+def _error_lines(err: bytes) -> list[str]:
+    return [l for l in err.decode("utf-8", "backslashreplace").splitlines() if l.strip()]
+
+
+@pytest.mark.parametrize("how", ["stdout closed", "stdout full", "broken pipe"])
+@pytest.mark.parametrize("command", sorted(STREAM_COMMANDS))
+def test_stdout_closed_full_or_broken(tmp_path, how, command):
+    """Output that cannot be written is one `error:` line and status 2; a reader that went
+    away (`| head -1`) ends it quietly with 141. Never an internal error or a traceback."""
+    import subprocess
+
+    args = STREAM_COMMANDS[command]
+    if how == "broken pipe":
+        # The reader has gone before the first write (as `head` may have, whatever the
+        # pipe's buffer holds): every write meets EPIPE.
+        read_end, write_end = os.pipe()
+        os.close(read_end)
+        try:
+            r = _run_matedit(*args, stdout=write_end, stderr=subprocess.PIPE)
+        finally:
+            os.close(write_end)
+        assert r.stderr == b"", r.stderr
+        assert r.returncode == 141
+        return
+    if how == "stdout full":
+        with open("/dev/full", "wb") as full:
+            r = _run_matedit(*args, stdout=full, stderr=subprocess.PIPE)
+    else:
+        r = _run_matedit(*args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         preexec_fn=_close_fd(1))
+    lines = _error_lines(r.stderr)
+    assert r.returncode == 2, r.stderr
+    assert len(lines) == 1 and lines[0].startswith("error: cannot write to standard output: "), \
+        lines
+
+
+@pytest.mark.parametrize("how", ["stderr closed", "stderr full"])
+@pytest.mark.parametrize("case", ["error", "success"])
+def test_stderr_closed_or_full_changes_only_what_is_seen(tmp_path, how, case):
+    """With stderr gone the status still tells, and nothing meant for stderr lands on
+    stdout."""
+    import subprocess
+
+    args = ["validate", tmp_path / "missing.json"] if case == "error" else \
+        ["nodes", "--category", "Math"]
+    if how == "stderr full":
+        with open("/dev/full", "wb") as full:
+            r = _run_matedit(*args, stdout=subprocess.PIPE, stderr=full)
+    else:
+        r = _run_matedit(*args, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                         preexec_fn=_close_fd(2))
+    if case == "error":
+        assert r.returncode == 2
+        assert r.stdout == b""
+    else:
+        assert r.returncode == 0
+        assert b"node kinds" in r.stdout and b"error" not in r.stdout
+
+
+BAD = b"\xff\xfe"  # not UTF-8: Python shows these bytes as surrogate escapes
+
+
+def _bytes_exists(path: bytes) -> bool:
+    return os.path.lexists(path) and os.path.getsize(path) > 0
+
+
+def _non_utf8_fixture(tmp: bytes) -> dict[str, bytes]:
+    """Files with non-UTF-8 names: an environment, a texture, a mesh, and a material
+    (itself so named) that reads the texture."""
+    import numpy as np
+
+    from matedit.io.images import write_image
+
+    env = tmp + b"/env" + BAD + b".exr"
+    tex = tmp + b"/tex" + BAD + b".png"
+    obj = tmp + b"/tri" + BAD + b".obj"
+    doc = tmp + b"/m" + BAD + b".json"
+    write_image(os.fsdecode(env), np.full((8, 16, 3), 0.5, np.float32))
+    write_image(os.fsdecode(tex), np.full((4, 4, 3), 0.25, np.float32))
+    with open(obj, "w") as f:
+        f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n")
+    raw = base_material()
+    _add_texture(raw, os.fsdecode(b"tex" + BAD + b".png"))
+    with open(doc, "w", encoding="utf-8") as f:
+        f.write(json.dumps(raw))  # the name is written as a \udcff escape, which JSON allows
+    os.mkdir(tmp + b"/dir" + BAD)
+    return {"env": env, "tex": tex, "obj": obj, "doc": doc, "dir": tmp + b"/dir" + BAD}
+
+
+# name -> (argv with {placeholders}, the files that must exist afterwards)
+NON_UTF8_CASES = {
+    "render -o": (["render", "doc", "-o", b"OUT.png", "--size", "16x16"], [b"OUT.png"]),
+    "render -o in a folder": (["render", "doc", "-o", b"dir/r.exr", "--size", "16x16"],
+                              [b"dir/r.exr"]),
+    "render --env": (["render", "doc", "-o", b"r.png", "--size", "16x16", "--env", "env"],
+                     [b"r.png"]),
+    "render --mesh": (["render", "doc", "-o", b"r.png", "--size", "16x16", "--mesh", "obj"],
+                      [b"r.png"]),
+    "brdf-lut -o": (["brdf-lut", "-o", b"OUT.exr", "--size", "8", "--samples", "64",
+                     "--no-cache"], [b"OUT.exr"]),
+    "bake -o": (["bake", "doc", "-o", b"dir", "--size", "8"], [b"dir/m" + BAD + b"_orm.png"]),
+    "bake-ibl ENV -o": (["bake-ibl", "env", "-o", b"OUT", "--size", "8", "--samples", "8",
+                         "--no-cache"], [b"OUT/brdf_lut.exr", b"OUT/prefiltered_mip0.exr"]),
+    "export .gltf": (["export", "doc", "-o", b"OUT.gltf", "--size", "8", "--mesh", "obj"],
+                     [b"OUT.gltf", b"OUT.bin"]),
+    "export .glb": (["export", "doc", "-o", b"OUT.glb", "--size", "8"], [b"OUT.glb"]),
+    "contact-sheet": (["contact-sheet", "doc", "-o", b"OUT.png", "--size", "16"],
+                      [b"OUT.png"]),
+}
+
+
+def _expand(arg, fixture: dict[str, bytes], tmp: bytes):
+    if isinstance(arg, str):
+        return fixture.get(arg, arg)
+    return tmp + b"/" + arg.replace(b"OUT", b"out" + BAD).replace(b"dir", b"dir" + BAD)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("case", sorted(NON_UTF8_CASES))
+def test_non_utf8_file_names(tmp_path, case):
+    """Names with bytes that are not UTF-8 (valid on Linux) work as inputs and outputs;
+    a texture so named is read (no warning), and the glTF's .bin URI names those bytes."""
+    import subprocess
+    import urllib.parse
+
+    tmp = os.fsencode(tmp_path)
+    fixture = _non_utf8_fixture(tmp)
+    args, outputs = NON_UTF8_CASES[case]
+    r = _run_matedit(*[_expand(a, fixture, tmp) for a in args], stdout=subprocess.PIPE,
+                     stderr=subprocess.PIPE, cwd=tmp)
+    err = r.stderr.decode("utf-8", "backslashreplace")
+    assert r.returncode == 0, err
+    assert "warning" not in err and "error" not in err, err  # the texture was read
+    for out in outputs:
+        assert _bytes_exists(_expand(out, fixture, tmp)), (out, os.listdir(tmp))
+    if case == "export .gltf":
+        gltf = json.loads(open(_expand(b"OUT.gltf", fixture, tmp), "rb").read())
+        uri = gltf["buffers"][0]["uri"]
+        assert uri.isascii()
+        assert urllib.parse.unquote_to_bytes(uri) == b"out" + BAD + b".bin"
+    if case == "bake-ibl ENV -o":  # the paths it prints are the bytes the shell gave
+        assert tmp + b"/out" + BAD + b"/ibl.json" in r.stdout.splitlines()
+
+
+@pytest.mark.parametrize("where", ["render --env", "render --mesh", "validate",
+                                   "bake-ibl ENV"])
+def test_non_utf8_names_in_error_messages(tmp_path, where):
+    """A missing file with a non-UTF-8 name is one `error:` line showing the byte as \\xNN."""
+    import subprocess
+
+    tmp = os.fsencode(tmp_path)
+    doc = write(tmp_path / "m.json", base_material())
+    missing = tmp + b"/gone" + BAD
+    args = {"render --env": ["render", doc, "-o", tmp + b"/r.png", "--env", missing + b".exr"],
+            "render --mesh": ["render", doc, "-o", tmp + b"/r.png", "--mesh",
+                              missing + b".obj"],
+            "validate": ["validate", missing + b".json"],
+            "bake-ibl ENV": ["bake-ibl", missing + b".exr", "-o", tmp + b"/o"]}[where]
+    r = _run_matedit(*args, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    lines = _error_lines(r.stderr)
+    assert r.returncode == 2, lines
+    assert len(lines) == 1 and lines[0].startswith("error: "), lines
+    assert "gone\\xff\\xfe" in lines[0], lines
+
+
+# OpenImageIO's `null` reader makes up an image (1024x1024, or whatever `?RES=` asks) for a
+# name ending in .null; it allocates only when the pixels are read.
+SYNTHETIC_NAMES = ["x.null", "x.null?RES=16384x8192.png", "x.null?RES=16384x8192",
+                   "x.nul", "x.term"]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("where", ["--env", "texture"])
+@pytest.mark.parametrize("name", SYNTHETIC_NAMES)
+def test_synthetic_image_readers_are_refused_before_allocating(tmp_path, name, where):
+    """A 2-byte file that selects a synthetic reader is refused, as an error (--env) or as a
+    texture that cannot be read (drawn as a checker), and memory stays small."""
+    import subprocess
+
+    (tmp_path / name).write_bytes(b"ab")
+    raw = base_material()
+    args = []
+    if where == "--env":
+        args = ["--env", tmp_path / name]
+    else:
+        _add_texture(raw, name)
+    doc = write(tmp_path / "m.json", raw)
+    script = ("import resource, sys\nfrom matedit.cli import main\n"
+              "rc = main(sys.argv[1:])\n"
+              "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)\n"
+              "raise SystemExit(rc)\n")
+    import sys
+
+    r = subprocess.run([sys.executable, "-c", script, "render", str(doc), "-o",
+                        str(tmp_path / "r.png"), "--size", "16x16", *map(str, args)],
+                       env=_matedit_env(), capture_output=True, text=True, timeout=18)
+    peak_mb = int(r.stdout.split()[-1])
+    assert peak_mb < 600, f"{peak_mb} MB"
+    lines = [l for l in r.stderr.splitlines() if l.strip()]
+    if where == "--env":
+        assert_clean_failure(r.returncode, r.stderr)
+        assert len(lines) == 1 and name.split("?")[0] in lines[0], lines
+    else:
+        assert r.returncode == 0, r.stderr  # the texture shows as a checker
+        assert not any(l.startswith("error") for l in lines), lines
+
+
+def test_images_are_read_only_by_real_formats_readers(tmp_path):
+    """The reader alone: a synthetic format is refused whatever its name says, and a real
+    image whose extension names another real format is still read."""
+    import numpy as np
+
+    from matedit.io.images import ImageError, read_image, write_image
+
+    (tmp_path / "x.null?RES=16384x8192.png").write_bytes(b"ab")
+    with pytest.raises(ImageError, match="null"):
+        read_image(tmp_path / "x.null?RES=16384x8192.png")
+    write_image(tmp_path / "real.exr", np.ones((2, 4, 3)))
+    os.rename(tmp_path / "real.exr", tmp_path / "really_exr.tif")
+    img = read_image(tmp_path / "really_exr.tif")
+    assert img.format_name == "openexr" and img.pixels.shape == (2, 4, 3)
+
+
+def _obj_limit_case(tmp_path, monkeypatch, case):
+    """(OBJ path, the words the error must hold) for one way past the limits; small limits
+    are patched in where the real ones would take seconds to reach."""
+    import matedit.render.mesh as mesh
+
+    tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+    if case == "one huge polygon":  # the real limit: a fan of 2,000,001 triangles
+        n = mesh.MAX_OBJ_TRIANGLES + 3 if hasattr(mesh, "MAX_OBJ_TRIANGLES") else 2_000_003
+        text = tri + "f" + " 1 2 3" * (n // 3 + 1) + "\n"
+        return write(tmp_path / "fan.obj", text), ["fan.obj:4:", "triangles"]
+    monkeypatch.setattr(mesh, "MAX_OBJ_VERTICES", 100, raising=False)
+    monkeypatch.setattr(mesh, "MAX_OBJ_TRIANGLES", 100, raising=False)
+    if case == "vertices":
+        text = "v 0 0 0\n" * 101 + "f 1 2 3\n"
+        return write(tmp_path / "v.obj", text), ["v.obj:101:", "more than 100 vertices"]
+    if case == "texture coordinates":
+        text = tri + "vt 0 0\n" * 101 + "f 1/1 2/2 3/3\n"
+        return write(tmp_path / "vt.obj", text), ["vt.obj:104:", "texture coordinates"]
+    if case == "normals":
+        text = tri + "vn 0 0 1\n" * 101 + "f 1//1 2//1 3//1\n"
+        return write(tmp_path / "vn.obj", text), ["vn.obj:104:", "normals"]
+    if case == "triangles":
+        text = tri + "f 1 2 3\n" * 101
+        return write(tmp_path / "f.obj", text), ["f.obj:104:", "more than 100 triangles"]
+    # distinct corners: 40 triangles of 60 positions and 3 UVs, 120 different pairs
+    text = "v 0 0 0\n" * 60 + "vt 0 0\nvt 1 0\nvt 0 1\n" + "".join(
+        "f " + " ".join(f"{c % 60 + 1}/{c // 60 + 1}" for c in range(3 * k, 3 * k + 3)) + "\n"
+        for k in range(40))
+    return write(tmp_path / "c.obj", text), ["c.obj:", "distinct vertices"]
+
+
+OBJ_LIMIT_CASES = ["one huge polygon", "vertices", "texture coordinates", "normals",
+                   "triangles", "distinct corners"]
+
+
+@pytest.mark.parametrize("case", OBJ_LIMIT_CASES)
+def test_obj_beyond_the_stated_limits_is_refused_while_parsing(tmp_path, monkeypatch, case):
+    import time
+
+    from matedit.render.mesh import MeshError, load_obj
+
+    path, words = _obj_limit_case(tmp_path, monkeypatch, case)
+    start = time.monotonic()
+    with pytest.raises(MeshError) as info:
+        load_obj(path)
+    assert time.monotonic() - start < 5
+    assert all(w in str(info.value) for w in words), str(info.value)
+    assert "the limit for a preview mesh" in str(info.value) or case == "distinct corners"
+
+
+@pytest.mark.gl
+def test_obj_beyond_the_limits_through_render(tmp_path, monkeypatch):
+    path, words = _obj_limit_case(tmp_path, monkeypatch, "one huge polygon")
+    doc = write(tmp_path / "m.json", base_material())
+    rc, _, err = cli("render", doc, "-o", tmp_path / "r.png", "--size", "16x16", "--mesh", path)
+    assert_clean_failure(rc, err)
+    assert len(err.splitlines()) == 1 and "triangles" in err
+
+
+DEGENERATE_OBJS = {
+    "zero-area triangle": "v 0 0 0\nv 0 0 0\nv 0 0 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                          "f 1/1 2/2 3/3\n",
+    "coincident UVs": "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nf 1/1 2/1 3/1\n",
+    "collinear points": "v 0 0 0\nv 1 0 0\nv 2 0 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                        "f 1/1 2/2 3/3\n",
+    "collinear UVs": "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 1\nvt 2 2\nf 1/1 2/2 3/3\n",
+    "zero normals": "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n",
+    "mixed with a good face": "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nvt 0 0\nvt 1 0\n"
+                              "vt 0 1\nf 1/1 2/2 3/3\nf 4/1 4/2 4/3\n",
+}
+
+
+@pytest.mark.parametrize("case", sorted(DEGENERATE_OBJS))
+def test_degenerate_obj_gets_finite_unit_frames(tmp_path, case):
+    import warnings
+
+    import numpy as np
+
+    from matedit.render.mesh import load_obj
+
+    path = write(tmp_path / "d.obj", DEGENERATE_OBJS[case])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a numpy warning fails the case
+        mesh = load_obj(path)
+    for name, v in (("normals", mesh.normals), ("tangents", mesh.tangents[:, :3])):
+        assert np.all(np.isfinite(v)), name
+        assert np.allclose(np.linalg.norm(v, axis=1), 1.0, atol=1e-5), (name, v)
+    assert np.allclose(np.sum(mesh.normals * mesh.tangents[:, :3], axis=1), 0.0, atol=1e-5)
+    assert set(np.unique(mesh.tangents[:, 3])) <= {-1.0, 1.0}
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("case", ["zero-area triangle", "coincident UVs", "zero normals"])
+def test_degenerate_obj_exports_finite_gltf_tangents(tmp_path, case):
+    import warnings
+
+    import numpy as np
+    import pygltflib
+
+    path = write(tmp_path / "d.obj", DEGENERATE_OBJS[case])
+    doc = write(tmp_path / "m.json", base_material())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rc, _, err = cli("export", doc, "-o", tmp_path / "d.glb", "--size", "4", "--mesh", path)
+    assert rc == 0, err
+    assert err == "", err
+    g = pygltflib.GLTF2().load(str(tmp_path / "d.glb"))
+    blob = g.binary_blob()
+    attrs = g.meshes[0].primitives[0].attributes
+    for index, width in ((attrs.NORMAL, 3), (attrs.TANGENT, 4)):
+        view = g.bufferViews[g.accessors[index].bufferView]
+        v = np.frombuffer(blob[view.byteOffset:view.byteOffset + view.byteLength],
+                          np.float32).reshape(-1, width)
+        assert np.all(np.isfinite(v))
+        assert np.allclose(np.linalg.norm(v[:, :3], axis=1), 1.0, atol=1e-5)
+
+
+def _sheet_case(tmp_path, case):
+    raw = base_material()
+    if case == "missing preview mesh":
+        raw["preview"] = {"mesh": "gone.obj"}
+    elif case == "missing preview environment":
+        raw["preview"] = {"environment": "gone.hdr"}
+    elif case == "unreadable preview mesh":
+        raw["preview"] = {"mesh": "bad.obj"}
+        write(tmp_path / "bad.obj", "v 0 0 0\nf 1 2 3\n")
+    elif case == "unreadable preview environment":
+        raw["preview"] = {"environment": "bad.hdr"}
+        (tmp_path / "bad.hdr").write_bytes(b"#?RADIANCE\nnot really\n")
+    return write(tmp_path / "m.json", raw)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("size", [16, 24, 32, 63, 64])
+def test_contact_sheet_small_tiles(tmp_path, size):
+    from matedit.io.images import read_image
+
+    doc = _sheet_case(tmp_path, "plain")
+    rc, _, err = cli("contact-sheet", doc, doc, "-o", tmp_path / "s.png", "--size", size)
+    assert rc == 0, err
+    assert read_image(tmp_path / "s.png").pixels.shape == (size, 2 * size, 3)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("case", ["missing preview mesh", "missing preview environment",
+                                  "unreadable preview mesh", "unreadable preview environment",
+                                  "size below the minimum"])
+def test_contact_sheet_bad_previews_name_material_and_field(tmp_path, case):
+    doc = _sheet_case(tmp_path, case)
+    size = "8" if case == "size below the minimum" else "16"
+    rc, _, err = cli("contact-sheet", doc, "-o", tmp_path / "s.png", "--size", size)
+    assert_clean_failure(rc, err)
+    lines = err.splitlines()
+    assert len(lines) == 1, lines
+    if case == "size below the minimum":
+        assert "16..2048" in lines[0]
+    else:
+        field = "preview.mesh" if "mesh" in case else "preview.environment"
+        assert lines[0].startswith(f"error: {doc}: {field}: "), lines
+    assert not (tmp_path / "s.png").exists()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("stem", ["odd name #1 %41", "caf\u00e9 & co", "a?b;c=d", "plain"])
+def test_gltf_buffer_uri_is_percent_encoded(tmp_path, stem):
+    import urllib.parse
+
+    import pygltflib
+
+    doc = write(tmp_path / "m.json", base_material())
+    out = tmp_path / f"{stem}.gltf"
+    rc, _, err = cli("export", doc, "-o", out, "--size", "4")
+    assert rc == 0, err
+    uri = json.loads(out.read_text(encoding="utf-8"))["buffers"][0]["uri"]
+    assert uri == urllib.parse.quote(f"{stem}.bin", safe="")
+    assert uri.isascii() and not set(" #?") & set(uri)
+    bin_path = tmp_path / urllib.parse.unquote(uri)
+    assert bin_path == tmp_path / f"{stem}.bin" and bin_path.is_file()
+    g = pygltflib.GLTF2().load(str(out))
+    assert g.buffers[0].byteLength == bin_path.stat().st_size
+
+
+@pytest.mark.parametrize("layout", ["empty", "other files only", "empty subfolders",
+                                    "beside a good file"])
+def test_validate_on_a_folder_without_documents(tmp_path, layout):
+    folder = tmp_path / "docs"
+    folder.mkdir()
+    args = [folder]
+    if layout == "other files only":
+        (folder / "notes.txt").write_text("x")
+        (folder / "m.json.bak").write_text("{}")
+    elif layout == "empty subfolders":
+        (folder / "a" / "b").mkdir(parents=True)
+    elif layout == "beside a good file":
+        args = [write(tmp_path / "m.json", base_material()), folder]
+    rc, out, err = cli("validate", *args)
+    assert_clean_failure(rc, err)
+    assert err.splitlines() == [
+        f"error: {folder}: no material, function or instance files (*.json)"]

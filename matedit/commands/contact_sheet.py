@@ -2,7 +2,9 @@
 every material rendered side by side and labelled, one PNG (the shipped samples by default).
 
 Each tile is what `matedit render` draws for that file (its preview mesh, the studio
-environment unless it names another, split-sum IBL), rendered in one GL context.
+environment unless it names another, split-sum IBL), rendered in one GL context. A preview
+mesh or environment that cannot be loaded is an error naming the material and the field.
+Tiles of at least LABEL_MIN_SIZE pixels carry the material's name; smaller ones do not.
 """
 
 from __future__ import annotations
@@ -11,8 +13,12 @@ import math
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError
+from matedit.cli import UsageError, one_line
 from matedit.io.inputs import declare_inputs
+
+MIN_SIZE = 16
+LABEL_BAND = 26  # pixels: the band under a tile that holds its name
+LABEL_MIN_SIZE = 64  # below this the band would hide most of the tile
 
 
 def register(sub) -> None:
@@ -48,16 +54,35 @@ def materials(files: list[str]) -> list[Path]:
 
 
 def _label(tile, text: str):
+    """The tile with `text` in a band along its bottom; tiles under LABEL_MIN_SIZE as they
+    are."""
     import numpy as np
     import OpenImageIO as oiio
 
     h, w, _ = tile.shape
-    buf = oiio.ImageBuf(oiio.ImageSpec(w, 26, 3, "float"))
+    if min(h, w) < LABEL_MIN_SIZE:
+        return tile
+    band_h = LABEL_BAND
+    buf = oiio.ImageBuf(oiio.ImageSpec(w, band_h, 3, "float"))
     oiio.ImageBufAlgo.render_text(buf, 6, 19, text, 15, "", (0.92, 0.92, 0.92))
-    band = np.asarray(buf.get_pixels(oiio.FLOAT)).reshape(26, w, 3)
+    band = np.asarray(buf.get_pixels(oiio.FLOAT)).reshape(band_h, w, 3)
     out = tile.copy()
-    out[h - 26:] = np.maximum(out[h - 26:] * 0.35, band)
+    out[h - band_h:] = np.maximum(out[h - band_h:] * 0.35, band)
     return out
+
+
+def _preview(doc, path: Path, key: str, override: str | None, fallback: str) -> tuple[str, str]:
+    """(what to load, the field it came from) for the tile's mesh or environment; a file
+    named by the document is relative to it, as `matedit render` reads it."""
+    from matedit.io.inputs import preview_file
+
+    if override:
+        return override, f"--{'mesh' if key == 'mesh' else 'env'}"
+    found = preview_file(doc, key)
+    if found is not None:
+        return str(found), f"{path}: preview.{key}"
+    value = doc.preview.get(key) if isinstance(doc.preview, dict) else None
+    return (value if isinstance(value, str) and value else fallback), f"{path}: preview.{key}"
 
 
 def run(args) -> int:
@@ -73,8 +98,8 @@ def run(args) -> int:
         raise UsageError(f"{out}: the output must be a .png file")
     if not out.parent.exists():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
-    if not 16 <= args.size <= 2048:
-        raise UsageError(f"--size must be 16..2048, got {args.size}")
+    if not MIN_SIZE <= args.size <= 2048:
+        raise UsageError(f"--size must be {MIN_SIZE}..2048, got {args.size}")
     if args.columns < 1:
         raise UsageError(f"--columns must be at least 1, got {args.columns}")
     paths = materials(args.files)
@@ -98,7 +123,8 @@ def run(args) -> int:
             d = exc.diagnostics[0]
             raise UsageError(f"{d.file or path}: {d.format()}") from None
 
-    from matedit.render import Renderer
+    from matedit.ibl import EnvironmentMapError
+    from matedit.render import MeshError, Renderer
     from matedit.render.context import headless_context
 
     n = args.size
@@ -110,12 +136,18 @@ def run(args) -> int:
         renderer = Renderer(ctx, (n, n), environment=None)
         env = None
         for i, (path, doc, compiled) in enumerate(docs):
-            want = doc.preview.get("environment") or "studio"
+            want, field = _preview(doc, path, "environment", None, "studio")
             if want != env:
-                renderer.set_environment(want)
+                try:
+                    renderer.set_environment(want)
+                except (EnvironmentMapError, ValueError, OSError) as exc:
+                    raise UsageError(f"{field}: {exc}") from None
                 env = want
-            mesh = args.mesh or doc.preview.get("mesh") or "sphere"
-            renderer.set_mesh(mesh)
+            mesh, field = _preview(doc, path, "mesh", args.mesh, "sphere")
+            try:
+                renderer.set_mesh(mesh)
+            except (MeshError, OSError) as exc:
+                raise UsageError(f"{field}: {exc}") from None
             # the cube's corners reach further than the sphere: step back so it fits a tile
             renderer.camera.reset()
             renderer.camera.distance *= 1.25 if mesh == "cube" else 1.0
@@ -128,7 +160,7 @@ def run(args) -> int:
                           doc.name or path.stem)
             r, c = divmod(i, cols)
             sheet[r * n:(r + 1) * n, c * n:(c + 1) * n] = tile
-            print(f"{i + 1}/{len(docs)} {path.name}", file=sys.stderr)
+            print(f"{i + 1}/{len(docs)} {one_line(path.name)}", file=sys.stderr)
         renderer.release()
     finally:
         ctx.release()

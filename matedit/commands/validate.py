@@ -27,6 +27,13 @@ def expand(files: list[str]) -> list[Path]:
     return out
 
 
+def empty_folders(files: list[str]) -> list[Path]:
+    """The folders named on the command line that hold no *.json at any depth: checking
+    nothing is not a pass."""
+    return [Path(f) for f in files if Path(f).is_dir() and next(Path(f).rglob("*.json"),
+                                                                None) is None]
+
+
 def _format_of(path: Path) -> str | None:
     """The `format` of a small JSON file, cheaply, to pick its reader; None if unknown."""
     import json
@@ -86,6 +93,9 @@ def problems(path: Path, resolver: FileResolver) -> list[tuple[str, str]]:
 def run(args) -> int:
     resolver = FileResolver()
     failed = False
+    for folder in empty_folders(args.files):
+        report("error", f"{folder}: no material, function or instance files (*.json)")
+        failed = True
     for path in expand(args.files):
         for severity, message in problems(path, resolver):
             report(severity, message)

@@ -9,7 +9,9 @@ matedit's (+Y up, bitangent = cross(normal, tangent) * w), which is glTF's.
 
 from __future__ import annotations
 
+import os
 import tempfile
+import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -137,8 +139,14 @@ def files_for(out: Path, maps: list[BakedMap], mesh, name: str,
         doc.set_binary_blob(data)
         return {out: b"".join(doc.save_to_bytes())}
     bin_path = out.with_suffix(".bin")
-    doc.buffers = [g.Buffer(uri=bin_path.name, byteLength=len(data))]
+    doc.buffers = [g.Buffer(uri=buffer_uri(bin_path), byteLength=len(data))]
     return {out: doc.gltf_to_json().encode("utf-8"), bin_path: data}
+
+
+def buffer_uri(path: Path) -> str:
+    """The relative URI of a file beside the .gltf: its name's bytes percent-encoded (RFC
+    3986), so spaces, '#', '%' and non-UTF-8 bytes reach a reader as the same name."""
+    return urllib.parse.quote(os.fsencode(path.name), safe="")
 
 
 def write(files: dict[Path, bytes]) -> None:

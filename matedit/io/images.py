@@ -4,11 +4,22 @@
 integer files are scaled to [0, 1]; whether they are sRGB is the caller's business,
 `ImageData.is_ldr` says which kind of file it was). Every failure - missing, empty,
 truncated, corrupt or unsupported - is an `ImageError` (a ValueError) naming the file.
+
+Only the file formats of `READ_FORMATS` are read: the name must end in one of their
+extensions and OpenImageIO must report one of them after opening, so its synthetic readers
+(`null`, which invents pixels from the file name) never run. The size is checked from the
+header, before any pixel is allocated. OpenImageIO takes names as UTF-8 text: a name with
+other bytes (valid on Linux) is reached through an ASCII link in a private temporary folder.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import shutil
+import stat
+import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,6 +44,18 @@ _LDR_BASETYPES = {
 
 
 MAX_IMAGE_PIXELS = 16384 * 8192
+# At most 4 channels' worth of those pixels (2 GiB as float32): the limit on what one read
+# may allocate, however the pixels and channels are split.
+MAX_IMAGE_VALUES = MAX_IMAGE_PIXELS * 4
+
+# File extension -> the OpenImageIO format that must read it (the formats the editor's
+# file dialogs offer). Anything else - OpenImageIO's `null` reader, its output-only `term`,
+# and formats matedit does not claim to read - is refused before it is opened.
+READ_FORMATS = {
+    ".png": "png", ".jpg": "jpeg", ".jpeg": "jpeg", ".exr": "openexr", ".hdr": "hdr",
+    ".tif": "tiff", ".tiff": "tiff", ".tga": "targa", ".bmp": "bmp",
+}
+_READERS = frozenset(READ_FORMATS.values())
 
 
 def _reason(exc: OSError) -> str:
@@ -54,6 +77,7 @@ class ImageData:
     format_name: str
     is_ldr: bool
     channel_names: tuple[str, ...]
+    is_8bit: bool = False  # stored as 8-bit integers (what an sRGB8 texture can upload)
 
     @property
     def height(self) -> int:
@@ -81,52 +105,108 @@ def _oiio_error(obj=None) -> str:
     return msg or "unknown OpenImageIO error"
 
 
+def _is_utf8(name: str) -> bool:
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError:  # surrogate escapes: bytes of a name that is not UTF-8
+        return False
+    return True
+
+
+@contextlib.contextmanager
+def oiio_name(path: Path, *, folder: bool = False) -> Iterator[str]:
+    """A name OpenImageIO can take for `path`: the path itself when it is UTF-8, otherwise
+    an ASCII link to the file (or, with `folder`, to its folder, for a writer that creates
+    the file) inside a private temporary folder, removed afterwards."""
+    name = os.fspath(path)
+    if _is_utf8(name):
+        yield name
+        return
+    leaf = path.name if folder else f"in{path.suffix.lower()}"
+    if not _is_utf8(leaf):
+        raise ImageError(f"{name}: OpenImageIO cannot take this file name (it is not UTF-8); "
+                         "rename the file")
+    try:
+        tmp = tempfile.mkdtemp(prefix="matedit-oiio-")
+    except OSError as exc:
+        raise ImageError(f"{name}: cannot make a temporary folder: {exc.strerror or exc}") \
+            from None
+    try:
+        if not _is_utf8(tmp):
+            raise ImageError(f"{name}: the file name is not UTF-8 and neither is the "
+                             "temporary folder; rename the file")
+        target = os.path.abspath(path.parent if folder else path)
+        link = os.path.join(tmp, "d" if folder else leaf)
+        os.symlink(target, link)
+        yield os.path.join(link, leaf) if folder else link
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
 def read_image(path: str | os.PathLike) -> ImageData:
     """Read the first subimage of `path` as float32 (H, W, C); raises ImageError."""
     p = Path(path)
     name = str(p)
     try:
-        check_readable_file(p)
+        st = os.stat(check_readable_file(p))
     except FileNotFoundError:
         raise ImageError(f"{name}: no such file") from None
     except IsADirectoryError:
         raise ImageError(f"{name}: is a directory, not an image") from None
     except OSError as exc:
         raise ImageError(f"{name}: {_reason(exc)}") from None
-    if p.stat().st_size == 0:
+    if not stat.S_ISREG(st.st_mode):  # pragma: no cover - replaced since the check
+        raise ImageError(f"{name}: is not a regular file")
+    if st.st_size == 0:
         raise ImageError(f"{name}: empty file")
-    inp = oiio.ImageInput.open(name)
-    if inp is None:
-        raise ImageError(f"{name}: cannot read image: {_oiio_error()}")
-    try:
-        spec = inp.spec()
-        w, h, c = spec.width, spec.height, spec.nchannels
-        if w <= 0 or h <= 0 or c <= 0:
-            raise ImageError(f"{name}: image has no pixels ({w}x{h}, {c} channels)")
-        if w * h > MAX_IMAGE_PIXELS or c > 64:
-            raise ImageError(f"{name}: image is too large ({w}x{h}, {c} channels; at most "
-                             f"{MAX_IMAGE_PIXELS} pixels)")
-        pixels = inp.read_image(0, 0, 0, c, "float")
-        err = inp.geterror() if inp.has_error else ""
-        if pixels is None or err:
-            raise ImageError(
-                f"{name}: corrupt or truncated image: {_oiio_error(inp) if not err else err}"
-            )
-        pixels = np.asarray(pixels, dtype=np.float32)
-        if pixels.ndim == 2:
-            pixels = pixels[:, :, None]
-        if pixels.shape != (h, w, c):
-            raise ImageError(f"{name}: unexpected pixel array shape {pixels.shape}")
-        data = ImageData(
-            pixels=np.ascontiguousarray(pixels),
-            path=name,
-            format_name=inp.format_name(),
-            is_ldr=spec.format.basetype in _LDR_BASETYPES,
-            channel_names=tuple(spec.channelnames),
+    ext = p.suffix.lower()
+    if ext not in READ_FORMATS:
+        raise ImageError(f"{name}: not an image file matedit reads (the name must end in "
+                         f"{', '.join(sorted(READ_FORMATS))})")
+    with oiio_name(p) as oname:
+        inp = oiio.ImageInput.open(oname)
+        if inp is None:
+            raise ImageError(f"{name}: cannot read image: {_oiio_error()}")
+        try:
+            return _read_opened(inp, name)
+        finally:
+            inp.close()
+
+
+def _read_opened(inp, name: str) -> ImageData:
+    """The pixels of an open ImageInput, once its format and size are known to be safe."""
+    fmt = inp.format_name()
+    if fmt not in _READERS:
+        raise ImageError(f"{name}: OpenImageIO reads it as {fmt!r}, not as an image format "
+                         f"matedit reads ({', '.join(sorted(_READERS))})")
+    spec = inp.spec()
+    w, h, c, d = spec.width, spec.height, spec.nchannels, spec.depth
+    if w <= 0 or h <= 0 or c <= 0:
+        raise ImageError(f"{name}: image has no pixels ({w}x{h}, {c} channels)")
+    if d > 1:
+        raise ImageError(f"{name}: is a volume image ({w}x{h}x{d}); expected a 2D image")
+    if w * h > MAX_IMAGE_PIXELS or c > 64 or w * h * c > MAX_IMAGE_VALUES:
+        raise ImageError(f"{name}: image is too large ({w}x{h}, {c} channels; at most "
+                         f"{MAX_IMAGE_PIXELS} pixels and {MAX_IMAGE_VALUES} values)")
+    pixels = inp.read_image(0, 0, 0, c, "float")
+    err = inp.geterror() if inp.has_error else ""
+    if pixels is None or err:
+        raise ImageError(
+            f"{name}: corrupt or truncated image: {_oiio_error(inp) if not err else err}"
         )
-    finally:
-        inp.close()
-    return data
+    pixels = np.asarray(pixels, dtype=np.float32)
+    if pixels.ndim == 2:
+        pixels = pixels[:, :, None]
+    if pixels.shape != (h, w, c):
+        raise ImageError(f"{name}: unexpected pixel array shape {pixels.shape}")
+    return ImageData(
+        pixels=np.ascontiguousarray(pixels),
+        path=name,
+        format_name=fmt,
+        is_ldr=spec.format.basetype in _LDR_BASETYPES,
+        channel_names=tuple(spec.channelnames),
+        is_8bit=spec.format.basetype in (oiio.UINT8, oiio.INT8),
+    )
 
 
 def write_image(path: str | os.PathLike, pixels: np.ndarray, *, half: bool = False) -> None:
@@ -155,11 +235,11 @@ def write_oiio(path: Path, spec, pixels: np.ndarray) -> None:
     """Write `pixels` with OpenImageIO, atomically, through `atomic_output`."""
     name = str(path)
     try:
-        with atomic_output(path) as tmp:
-            out = oiio.ImageOutput.create(str(tmp))
+        with atomic_output(path) as tmp, oiio_name(Path(tmp), folder=True) as oname:
+            out = oiio.ImageOutput.create(oname)
             if out is None:
                 raise ImageError(f"{name}: no image writer for this file type: {_oiio_error()}")
-            ok = out.open(str(tmp), spec) and out.write_image(np.ascontiguousarray(pixels))
+            ok = out.open(oname, spec) and out.write_image(np.ascontiguousarray(pixels))
             err = "" if ok else _oiio_error(out)
             out.close()
             if not ok:

@@ -6,8 +6,12 @@ UVs, triangle indices); `GpuMesh` uploads it to a moderngl context.
 
 from __future__ import annotations
 
+import io
+import itertools
 import math
 import os
+import re
+from array import array
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +20,13 @@ import numpy as np
 from matedit.io.atomic import UnsafeFileError, read_bounded
 
 MAX_OBJ_BYTES = 256 * 1024 * 1024
+# A preview mesh has at most 2 million vertices (each of v, vt and vn, and the distinct
+# corners the GPU draws) and 2 million triangles after fanning. A scanned asset at preview
+# density fits; such a file parses in about 10 s within 1 GB, and llvmpipe draws it in well
+# under a second a frame. Counted while parsing, so no file within MAX_OBJ_BYTES (which
+# could otherwise list ~100 million corners) grows past it.
+MAX_OBJ_VERTICES = 2_000_000
+MAX_OBJ_TRIANGLES = 2_000_000
 
 BUILTIN_MESHES = ("sphere", "cube", "plane", "cylinder")
 
@@ -46,23 +57,31 @@ def _normalize(v: np.ndarray) -> np.ndarray:
 
 
 def compute_tangents(p: np.ndarray, n: np.ndarray, uv: np.ndarray, idx: np.ndarray) -> np.ndarray:
-    """Per-vertex tangents from UV gradients (Lengyel's method), Gram-Schmidt against N."""
+    """Per-vertex tangents from UV gradients (Lengyel's method), Gram-Schmidt against N.
+
+    Where the UVs give no direction (coincident or collinear UVs, zero-area triangles) the
+    tangent is any unit vector orthogonal to N, so every tangent is finite and unit. The
+    triangles are taken a million at a time, which bounds the temporary arrays."""
     t = np.zeros_like(p)
     b = np.zeros_like(p)
-    p0, p1, p2 = p[idx[:, 0]], p[idx[:, 1]], p[idx[:, 2]]
-    w0, w1, w2 = uv[idx[:, 0]], uv[idx[:, 1]], uv[idx[:, 2]]
-    e1, e2 = p1 - p0, p2 - p0
-    d1, d2 = w1 - w0, w2 - w0
-    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
-    r = np.where(np.abs(det) > 1e-12, 1.0 / np.where(det == 0, 1, det), 0.0)[:, None]
-    sdir = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * r
-    tdir = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * r
-    for k in range(3):
-        np.add.at(t, idx[:, k], sdir)
-        np.add.at(b, idx[:, k], tdir)
+    step = 1 << 20
+    for lo in range(0, len(idx), step):
+        tri = idx[lo:lo + step]
+        p0, w0 = p[tri[:, 0]], uv[tri[:, 0]]
+        e1, e2 = p[tri[:, 1]] - p0, p[tri[:, 2]] - p0
+        d1, d2 = uv[tri[:, 1]] - w0, uv[tri[:, 2]] - w0
+        det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+        r = np.zeros_like(det)
+        usable = np.abs(det) > 1e-12
+        r[usable] = 1.0 / det[usable]
+        sdir = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * r[:, None]
+        tdir = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * r[:, None]
+        for k in range(3):
+            np.add.at(t, tri[:, k], sdir)
+            np.add.at(b, tri[:, k], tdir)
     t = t - n * np.sum(n * t, axis=1, keepdims=True)
     fallback = np.cross(n, np.where(np.abs(n[:, 1:2]) < 0.99, [0, 1, 0], [1, 0, 0]))
-    bad = np.linalg.norm(t, axis=1) < 1e-8
+    bad = ~(np.linalg.norm(t, axis=1) >= 1e-8)  # NaN counts as bad
     t[bad] = fallback[bad]
     t = _normalize(t)
     w = np.where(np.sum(np.cross(n, t) * b, axis=1) < 0.0, -1.0, 1.0)
@@ -71,7 +90,9 @@ def compute_tangents(p: np.ndarray, n: np.ndarray, uv: np.ndarray, idx: np.ndarr
 
 def _finish(p, n, uv, idx, tangents=None) -> MeshData:
     p = np.asarray(p, np.float32)
-    n = _normalize(np.asarray(n, np.float64)).astype(np.float32)
+    n = _normalize(np.asarray(n, np.float64))
+    n[~(np.linalg.norm(n, axis=1) > 0.5)] = (0.0, 1.0, 0.0)  # no direction: face up (+Y)
+    n = n.astype(np.float32)
     uv = np.asarray(uv, np.float32)
     idx = np.asarray(idx, np.uint32).reshape(-1, 3)
     tan = tangents if tangents is not None else compute_tangents(
@@ -186,7 +207,9 @@ def load_obj(path: str | Path) -> MeshData:
     """Triangulated positions, normals and UVs from a Wavefront OBJ (no code is executed).
 
     Faces may use v, v/vt, v//vn or v/vt/vn with negative (relative) indices; polygons are
-    fanned. Missing normals are computed (smooth), missing UVs are zero.
+    fanned. Missing normals are computed (smooth), missing UVs are zero. The counts are
+    bounded while parsing (MAX_OBJ_VERTICES, MAX_OBJ_TRIANGLES), so a file within the read
+    limit cannot expand past what a preview draws in seconds.
     """
     path = Path(path)
     try:
@@ -198,64 +221,29 @@ def load_obj(path: str | Path) -> MeshData:
     except (OSError, UnicodeDecodeError) as exc:
         raise MeshError(f"{path}: cannot read as an OBJ text file "
                         f"({getattr(exc, 'strerror', None) or exc})") from None
-    vs, vts, vns = [], [], []
-    corners: dict[tuple[int, int, int], int] = {}
-    out_p, out_uv, out_n, tris = [], [], [], []
-    has_n = True
-    for lineno, raw in enumerate(text.splitlines(), 1):
-        parts = raw.split("#", 1)[0].split()
-        if not parts:
-            continue
-        tag, args = parts[0], parts[1:]
-        try:
-            if tag == "v":
-                vs.append([float(x) for x in args[:3]])
-                if len(vs[-1]) != 3:
-                    raise ValueError("a vertex needs 3 coordinates")
-            elif tag == "vt":
-                vts.append([float(x) for x in (args + ["0"])[:2]])
-            elif tag == "vn":
-                vns.append([float(x) for x in args[:3]])
-                if len(vns[-1]) != 3:
-                    raise ValueError("a normal needs 3 components")
-            elif tag == "f":
-                if len(args) < 3:
-                    raise ValueError("a face needs at least 3 corners")
-                ids = []
-                for corner in args:
-                    fields = (corner.split("/") + ["", ""])[:3]
-                    vi = _obj_index(fields[0], len(vs), "vertex")
-                    ti = _obj_index(fields[1], len(vts), "texture coordinate") if fields[1] \
-                        else -1
-                    ni = _obj_index(fields[2], len(vns), "normal") if fields[2] else -1
-                    has_n &= ni >= 0
-                    key = (vi, ti, ni)
-                    if key not in corners:
-                        corners[key] = len(out_p)
-                        out_p.append(vs[vi])
-                        out_uv.append(vts[ti] if ti >= 0 else [0.0, 0.0])
-                        out_n.append(vns[ni] if ni >= 0 else [0.0, 0.0, 0.0])
-                    ids.append(corners[key])
-                for k in range(1, len(ids) - 1):
-                    tris.append((ids[0], ids[k], ids[k + 1]))
-        except (ValueError, IndexError) as exc:
-            raise MeshError(f"{path}:{lineno}: {exc}: {raw.strip()[:60]!r}") from None
-    if not tris:
-        raise MeshError(f"{path}: no faces found (is it an OBJ file?)")
-    p = np.asarray(out_p, np.float64)
-    if not np.all(np.isfinite(p)):
-        raise MeshError(f"{path}: vertex positions are not finite")
-    idx = np.asarray(tris, np.uint32)
-    n = np.asarray(out_n, np.float64)
-    uv = np.asarray(out_uv, np.float64)
-    if not np.all(np.isfinite(uv)):
-        raise MeshError(f"{path}: texture coordinates (vt) are not finite")
-    if not np.all(np.isfinite(n)):
-        raise MeshError(f"{path}: normals (vn) are not finite")
-    if float(np.max(np.abs(p))) > 1e30:
-        raise MeshError(f"{path}: vertex positions are too large (beyond 1e30)")
+    obj = _ObjParser(path)
+    obj.parse(text)
+    del text
+    obj.release_text()
+    corner_of, unique = _distinct_corners(obj.corners())
+    if len(unique) > MAX_OBJ_VERTICES:
+        raise MeshError(f"{path}: more than {MAX_OBJ_VERTICES:,} distinct vertices (position, "
+                        "texture coordinate and normal combinations)")
+    idx = corner_of[_fan(obj.faces())]
+    vs, vts, vns, has_n = obj.vs, obj.vts, obj.vns, obj.has_normals()
+    p = np.frombuffer(vs, np.float64).reshape(-1, 3)[unique[:, 0]]
+    uv = np.zeros((len(unique), 2))
+    has_uv = unique[:, 1] >= 0
+    uv[has_uv] = np.frombuffer(vts, np.float64).reshape(-1, 2)[unique[has_uv, 1]]
+    n = np.frombuffer(vns, np.float64).reshape(-1, 3)[unique[:, 2]] if has_n else \
+        np.zeros_like(p)
+    for values, what in ((p, "vertex positions"), (uv, "texture coordinates (vt)"),
+                         (n, "normals (vn)")):
+        if not np.all(np.isfinite(values)):
+            raise MeshError(f"{path}: {what} are not finite")
+        if float(np.max(np.abs(values))) > 1e30:
+            raise MeshError(f"{path}: {what} are too large (beyond 1e30)")
     if not has_n:
-        n = np.zeros_like(p)
         fn = np.cross(p[idx[:, 1]] - p[idx[:, 0]], p[idx[:, 2]] - p[idx[:, 0]])
         for k in range(3):
             np.add.at(n, idx[:, k], fn)
@@ -267,12 +255,233 @@ def load_obj(path: str | Path) -> MeshData:
     return _finish(p, n, uv, idx)
 
 
-def _obj_index(field: str, count: int, what: str) -> int:
-    i = int(field)
-    j = i - 1 if i > 0 else count + i
-    if not 0 <= j < count:
-        raise ValueError(f"{what} index {i} out of range (have {count})")
-    return j
+def _limit(path: Path, lineno: int, what: str) -> MeshError:
+    return MeshError(f"{path}:{lineno}: {what}: the limit for a preview mesh")
+
+
+_INT = r"[-+]?[0-9]{1,18}"
+# Faces whose corners all share one of the four layouts keep their text, read at the end by
+# numpy in one pass; anything else (mixed layouts, odd spellings, huge numbers) is read
+# corner by corner. Layout -> (group, fields per corner, the v/vt/vn columns they fill).
+_FACE_LAYOUTS = {
+    (0, False): (re.compile(rf"{_INT}(?: {_INT})*"), 0),
+    (1, False): (re.compile(rf"{_INT}/{_INT}(?: {_INT}/{_INT})*"), 1),
+    (2, True): (re.compile(rf"{_INT}//{_INT}(?: {_INT}//{_INT})*"), 2),
+    (2, False): (re.compile(rf"{_INT}/{_INT}/{_INT}(?: {_INT}/{_INT}/{_INT})*"), 3),
+}
+_GROUP_COLUMNS = ([0], [0, 1], [0, 2], [0, 1, 2], [0, 1, 2])
+_SLOW = 4
+_WHAT = ("vertex", "texture coordinate", "normal")
+_HUGE = 1 << 62  # beyond any count the limits allow; kept out of the 64-bit arrays
+
+
+class _ObjParser:
+    """The records of an OBJ as flat arrays, counted against the limits line by line.
+
+    Corners keep the file's index (0: absent) with the record counts of their face, so
+    relative indices are resolved, and every index checked, at the end with numpy."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.vs, self.vts, self.vns = array("d"), array("d"), array("d")
+        self.texts: tuple[list[str], ...] = ([], [], [], [])  # face corners, by layout
+        self.slow = array("q")  # v, vt, vn (0: absent) of the corners read one by one
+        self.face_info = array("q")  # per face: corners, group, #v, #vt, #vn, line
+        self.triangles = 0
+        self.text = ""
+        self._raw: np.ndarray | None = None
+        self._resolved_cache: tuple | None = None
+
+    def parse(self, text: str) -> None:
+        self.text = text
+        vs, vts, vns = self.vs, self.vts, self.vns
+        info, texts = self.face_info, self.texts
+        nv = nt = nn = 0
+        split_max = MAX_OBJ_TRIANGLES + 3
+        lineno = 0
+        for lineno, line in enumerate(io.StringIO(text, newline=None), 1):
+            if "#" in line:
+                line = line.split("#", 1)[0]
+            # At most the corners one more face may have are split out: a longer face is
+            # refused below without its corners ever being listed.
+            parts = line.split(None, split_max)
+            if not parts:
+                continue
+            tag = parts[0]
+            try:
+                if tag == "f":
+                    n = len(parts) - 1
+                    if n < 3:
+                        raise ValueError("a face needs at least 3 corners")
+                    self.triangles += n - 2
+                    if self.triangles > MAX_OBJ_TRIANGLES:
+                        raise _limit(self.path, lineno, f"more than {MAX_OBJ_TRIANGLES:,} "
+                                     "triangles after the polygons are fanned")
+                    split_max = max(MAX_OBJ_TRIANGLES - self.triangles + 3, 8)
+                    first = parts[1]
+                    layout = _FACE_LAYOUTS.get((first.count("/"), "//" in first))
+                    joined = " ".join(parts[1:]) if layout else ""
+                    if layout and layout[0].fullmatch(joined):
+                        group = layout[1]
+                        texts[group].append(joined)
+                    else:
+                        group = _SLOW
+                        self._slow_corners(parts[1:])
+                    info.extend((n, group, nv, nt, nn, lineno))
+                elif tag == "v":
+                    if len(parts) < 4:
+                        raise ValueError("a vertex needs 3 coordinates")
+                    vs.extend((float(parts[1]), float(parts[2]), float(parts[3])))
+                    nv += 1
+                    if nv > MAX_OBJ_VERTICES:
+                        raise _limit(self.path, lineno,
+                                     f"more than {MAX_OBJ_VERTICES:,} vertices")
+                elif tag == "vt":
+                    if len(parts) < 2:
+                        raise ValueError("a texture coordinate needs a value")
+                    vts.extend((float(parts[1]), float(parts[2]) if len(parts) > 2 else 0.0))
+                    nt += 1
+                    if nt > MAX_OBJ_VERTICES:
+                        raise _limit(self.path, lineno,
+                                     f"more than {MAX_OBJ_VERTICES:,} texture coordinates")
+                elif tag == "vn":
+                    if len(parts) < 4:
+                        raise ValueError("a normal needs 3 components")
+                    vns.extend((float(parts[1]), float(parts[2]), float(parts[3])))
+                    nn += 1
+                    if nn > MAX_OBJ_VERTICES:
+                        raise _limit(self.path, lineno,
+                                     f"more than {MAX_OBJ_VERTICES:,} normals")
+            except (ValueError, OverflowError) as exc:
+                if isinstance(exc, MeshError):
+                    raise
+                self._check_indices()  # an earlier bad index is the first error
+                raise MeshError(f"{self.path}:{lineno}: {exc}: "
+                                f"{line.strip()[:60]!r}") from None
+        self._check_indices()
+
+    def _slow_corners(self, corners: list[str]) -> None:
+        fields = [(corner.split("/") + ["", ""])[:3] for corner in corners]
+        values = [[int(x) if x else 0 for x in f] for f in fields]
+        if any(not f[0] for f in fields):
+            raise ValueError("a face corner needs a vertex index")
+        for corner in values:
+            for f, value in enumerate(corner):
+                if abs(value) > _HUGE:
+                    raise ValueError(f"{_WHAT[f]} index {value} out of range")
+        for corner in values:
+            self.slow.extend(corner)
+
+    def corner_count(self) -> int:
+        return int(np.frombuffer(self.face_info, np.int64).reshape(-1, 6)[:, 0].sum())
+
+    def raw(self) -> np.ndarray:
+        """(corners, 3): each corner's v, vt, vn index as written (0: absent), file order."""
+        if self._raw is not None and len(self._raw) == self.corner_count():
+            return self._raw
+        info = np.frombuffer(self.face_info, np.int64).reshape(-1, 6)
+        count = info[:, 0]
+        start = np.cumsum(count) - count
+        raw = np.zeros((int(count.sum()), 3), np.int64)
+        for group, columns in enumerate(_GROUP_COLUMNS):
+            faces = np.nonzero(info[:, 1] == group)[0]
+            if not len(faces):
+                continue
+            if group == _SLOW:
+                values = np.frombuffer(self.slow, np.int64)
+            else:
+                values = np.fromstring(" ".join(self.texts[group]).replace("/", " "),
+                                       dtype=np.int64, sep=" ")
+            n = count[faces]
+            ids = np.repeat(start[faces] - (np.cumsum(n) - n), n) + np.arange(int(n.sum()))
+            raw[np.ix_(ids, columns)] = values.reshape(-1, len(columns))
+        self._raw = raw
+        return raw
+
+    def release_text(self) -> None:
+        """Drop the file's text and the faces' text once the corners are arrays."""
+        self.raw()
+        self.text = ""
+        self.texts = ([], [], [], [])
+        self.slow = array("q")
+
+    def _resolved(self):
+        """Per corner: its face, each field's 0-based index (-1: absent or invalid), and a
+        mask of the indices that are out of range, per field."""
+        if self._resolved_cache is not None and self._resolved_cache[0] == len(self.face_info):
+            return self._resolved_cache[1]
+        info = np.frombuffer(self.face_info, np.int64).reshape(-1, 6)
+        face = np.repeat(np.arange(len(info)), info[:, 0])
+        raw = self.raw()
+        out, bad = [], []
+        for f in range(3):
+            r = raw[:, f]
+            have = info[face, 2 + f]
+            j = np.where(r > 0, r - 1, have + r)
+            wrong = (j < 0) | (j >= have)
+            if f:
+                wrong &= r != 0
+            out.append(np.where(wrong | (r == 0), -1, j))
+            bad.append(wrong)
+        self._resolved_cache = (len(self.face_info), (info, face, out, bad))
+        return info, face, out, bad
+
+    def _check_indices(self) -> None:
+        """Raise the first out-of-range index in file order, naming the corner's line."""
+        if not len(self.face_info):
+            return
+        info, face, _, bad = self._resolved()
+        any_bad = bad[0] | bad[1] | bad[2]
+        if not any_bad.any():
+            return
+        c = int(np.argmax(any_bad))
+        f = next(k for k in range(3) if bad[k][c])
+        value = int(self.raw()[c, f])
+        have = int(info[face[c], 2 + f])
+        lineno = int(info[face[c], 5])
+        line = next(itertools.islice(io.StringIO(self.text, newline=None), lineno - 1, None))
+        raise MeshError(f"{self.path}:{lineno}: {_WHAT[f]} index {value} out of range "
+                        f"(have {have}): {line.split('#', 1)[0].strip()[:60]!r}")
+
+    def corners(self) -> np.ndarray:
+        if not self.triangles:
+            raise MeshError(f"{self.path}: no faces found (is it an OBJ file?)")
+        _, _, out, _ = self._resolved()
+        return np.stack(out, axis=1)
+
+    def faces(self) -> np.ndarray:
+        """(faces, 2): each face's first corner and its corner count."""
+        count = np.frombuffer(self.face_info, np.int64).reshape(-1, 6)[:, 0]
+        return np.stack([np.cumsum(count) - count, count], axis=1)
+
+    def has_normals(self) -> bool:
+        return bool(np.all(self.raw()[:, 2] != 0))
+
+
+def _distinct_corners(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(output vertex of each corner, the distinct (v, vt, vn) rows), numbered in order of
+    first appearance, as the file lists them."""
+    c = corners.astype(np.int64)
+    span = c.max(axis=0) + 2  # -1 (absent) .. max
+    if float(span[0]) * float(span[1]) * float(span[2]) < 2.0 ** 62:
+        key = ((c[:, 0] + 1) * span[1] + (c[:, 1] + 1)) * span[2] + (c[:, 2] + 1)
+        _, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+    else:
+        _, first, inverse = np.unique(c, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return rank[inverse.reshape(-1)], c[first[order]]
+
+
+def _fan(faces: np.ndarray) -> np.ndarray:
+    """Triangles (first, k, k + 1) of each face's corners, as corner numbers."""
+    start, count = faces[:, 0].astype(np.int64), faces[:, 1].astype(np.int64)
+    per = count - 2
+    face = np.repeat(np.arange(len(faces)), per)
+    k = np.arange(int(per.sum())) - np.repeat(np.cumsum(per) - per, per) + 1
+    base = start[face]
+    return np.stack([base, base + k, base + k + 1], axis=1)
 
 
 def builtin_mesh(name: str) -> MeshData:

@@ -123,7 +123,7 @@ def load_texture(path: str | os.PathLike, space: str) -> TextureImage:
     img = read_image(path)
     linear = decode(img.pixels, img.is_ldr, space)[::-1]
     srgb8 = None
-    if space == SRGB and img.is_ldr and _is_8bit(path):
+    if space == SRGB and img.is_ldr and img.is_8bit:
         rgba = decode(img.pixels, True, LINEAR)[::-1]  # codes / 255, alpha added
         srgb8 = np.ascontiguousarray(np.rint(rgba * 255.0).clip(0, 255).astype(np.uint8))
     return TextureImage(np.ascontiguousarray(linear), srgb8, space)
@@ -143,18 +143,6 @@ def load_texture_cached(path: str | os.PathLike, space: str) -> TextureImage:
             _CACHE.clear()
         _CACHE[key] = hit
     return hit
-
-
-def _is_8bit(path) -> bool:
-    import OpenImageIO as oiio
-
-    inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        return False
-    try:
-        return inp.spec().format.basetype in (oiio.UINT8, oiio.INT8)
-    finally:
-        inp.close()
 
 
 def mip_chain(linear: np.ndarray) -> list[np.ndarray]:
