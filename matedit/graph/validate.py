@@ -18,6 +18,7 @@ import networkx as nx
 from matedit.graph import nodes
 from matedit.graph.model import Link, MaterialDocument
 from matedit.graph.names import identifier_problem
+from matedit.graph.numbers import gpu_number_problem
 from matedit.graph.ports import (
     FunctionResolver,
     NodePorts,
@@ -119,6 +120,11 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
         if node.kind not in nodes.REGISTRY:
             diags.append(error(f"unknown node kind {node.kind!r}", nid, "kind", f))
             continue
+        for s in nodes.REGISTRY[node.kind].settings:  # ranges, curves: the float32 rule
+            if s.kind == "number" and s.name in node.settings:
+                why = gpu_number_problem(node.settings[s.name])
+                if why:
+                    diags.append(error(why, nid, s.name, f))
         try:
             ports[nid] = node_ports(node, resolver, doc)
         except PortError as exc:
