@@ -483,3 +483,412 @@ def test_loader_never_raises_anything_but_format_errors(mutation):
 
     again = loads(dumps(doc), "m.json")  # a file that loads also saves, and loads again
     assert dumps(again) == dumps(doc)
+
+
+# === Numbers, nesting and MaterialX values (issue 22): float32 at every entry point of a number,
+# huge integers, duplicate keys in rigs, --exposure, malformed MaterialX numbers, deeply nested
+# JSON per reader, the default exposure, and generated rig and instance files ==================
+#
+# The rule: a number the renderer would receive is finite and within float32 (one function,
+# matedit.graph.numbers.gpu_number_problem, asked by every format); JSON text goes through one
+# bounded-depth parser (matedit.io.jsontext.parse_json). Refusals are exit 2 with `error:` lines
+# naming the file, the node (parameter, light) and the field.
+
+N22 = '"@N@"'  # where a raw JSON token goes into a file written as JSON text
+
+
+def _rig22() -> dict:
+    """A valid rig: a sphere light, then a tube light (light 1)."""
+    return {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "sphere", "position": [2.4, 2.8, 3.0], "radius": 0.3,
+         "color": [1.0, 0.96, 0.9], "intensity": 18.0, "influence_radius": 25.0},
+        {"type": "tube", "position": [-2.8, 1.6, -2.4], "direction": [0, 1, 0],
+         "radius": 0.04, "length": 1.6, "color": [0.75, 0.85, 1.0], "intensity": 10.0}]}
+
+
+def _text22(raw: dict, token: str) -> str:
+    return json.dumps(raw).replace(N22, token)
+
+
+def _material22(tmp, token="0.4", where=None) -> object:
+    """base_material as m.json, with `token` as raw JSON at `where` (a function of the dict)."""
+    raw = base_material()
+    if where is not None:
+        where(raw)
+    return write(tmp / "m.json", _text22(raw, token))
+
+
+def _instance22(tmp, parameters: str) -> object:
+    """i.json: an instance of a valid m.json with `parameters` (JSON text) as its overrides."""
+    _material22(tmp)
+    return write(tmp / "i.json", '{"format": "matedit.instance", "version": 2, "name": "i", '
+                 f'"parent": "m.json", "parameters": {parameters}}}')
+
+
+def _rig_file22(tmp, field, token, light=1) -> object:
+    raw = _rig22()
+    if isinstance(field, tuple):  # (list field, index)
+        raw["lights"][light][field[0]][field[1]] = "@N@"
+    else:
+        raw["lights"][light][field] = "@N@"
+    return write(tmp / "rig.json", _text22(raw, token))
+
+
+def _add_constant22(raw):
+    raw["nodes"].append({"id": "k", "kind": "constant", "position": [0, 0],
+                         "settings": {"type": "float", "value": "@N@"}})
+    raw["links"].append({"from": ["k", "value"], "to": ["make", "metallic"]})
+
+
+def _function22(tmp, token):
+    fn = function_doc()
+    fn["nodes"][0]["settings"]["default"] = "@N@"
+    write(tmp / "f.json", _text22(fn, token))
+    raw = base_material()
+    raw["nodes"].append({"id": "call", "kind": "function_call", "position": [200, 0],
+                         "settings": {"function": "f.json"}})
+    raw["links"] += [{"from": ["call", "result"], "to": ["make", "metallic"]}]
+    return write(tmp / "m.json", raw)
+
+
+def _set(path, value="@N@"):
+    """A mutation of base_material's dict: raw[path...] = value."""
+    def apply(raw):
+        target = raw
+        for p in path[:-1]:
+            target = target[p]
+        target[path[-1]] = value
+    return apply
+
+
+def _float32_rig(field):
+    name = field if isinstance(field, str) else field[0]
+    return lambda t, v: ("rig", _rig_file22(t, field, v), ["rig.json", "light 1", f"field {name}"])
+
+
+# entry -> (what kind of file, the file, what every message must name)
+FLOAT32_ENTRIES = {
+    "material value": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 1, "values", "value"])), ["m.json", "node r", "field value"]),
+    "input value": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 2, "values", "b"])), ["m.json", "node m", "field b"]),
+    "colour component": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 0, "values", "value"], [0.5, "@N@", 0.5])),
+        ["m.json", "node col", "field value"]),
+    "constant setting": lambda t, v: ("material", _material22(t, v, _add_constant22),
+                                      ["m.json", "node k", "field value"]),
+    "parameter range": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 1, "settings", "ui_max"])), ["m.json", "node r", "field ui_max"]),
+    "function input default": lambda t, v: ("function", _function22(t, v),
+                                            ["m.json", "node call", "field a"]),
+    "instance scalar override": lambda t, v: ("instance", _instance22(t, f'{{"rough": {v}}}'),
+                                              ["i.json", "parameter rough"]),
+    "instance colour override": lambda t, v: ("instance", _instance22(
+        t, f'{{"tint": [0.1, {v}, 0.1]}}'), ["i.json", "parameter tint"]),
+    **{f"rig {f if isinstance(f, str) else f[0]}": _float32_rig(f)
+       for f in ["intensity", ("color", 0), ("position", 2), "length", "radius",
+                 ("direction", 1), "influence_radius"]},
+}
+FLOAT32_VALUES = ["3.5e38", "1e308", "-1e39", str(10**39)]
+
+
+@pytest.mark.parametrize("value", FLOAT32_VALUES)
+@pytest.mark.parametrize("entry", [*sorted(FLOAT32_ENTRIES), "render --exposure"])
+def test_float32_overflow_is_refused_where_the_number_enters(tmp_path, entry, value):
+    """validate refuses what a float32 uniform cannot hold, naming file, node and field; the
+    commands that would pack it (compile, render, bake) refuse it the same way, never with
+    "float too large to pack"."""
+    if entry == "render --exposure":
+        doc = _material22(tmp_path)
+        rc, _, err = cli("render", doc, "-o", tmp_path / "x.png", "--size", "8x8",
+                         f"--exposure={value}")
+        assert_clean_failure(rc, err)
+        assert "--exposure" in err and "pack" not in err
+        return
+    kind, path, needles = FLOAT32_ENTRIES[entry](tmp_path, value)
+    png = ("-o", tmp_path / "x.png", "--size", "8x8")
+    good = write(tmp_path / "good.json", base_material())
+    runs = {"rig": [("validate", path), ("render", good, *png, "--lights", path)],
+            "instance": [("validate", path), ("render", path, *png),
+                         ("compile", path, "-o", tmp_path / "out")],
+            "material": [("validate", path), ("render", path, *png),
+                         ("compile", path, "-o", tmp_path / "out"),
+                         ("bake", path, "-o", tmp_path / "bake", "--size", "8")]}
+    runs["function"] = runs["material"]
+    for args in runs[kind]:
+        rc, _, err = cli(*args)
+        assert_clean_failure(rc, err)
+        assert all(n in err for n in needles) and "float32" in err, (args[0], err)
+        assert "pack" not in err, err
+    if kind == "function":  # the function file itself names its input node
+        rc, _, err = cli("validate", tmp_path / "f.json")
+        assert_clean_failure(rc, err)
+        assert "f.json" in err and "node i0" in err and "field default" in err, err
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("digits", [400, 5000])
+@pytest.mark.parametrize("where", ["rig intensity", "rig position", "rig version",
+                                   "instance override", "material value"])
+def test_huge_integers_are_clean_errors(tmp_path, where, digits):
+    """A 400-digit (or 5000-digit, past Python's conversion limit) integer is an `error:`
+    line from validate and render, never an internal OverflowError."""
+    token = "9" * digits
+    if where.startswith("rig"):
+        raw = _rig22()
+        if where == "rig version":
+            raw["version"] = "@N@"
+        elif where == "rig position":
+            raw["lights"][1]["position"][0] = "@N@"
+        else:
+            raw["lights"][1]["intensity"] = "@N@"
+        rig = write(tmp_path / "rig.json", _text22(raw, token))
+        checks = [("validate", rig), ("render", _material22(tmp_path), "-o",
+                                      tmp_path / "x.png", "--size", "8x8", "--lights", rig)]
+        name = "rig.json"
+    elif where == "instance override":
+        inst = _instance22(tmp_path, f'{{"rough": {token}}}')
+        checks = [("validate", inst), ("render", inst, "-o", tmp_path / "x.png", "--size",
+                                       "8x8")]
+        name = "i.json"
+    else:
+        doc = _material22(tmp_path, token, _set(["nodes", 1, "values", "value"]))
+        checks = [("validate", doc), ("render", doc, "-o", tmp_path / "x.png", "--size", "8x8")]
+        name = "m.json"
+    for args in checks:
+        rc, _, err = cli(*args)
+        assert_clean_failure(rc, err)
+        assert name in err and "Overflow" not in err and token not in err, err
+
+
+@pytest.mark.parametrize("case", ["format twice", "lights twice", "intensity twice",
+                                  "type twice", "name twice"])
+def test_rig_duplicate_keys_are_refused(tmp_path, case):
+    """Rigs refuse a key twice in one object, as documents do (the same parser)."""
+    text = json.dumps(_rig22())
+    if case == "format twice":
+        text = text.replace('{"format"', '{"format": "matedit.lightrig", "format"', 1)
+    elif case == "lights twice":
+        text = text.replace('"lights": [', '"lights": [], "lights": [', 1)
+    elif case == "intensity twice":
+        text = text.replace('"intensity": 10.0', '"intensity": 10.0, "intensity": 1e3', 1)
+    elif case == "type twice":
+        text = text.replace('{"type": "tube"', '{"type": "point", "type": "tube"', 1)
+    else:
+        text = text.replace('{"type": "tube"', '{"name": "a", "name": "b", "type": "tube"', 1)
+    key = case.split()[0]
+    rig = write(tmp_path / "rig.json", text)
+    from matedit.io.rig import RigError
+    from matedit.io.rig import loads as rig_loads
+
+    with pytest.raises(RigError, match=f"key '{key}' appears twice"):
+        rig_loads(text, "rig.json")
+    for args in [("validate", rig), ("render", _material22(tmp_path), "-o", tmp_path / "x.png",
+                                     "--size", "8x8", "--lights", rig)]:
+        rc, _, err = cli(*args)
+        assert_clean_failure(rc, err)
+        assert "rig.json" in err and f"'{key}' appears twice" in err, err
+
+
+@pytest.mark.parametrize("value, ok", [
+    ("nan", False), ("NaN", False), ("inf", False), ("-inf", False), ("1e308", False),
+    ("1e400", False), ("30.5", False), ("-31", False), ("abc", False),
+    pytest.param("30", True, marks=pytest.mark.gl), pytest.param("-30", True,
+                                                                  marks=pytest.mark.gl),
+])
+def test_exposure_option_is_a_finite_number_of_stops_within_30(tmp_path, value, ok):
+    """`render --exposure` takes -30..30 EV; NaN, infinities and 2**EV overflows are one
+    `error:` line naming the option (exit 2); the extremes render."""
+    out = tmp_path / "x.png"
+    rc, _, err = cli("render", _material22(tmp_path), "-o", out, "--size", "8x8",
+                     f"--exposure={value}")
+    if ok:
+        assert rc == 0 and out.is_file(), err
+        return
+    assert_clean_failure(rc, err)
+    assert len(err.strip().splitlines()) == 1 and "--exposure" in err, err
+    assert not out.exists()
+
+
+# MaterialX documents, written by hand: each holds one malformed number
+def _mx22(body: str) -> str:
+    return ('<?xml version="1.0"?>\n<materialx version="1.39">\n' + body +
+            '<surfacematerial name="M" type="material"><input name="surfaceshader" '
+            'type="surfaceshader" nodename="S"/></surfacematerial>\n</materialx>\n')
+
+
+def _mx_extract22(index: str) -> str:
+    return _mx22('<nodegraph name="NG"><constant name="c" type="color3"><input name="value" '
+                 'type="color3" value="0.2,0.4,0.6"/></constant><extract name="ex" '
+                 'type="float"><input name="in" type="color3" nodename="c"/><input '
+                 f'name="index" type="integer" value="{index}"/></extract><output name="o" '
+                 'type="float" nodename="ex"/></nodegraph><standard_surface name="S" '
+                 'type="surfaceshader"><input name="metalness" type="float" nodegraph="NG" '
+                 'output="o"/></standard_surface>')
+
+
+def _mx_normalmap22(scale: str, value: str | None = None) -> str:
+    source = (f'<input name="in" type="vector3" value="{value}"/>' if value is not None else
+              '<input name="in" type="vector3" nodename="img"/>')
+    return _mx22('<nodegraph name="NG"><image name="img" type="vector3"><input name="file" '
+                 'type="filename" value="n.png"/></image><normalmap name="nm" '
+                 f'type="vector3">{source}<input name="scale" type="float" value="{scale}"/>'
+                 '</normalmap><output name="o" type="vector3" nodename="nm"/></nodegraph>'
+                 '<standard_surface name="S" type="surfaceshader"><input name="normal" '
+                 'type="vector3" nodegraph="NG" output="o"/></standard_surface>')
+
+
+def _mx_surface22(name: str, type_: str, value: str, more: str = "") -> str:
+    return _mx22(f'<standard_surface name="S" type="surfaceshader"><input name="{name}" '
+                 f'type="{type_}" value="{value}"/>{more}</standard_surface>')
+
+
+def _mx_graph22(value: str) -> str:
+    return _mx22('<nodegraph name="NG"><multiply name="mul" type="color3"><input name="in1" '
+                 'type="color3" value="0.5,0.5,0.5"/><input name="in2" type="color3" '
+                 f'value="{value}"/></multiply><output name="o" type="color3" '
+                 'nodename="mul"/></nodegraph><standard_surface name="S" '
+                 'type="surfaceshader"><input name="base_color" type="color3" nodegraph="NG" '
+                 'output="o"/></standard_surface>')
+
+
+def _mx_interface22(value: str) -> str:
+    return _mx22(f'<nodegraph name="NG"><input name="amt" type="float" value="{value}"/>'
+                 '<multiply name="mul" type="float"><input name="in1" type="float" '
+                 'interfacename="amt"/><input name="in2" type="float" value="0.5"/></multiply>'
+                 '<output name="o" type="float" nodename="mul"/></nodegraph><standard_surface '
+                 'name="S" type="surfaceshader"><input name="metalness" type="float" '
+                 'nodegraph="NG" output="o"/></standard_surface>')
+
+
+# case -> (document, the node and the input its error names)
+MTLX_MALFORMED = {
+    "extract index empty": (_mx_extract22(""), "NG/ex", "input index"),
+    "extract index text": (_mx_extract22("abc"), "NG/ex", "input index"),
+    "extract index NaN": (_mx_extract22("nan"), "NG/ex", "input index"),
+    "extract index 1.5": (_mx_extract22("1.5"), "NG/ex", "input index"),
+    "extract index 1e308": (_mx_extract22("1e308"), "NG/ex", "input index"),
+    "normalmap scale abc": (_mx_normalmap22("abc"), "NG/nm", "input scale"),
+    "normalmap scale NaN": (_mx_normalmap22("nan"), "NG/nm", "input scale"),
+    "normalmap scale 1e308": (_mx_normalmap22("1e308"), "NG/nm", "input scale"),
+    "normalmap value overflows when decoded": (_mx_normalmap22("1", "3e38,0.5,1"), "NG/nm",
+                                               "input in"),
+    "colour 1e308": (_mx_surface22("base_color", "color3", "1e308,0,0"), "node S",
+                     "input base_color"),
+    "colour text": (_mx_surface22("base_color", "color3", "red"), "node S",
+                    "input base_color"),
+    "float 1e308": (_mx_surface22("metalness", "float", "1e308"), "node S", "input metalness"),
+    "float inf": (_mx_surface22("metalness", "float", "inf"), "node S", "input metalness"),
+    "float -1e39": (_mx_surface22("metalness", "float", "-1e39"), "node S",
+                    "input metalness"),
+    "vector 1e39 in a nodegraph": (_mx_graph22("1e39,1,1"), "NG/mul", "input in2"),
+    "interface input 1e308": (_mx_interface22("1e308"), "node NG", "input amt"),
+    "colour times weight overflows": (
+        _mx_surface22("emission_color", "color3", "3e38,3e38,3e38",
+                      '<input name="emission" type="float" value="3e38"/>'),
+        "node S", "emission_color"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MTLX_MALFORMED))
+def test_mtlx_import_of_malformed_numbers_is_a_clean_error(tmp_path, case):
+    """Empty, textual, NaN, infinite and beyond-float32 numbers in any numeric MaterialX input
+    are `error:` lines naming the .mtlx file, the node and the input; nothing is written."""
+    text, node, inp = MTLX_MALFORMED[case]
+    src = write(tmp_path / "in.mtlx", text)
+    out = tmp_path / "out.json"
+    rc, _, err = cli("import", src, "-o", out)
+    assert_clean_failure(rc, err)
+    assert "in.mtlx" in err and node in err and inp in err, err
+    assert not out.exists()
+
+
+def _nested22(shape: str) -> str:
+    """JSON text of a nesting `shape`: 100,000 arrays, 100,000 objects, or arrays for a field
+    of the top-level object so that the file nests "N levels" (the top object is one)."""
+    if shape == "100000 arrays":
+        return "[" * 100_000 + "]" * 100_000
+    if shape == "100000 objects":
+        return '{"a": ' * 100_000 + "1" + "}" * 100_000
+    depth = int(shape.split()[0]) - 1
+    return "[" * depth + "]" * depth
+
+
+def _deep_material22(tmp, shape, name="m.json"):
+    """A material whose whole text (the 100,000 shapes) or an unknown field is `shape`."""
+    if shape.startswith("100000"):
+        return write(tmp / name, _nested22(shape))
+    return write(tmp / name, _text22({**base_material(), "x_deep": "@N@"}, _nested22(shape)))
+
+
+def _nested_reader22(tmp, reader, shape):
+    """(command line, or a callable raising the format's error) for `reader` on `shape`."""
+    if reader in ("validate", "compile", "render"):
+        doc = _deep_material22(tmp, shape)
+        return {"validate": ("validate", doc), "compile": ("compile", doc, "-o", tmp / "out"),
+                "render": ("render", doc, "-o", tmp / "x.png", "--size", "8x8")}[reader]
+    if reader.startswith("rig"):
+        text = (_nested22(shape) if shape.startswith("100000") else
+                _text22({**_rig22(), "lights": "@N@"}, _nested22(shape)))
+        rig = write(tmp / "rig.json", text)
+        if reader == "rig (validate)":
+            return ("validate", rig)
+        return ("render", _material22(tmp), "-o", tmp / "x.png", "--size", "8x8", "--lights",
+                rig)
+    if reader == "instance":
+        inst = (write(tmp / "i.json", _nested22(shape)) if shape.startswith("100000") else
+                _instance22(tmp, f'{{"rough": 0.5, "x": {_nested22(shape)}}}'))
+        return ("render", inst, "-o", tmp / "x.png", "--size", "8x8")
+    if reader == "instance parent":
+        _deep_material22(tmp, shape, "p.json")
+        inst = write(tmp / "i.json", '{"format": "matedit.instance", "version": 2, '
+                     '"parent": "p.json", "parameters": {}}')
+        return ("validate", inst)
+    assert reader == "recovery file"  # the editor reads it with matedit.io.document.loads
+    rec = _deep_material22(tmp, shape, "rec.json")
+    return lambda: loads(rec.read_text(encoding="utf-8"), str(rec), tmp / "m.json")
+
+
+NESTED_READERS = ["validate", "compile", "render", "rig (validate)", "rig (render --lights)",
+                  "instance", "instance parent", "recovery file"]
+
+
+@pytest.mark.parametrize("shape", ["100000 arrays", "100000 objects", "65 levels",
+                                   "900 levels"])
+@pytest.mark.parametrize("reader", NESTED_READERS)
+def test_deeply_nested_json_is_one_error_per_reader(tmp_path, reader, shape):
+    """Every JSON reader refuses nesting beyond 64 levels with an `error:` line (exit 2) or its
+    format's error; never a RecursionError. 64 levels (the limit) still load."""
+    job = _nested_reader22(tmp_path, reader, shape)
+    if callable(job):
+        with pytest.raises(FormatError, match="nest more than 64 deep"):
+            job()
+    else:
+        rc, _, err = cli(*job)
+        assert_clean_failure(rc, err)
+        assert "nest more than 64 deep" in err and "Recursion" not in err, err
+    if reader == "validate" and shape == "65 levels":  # the limit itself is fine
+        rc, _, err = cli("validate", _deep_material22(tmp_path, "64 levels"))
+        assert rc == 0, err
+
+
+@pytest.mark.gl
+def test_default_exposure_is_the_documented_0_ev(tmp_path):
+    """0 EV: the renderer's default, what `render` applies without --exposure, what the
+    editor's viewport starts at and what docs/cli.md states (no hidden -0.5 EV look)."""
+    from pathlib import Path
+
+    from matedit.render.settings import DEFAULT_EXPOSURE_EV, PreviewSettings
+
+    assert DEFAULT_EXPOSURE_EV == 0.0 and PreviewSettings().exposure == 0.0
+    docs = (Path(__file__).resolve().parent.parent / "docs" / "cli.md").read_text("utf-8")
+    row = next(l for l in docs.splitlines() if l.startswith("| `--exposure EV`"))
+    assert row.split("|")[2].strip() == "0", row
+    doc = _material22(tmp_path)
+    outs = {}
+    for name, extra in {"default": [], "0": ["--exposure=0"], "-0.5": ["--exposure=-0.5"]}.items():
+        outs[name] = tmp_path / f"{name}.png"
+        rc, _, err = cli("render", doc, "-o", outs[name], "--size", "16x16", *extra)
+        assert rc == 0, err
+    assert outs["default"].read_bytes() == outs["0"].read_bytes()
+    assert outs["default"].read_bytes() != outs["-0.5"].read_bytes()

@@ -16,7 +16,7 @@ import json
 import math
 from typing import Any
 
-MAX_DEPTH = 64  # nested arrays and objects; real files need fewer than ten
+MAX_DEPTH = 64  # levels of arrays and objects, the top-level value one; real files use < 10
 MAX_FLOAT_INT = 2**1023  # larger integers do not round-trip through a 64-bit float
 
 
