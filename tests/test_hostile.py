@@ -26,7 +26,7 @@ from hostile import (
     function_doc,
     write,
 )
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from matedit.graph.names import GLSL_KEYWORDS, identifier_problem
@@ -892,3 +892,269 @@ def test_default_exposure_is_the_documented_0_ev(tmp_path):
         assert rc == 0, err
     assert outs["default"].read_bytes() == outs["0"].read_bytes()
     assert outs["default"].read_bytes() != outs["-0.5"].read_bytes()
+
+
+# --- generated rig and instance files --------------------------------------------------------
+
+# The formats' loaders are quick: three times the documents' generated cases each.
+HSET22 = settings(HSET, max_examples=3 * EXAMPLES)
+
+
+class _Raw22(str):
+    """A JSON token written as it is (NaN, 1e400, a 400-digit integer, deep nesting)."""
+
+
+class _Pairs22(list):
+    """A JSON object as (key, value) pairs, so that a key may appear twice."""
+
+
+def _json22(v) -> str:
+    if isinstance(v, _Raw22):
+        return str(v)
+    if isinstance(v, dict):
+        v = _Pairs22(v.items())
+    if isinstance(v, _Pairs22):
+        return "{" + ", ".join(f"{json.dumps(k)}: {_json22(x)}" for k, x in v) + "}"
+    if isinstance(v, list):
+        return "[" + ", ".join(_json22(x) for x in v) + "]"
+    return json.dumps(v)  # floats: NaN and Infinity come out as those (invalid) tokens
+
+
+def _pairs22(v):
+    """`v` with every dict as _Pairs22 (the generated mutations edit pairs)."""
+    if isinstance(v, dict):
+        return _Pairs22((k, _pairs22(x)) for k, x in v.items())
+    if isinstance(v, list):
+        return [_pairs22(x) for x in v]
+    return v
+
+
+RAW_TOKENS22 = ["1e400", "-1e999", "NaN", "Infinity", "-Infinity", "3.5e38", "-3.4028236e38",
+                "3.4028234e38", "1e39", "1e308", "1e-400", "1e-40", "9" * 400, "-" + "9" * 400,
+                "9" * 5000, "1e12", "1e6", "1e-7", "-0.0", "0", "1", "true", "null",
+                "[" * 70 + "]" * 70, '{"a": ' * 70 + "1" + "}" * 70,
+                "[" * 100_000 + "]" * 100_000]
+hostile_values22 = st.one_of(
+    json_values, st.sampled_from(RAW_TOKENS22).map(_Raw22), st.floats(), st.text(max_size=12),
+    st.lists(st.one_of(st.floats(), st.integers(), st.sampled_from(RAW_TOKENS22[:16])
+                       .map(_Raw22)), max_size=4))
+
+
+def _mutate22(top: _Pairs22, ops, objects: dict) -> str:
+    """Apply (operation, object, key, value) edits to the pairs of `top` and its objects
+    (found by `objects[name](top)`, None when an earlier edit removed them); the JSON text."""
+    for op, where, key, value in ops:
+        obj = objects[where](top)
+        if obj is None:
+            continue
+        if op == "element":
+            if type(obj) is list and obj:  # an array, not an object's pairs
+                obj[hash(key) % len(obj)] = value
+            continue
+        if not isinstance(obj, _Pairs22):
+            continue
+        i = next((n for n, (k, _) in enumerate(obj) if k == key), None)
+        if op == "delete":
+            if i is not None:
+                del obj[i]
+        elif op == "duplicate" or i is None:
+            obj.append((key, value))
+        else:
+            obj[i] = (key, value)
+    return _json22(top)
+
+
+def _member22(obj, key):
+    if isinstance(obj, _Pairs22):
+        return next((v for k, v in obj if k == key), None)
+    if type(obj) is list and isinstance(key, int) and key < len(obj):
+        return obj[key]
+    return None
+
+
+RIG_OBJECTS22 = {
+    "top": lambda t: t,
+    "light 0": lambda t: _member22(_member22(t, "lights"), 0),
+    "light 1": lambda t: _member22(_member22(t, "lights"), 1),
+    "light 1 position": lambda t: _member22(_member22(_member22(t, "lights"), 1), "position"),
+    "light 1 color": lambda t: _member22(_member22(_member22(t, "lights"), 1), "color"),
+    "light 0 direction": lambda t: _member22(_member22(_member22(t, "lights"), 0), "direction"),
+}
+RIG_KEYS22 = ["format", "version", "lights", "type", "position", "direction", "radius", "length",
+              "color", "intensity", "influence_radius", "name"]
+
+
+def _edits22(objects, keys):
+    return st.lists(st.tuples(st.sampled_from(["set", "set", "delete", "duplicate", "element"]),
+                              st.sampled_from(sorted(objects)),
+                              st.one_of(st.sampled_from(keys), st.text(max_size=6)),
+                              hostile_values22), min_size=1, max_size=4)
+
+
+def _light_context22():
+    """Shading points on the unit sphere seen from the camera, rough to near-mirror."""
+    import numpy as np
+
+    from matedit.shading.lights import makeShadingContext
+
+    d = np.array([[0, 0, 1], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [0, 0, -1],
+                  [0.6, 0.0, 0.8], [0.0, -0.6, 0.8]], float)
+    v = np.array([0.0, 0.0, 4.0]) - d
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    n = len(d)
+    return makeShadingContext(d, d, v, np.full((n, 3), 0.8), np.full((n, 3), 0.04),
+                              np.linspace(0.0, 1.0, n))
+
+
+def _assert_lights_finite22(lights) -> None:
+    """What the renderer does with a rig, without GL: the LightsBlock packs with no numpy
+    warning and holds finite float32s, and each light's radiance (the shading twin) stays
+    far inside float32 at points on the preview sphere."""
+    import warnings
+
+    import numpy as np
+
+    from matedit.shading.lights import evaluateLight
+    from matedit.shading.lights_block import pack_lights
+
+    s = _light_context22()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # an overflow in a cast fails the case
+        block = np.frombuffer(pack_lights(lights), "<f4")
+        assert np.isfinite(block).all()
+        for light in lights:
+            radiance = evaluateLight(s, light)
+            assert np.isfinite(radiance).all() and np.abs(radiance).max() < 1e30, light
+
+
+@HTIMEOUT
+@HSET22
+@given(edits=_edits22(RIG_OBJECTS22, RIG_KEYS22))
+def test_generated_rigs_load_cleanly_or_light_finitely(edits):
+    """Mutated rigs (wrong types, huge, NaN and infinite numbers, 400-digit integers, deep
+    nesting, duplicate and missing keys, unknown fields, unicode): the loader raises RigError
+    naming the file, or the lights pack and shine finitely. 3 x HOSTILE_EXAMPLES cases."""
+    from matedit.io.rig import RigError
+    from matedit.io.rig import loads as rig_loads
+
+    text = _mutate22(_pairs22(_rig22()), edits, RIG_OBJECTS22)
+    try:
+        lights = rig_loads(text, "rig.json")
+    except RigError as exc:
+        assert str(exc).startswith("rig.json: "), exc
+        event("refused")
+        return
+    event("loaded")
+    _assert_lights_finite22(lights)
+
+
+INSTANCE_OBJECTS22 = {
+    "top": lambda t: t,
+    "parameters": lambda t: _member22(t, "parameters"),
+    "tint": lambda t: _member22(_member22(t, "parameters"), "tint"),
+    "preview": lambda t: _member22(t, "preview"),
+}
+INSTANCE_KEYS22 = ["format", "version", "name", "description", "parent", "parameters",
+                   "parent_parameters", "preview", "rough", "tint", "mesh", "environment"]
+
+
+@HTIMEOUT
+@HSET22
+@given(edits=_edits22(INSTANCE_OBJECTS22, INSTANCE_KEYS22))
+def test_generated_instances_load_cleanly_or_compile_finite(tmp_path_factory, edits):
+    """Mutated instances of a valid material: loading and resolving raise FormatError or
+    InstanceError naming the instance (or report its parameter errors), or the effective
+    material compiles and its uniform block packs finite float32s with no numpy warning.
+    3 x HOSTILE_EXAMPLES cases."""
+    import struct
+    import warnings
+
+    import numpy as np
+
+    from matedit.compiler import compile_document
+    from matedit.io.document import FileResolver
+    from matedit.io.instance import InstanceError, load_instance, resolve
+
+    tmp = tmp_path_factory.mktemp("inst")
+    write(tmp / "m.json", base_material())
+    base = {"format": "matedit.instance", "version": 2, "name": "i", "parent": "m.json",
+            "parameters": {"rough": 0.3, "tint": [0.5, 0.2, 0.1]}, "preview": {"mesh": "cube"}}
+    path = write(tmp / "i.json", _mutate22(_pairs22(base), edits, INSTANCE_OBJECTS22))
+    try:
+        r = resolve(load_instance(path))
+    except (FormatError, InstanceError) as exc:
+        assert str(exc).startswith(str(path)), exc
+        event("refused")
+        return
+    if r.errors:
+        assert all(p.file == str(path) for p in r.errors), r.errors
+        event("parameter errors")
+        return
+    event("compiled")
+    compiled = compile_document(r.document, FileResolver())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        data = compiled.pack_uniforms()
+        floats = np.frombuffer(data, "<f4")
+        assert np.isfinite(floats).all() and struct.calcsize(f"<{len(floats)}f") == len(data)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("case", ["rig at the limits", "rig at the limits, reference",
+                                  "rig far away", "instance at float32's edge",
+                                  "rig colour times intensity beyond the limit"])
+def test_a_handful_of_extreme_files_render_finite_pixels(tmp_path, case):
+    """The few renders behind the generated cases: rigs at the stated limits render finite
+    linear pixels with nothing on stderr (no numpy warning), in split sum and reference;
+    an instance at float32's edge renders; a rig past the limit is refused, not rendered."""
+    import warnings
+
+    import numpy as np
+
+    from matedit.io.images import read_image
+
+    good = write(tmp_path / "m.json", base_material())
+    near = {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "sphere", "position": [2, 2, 3], "radius": 1e6, "color": [1, 1, 1],
+         "intensity": 1e12, "influence_radius": 1e6},
+        {"type": "tube", "position": [-1.5, 0, 0], "direction": [0, 1, 0], "radius": 0.04,
+         "length": 1e6, "color": [1e6, 1e6, 1e6], "intensity": 1e6, "influence_radius": 1e6},
+        {"type": "point", "position": [0, 0, 1.001], "intensity": 1e12,
+         "influence_radius": 1e6},
+        {"type": "point", "position": [0, 0, 1.5], "intensity": 1e12,
+         "influence_radius": 1e-6},
+        {"type": "directional", "direction": [0, 0, -1], "color": [1e12, 0, 1],
+         "intensity": 1}]}
+    far = {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "tube", "position": [1e6, -1e6, 1e6], "direction": [1, 1, 0], "radius": 1e6,
+         "length": 1e6, "intensity": 1e12, "influence_radius": 1e6},
+        {"type": "sphere", "position": [-1e6, 1e6, -1e6], "radius": 1e6, "intensity": 1e12,
+         "influence_radius": 1e6}]}
+    beyond = {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "point", "position": [0, 0, 3], "color": [1e7, 1, 1], "intensity": 1e6}]}
+    args: list = ["render", good]
+    if case.startswith("instance"):
+        inst = write(tmp_path / "i.json", {"format": "matedit.instance", "version": 2,
+                                           "parent": "m.json", "parameters": {
+                                               "rough": 3.4e38, "tint": [1e30, 0.5, 0.0]}})
+        args = ["render", inst]
+    else:
+        rig = {"rig far away": far, "rig colour times intensity beyond the limit": beyond
+               }.get(case, near)
+        args += ["--lights", write(tmp_path / "rig.json", rig)]
+    if case.endswith("reference"):
+        args += ["--ibl", "reference", "--samples", "4"]
+    for out in ("x.exr", "x.png"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # a numpy warning would be an internal error
+            rc, _, err = cli(*args, "-o", tmp_path / out, "--size", "16x16")
+        if "beyond" in case:
+            assert_clean_failure(rc, err)
+            assert "light 0, field intensity" in err and "1e+12" in err, err
+            return
+        assert rc == 0 and err == "", err
+    pixels = read_image(tmp_path / "x.exr").pixels
+    if case.startswith("rig"):
+        assert np.isfinite(pixels).all()
+    else:  # a material's own arithmetic may overflow; never to NaN
+        assert not np.isnan(pixels).any()
