@@ -26,7 +26,7 @@ from hostile import (
     function_doc,
     write,
 )
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
 from matedit.graph.names import GLSL_KEYWORDS, identifier_problem
@@ -949,7 +949,8 @@ def _mutate22(top: _Pairs22, ops, objects: dict) -> str:
             continue
         if op == "element":
             if type(obj) is list and obj:  # an array, not an object's pairs
-                obj[hash(key) % len(obj)] = value
+                at = key if isinstance(key, int) else sum(map(ord, str(key)))
+                obj[at % len(obj)] = value  # deterministic (str hashes are salted)
             continue
         if not isinstance(obj, _Pairs22):
             continue
@@ -985,9 +986,11 @@ RIG_KEYS22 = ["format", "version", "lights", "type", "position", "direction", "r
 
 
 def _edits22(objects, keys):
+    """1 to 4 edits, mostly of the format's own keys (an unknown key is refused at once)."""
+    known = st.sampled_from(keys)
     return st.lists(st.tuples(st.sampled_from(["set", "set", "delete", "duplicate", "element"]),
                               st.sampled_from(sorted(objects)),
-                              st.one_of(st.sampled_from(keys), st.text(max_size=6)),
+                              st.one_of(known, known, known, st.text(max_size=6)),
                               hostile_values22), min_size=1, max_size=4)
 
 
@@ -1030,6 +1033,11 @@ def _assert_lights_finite22(lights) -> None:
 @HTIMEOUT
 @HSET22
 @given(edits=_edits22(RIG_OBJECTS22, RIG_KEYS22))
+@example(edits=[("set", "light 1", "intensity", _Raw22("1e39"))])
+@example(edits=[("element", "light 1 color", 0, _Raw22("3.4e38"))])
+@example(edits=[("element", "light 1 position", 1, _Raw22("9" * 400))])
+@example(edits=[("set", "light 0", "radius", _Raw22("1e308"))])
+@example(edits=[("duplicate", "light 1", "intensity", 5.0)])
 def test_generated_rigs_load_cleanly_or_light_finitely(edits):
     """Mutated rigs (wrong types, huge, NaN and infinite numbers, 400-digit integers, deep
     nesting, duplicate and missing keys, unknown fields, unicode): the loader raises RigError
@@ -1061,6 +1069,9 @@ INSTANCE_KEYS22 = ["format", "version", "name", "description", "parent", "parame
 @HTIMEOUT
 @HSET22
 @given(edits=_edits22(INSTANCE_OBJECTS22, INSTANCE_KEYS22))
+@example(edits=[("set", "parameters", "rough", _Raw22("3.5e38"))])
+@example(edits=[("element", "tint", 2, _Raw22("1e308"))])
+@example(edits=[("set", "parameters", "rough", _Raw22("[" * 100_000 + "]" * 100_000))])
 def test_generated_instances_load_cleanly_or_compile_finite(tmp_path_factory, edits):
     """Mutated instances of a valid material: loading and resolving raise FormatError or
     InstanceError naming the instance (or report its parameter errors), or the effective
