@@ -16,7 +16,9 @@ vec3 tonemapACES(vec3 x) {
     const float c = 2.43;
     const float d = 0.59;
     const float e = 0.14;
-    x = max(x, vec3(0.0));
+    // The curve reaches 1 near x = 7.2; bounding x at 1e4 changes no output and keeps the
+    // squares finite for any input, an infinity included.
+    x = min(max(x, vec3(0.0)), vec3(1e4));
     return saturate((x * (a * x + b)) / (x * (c * x + d) + e));
 }
 

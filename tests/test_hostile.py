@@ -26,7 +26,7 @@ from hostile import (
     function_doc,
     write,
 )
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
 from matedit.graph.names import GLSL_KEYWORDS, identifier_problem
@@ -945,3 +945,687 @@ def test_validate_on_a_folder_without_documents(tmp_path, layout):
     assert_clean_failure(rc, err)
     assert err.splitlines() == [
         f"error: {folder}: no material, function or instance files (*.json)"]
+# === Numbers, nesting and MaterialX values (issue 22): float32 at every entry point of a number,
+# huge integers, duplicate keys in rigs, --exposure, malformed MaterialX numbers, deeply nested
+# JSON per reader, the default exposure, and generated rig and instance files ==================
+#
+# The rule: a number the renderer would receive is finite and within float32 (one function,
+# matedit.graph.numbers.gpu_number_problem, asked by every format); JSON text goes through one
+# bounded-depth parser (matedit.io.jsontext.parse_json). Refusals are exit 2 with `error:` lines
+# naming the file, the node (parameter, light) and the field.
+
+N22 = '"@N@"'  # where a raw JSON token goes into a file written as JSON text
+
+
+def _rig22() -> dict:
+    """A valid rig: a sphere light, then a tube light (light 1)."""
+    return {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "sphere", "position": [2.4, 2.8, 3.0], "radius": 0.3,
+         "color": [1.0, 0.96, 0.9], "intensity": 18.0, "influence_radius": 25.0},
+        {"type": "tube", "position": [-2.8, 1.6, -2.4], "direction": [0, 1, 0],
+         "radius": 0.04, "length": 1.6, "color": [0.75, 0.85, 1.0], "intensity": 10.0}]}
+
+
+def _text22(raw: dict, token: str) -> str:
+    return json.dumps(raw).replace(N22, token)
+
+
+def _material22(tmp, token="0.4", where=None) -> object:
+    """base_material as m.json, with `token` as raw JSON at `where` (a function of the dict)."""
+    raw = base_material()
+    if where is not None:
+        where(raw)
+    return write(tmp / "m.json", _text22(raw, token))
+
+
+def _instance22(tmp, parameters: str) -> object:
+    """i.json: an instance of a valid m.json with `parameters` (JSON text) as its overrides."""
+    _material22(tmp)
+    return write(tmp / "i.json", '{"format": "matedit.instance", "version": 2, "name": "i", '
+                 f'"parent": "m.json", "parameters": {parameters}}}')
+
+
+def _rig_file22(tmp, field, token, light=1) -> object:
+    raw = _rig22()
+    if isinstance(field, tuple):  # (list field, index)
+        raw["lights"][light][field[0]][field[1]] = "@N@"
+    else:
+        raw["lights"][light][field] = "@N@"
+    return write(tmp / "rig.json", _text22(raw, token))
+
+
+def _add_constant22(raw):
+    raw["nodes"].append({"id": "k", "kind": "constant", "position": [0, 0],
+                         "settings": {"type": "float", "value": "@N@"}})
+    raw["links"].append({"from": ["k", "value"], "to": ["make", "metallic"]})
+
+
+def _function22(tmp, token):
+    fn = function_doc()
+    fn["nodes"][0]["settings"]["default"] = "@N@"
+    write(tmp / "f.json", _text22(fn, token))
+    raw = base_material()
+    raw["nodes"].append({"id": "call", "kind": "function_call", "position": [200, 0],
+                         "settings": {"function": "f.json"}})
+    raw["links"] += [{"from": ["call", "result"], "to": ["make", "metallic"]}]
+    return write(tmp / "m.json", raw)
+
+
+def _set(path, value="@N@"):
+    """A mutation of base_material's dict: raw[path...] = value."""
+    def apply(raw):
+        target = raw
+        for p in path[:-1]:
+            target = target[p]
+        target[path[-1]] = value
+    return apply
+
+
+def _float32_rig(field):
+    name = field if isinstance(field, str) else field[0]
+    return lambda t, v: ("rig", _rig_file22(t, field, v), ["rig.json", "light 1", f"field {name}"])
+
+
+# entry -> (what kind of file, the file, what every message must name)
+FLOAT32_ENTRIES = {
+    "material value": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 1, "values", "value"])), ["m.json", "node r", "field value"]),
+    "input value": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 2, "values", "b"])), ["m.json", "node m", "field b"]),
+    "colour component": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 0, "values", "value"], [0.5, "@N@", 0.5])),
+        ["m.json", "node col", "field value"]),
+    "constant setting": lambda t, v: ("material", _material22(t, v, _add_constant22),
+                                      ["m.json", "node k", "field value"]),
+    "parameter range": lambda t, v: ("material", _material22(
+        t, v, _set(["nodes", 1, "settings", "ui_max"])), ["m.json", "node r", "field ui_max"]),
+    "function input default": lambda t, v: ("function", _function22(t, v),
+                                            ["m.json", "node call", "field a"]),
+    "instance scalar override": lambda t, v: ("instance", _instance22(t, f'{{"rough": {v}}}'),
+                                              ["i.json", "parameter rough"]),
+    "instance colour override": lambda t, v: ("instance", _instance22(
+        t, f'{{"tint": [0.1, {v}, 0.1]}}'), ["i.json", "parameter tint"]),
+    **{f"rig {f if isinstance(f, str) else f[0]}": _float32_rig(f)
+       for f in ["intensity", ("color", 0), ("position", 2), "length", "radius",
+                 ("direction", 1), "influence_radius"]},
+}
+FLOAT32_VALUES = ["3.5e38", "1e308", "-1e39", str(10**39)]
+
+
+@pytest.mark.parametrize("value", FLOAT32_VALUES)
+@pytest.mark.parametrize("entry", [*sorted(FLOAT32_ENTRIES), "render --exposure"])
+def test_float32_overflow_is_refused_where_the_number_enters(tmp_path, entry, value):
+    """validate refuses what a float32 uniform cannot hold, naming file, node and field; the
+    commands that would pack it (compile, render, bake) refuse it the same way, never with
+    "float too large to pack"."""
+    if entry == "render --exposure":
+        doc = _material22(tmp_path)
+        rc, _, err = cli("render", doc, "-o", tmp_path / "x.png", "--size", "8x8",
+                         f"--exposure={value}")
+        assert_clean_failure(rc, err)
+        assert "--exposure" in err and "pack" not in err
+        return
+    kind, path, needles = FLOAT32_ENTRIES[entry](tmp_path, value)
+    png = ("-o", tmp_path / "x.png", "--size", "8x8")
+    good = write(tmp_path / "good.json", base_material())
+    runs = {"rig": [("validate", path), ("render", good, *png, "--lights", path)],
+            "instance": [("validate", path), ("render", path, *png),
+                         ("compile", path, "-o", tmp_path / "out")],
+            "material": [("validate", path), ("render", path, *png),
+                         ("compile", path, "-o", tmp_path / "out"),
+                         ("bake", path, "-o", tmp_path / "bake", "--size", "8")]}
+    runs["function"] = runs["material"]
+    for args in runs[kind]:
+        rc, _, err = cli(*args)
+        assert_clean_failure(rc, err)
+        assert all(n in err for n in needles) and "float32" in err, (args[0], err)
+        assert "pack" not in err, err
+    if kind == "function":  # the function file itself names its input node
+        rc, _, err = cli("validate", tmp_path / "f.json")
+        assert_clean_failure(rc, err)
+        assert "f.json" in err and "node i0" in err and "field default" in err, err
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("digits", [400, 5000])
+@pytest.mark.parametrize("where", ["rig intensity", "rig position", "rig version",
+                                   "instance override", "material value"])
+def test_huge_integers_are_clean_errors(tmp_path, where, digits):
+    """A 400-digit (or 5000-digit, past Python's conversion limit) integer is an `error:`
+    line from validate and render, never an internal OverflowError."""
+    token = "9" * digits
+    if where.startswith("rig"):
+        raw = _rig22()
+        if where == "rig version":
+            raw["version"] = "@N@"
+        elif where == "rig position":
+            raw["lights"][1]["position"][0] = "@N@"
+        else:
+            raw["lights"][1]["intensity"] = "@N@"
+        rig = write(tmp_path / "rig.json", _text22(raw, token))
+        checks = [("validate", rig), ("render", _material22(tmp_path), "-o",
+                                      tmp_path / "x.png", "--size", "8x8", "--lights", rig)]
+        name = "rig.json"
+    elif where == "instance override":
+        inst = _instance22(tmp_path, f'{{"rough": {token}}}')
+        checks = [("validate", inst), ("render", inst, "-o", tmp_path / "x.png", "--size",
+                                       "8x8")]
+        name = "i.json"
+    else:
+        doc = _material22(tmp_path, token, _set(["nodes", 1, "values", "value"]))
+        checks = [("validate", doc), ("render", doc, "-o", tmp_path / "x.png", "--size", "8x8")]
+        name = "m.json"
+    for args in checks:
+        rc, _, err = cli(*args)
+        assert_clean_failure(rc, err)
+        assert name in err and "Overflow" not in err and token not in err, err
+
+
+@pytest.mark.parametrize("case", ["format twice", "lights twice", "intensity twice",
+                                  "type twice", "name twice"])
+def test_rig_duplicate_keys_are_refused(tmp_path, case):
+    """Rigs refuse a key twice in one object, as documents do (the same parser)."""
+    text = json.dumps(_rig22())
+    if case == "format twice":
+        text = text.replace('{"format"', '{"format": "matedit.lightrig", "format"', 1)
+    elif case == "lights twice":
+        text = text.replace('"lights": [', '"lights": [], "lights": [', 1)
+    elif case == "intensity twice":
+        text = text.replace('"intensity": 10.0', '"intensity": 10.0, "intensity": 1e3', 1)
+    elif case == "type twice":
+        text = text.replace('{"type": "tube"', '{"type": "point", "type": "tube"', 1)
+    else:
+        text = text.replace('{"type": "tube"', '{"name": "a", "name": "b", "type": "tube"', 1)
+    key = case.split()[0]
+    rig = write(tmp_path / "rig.json", text)
+    from matedit.io.rig import RigError
+    from matedit.io.rig import loads as rig_loads
+
+    with pytest.raises(RigError, match=f"key '{key}' appears twice"):
+        rig_loads(text, "rig.json")
+    for args in [("validate", rig), ("render", _material22(tmp_path), "-o", tmp_path / "x.png",
+                                     "--size", "8x8", "--lights", rig)]:
+        rc, _, err = cli(*args)
+        assert_clean_failure(rc, err)
+        assert "rig.json" in err and f"'{key}' appears twice" in err, err
+
+
+@pytest.mark.parametrize("value, ok", [
+    ("nan", False), ("NaN", False), ("inf", False), ("-inf", False), ("1e308", False),
+    ("1e400", False), ("30.5", False), ("-31", False), ("abc", False),
+    pytest.param("30", True, marks=pytest.mark.gl), pytest.param("-30", True,
+                                                                  marks=pytest.mark.gl),
+])
+def test_exposure_option_is_a_finite_number_of_stops_within_30(tmp_path, value, ok):
+    """`render --exposure` takes -30..30 EV; NaN, infinities and 2**EV overflows are one
+    `error:` line naming the option (exit 2); the extremes render."""
+    out = tmp_path / "x.png"
+    rc, _, err = cli("render", _material22(tmp_path), "-o", out, "--size", "8x8",
+                     f"--exposure={value}")
+    if ok:
+        assert rc == 0 and out.is_file(), err
+        return
+    assert_clean_failure(rc, err)
+    assert len(err.strip().splitlines()) == 1 and "--exposure" in err, err
+    assert not out.exists()
+
+
+# MaterialX documents, written by hand: each holds one malformed number
+def _mx22(body: str) -> str:
+    return ('<?xml version="1.0"?>\n<materialx version="1.39">\n' + body +
+            '<surfacematerial name="M" type="material"><input name="surfaceshader" '
+            'type="surfaceshader" nodename="S"/></surfacematerial>\n</materialx>\n')
+
+
+def _mx_extract22(index: str) -> str:
+    return _mx22('<nodegraph name="NG"><constant name="c" type="color3"><input name="value" '
+                 'type="color3" value="0.2,0.4,0.6"/></constant><extract name="ex" '
+                 'type="float"><input name="in" type="color3" nodename="c"/><input '
+                 f'name="index" type="integer" value="{index}"/></extract><output name="o" '
+                 'type="float" nodename="ex"/></nodegraph><standard_surface name="S" '
+                 'type="surfaceshader"><input name="metalness" type="float" nodegraph="NG" '
+                 'output="o"/></standard_surface>')
+
+
+def _mx_normalmap22(scale: str, value: str | None = None) -> str:
+    source = (f'<input name="in" type="vector3" value="{value}"/>' if value is not None else
+              '<input name="in" type="vector3" nodename="img"/>')
+    return _mx22('<nodegraph name="NG"><image name="img" type="vector3"><input name="file" '
+                 'type="filename" value="n.png"/></image><normalmap name="nm" '
+                 f'type="vector3">{source}<input name="scale" type="float" value="{scale}"/>'
+                 '</normalmap><output name="o" type="vector3" nodename="nm"/></nodegraph>'
+                 '<standard_surface name="S" type="surfaceshader"><input name="normal" '
+                 'type="vector3" nodegraph="NG" output="o"/></standard_surface>')
+
+
+def _mx_surface22(name: str, type_: str, value: str, more: str = "") -> str:
+    return _mx22(f'<standard_surface name="S" type="surfaceshader"><input name="{name}" '
+                 f'type="{type_}" value="{value}"/>{more}</standard_surface>')
+
+
+def _mx_graph22(value: str) -> str:
+    return _mx22('<nodegraph name="NG"><multiply name="mul" type="color3"><input name="in1" '
+                 'type="color3" value="0.5,0.5,0.5"/><input name="in2" type="color3" '
+                 f'value="{value}"/></multiply><output name="o" type="color3" '
+                 'nodename="mul"/></nodegraph><standard_surface name="S" '
+                 'type="surfaceshader"><input name="base_color" type="color3" nodegraph="NG" '
+                 'output="o"/></standard_surface>')
+
+
+def _mx_interface22(value: str) -> str:
+    return _mx22(f'<nodegraph name="NG"><input name="amt" type="float" value="{value}"/>'
+                 '<multiply name="mul" type="float"><input name="in1" type="float" '
+                 'interfacename="amt"/><input name="in2" type="float" value="0.5"/></multiply>'
+                 '<output name="o" type="float" nodename="mul"/></nodegraph><standard_surface '
+                 'name="S" type="surfaceshader"><input name="metalness" type="float" '
+                 'nodegraph="NG" output="o"/></standard_surface>')
+
+
+# case -> (document, the node and the input its error names)
+MTLX_MALFORMED = {
+    "extract index empty": (_mx_extract22(""), "NG/ex", "input index"),
+    "extract index text": (_mx_extract22("abc"), "NG/ex", "input index"),
+    "extract index NaN": (_mx_extract22("nan"), "NG/ex", "input index"),
+    "extract index 1.5": (_mx_extract22("1.5"), "NG/ex", "input index"),
+    "extract index 1e308": (_mx_extract22("1e308"), "NG/ex", "input index"),
+    "normalmap scale abc": (_mx_normalmap22("abc"), "NG/nm", "input scale"),
+    "normalmap scale NaN": (_mx_normalmap22("nan"), "NG/nm", "input scale"),
+    "normalmap scale 1e308": (_mx_normalmap22("1e308"), "NG/nm", "input scale"),
+    "normalmap value overflows when decoded": (_mx_normalmap22("1", "3e38,0.5,1"), "NG/nm",
+                                               "input in"),
+    "colour 1e308": (_mx_surface22("base_color", "color3", "1e308,0,0"), "node S",
+                     "input base_color"),
+    "colour text": (_mx_surface22("base_color", "color3", "red"), "node S",
+                    "input base_color"),
+    "float 1e308": (_mx_surface22("metalness", "float", "1e308"), "node S", "input metalness"),
+    "float inf": (_mx_surface22("metalness", "float", "inf"), "node S", "input metalness"),
+    "float -1e39": (_mx_surface22("metalness", "float", "-1e39"), "node S",
+                    "input metalness"),
+    "vector 1e39 in a nodegraph": (_mx_graph22("1e39,1,1"), "NG/mul", "input in2"),
+    "interface input 1e308": (_mx_interface22("1e308"), "node NG", "input amt"),
+    "colour times weight overflows": (
+        _mx_surface22("emission_color", "color3", "3e38,3e38,3e38",
+                      '<input name="emission" type="float" value="3e38"/>'),
+        "node S", "emission_color"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MTLX_MALFORMED))
+def test_mtlx_import_of_malformed_numbers_is_a_clean_error(tmp_path, case):
+    """Empty, textual, NaN, infinite and beyond-float32 numbers in any numeric MaterialX input
+    are `error:` lines naming the .mtlx file, the node and the input; nothing is written."""
+    text, node, inp = MTLX_MALFORMED[case]
+    src = write(tmp_path / "in.mtlx", text)
+    out = tmp_path / "out.json"
+    rc, _, err = cli("import", src, "-o", out)
+    assert_clean_failure(rc, err)
+    assert "in.mtlx" in err and node in err and inp in err, err
+    assert not out.exists()
+
+
+def _nested22(shape: str) -> str:
+    """JSON text of a nesting `shape`: 100,000 arrays, 100,000 objects, or arrays for a field
+    of the top-level object so that the file nests "N levels" (the top object is one)."""
+    if shape == "100000 arrays":
+        return "[" * 100_000 + "]" * 100_000
+    if shape == "100000 objects":
+        return '{"a": ' * 100_000 + "1" + "}" * 100_000
+    depth = int(shape.split()[0]) - 1
+    return "[" * depth + "]" * depth
+
+
+def _deep_material22(tmp, shape, name="m.json"):
+    """A material whose whole text (the 100,000 shapes) or an unknown field is `shape`."""
+    if shape.startswith("100000"):
+        return write(tmp / name, _nested22(shape))
+    return write(tmp / name, _text22({**base_material(), "x_deep": "@N@"}, _nested22(shape)))
+
+
+def _nested_reader22(tmp, reader, shape):
+    """(command line, or a callable raising the format's error) for `reader` on `shape`."""
+    if reader in ("validate", "compile", "render"):
+        doc = _deep_material22(tmp, shape)
+        return {"validate": ("validate", doc), "compile": ("compile", doc, "-o", tmp / "out"),
+                "render": ("render", doc, "-o", tmp / "x.png", "--size", "8x8")}[reader]
+    if reader.startswith("rig"):
+        text = (_nested22(shape) if shape.startswith("100000") else
+                _text22({**_rig22(), "lights": "@N@"}, _nested22(shape)))
+        rig = write(tmp / "rig.json", text)
+        if reader == "rig (validate)":
+            return ("validate", rig)
+        return ("render", _material22(tmp), "-o", tmp / "x.png", "--size", "8x8", "--lights",
+                rig)
+    if reader == "instance":
+        inst = (write(tmp / "i.json", _nested22(shape)) if shape.startswith("100000") else
+                _instance22(tmp, f'{{"rough": 0.5, "x": {_nested22(shape)}}}'))
+        return ("render", inst, "-o", tmp / "x.png", "--size", "8x8")
+    if reader == "instance parent":
+        _deep_material22(tmp, shape, "p.json")
+        inst = write(tmp / "i.json", '{"format": "matedit.instance", "version": 2, '
+                     '"parent": "p.json", "parameters": {}}')
+        return ("validate", inst)
+    assert reader == "recovery file"  # the editor reads it with matedit.io.document.loads
+    rec = _deep_material22(tmp, shape, "rec.json")
+    return lambda: loads(rec.read_text(encoding="utf-8"), str(rec), tmp / "m.json")
+
+
+NESTED_READERS = ["validate", "compile", "render", "rig (validate)", "rig (render --lights)",
+                  "instance", "instance parent", "recovery file"]
+
+
+@pytest.mark.parametrize("shape", ["100000 arrays", "100000 objects", "65 levels",
+                                   "900 levels"])
+@pytest.mark.parametrize("reader", NESTED_READERS)
+def test_deeply_nested_json_is_one_error_per_reader(tmp_path, reader, shape):
+    """Every JSON reader refuses nesting beyond 64 levels with an `error:` line (exit 2) or its
+    format's error; never a RecursionError. 64 levels (the limit) still load."""
+    job = _nested_reader22(tmp_path, reader, shape)
+    if callable(job):
+        with pytest.raises(FormatError, match="nest more than 64 deep"):
+            job()
+    else:
+        rc, _, err = cli(*job)
+        assert_clean_failure(rc, err)
+        assert "nest more than 64 deep" in err and "Recursion" not in err, err
+    if reader == "validate" and shape == "65 levels":  # the limit itself is fine
+        rc, _, err = cli("validate", _deep_material22(tmp_path, "64 levels"))
+        assert rc == 0, err
+
+
+@pytest.mark.gl
+def test_default_exposure_is_the_documented_0_ev(tmp_path):
+    """0 EV: the renderer's default, what `render` applies without --exposure, what the
+    editor's viewport starts at and what docs/cli.md states (no hidden -0.5 EV look)."""
+    from pathlib import Path
+
+    from matedit.render.settings import DEFAULT_EXPOSURE_EV, PreviewSettings
+
+    assert DEFAULT_EXPOSURE_EV == 0.0 and PreviewSettings().exposure == 0.0
+    docs = (Path(__file__).resolve().parent.parent / "docs" / "cli.md").read_text("utf-8")
+    row = next(l for l in docs.splitlines() if l.startswith("| `--exposure EV`"))
+    assert row.split("|")[2].strip() == "0", row
+    doc = _material22(tmp_path)
+    outs = {}
+    for name, extra in {"default": [], "0": ["--exposure=0"], "-0.5": ["--exposure=-0.5"]}.items():
+        outs[name] = tmp_path / f"{name}.png"
+        rc, _, err = cli("render", doc, "-o", outs[name], "--size", "16x16", *extra)
+        assert rc == 0, err
+    assert outs["default"].read_bytes() == outs["0"].read_bytes()
+    assert outs["default"].read_bytes() != outs["-0.5"].read_bytes()
+
+
+# --- generated rig and instance files --------------------------------------------------------
+
+# The formats' loaders are quick: three times the documents' generated cases each.
+HSET22 = settings(HSET, max_examples=3 * EXAMPLES)
+
+
+class _Raw22(str):
+    """A JSON token written as it is (NaN, 1e400, a 400-digit integer, deep nesting)."""
+
+
+class _Pairs22(list):
+    """A JSON object as (key, value) pairs, so that a key may appear twice."""
+
+
+def _json22(v) -> str:
+    if isinstance(v, _Raw22):
+        return str(v)
+    if isinstance(v, dict):
+        v = _Pairs22(v.items())
+    if isinstance(v, _Pairs22):
+        return "{" + ", ".join(f"{json.dumps(k)}: {_json22(x)}" for k, x in v) + "}"
+    if isinstance(v, list):
+        return "[" + ", ".join(_json22(x) for x in v) + "]"
+    return json.dumps(v)  # floats: NaN and Infinity come out as those (invalid) tokens
+
+
+def _pairs22(v):
+    """`v` with every dict as _Pairs22 (the generated mutations edit pairs)."""
+    if isinstance(v, dict):
+        return _Pairs22((k, _pairs22(x)) for k, x in v.items())
+    if isinstance(v, list):
+        return [_pairs22(x) for x in v]
+    return v
+
+
+RAW_TOKENS22 = ["1e400", "-1e999", "NaN", "Infinity", "-Infinity", "3.5e38", "-3.4028236e38",
+                "3.4028234e38", "1e39", "1e308", "1e-400", "1e-40", "9" * 400, "-" + "9" * 400,
+                "9" * 5000, "1e12", "1e6", "1e-7", "-0.0", "0", "1", "true", "null",
+                "[" * 70 + "]" * 70, '{"a": ' * 70 + "1" + "}" * 70,
+                "[" * 100_000 + "]" * 100_000]
+hostile_values22 = st.one_of(
+    json_values, st.sampled_from(RAW_TOKENS22).map(_Raw22), st.floats(), st.text(max_size=12),
+    st.lists(st.one_of(st.floats(), st.integers(), st.sampled_from(RAW_TOKENS22[:16])
+                       .map(_Raw22)), max_size=4))
+
+
+def _mutate22(top: _Pairs22, ops, objects: dict) -> str:
+    """Apply (operation, object, key, value) edits to the pairs of `top` and its objects
+    (found by `objects[name](top)`, None when an earlier edit removed them); the JSON text."""
+    for op, where, key, value in ops:
+        obj = objects[where](top)
+        if obj is None:
+            continue
+        if op == "element":
+            if type(obj) is list and obj:  # an array, not an object's pairs
+                at = key if isinstance(key, int) else sum(map(ord, str(key)))
+                obj[at % len(obj)] = value  # deterministic (str hashes are salted)
+            continue
+        if not isinstance(obj, _Pairs22):
+            continue
+        i = next((n for n, (k, _) in enumerate(obj) if k == key), None)
+        if op == "delete":
+            if i is not None:
+                del obj[i]
+        elif op == "duplicate" or i is None:
+            obj.append((key, value))
+        else:
+            obj[i] = (key, value)
+    return _json22(top)
+
+
+def _member22(obj, key):
+    if isinstance(obj, _Pairs22):
+        return next((v for k, v in obj if k == key), None)
+    if type(obj) is list and isinstance(key, int) and key < len(obj):
+        return obj[key]
+    return None
+
+
+RIG_OBJECTS22 = {
+    "top": lambda t: t,
+    "light 0": lambda t: _member22(_member22(t, "lights"), 0),
+    "light 1": lambda t: _member22(_member22(t, "lights"), 1),
+    "light 1 position": lambda t: _member22(_member22(_member22(t, "lights"), 1), "position"),
+    "light 1 color": lambda t: _member22(_member22(_member22(t, "lights"), 1), "color"),
+    "light 0 direction": lambda t: _member22(_member22(_member22(t, "lights"), 0), "direction"),
+}
+RIG_KEYS22 = ["format", "version", "lights", "type", "position", "direction", "radius", "length",
+              "color", "intensity", "influence_radius", "name"]
+
+
+def _edits22(objects, keys):
+    """1 to 4 edits, mostly of the format's own keys (an unknown key is refused at once)."""
+    known = st.sampled_from(keys)
+    return st.lists(st.tuples(st.sampled_from(["set", "set", "delete", "duplicate", "element"]),
+                              st.sampled_from(sorted(objects)),
+                              st.one_of(known, known, known, st.text(max_size=6)),
+                              hostile_values22), min_size=1, max_size=4)
+
+
+def _light_context22():
+    """Shading points on the unit sphere seen from the camera, rough to near-mirror."""
+    import numpy as np
+
+    from matedit.shading.lights import makeShadingContext
+
+    d = np.array([[0, 0, 1], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [0, 0, -1],
+                  [0.6, 0.0, 0.8], [0.0, -0.6, 0.8]], float)
+    v = np.array([0.0, 0.0, 4.0]) - d
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    n = len(d)
+    return makeShadingContext(d, d, v, np.full((n, 3), 0.8), np.full((n, 3), 0.04),
+                              np.linspace(0.0, 1.0, n))
+
+
+def _assert_lights_finite22(lights) -> None:
+    """What the renderer does with a rig, without GL: the LightsBlock packs with no numpy
+    warning and holds finite float32s, and each light's radiance (the shading twin) stays
+    far inside float32 at points on the preview sphere."""
+    import warnings
+
+    import numpy as np
+
+    from matedit.shading.lights import evaluateLight
+    from matedit.shading.lights_block import pack_lights
+
+    s = _light_context22()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # an overflow in a cast fails the case
+        block = np.frombuffer(pack_lights(lights), "<f4")
+        assert np.isfinite(block).all()
+        for light in lights:
+            radiance = evaluateLight(s, light)
+            assert np.isfinite(radiance).all() and np.abs(radiance).max() < 1e30, light
+
+
+@HTIMEOUT
+@HSET22
+@given(edits=_edits22(RIG_OBJECTS22, RIG_KEYS22))
+@example(edits=[("set", "light 1", "intensity", _Raw22("1e39"))])
+@example(edits=[("element", "light 1 color", 0, _Raw22("3.4e38"))])
+@example(edits=[("element", "light 1 position", 1, _Raw22("9" * 400))])
+@example(edits=[("set", "light 0", "radius", _Raw22("1e308"))])
+@example(edits=[("duplicate", "light 1", "intensity", 5.0)])
+def test_generated_rigs_load_cleanly_or_light_finitely(edits):
+    """Mutated rigs (wrong types, huge, NaN and infinite numbers, 400-digit integers, deep
+    nesting, duplicate and missing keys, unknown fields, unicode): the loader raises RigError
+    naming the file, or the lights pack and shine finitely. 3 x HOSTILE_EXAMPLES cases."""
+    from matedit.io.rig import RigError
+    from matedit.io.rig import loads as rig_loads
+
+    text = _mutate22(_pairs22(_rig22()), edits, RIG_OBJECTS22)
+    try:
+        lights = rig_loads(text, "rig.json")
+    except RigError as exc:
+        assert str(exc).startswith("rig.json: "), exc
+        event("refused")
+        return
+    event("loaded")
+    _assert_lights_finite22(lights)
+
+
+INSTANCE_OBJECTS22 = {
+    "top": lambda t: t,
+    "parameters": lambda t: _member22(t, "parameters"),
+    "tint": lambda t: _member22(_member22(t, "parameters"), "tint"),
+    "preview": lambda t: _member22(t, "preview"),
+}
+INSTANCE_KEYS22 = ["format", "version", "name", "description", "parent", "parameters",
+                   "parent_parameters", "preview", "rough", "tint", "mesh", "environment"]
+
+
+@HTIMEOUT
+@HSET22
+@given(edits=_edits22(INSTANCE_OBJECTS22, INSTANCE_KEYS22))
+@example(edits=[("set", "parameters", "rough", _Raw22("3.5e38"))])
+@example(edits=[("element", "tint", 2, _Raw22("1e308"))])
+@example(edits=[("set", "parameters", "rough", _Raw22("[" * 100_000 + "]" * 100_000))])
+def test_generated_instances_load_cleanly_or_compile_finite(tmp_path_factory, edits):
+    """Mutated instances of a valid material: loading and resolving raise FormatError or
+    InstanceError naming the instance (or report its parameter errors), or the effective
+    material compiles and its uniform block packs finite float32s with no numpy warning.
+    3 x HOSTILE_EXAMPLES cases."""
+    import struct
+    import warnings
+
+    import numpy as np
+
+    from matedit.compiler import compile_document
+    from matedit.io.document import FileResolver
+    from matedit.io.instance import InstanceError, load_instance, resolve
+
+    tmp = tmp_path_factory.mktemp("inst")
+    write(tmp / "m.json", base_material())
+    base = {"format": "matedit.instance", "version": 2, "name": "i", "parent": "m.json",
+            "parameters": {"rough": 0.3, "tint": [0.5, 0.2, 0.1]}, "preview": {"mesh": "cube"}}
+    path = write(tmp / "i.json", _mutate22(_pairs22(base), edits, INSTANCE_OBJECTS22))
+    try:
+        r = resolve(load_instance(path))
+    except (FormatError, InstanceError) as exc:
+        assert str(exc).startswith(str(path)), exc
+        event("refused")
+        return
+    if r.errors:
+        assert all(p.file == str(path) for p in r.errors), r.errors
+        event("parameter errors")
+        return
+    event("compiled")
+    compiled = compile_document(r.document, FileResolver())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        data = compiled.pack_uniforms()
+        floats = np.frombuffer(data, "<f4")
+        assert np.isfinite(floats).all() and struct.calcsize(f"<{len(floats)}f") == len(data)
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("case", ["rig at the limits", "rig at the limits, reference",
+                                  "rig far away", "instance at float32's edge",
+                                  "rig colour times intensity beyond the limit"])
+def test_a_handful_of_extreme_files_render_finite_pixels(tmp_path, case):
+    """The few renders behind the generated cases: rigs at the stated limits render finite
+    linear pixels with nothing on stderr (no numpy warning), in split sum and reference;
+    an instance at float32's edge renders; a rig past the limit is refused, not rendered."""
+    import warnings
+
+    import numpy as np
+
+    from matedit.io.images import read_image
+
+    good = write(tmp_path / "m.json", base_material())
+    near = {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "sphere", "position": [2, 2, 3], "radius": 1e6, "color": [1, 1, 1],
+         "intensity": 1e12, "influence_radius": 1e6},
+        {"type": "tube", "position": [-1.5, 0, 0], "direction": [0, 1, 0], "radius": 0.04,
+         "length": 1e6, "color": [1e6, 1e6, 1e6], "intensity": 1e6, "influence_radius": 1e6},
+        {"type": "point", "position": [0, 0, 1.001], "intensity": 1e12,
+         "influence_radius": 1e6},
+        {"type": "point", "position": [0, 0, 1.5], "intensity": 1e12,
+         "influence_radius": 1e-6},
+        {"type": "directional", "direction": [0, 0, -1], "color": [1e12, 0, 1],
+         "intensity": 1}]}
+    far = {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "tube", "position": [1e6, -1e6, 1e6], "direction": [1, 1, 0], "radius": 1e6,
+         "length": 1e6, "intensity": 1e12, "influence_radius": 1e6},
+        {"type": "sphere", "position": [-1e6, 1e6, -1e6], "radius": 1e6, "intensity": 1e12,
+         "influence_radius": 1e6}]}
+    beyond = {"format": "matedit.lightrig", "version": 1, "lights": [
+        {"type": "point", "position": [0, 0, 3], "color": [1e7, 1, 1], "intensity": 1e6}]}
+    args: list = ["render", good]
+    if case.startswith("instance"):
+        inst = write(tmp_path / "i.json", {"format": "matedit.instance", "version": 2,
+                                           "parent": "m.json", "parameters": {
+                                               "rough": 3.4e38, "tint": [1e30, 0.5, 0.0]}})
+        args = ["render", inst]
+    else:
+        rig = {"rig far away": far, "rig colour times intensity beyond the limit": beyond
+               }.get(case, near)
+        args += ["--lights", write(tmp_path / "rig.json", rig)]
+    if case.endswith("reference"):
+        args += ["--ibl", "reference", "--samples", "4"]
+    for out in ("x.exr", "x.png"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # a numpy warning would be an internal error
+            rc, _, err = cli(*args, "-o", tmp_path / out, "--size", "16x16")
+        if "beyond" in case:
+            assert_clean_failure(rc, err)
+            assert "light 0, field intensity" in err and "1e+12" in err, err
+            return
+        assert rc == 0 and err == "", err
+    pixels = read_image(tmp_path / "x.exr").pixels
+    if case.startswith("rig"):
+        assert np.isfinite(pixels).all()
+    else:  # a material's own arithmetic may overflow; never to NaN
+        assert not np.isnan(pixels).any()

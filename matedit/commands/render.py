@@ -33,7 +33,8 @@ def register(sub) -> None:
     p.add_argument("--ibl", default="splitsum", choices=["splitsum", "reference", "difference"],
                    help="split-sum approximation, converged importance-sampled reference, "
                    "or a heat map of their difference")
-    p.add_argument("--exposure", type=float, default=None, metavar="EV")
+    p.add_argument("--exposure", type=_exposure, default=None, metavar="EV",
+                   help="exposure in stops, -30 to 30 (default 0)")
     p.add_argument("--lights", default="default", metavar="default|none|RIG.json",
                    help="the built-in light rig, no analytic lights, or a light-rig file "
                    "(format matedit.lightrig)")
@@ -46,6 +47,22 @@ def register(sub) -> None:
                    "\"energy_compensation\": true)")
     declare_inputs(p, file="document", mesh="mesh", env="environment", lights="rig")
     p.set_defaults(run=run)
+
+
+def _exposure(text: str) -> float:
+    """--exposure EV: a finite number of stops within the stated range (settings.py)."""
+    import argparse
+
+    from matedit.render.settings import exposure_problem
+
+    try:
+        ev = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    why = exposure_problem(ev)
+    if why:
+        raise argparse.ArgumentTypeError(why)
+    return ev
 
 
 def _size(text: str) -> tuple[int, int]:

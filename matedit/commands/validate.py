@@ -36,12 +36,11 @@ def empty_folders(files: list[str]) -> list[Path]:
 
 def _format_of(path: Path) -> str | None:
     """The `format` of a small JSON file, cheaply, to pick its reader; None if unknown."""
-    import json
-
     from matedit.io.atomic import read_bounded
+    from matedit.io.jsontext import parse_json
 
     try:
-        raw = json.loads(read_bounded(path, 1 << 20))
+        raw = parse_json(read_bounded(path, 1 << 20))
     except (OSError, ValueError):
         return None
     return raw.get("format") if isinstance(raw, dict) else None

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from enum import Enum
 
+from matedit.graph.numbers import gpu_number_problem
+
 
 class PortType(str, Enum):
     FLOAT = "float"
@@ -83,21 +85,23 @@ def coerce_value(t: PortType, value: object) -> float | list[float]:
     if isinstance(value, bool) or value is None:
         raise ValueError(f"expected a number or {n} numbers, got {value!r}")
     if isinstance(value, (int, float)):
+        _check_gpu_number(value)
         v = float(value)
-        _check_finite(v)
         return v if n == 1 else [v] * n
     if isinstance(value, (list, tuple)):
         if len(value) != n or not all(
             isinstance(x, (int, float)) and not isinstance(x, bool) for x in value
         ):
             raise ValueError(f"expected {n} numbers for {t}, got {value!r}")
+        for x in value:
+            _check_gpu_number(x)
         vals = [float(x) for x in value]
-        for v in vals:
-            _check_finite(v)
         return vals[0] if n == 1 else vals
     raise ValueError(f"expected a number or {n} numbers, got {type(value).__name__}")
 
 
-def _check_finite(v: float) -> None:
-    if v != v or v in (float("inf"), float("-inf")):
-        raise ValueError(f"value {v} is not finite")
+def _check_gpu_number(v: int | float) -> None:
+    """Refuse what a float32 uniform cannot hold (matedit.graph.numbers, the one rule)."""
+    why = gpu_number_problem(v)
+    if why:
+        raise ValueError(why)

@@ -18,6 +18,7 @@ import networkx as nx
 from matedit.graph import nodes
 from matedit.graph.model import Link, MaterialDocument
 from matedit.graph.names import identifier_problem
+from matedit.graph.numbers import gpu_number_problem
 from matedit.graph.ports import (
     FunctionResolver,
     NodePorts,
@@ -119,6 +120,11 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
         if node.kind not in nodes.REGISTRY:
             diags.append(error(f"unknown node kind {node.kind!r}", nid, "kind", f))
             continue
+        for s in nodes.REGISTRY[node.kind].settings:  # ranges, curves: the float32 rule
+            if s.kind == "number" and s.name in node.settings:
+                why = gpu_number_problem(node.settings[s.name])
+                if why:
+                    diags.append(error(why, nid, s.name, f))
         try:
             ports[nid] = node_ports(node, resolver, doc)
         except PortError as exc:
@@ -210,6 +216,11 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
                     coerce_value(t, node.values[spec.name])
                 except ValueError as exc:
                     diags.append(error(str(exc), nid, spec.name, f))
+            elif t is not None and t.is_numeric:  # a function file's default becomes a uniform
+                why = _default_number_problem(spec.default)
+                if why:
+                    diags.append(error(f"the default of input {spec.name!r}: {why}", nid,
+                                       spec.name, f))
         d = nodes.REGISTRY[node.kind]
         for vf in d.values:
             if vf.name in node.values:
@@ -299,6 +310,17 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                                    n.id, "name", f))
             params[name] = n.id
     return diags
+
+
+def _default_number_problem(default) -> str | None:
+    """The float32 rule for the numbers of a port's default (a function file's input)."""
+    values = default if isinstance(default, (list, tuple)) else [default]
+    for x in values:
+        if isinstance(x, (int, float)) and not isinstance(x, bool):
+            why = gpu_number_problem(x)
+            if why:
+                return why
+    return None
 
 
 def _check_input_default(n, f) -> list[Diagnostic]:

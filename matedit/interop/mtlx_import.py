@@ -16,7 +16,6 @@ must be relative and stay text in the document (they are never read here).
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +24,7 @@ from typing import Any
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.names import identifier_problem, mangle
 from matedit.graph.nodes import Role, definition, kind_for
+from matedit.graph.numbers import gpu_number_problem
 from matedit.interop import mtlx_map
 from matedit.interop.mtlx_colorspace import from_materialx
 from matedit.io.atomic import read_bounded
@@ -89,12 +89,26 @@ class Src:
 
 
 def _floats(text: str, where: str) -> list[float]:
+    """The numbers of a MaterialX value string, each under the float32 rule every format
+    follows (matedit.graph.numbers); ValueError naming `where` (node and input) otherwise."""
     try:
         vals = [float(x) for x in text.split(",")] if text.strip() else []
     except ValueError:
         raise ValueError(f"{where}: value {text[:40]!r} is not a number list") from None
-    if not all(math.isfinite(v) for v in vals):
-        raise ValueError(f"{where}: value {text[:40]!r} is not finite")
+    for v in vals:
+        why = gpu_number_problem(v)
+        if why:
+            raise ValueError(f"{where}: {why} (in {text[:40]!r})")
+    return vals
+
+
+def _computed(vals: list[float], where: str) -> list[float]:
+    """Constants the importer folds (a colour times its weight): the same rule, so a product
+    of two representable numbers that overflows is an error, not an infinity in the file."""
+    for v in vals:
+        why = gpu_number_problem(v)
+        if why:
+            raise ValueError(f"{where}: the folded {why}")
     return vals
 
 
@@ -222,7 +236,8 @@ class _Importer:
                      "values are supported")
             return None
         try:
-            vals = _floats(gin.getValueString(), f"interface input {gin.getName()}")
+            vals = _floats(gin.getValueString(), f"node {self.name_of(gin.getParent())}: "
+                           f"interface input {gin.getName()}")
         except ValueError as exc:
             self.err(str(exc))
             return None
@@ -287,10 +302,8 @@ class _Importer:
             self._defaults(node, nid, ports)
             return Src(nid, definition(kind).outputs[0].name, width=width)
         if cat == "extract":
-            idx_in = node.getInput("index")
-            idx = int(_floats(idx_in.getValueString(), where)[0]) if idx_in is not None else 0
-            if not 0 <= idx <= 3:
-                self.err(f"{where}: extract index {idx} out of range")
+            idx = self.index(node, where)
+            if idx is None:
                 return None
             nid = self.add(name, kind_for(Role.COMPONENT_MASK), {"channels": "xyzw"[idx]},
                            depth=depth)
@@ -332,7 +345,8 @@ class _Importer:
                                depth=depth)
                 self.connect(s, nid, "value")
                 return Src(nid, "result", width=width)
-            self.err(f"{where}: convert {inp.getType()} to {t} is not supported")
+            self.err(f"{where}: convert {inp.getType() if inp is not None else 'float'} to "
+                     f"{t} is not supported")
             return None
         if cat == "texcoord":
             idx_in = node.getInput("index")
@@ -377,6 +391,23 @@ class _Importer:
             return self.image(node, depth, where, width)
         self.err(f"{where}: unsupported MaterialX node {cat!r} (type {t})")
         return None
+
+    def index(self, node, where: str) -> int | None:
+        """extract's index: an integer 0 to 3 given as a value (None after an error)."""
+        idx_in = node.getInput("index")
+        if idx_in is None:
+            return 0
+        text = idx_in.getValueString()
+        iw = f"{where}: input index"
+        try:
+            vals = _floats(text, iw)
+        except ValueError as exc:
+            self.err(str(exc))
+            return None
+        if len(vals) != 1 or not vals[0].is_integer() or not 0 <= vals[0] <= 3:
+            self.err(f"{iw}: must be an integer 0 to 3 given as a value, got {text[:40]!r}")
+            return None
+        return int(vals[0])
 
     def _defaults(self, node, nid: str, ports: dict[str, str]) -> None:
         """Unset MaterialX inputs take the node definition's defaults, not ours."""
@@ -502,8 +533,13 @@ class _Importer:
                 if w is None:
                     w = Src(value=[1.0], width=1)
                 if w.node is None and src.node is None:
-                    src = Src(value=[v * w.value[0] * factor for v in src.value],
-                              width=src.width)
+                    try:
+                        src = Src(value=_computed([v * w.value[0] * factor for v in src.value],
+                                                  f"node {self.name_of(shader)}: inputs {inp} "
+                                                  f"and {scale}"), width=src.width)
+                    except ValueError as exc:
+                        self.err(str(exc))
+                        continue
                 elif not (w.node is None and w.value[0] * factor == 1.0):
                     mul = self.add(f"{attr}_weight", _kind("multiply"))
                     self.connect(src, mul, "a")
@@ -545,15 +581,27 @@ class _Importer:
             if up.getInput(extra) is not None:
                 self.err(f"{where}: a normalmap with its own {extra} input is not supported")
         sc = up.getInput("scale")
-        if sc is not None and (sc.getNodeName() or sc.getInterfaceName()
-                               or _floats(sc.getValueString() or "1", where) != [1.0]):
-            self.err(f"{where}: normalmap scale other than 1 is not supported")
+        if sc is not None:
+            try:
+                ones = not (sc.getNodeName() or sc.getInterfaceName()) and all(
+                    v == 1.0 for v in _floats(sc.getValueString() or "1",
+                                              f"{where}: input scale"))
+            except ValueError as exc:
+                self.err(str(exc))
+            else:
+                if not ones:
+                    self.err(f"{where}: input scale: normalmap scale other than 1 is not "
+                             "supported")
         enc = self.input_src(up, "in", 1)
         if enc is None:
             return
         if enc.node is None:
-            self.connect(Src(value=[v * 2.0 - 1.0 for v in enc.value], width=3), make,
-                         "normal")
+            try:
+                decoded = _computed([v * 2.0 - 1.0 for v in enc.value], f"{where}: input in")
+            except ValueError as exc:
+                self.err(str(exc))
+                return
+            self.connect(Src(value=decoded, width=3), make, "normal")
             return
         two = self.add(f"{up.getName()}_x2", _kind("multiply"), values={"b": [2.0, 2.0, 2.0]})
         self.connect(enc, two, "a")

@@ -17,6 +17,7 @@ from typing import Any
 from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.nodes import Role, role_of
 from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
+from matedit.io.jsontext import JSONTextError, check_json_value, parse_json
 from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
 
 FORMATS = {"matedit.material": DocumentKind.MATERIAL, "matedit.function": DocumentKind.FUNCTION}
@@ -39,23 +40,6 @@ class FormatError(ValueError):
         super().__init__(f"{file or '<document>'}: {loc}{message}")
 
 
-def _no_constants(name: str) -> Any:
-    raise ValueError(f"{name} is not valid JSON")
-
-
-class _DuplicateKey(ValueError):
-    pass
-
-
-def _object(pairs: list[tuple[str, Any]]) -> dict:
-    out: dict[str, Any] = {}
-    for k, v in pairs:
-        if k in out:
-            raise _DuplicateKey(k)
-        out[k] = v
-    return out
-
-
 def _where(raw: Any, path: list) -> tuple[str | None, str]:
     """(node id, field) for a position inside the raw document, for error messages."""
     node, rest = None, path
@@ -72,42 +56,30 @@ def _where(raw: Any, path: list) -> tuple[str | None, str]:
     return node, "".join(parts) or "<top>"
 
 
+def _located(exc: JSONTextError, file: str | None) -> FormatError:
+    """A FormatError naming the node and field where `parse_json`'s rules failed."""
+    if exc.path and exc.value is not None:
+        node, fld = _where(exc.value, exc.path)
+        return FormatError(file, exc.reason, node, fld)
+    return FormatError(file, exc.reason, field=exc.field)
+
+
 def _check_numbers(raw: Any, file: str | None) -> None:
-    """Every number must fit a 64-bit float (1e400 parses to infinity and cannot be saved)."""
-    stack: list[tuple[Any, list]] = [(raw, [])]
-    while stack:
-        value, path = stack.pop()
-        bad = None
-        if isinstance(value, float):
-            if value != value or value in (float("inf"), float("-inf")):
-                bad = "number is too large for a 64-bit float"
-        elif isinstance(value, int) and not isinstance(value, bool):
-            if abs(value) > 2**1023:
-                bad = "integer is too large for a 64-bit float"
-        elif isinstance(value, dict):
-            stack.extend((v, [*path, k]) for k, v in value.items())
-        elif isinstance(value, list):
-            stack.extend((v, [*path, i]) for i, v in enumerate(value))
-        if bad:
-            node, fld = _where(raw, path)
-            raise FormatError(file, bad, node, fld)
+    """Depth and 64-bit numbers of a dict from elsewhere (matedit.io.jsontext's rules)."""
+    try:
+        check_json_value(raw)
+    except JSONTextError as exc:
+        raise _located(exc, file) from None
 
 
 def parse_json_text(text: str, file: str | None = None) -> Any:
-    """The JSON value of a document's text: no BOM, no duplicate keys, no NaN/infinity,
-    every number a 64-bit float (shared by materials, functions and instances)."""
-    if text.startswith("\ufeff"):
-        raise FormatError(file, "starts with a UTF-8 byte-order mark; save the file as UTF-8 "
-                          "without a BOM")
+    """The JSON value of a document's text (matedit.io.jsontext.parse_json: no BOM, no
+    duplicate keys, no NaN/infinity, bounded nesting, every number a 64-bit float), shared by
+    materials, functions and instances; raises FormatError naming the node and field."""
     try:
-        raw = json.loads(text, parse_constant=_no_constants, object_pairs_hook=_object)
-    except _DuplicateKey as exc:
-        raise FormatError(file, f"key {exc.args[0]!r} appears twice in one JSON object",
-                          field=str(exc.args[0])) from None
-    except (ValueError, RecursionError) as exc:
-        raise FormatError(file, f"not valid JSON: {exc}") from None
-    _check_numbers(raw, file)
-    return raw
+        return parse_json(text)
+    except JSONTextError as exc:
+        raise _located(exc, file) from None
 
 
 def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:

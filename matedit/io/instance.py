@@ -38,6 +38,7 @@ from typing import Any
 from matedit.graph.model import MaterialDocument
 from matedit.graph.names import identifier_problem
 from matedit.graph.nodes import REGISTRY
+from matedit.graph.numbers import describe_number, gpu_number_problem, gpu_numbers_problem
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import (
     FormatError,
@@ -46,6 +47,7 @@ from matedit.io.document import (
     read_document_text,
     rebase_references,
 )
+from matedit.io.jsontext import JSONTextError, parse_json
 from matedit.io.migrations import CURRENT_VERSION
 
 FORMAT = "matedit.instance"
@@ -164,9 +166,9 @@ MIGRATIONS = {1: _v1_to_v2}
 def is_instance_text(text: str) -> bool:
     """True when `text` is JSON whose top level says "format": "matedit.instance"."""
     try:
-        raw = json.loads(text)
-    except (ValueError, RecursionError):
-        return False
+        raw = parse_json(text)
+    except JSONTextError:
+        return False  # the material reader reports why
     return isinstance(raw, dict) and raw.get("format") == FORMAT
 
 
@@ -371,11 +373,15 @@ def _num(x: Any) -> bool:
 def value_problem(t: str, value: Any) -> str | None:
     """Why `value` cannot be a parameter of type `t` (None when it can)."""
     if t == "scalar":
-        return None if _num(value) else f"a scalar parameter takes a number, got {value!r}"
+        if not _num(value):
+            return f"a scalar parameter takes a number, got {describe_number(value)}"
+        return gpu_number_problem(value)  # the float32 rule every format shares
     if t in ("vector", "color"):
         n = 4 if t == "vector" else 3
         ok = isinstance(value, list) and len(value) == n and all(_num(x) for x in value)
-        return None if ok else f"a {t} parameter takes a list of {n} numbers, got {value!r}"
+        if not ok:
+            return f"a {t} parameter takes a list of {n} numbers, got {describe_number(value)}"
+        return gpu_numbers_problem(value, n)
     if t == "texture":
         ok = isinstance(value, str) and "\0" not in value and len(value) < 4096
         return None if ok else f"a texture parameter takes a file path, got {value!r}"

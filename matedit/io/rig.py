@@ -24,6 +24,12 @@ intensity of point, sphere and tube lights (radiance scale times the inverse-squ
 falloff, SHADING.md eq 9), the irradiance of a directional light; ``influence_radius``
 metres (> 0, the falloff window's R). Omitted fields take the defaults below. At most 16
 lights (the shader's block). Unknown fields are errors (a typo must not pass silently).
+
+Numbers follow the rule of every format (finite, within float32: matedit.graph.numbers) and
+stated limits that keep the shader's squares and products finite: positions, radii, lengths
+and influence radii within 1e6 m (an influence radius at least 1e-6 m), and intensity times
+the brightest colour component at most 1e12. The text follows the JSON rules of documents
+(matedit.io.jsontext): no key twice in an object, at most 64 levels of nesting.
 """
 
 from __future__ import annotations
@@ -33,13 +39,21 @@ import math
 import os
 from pathlib import Path
 
+from matedit.graph.numbers import FLOAT32_MAX, describe_number, gpu_number_problem
 from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
+from matedit.io.jsontext import JSONTextError, parse_json
 from matedit.shading.lights import LIGHT_TYPES, Light
 
 FORMAT = "matedit.lightrig"
 VERSION = 1
 MAX_RIG_BYTES = 1 << 20
 MAX_LIGHTS = 16
+# Stated limits, well inside float32, so that what the shader squares and multiplies stays
+# finite: lengths (positions, radii, tube lengths, influence radii) in metres, and a light's
+# radiance scale (intensity times its brightest colour component).
+MAX_EXTENT = 1e6
+MIN_INFLUENCE_RADIUS = 1e-6
+MAX_LEVEL = 1e12
 FIELDS = ("type", "position", "direction", "radius", "length", "color", "intensity",
           "influence_radius", "name")
 
@@ -59,22 +73,28 @@ class RigError(ValueError):
         super().__init__(f"{file or '<rig>'}: {loc}{message}")
 
 
-def _finite(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-
-
-def _vec3(raw, file, i, name) -> tuple[float, float, float]:
-    if not (isinstance(raw, list) and len(raw) == 3 and all(_finite(v) for v in raw)):
-        raise RigError(file, "must be a list of 3 finite numbers", i, name)
-    return tuple(float(v) for v in raw)
-
-
-def _scalar(raw, file, i, name, *, positive=False) -> float:
-    if not _finite(raw):
-        raise RigError(file, "must be a finite number", i, name)
-    if raw < 0 or (positive and raw == 0):
-        raise RigError(file, "must be > 0" if positive else "must be >= 0", i, name)
+def _number(raw, file, i, name, limit: float) -> float:
+    """A field under the float32 rule (matedit.graph.numbers) and the rig's stated limit."""
+    why = gpu_number_problem(raw)
+    if why is None and abs(raw) > limit:
+        why = f"value {describe_number(raw)} is beyond the limit of {limit:g}"
+    if why:
+        raise RigError(file, why, i, name)
     return float(raw)
+
+
+def _vec3(raw, file, i, name, limit: float = MAX_EXTENT) -> tuple[float, float, float]:
+    if not (isinstance(raw, list) and len(raw) == 3):
+        raise RigError(file, "must be a list of 3 finite numbers", i, name)
+    return tuple(_number(v, file, i, name, limit) for v in raw)
+
+
+def _scalar(raw, file, i, name, *, positive=False, limit: float = MAX_EXTENT) -> float:
+    value = _number(raw, file, i, name, limit)
+    if value < 0 or (positive and value < MIN_INFLUENCE_RADIUS):
+        raise RigError(file, f"must be >= {MIN_INFLUENCE_RADIUS:g}" if positive
+                       else "must be >= 0", i, name)
+    return value
 
 
 def light_from_dict(raw, file: str | None = None, index: int = 0) -> Light:
@@ -90,22 +110,28 @@ def light_from_dict(raw, file: str | None = None, index: int = 0) -> Light:
     d = Light(kind)
     position = _vec3(raw.get("position", list(d.position)), file, index, "position")
     direction = _vec3(raw.get("direction", [0.0, 1.0, 0.0] if kind == "tube"
-                              else list(d.direction)), file, index, "direction")
+                              else list(d.direction)), file, index, "direction", FLOAT32_MAX)
     n = math.sqrt(sum(v * v for v in direction))
     if n < 1e-9:
         raise RigError(file, "must not be the zero vector", index, "direction")
-    color = _vec3(raw.get("color", list(d.color)), file, index, "color")
+    color = _vec3(raw.get("color", list(d.color)), file, index, "color", MAX_LEVEL)
     if min(color) < 0:
         raise RigError(file, "components must be >= 0", index, "color")
     radius = _scalar(raw.get("radius", 0.0), file, index, "radius")
     length = _scalar(raw.get("length", 0.0), file, index, "length")
+    intensity = _scalar(raw.get("intensity", d.intensity), file, index, "intensity",
+                        limit=MAX_LEVEL)
+    if intensity * max(color) > MAX_LEVEL:  # the light's radiance scale, colour times intensity
+        raise RigError(file, f"intensity {intensity:g} times its brightest colour component "
+                       f"{max(color):g} is {intensity * max(color):.3g}; at most {MAX_LEVEL:g}",
+                       index, "intensity")
+    influence = _scalar(raw.get("influence_radius", d.influence_radius), file, index,
+                        "influence_radius", positive=True)
     if "name" in raw and not isinstance(raw["name"], str):
         raise RigError(file, "must be a string", index, "name")
     return Light(kind=kind, position=position,
                  direction=tuple(v / n for v in direction), color=color,
-                 intensity=_scalar(raw.get("intensity", d.intensity), file, index, "intensity"),
-                 influence_radius=_scalar(raw.get("influence_radius", d.influence_radius),
-                                          file, index, "influence_radius", positive=True),
+                 intensity=intensity, influence_radius=influence,
                  source_radius=radius if kind in ("sphere", "tube") else 0.0,
                  source_length=length if kind == "tube" else 0.0)
 
@@ -135,15 +161,20 @@ def rig_from_dict(raw, file: str | None = None) -> list[Light]:
     return [light_from_dict(x, file, i) for i, x in enumerate(lights)]
 
 
-def _no_constants(name: str):
-    raise ValueError(f"{name} is not valid JSON")
-
-
-def loads(text: str, file: str | None = None) -> list[Light]:
+def loads(text: str | bytes, file: str | None = None) -> list[Light]:
+    """A rig from its text under the JSON rules every document follows (matedit.io.jsontext:
+    no duplicate keys, bounded nesting, 64-bit numbers); raises RigError."""
     try:
-        raw = json.loads(text, parse_constant=_no_constants)
-    except (ValueError, RecursionError) as exc:
-        raise RigError(file, f"not valid JSON: {exc}") from None
+        raw = parse_json(text)
+    except JSONTextError as exc:
+        light = exc.path[1] if len(exc.path) >= 2 and exc.path[0] == "lights" and \
+            isinstance(exc.path[1], int) else None
+        fld = exc.field
+        if light is not None and len(exc.path) >= 3:
+            fld = str(exc.path[2])
+        elif exc.path and light is None:
+            fld = str(exc.path[0])
+        raise RigError(file, exc.reason, light, fld) from None
     return rig_from_dict(raw, file)
 
 
@@ -160,11 +191,7 @@ def load(path: str | os.PathLike) -> list[Light]:
         raise RigError(name, str(exc).split(": ", 1)[-1]) from None
     except OSError as exc:
         raise RigError(name, f"cannot read: {exc.strerror or exc}") from None
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise RigError(name, "not UTF-8 text") from None
-    return loads(text, name)
+    return loads(data, name)
 
 
 def light_to_dict(light: Light) -> dict:

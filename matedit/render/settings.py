@@ -3,11 +3,29 @@ sets between frames, needing no GL work (the Renderer holds them; the scene pass
 
 from __future__ import annotations
 
+import math
+
 from matedit.render.camera import OrbitCamera
 from matedit.render.lights import default_rig
 from matedit.shading.lights import Light
 
 MODES = ("splitsum", "reference", "difference")
+# 0 EV: the scene's radiance as it is, what the editor's viewport starts at and what
+# `matedit render` applies without --exposure (docs/cli.md).
+DEFAULT_EXPOSURE_EV = 0.0
+# Exposures beyond +-30 EV (a factor of about 1e9) are no use for a preview and bring the
+# display pass near float32's limits; `render --exposure` refuses them.
+EXPOSURE_LIMIT_EV = 30.0
+
+
+def exposure_problem(ev: float) -> str | None:
+    """Why `ev` cannot be an exposure (None when it can): NaN, infinite or beyond +-30 EV."""
+    if not math.isfinite(ev):
+        return f"exposure must be a finite number of stops, got {ev!r}"
+    if abs(ev) > EXPOSURE_LIMIT_EV:
+        return (f"exposure must be within -{EXPOSURE_LIMIT_EV:g}..{EXPOSURE_LIMIT_EV:g} EV, "
+                f"got {ev:g}")
+    return None
 
 
 class PreviewSettings:
@@ -15,7 +33,7 @@ class PreviewSettings:
         self.camera = OrbitCamera()
         self.lights: list[Light] = default_rig()  # change through Renderer.set_lights
         self.mode = "splitsum"  # one of MODES
-        self.exposure = -0.5  # EV, applied by the display pass
+        self.exposure = DEFAULT_EXPOSURE_EV  # EV, applied by the display pass
         self.time = 0.0  # seconds, FrameBlock params.x
         self.show_background = True
         self.background_blur = 0.0  # 0 (sharp) to 1 (the roughest prefiltered mip)

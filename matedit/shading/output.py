@@ -12,7 +12,7 @@ def applyExposure(color, exposureEV) -> np.ndarray:
 
 
 def tonemapACES(x) -> np.ndarray:
-    x = np.maximum(f64(x), 0.0)
+    x = np.minimum(np.maximum(f64(x), 0.0), 1e4)  # as output.glsl: no change below 1e4
     return saturate((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14))
 
 
