@@ -607,7 +607,8 @@ def test_hostile_recovery_entry_is_named_in_one_message(recovery_folder):
     assert len(problems) == len(HOSTILE_RECOVERY)
     assert all(p.startswith(f"bad{i:02d}.json: ") for i, p in enumerate(problems))
     line = recovery.skipped_message(problems)
-    assert line.startswith(f"skipped {len(HOSTILE_RECOVERY)} damaged recovery files: ")
+    assert line == (f"skipped {len(HOSTILE_RECOVERY)} damaged recovery files: {problems[0]}; "
+                    f"{problems[1]}; and {len(HOSTILE_RECOVERY) - 2} more")
 
 
 def test_the_liveness_check_takes_any_pid():
@@ -622,7 +623,7 @@ def test_the_liveness_check_takes_any_pid():
 @GUI_TIMEOUT
 @pytest.mark.gui
 @pytest.mark.usefixtures("app_env")
-def test_launch_with_hostile_recovery_entries_offers_the_good_ones(qtbot):
+def test_launch_with_hostile_recovery_entries_offers_the_good_ones(qtbot, capfd):
     """The real editor window at launch: every hostile class at once beside two crashed
     editors' real autosaves; the launch neither fails nor hangs, the damaged entries are
     named once in the status bar and on stderr, and the good work is recovered."""
@@ -660,6 +661,8 @@ def test_launch_with_hostile_recovery_entries_offers_the_good_ones(qtbot):
     assert len(w.actions.skipped_recoveries) == len(HOSTILE_RECOVERY)
     qtbot.waitUntil(lambda: "damaged recovery file" in w.statusBar().currentMessage(),
                     timeout=5000)
+    err = capfd.readouterr().err
+    assert all(f"bad{i:02d}.json: " in err for i in range(len(HOSTILE_RECOVERY)))
     assert w.shown_errors == []  # a status line, not a modal box
     # shown once: the next launch finds nothing to complain about
     w2 = test_app_support.make_window(qtbot, answers={"recover_all": lambda es: {}})

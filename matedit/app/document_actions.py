@@ -251,13 +251,17 @@ class DocumentActions(QObject):
     def start(self, path: str | os.PathLike | None, fallback: Path | None) -> None:
         """At start-up: open `path` (or the fallback sample), and offer every recovery file
         that an editor which did not close cleanly left behind, `path`'s among them."""
-        entries, skipped = scan_recoveries(
-            skip={a.recovery_file() for a in list(DocumentActions._live)
-                  if a is not self and shiboken6.isValid(a)})
+        try:
+            entries, skipped = scan_recoveries(
+                skip={a.recovery_file() for a in list(DocumentActions._live)
+                      if a is not self and shiboken6.isValid(a)})
+        except Exception as exc:  # noqa: BLE001 - the launch never fails for a recovery file
+            entries, skipped = [], [f"the recovery folder cannot be read ({exc})"]
         self.skipped_recoveries = skipped
-        if skipped:  # in the status bar and on stderr, once: the entries are set aside
+        if skipped:  # once, as the entries are set aside: every one on stderr, the status bar
+            for line in skipped:
+                print(f"matedit: skipped a damaged recovery file: {line}", file=sys.stderr)
             text = skipped_message(skipped)
-            print(f"matedit: {text}", file=sys.stderr)
             QTimer.singleShot(0, self, lambda: self.message.emit(text))
         decisions = self.ask_recover_all(entries) if entries else {}
         chosen: list[tuple[RecoveryEntry, MaterialDocument]] = []

@@ -282,11 +282,15 @@ def find_recoveries(skip: set[Path] = frozenset()) -> list[RecoveryEntry]:
     return scan_recoveries(skip)[0]
 
 
-def skipped_message(problems: list[str]) -> str:
-    """One status line for every recovery entry skipped at start-up."""
+def skipped_message(problems: list[str], shown: int = 2) -> str:
+    """One status line for the recovery entries skipped at start-up: the first `shown`
+    with their reasons, then how many more ("" when none was skipped)."""
     n = len(problems)
-    head = (f"skipped {n} damaged recovery file{'s' if n != 1 else ''}" if n else "")
-    return f"{head}: " + "; ".join(problems) if n else ""
+    if not n:
+        return ""
+    head = f"skipped {n} damaged recovery file{'s' if n != 1 else ''}"
+    text = f"{head}: " + "; ".join(problems[:shown])
+    return text + (f"; and {n - shown} more" if n > shown else "")
 
 
 class RecoveryDialog(QDialog):

@@ -222,8 +222,8 @@ def load(path: Path, schema: dict[str, Spec],
         return read_entry(path, schema)
     except FileNotFoundError:
         return None
-    except BadCacheEntry as exc:
-        discard(path)
+    except Exception as exc:  # noqa: BLE001 - BadCacheEntry, or whatever else a file does:
+        discard(path)  # the entry can always be baked again
         if problems is not None:
             problems.append(f"{path}: discarded a damaged IBL cache entry ({exc}); baked again")
         return None
@@ -231,14 +231,11 @@ def load(path: Path, schema: dict[str, Spec],
 
 def save(path: Path, arrays: dict[str, np.ndarray]) -> None:
     """Write arrays, the format version and their checksum to `path` atomically (temporary
-    file in the same folder, then rename); a link planted at `path` is replaced, never
-    written through."""
+    file in the same folder, then rename)."""
     arrays = {k: _c_order(v) for k, v in arrays.items()}
     _full_schema({k: Spec((), "U") for k in arrays})  # the cache's own names are not taken
     full = {**arrays, VERSION_NAME: np.array(CACHE_FORMAT, dtype="<i8"),
             CHECKSUM_NAME: np.array(checksum(arrays))}
     buf = io.BytesIO()
     np.savez(buf, **full)
-    if os.path.islink(path):
-        os.unlink(path)
     atomic_write_bytes(path, buf.getvalue())
