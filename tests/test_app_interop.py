@@ -160,3 +160,57 @@ def test_editor_import_of_several_materials_asks_which(qtbot, tmp_path, monkeypa
     assert doc.path == tmp_path / "blue.json"
     (surface,) = [n for n in doc.graph.nodes.values() if n.kind == "make_attributes"]
     assert surface.values["baseColor"] == pytest.approx(list(MATERIALS["blue"]))
+
+
+def _one_material_mtlx(name: str) -> str:
+    return ('<?xml version="1.0"?>\n<materialx version="1.39">'
+            f'<standard_surface name="S" type="surfaceshader"><input name="base_color" '
+            'type="color3" value="0.2, 0.4, 0.8"/></standard_surface>'
+            f'<surfacematerial name="{name}" type="material"><input name="surfaceshader" '
+            'type="surfaceshader" nodename="S"/></surfacematerial></materialx>\n')
+
+
+def test_editor_import_proposes_a_new_name_and_never_replaces_the_open_document(
+        qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QFileDialog
+
+    from matedit.app import file_dialogs
+    from matedit.app.document_actions import new_material
+    from matedit.graph.commands import SetLabel
+    from matedit.io.document import save
+
+    doc = new_material()
+    doc.name = "tile"
+    save(doc, tmp_path / "tile.json")
+    mine = tmp_path / "tile.json"
+    before = mine.read_bytes()
+    (tmp_path / "tile_2.json").write_text("{}")  # taken too: the proposal skips it
+    src = tmp_path / "tile.mtlx"
+    src.write_text(_one_material_mtlx("tile"))  # its material's name is the open file's
+    w = make_window(qtbot, mine)
+    assert w.controller.push(SetLabel("out", "unsaved edit"))
+
+    asked = []
+    monkeypatch.setattr(file_dialogs, "save_file",
+                        lambda parent, caption, directory, filter: (asked.append(directory)
+                                                                    or answer[0], ""))
+    answer = [str(mine)]  # the artist picks the open document's own file anyway
+    assert not w.interop.import_mtlx(src)
+    assert asked == [str(tmp_path / "tile_3.json")]  # a new name, in the document's folder
+    assert w.shown_errors and "open in the editor" in w.shown_errors[-1][1]
+    assert "tile.json" in w.shown_errors[-1][1]
+    assert mine.read_bytes() == before  # never replaced
+    assert w.controller.document.path == mine and w.controller.dirty
+    assert w.controller.document.graph.nodes["out"].label == "unsaved edit"
+    # Asked without a dialog, the same refusal.
+    assert not w.interop.import_mtlx(src, mine)
+    assert mine.read_bytes() == before and w.controller.dirty
+
+    # An existing file other than the open document: the save dialog asks before replacing.
+    dlg = file_dialogs.make_dialog(None, "save", str(tmp_path), mode="save")
+    assert not dlg.testOption(QFileDialog.Option.DontConfirmOverwrite)
+    dlg.deleteLater()
+    answer[0] = asked[0]  # the proposal, taken
+    assert w.interop.import_mtlx(src), w.interop.last_message
+    assert w.controller.document.path == tmp_path / "tile_3.json"
+    assert mine.read_bytes() == before

@@ -146,3 +146,89 @@ def test_render_settings_are_a_typed_record_applied_to_the_renderer(window, qtbo
     box.setChecked(True)
     assert view.settings.show_background and r.show_background
     assert view.settings.environment_intensity == 0.5  # the other fields kept
+
+
+# --- the last good shader belongs to the document (issue 22) ---------------------------------
+
+def _never_compiles(path):
+    """A material that loads but does not compile: a number wired into the output."""
+    from matedit.app.document_actions import new_material
+    from matedit.graph.model import Node
+    from matedit.io.document import save
+
+    doc = new_material()
+    doc.name = "Broken wiring"
+    doc.graph.nodes["c"] = Node("c", "constant", (0.0, 0.0), {}, {"value": 0.5})
+    doc.graph.links.add(Link("c", "value", "out", "attributes"))
+    save(doc, path)
+    return path
+
+
+def _centre(img: np.ndarray) -> np.ndarray:
+    h, w, _ = img.shape
+    return img[h // 2 - 5: h // 2 + 5, w // 2 - 5: w // 2 + 5].mean(axis=(0, 1))
+
+
+def test_a_material_that_never_compiled_shows_no_other_documents_shader(window, qtbot,
+                                                                        tmp_path):
+    view = window.viewport.view
+    good = frame(qtbot, view)
+    assert _centre(good).max() > 0.1 and window.viewport.shows_material()
+    assert window.compiler.last_good is not None
+
+    broken = _never_compiles(tmp_path / "broken.json")
+    assert window.actions.open(broken)
+    settle(qtbot, window)
+    assert window.controller.document.path == broken  # the file asked for is open
+    assert window.compiler.current is None and window.compiler.last_good is None
+    # What is drawn: no material program at all, and a notice saying why.
+    assert not view.renderer.has_material and not window.viewport.shows_material()
+    shown = frame(qtbot, view)
+    assert np.abs(_centre(shown) - _centre(good)).max() > 0.05, "the old sphere is still drawn"
+    notice = window.viewport.failure_message
+    assert notice.startswith("This material does not compile")
+    assert "cannot connect float to MaterialAttributes" in notice
+    assert window.viewport.failure.isVisible()
+    # The GLSL panel shows no other document's code, and says so; Diagnostics list the error.
+    code = window.code.text.toPlainText()
+    assert "does not compile" in window.code.info.text()
+    assert "void main" not in code and "cannot connect float" in code
+    assert any(p.severity == "error" and p.node_id == "out" for p in window.diagnostics.problems)
+    assert "nothing to show" in window.compile_label.text()
+
+    # Fixing it in place draws it, and the notice goes.
+    from matedit.graph.commands import Disconnect
+
+    assert window.controller.push(Disconnect(Link("c", "value", "out", "attributes")))
+    settle(qtbot, window)
+    assert window.compiler.current is not None
+    assert view.renderer.has_material and window.viewport.shows_material()
+    assert window.viewport.failure_message == ""
+
+
+def test_a_new_document_whose_glsl_fails_to_link_draws_nothing_of_the_last(window, qtbot):
+    view = window.viewport.view
+    frame(qtbot, view)
+    cm = copy.copy(window.compiler.current)
+    broken = "#version 330 core\nvoid main() { this is not glsl; }\n"
+
+    class Broken(type(cm)):
+        fragment_text = property(lambda self: broken)
+
+        def variant(self, entry, defines=()):
+            return self
+
+    cm.__class__ = Broken
+    cm.structure_hash = "broken-new-document"
+    window.actions.ask_save_changes = lambda _n: "discard"
+    # The new document's first program is the broken one: the panel sees no other compile.
+    window.compiler.compiled.disconnect(window.viewport.on_compiled)
+    try:
+        assert window.actions.new()
+        settle(qtbot, window)
+        window.viewport.on_compiled(cm)  # and it fails in the driver
+    finally:
+        window.compiler.compiled.connect(window.viewport.on_compiled)
+    assert not view.renderer.has_material and not window.viewport.shows_material()
+    assert window.viewport.failure_message.startswith("This material's GLSL does not build")
+    assert any(p.source == "GL" for p in window.diagnostics.problems)

@@ -1629,3 +1629,370 @@ def test_a_handful_of_extreme_files_render_finite_pixels(tmp_path, case):
         assert np.isfinite(pixels).all()
     else:  # a material's own arithmetic may overflow; never to NaN
         assert not np.isnan(pixels).any()
+# === State the app keeps: recovery entries and IBL cache entries (issue 22) ====================
+# Both are files the editor finds on disk at launch, so both are untrusted input: each hostile
+# class below must be skipped or discarded with a message, never crash, hang (pytest-timeout
+# ends one) or execute anything, and the good entries beside it must still be used.
+
+import math  # noqa: E402
+import shutil  # noqa: E402
+import stat  # noqa: E402
+
+import numpy as np  # noqa: E402
+from test_app_support import app_env  # noqa: E402, F401 - the GUI tests' fixture
+
+GUI_TIMEOUT = pytest.mark.timeout(180, method="signal")  # a few editor windows each
+
+
+def _recovery_meta(pid=1, when=1.7e9, name="good", document=None, kind="material") -> str:
+    return json.dumps({"pid": pid, "time": when, "name": name, "document": document,
+                       "kind": kind})
+
+
+def _plant_recovery(folder, name: str, kind: str) -> None:
+    """A recovery entry `name` of one hostile class `kind` in `folder`."""
+    rec, meta = folder / f"{name}.json", folder / f"{name}.meta"
+    rec.write_text(json.dumps(base_material()))
+    text = {
+        "pid 2**40": _recovery_meta(pid=2**40),
+        "negative pid": _recovery_meta(pid=-5),
+        "pid true": _recovery_meta(pid=True),
+        "pid string": _recovery_meta(pid="4242"),
+        "pid 400 digits": '{"pid": ' + "9" * 400 + "}",
+        "time 1e309": '{"pid": 1, "time": 1e309}',
+        "time NaN": '{"pid": 1, "time": NaN}',
+        "time -inf": '{"pid": 1, "time": -Infinity}',
+        "time -1e300": _recovery_meta(when=-1e300),
+        "time string": _recovery_meta(when="yesterday"),
+        "name a list": _recovery_meta(name=["x"]),
+        "document a number": _recovery_meta(document=7),
+        "document with NUL": _recovery_meta(document="a\u0000b.json"),
+        "kind unknown": _recovery_meta(kind="shader"),
+        "meta a list": "[1, 2, 3]",
+        "meta deeply nested": "[" * 50000 + "]" * 50000,
+    }.get(kind)
+    if text is not None:
+        meta.write_text(text)
+    elif kind == "meta invalid UTF-8":
+        meta.write_bytes(b'{"pid": 1, "name": "\xff\xfe"}')
+    elif kind == "meta huge":  # over the 64 KiB a metadata file may have
+        _sparse(meta, 1 << 20)
+    elif kind == "meta FIFO":
+        os.mkfifo(meta)
+    elif kind == "meta link to /dev/zero":
+        os.symlink("/dev/zero", meta)
+    elif kind == "recovery file FIFO":
+        rec.unlink()
+        os.mkfifo(rec)
+        meta.write_text(_recovery_meta())
+    elif kind == "recovery file link to /dev/zero":
+        rec.unlink()
+        os.symlink("/dev/zero", rec)
+        meta.write_text(_recovery_meta())
+    elif kind == "recovery file link elsewhere":
+        rec.unlink()
+        elsewhere = folder.parent / "elsewhere.json"
+        elsewhere.write_text(json.dumps(base_material()))
+        os.symlink(elsewhere, rec)
+        meta.write_text(_recovery_meta())
+    elif kind == "recovery file huge":  # over the 64 MiB a document may have
+        _sparse(rec, 65 << 20)
+        meta.write_text(_recovery_meta())
+    else:
+        raise AssertionError(kind)
+
+
+HOSTILE_RECOVERY = [
+    "pid 2**40", "negative pid", "pid true", "pid string", "pid 400 digits", "time 1e309",
+    "time NaN", "time -inf", "time -1e300", "time string", "name a list", "document a number",
+    "document with NUL", "kind unknown", "meta a list", "meta deeply nested",
+    "meta invalid UTF-8", "meta huge", "meta FIFO", "meta link to /dev/zero",
+    "recovery file FIFO", "recovery file link to /dev/zero", "recovery file link elsewhere",
+    "recovery file huge",
+]
+
+
+@pytest.fixture
+def recovery_folder(tmp_path, monkeypatch):
+    folder = tmp_path / "recovery"
+    folder.mkdir()
+    monkeypatch.setenv("MATEDIT_RECOVERY_DIR", str(folder))
+    (folder / "good.json").write_text(json.dumps(base_material()))
+    (folder / "good.meta").write_text(_recovery_meta(pid=2**31 - 1))  # no such process
+    return folder
+
+
+@pytest.mark.parametrize("kind", HOSTILE_RECOVERY)
+def test_hostile_recovery_entry_is_skipped_and_set_aside(recovery_folder, kind):
+    pytest.importorskip("PySide6")
+    from matedit.app import recovery
+
+    _plant_recovery(recovery_folder, "bad", kind)
+    entries = recovery.find_recoveries()  # never raises, never blocks
+    assert [e.rec.name for e in entries] == ["good.json"]  # the good one is still offered
+    assert all(e.describe() for e in entries)
+    # the scan that found it set it aside: kept for a person, never offered or named again
+    assert not os.path.lexists(recovery_folder / "bad.json")
+    assert os.path.lexists(recovery_folder / "bad.json.unreadable")
+    again, problems = recovery.scan_recoveries()
+    assert [e.rec.name for e in again] == ["good.json"] and problems == []
+    if kind == "recovery file link to /dev/zero":
+        assert stat.S_ISCHR(os.stat("/dev/zero").st_mode)
+
+
+def test_hostile_recovery_entry_is_named_in_one_message(recovery_folder):
+    pytest.importorskip("PySide6")
+    from matedit.app import recovery
+
+    for i, kind in enumerate(HOSTILE_RECOVERY):
+        _plant_recovery(recovery_folder, f"bad{i:02d}", kind)
+    entries, problems = recovery.scan_recoveries()
+    assert [e.rec.name for e in entries] == ["good.json"]
+    assert len(problems) == len(HOSTILE_RECOVERY)
+    assert all(p.startswith(f"bad{i:02d}.json: ") for i, p in enumerate(problems))
+    line = recovery.skipped_message(problems)
+    assert line == (f"skipped {len(HOSTILE_RECOVERY)} damaged recovery files: {problems[0]}; "
+                    f"{problems[1]}; and {len(HOSTILE_RECOVERY) - 2} more")
+
+
+def test_the_liveness_check_takes_any_pid():
+    pytest.importorskip("PySide6")
+    from matedit.app.recovery import _alive
+
+    for pid in (2**40, -(2**40), 2**64, -1, 0, os.getpid()):
+        assert _alive(pid) is False
+    assert _alive(os.getppid()) is True
+
+
+@GUI_TIMEOUT
+@pytest.mark.gui
+@pytest.mark.usefixtures("app_env")
+def test_launch_with_hostile_recovery_entries_offers_the_good_ones(qtbot, capfd):
+    """The real editor window at launch: every hostile class at once beside two crashed
+    editors' real autosaves; the launch neither fails nor hangs, the damaged entries are
+    named once in the status bar and on stderr, and the good work is recovered."""
+    import shiboken6
+    import test_app_support
+    from PySide6.QtCore import QPointF
+
+    from matedit.app.recovery import recovery_dir
+    from matedit.graph.commands import SetLabel
+
+    keep = {"recover_all": lambda entries: {e.rec: "keep" for e in entries}}
+    for label in ("first crash", "second crash"):
+        w = test_app_support.make_window(qtbot, track=False, answers=keep)
+        nid = w.tabs.material.canvas.add_node_at("material_output", QPointF(0, 0))
+        assert w.controller.push(SetLabel(nid, label))
+        assert w.actions.autosave() is not None
+        shiboken6.delete(w)  # the editor dies: the autosave stays
+    folder = recovery_dir()
+    for i, kind in enumerate(HOSTILE_RECOVERY):
+        _plant_recovery(folder, f"bad{i:02d}", kind)
+
+    seen: list = []
+
+    def recover_all(entries):
+        seen.extend(entries)
+        return {e.rec: "recover" for e in entries}
+
+    w = test_app_support.make_window(qtbot, answers={"recover_all": recover_all})
+    assert len(seen) == 2 and all(e.document is None for e in seen)
+    labels = {n.label for win in [w, *w.extra_windows]
+              for n in win.controller.document.graph.nodes.values()}
+    assert {"first crash", "second crash"} <= labels
+    for other in w.extra_windows:
+        qtbot.addWidget(other)
+    assert len(w.actions.skipped_recoveries) == len(HOSTILE_RECOVERY)
+    qtbot.waitUntil(lambda: "damaged recovery file" in w.statusBar().currentMessage(),
+                    timeout=5000)
+    err = capfd.readouterr().err
+    assert all(f"bad{i:02d}.json: " in err for i in range(len(HOSTILE_RECOVERY)))
+    assert w.shown_errors == []  # a status line, not a modal box
+    # shown once: the next launch finds nothing to complain about
+    w2 = test_app_support.make_window(qtbot, answers={"recover_all": lambda es: {}})
+    assert w2.actions.skipped_recoveries == []
+
+
+# --- IBL cache entries ----------------------------------------------------------------------
+
+_SMALL_BAKE = dict(size=16, samples=16, lut_size=16, lut_samples=256)
+
+
+def _small_env():
+    from matedit.ibl import Environment
+
+    rng = np.random.default_rng(22)
+    return Environment(name="hostile", equirect=(rng.random((32, 64, 3)) * 4).astype("f4"))
+
+
+class _Unpickled:
+    """An object whose unpickling makes a folder: proof that loading ran code from a file."""
+
+    def __init__(self, marker):
+        self.marker = str(marker)
+
+    def __reduce__(self):
+        return (os.mkdir, (self.marker,))
+
+
+def _npz_arrays(path):
+    with np.load(path, allow_pickle=False) as data:
+        return {name: data[name] for name in data.files}
+
+
+def _write_npz(path, arrays):
+    path.unlink()
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+
+
+def _mutate_arrays(change):
+    def mutate(path, target, tmp):
+        arrays = _npz_arrays(path)
+        arrays[target] = change(arrays[target], tmp)
+        _write_npz(path, arrays)
+    return mutate
+
+
+def _replace_file(make):
+    def mutate(path, target, tmp):
+        path.unlink()
+        make(path, tmp)
+    return mutate
+
+
+def _flip_middle(path, target, tmp):
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2] ^= 0x55
+    path.write_bytes(bytes(data))
+
+
+def _scaled_keeping_checksum(path, target, tmp):
+    arrays = _npz_arrays(path)
+    arrays[target] = (arrays[target] * np.float32(1.25)).astype(arrays[target].dtype)
+    _write_npz(path, arrays)  # the stored checksum no longer matches
+
+
+def _older_format(path, target, tmp):
+    from matedit.ibl import cache
+
+    arrays = _npz_arrays(path)
+    arrays[cache.VERSION_NAME] = np.array(cache.CACHE_FORMAT - 1, dtype="<i8")
+    _write_npz(path, arrays)  # checksum still right: only the version is wrong
+
+
+def _link_to_copy(path, target, tmp):
+    decoy = tmp / "decoy.npz"
+    shutil.copyfile(path, decoy)
+    path.unlink()
+    os.symlink(decoy, path)
+
+
+def _sparse(path, size):
+    with open(path, "wb") as f:  # no disk space taken
+        f.truncate(size)
+
+
+def _set(a, value):
+    a = a.copy()
+    a.flat[len(a.flat) // 2] = value
+    return a
+
+
+HOSTILE_CACHE = {
+    "FIFO": _replace_file(lambda p, tmp: os.mkfifo(p)),
+    "link to /dev/zero": _replace_file(lambda p, tmp: os.symlink("/dev/zero", p)),
+    "link to a valid entry elsewhere": _link_to_copy,
+    "a folder": _replace_file(lambda p, tmp: p.mkdir()),
+    "huge sparse file": _replace_file(lambda p, tmp: _sparse(p, 64 << 20)),
+    "not a zip": _replace_file(lambda p, tmp: p.write_bytes(os.urandom(4096))),
+    "a pickle": _replace_file(lambda p, tmp: p.write_bytes(
+        __import__("pickle").dumps(_Unpickled(tmp / "ran")))),
+    "truncated": lambda p, target, tmp: p.write_bytes(p.read_bytes()[: p.stat().st_size // 2]),
+    "a byte flipped": _flip_middle,
+    "string array": _mutate_arrays(lambda a, tmp: np.full(a.shape, "0.5")),
+    "object array": _mutate_arrays(lambda a, tmp: np.array(
+        [_Unpickled(tmp / "ran")] * a.size, dtype=object).reshape(a.shape)),
+    "wrong shape": _mutate_arrays(lambda a, tmp: a[..., :1].copy()),
+    "wrong dtype": _mutate_arrays(lambda a, tmp: a.astype(np.float16)),
+    "a NaN": _mutate_arrays(lambda a, tmp: _set(a, np.nan)),
+    "an infinity": _mutate_arrays(lambda a, tmp: _set(a, np.inf)),
+    "values changed, checksum kept": _scaled_keeping_checksum,
+    "an older format version": _older_format,
+}
+
+
+@pytest.fixture(scope="module")
+def clean_bake(gl_ctx, tmp_path_factory):
+    """One bake into a fresh cache: the result every rebuilt entry must equal, and its
+    files (an `ibl-` entry and an `lut-` entry)."""
+    from matedit.ibl import BakeSettings, bake
+
+    folder = tmp_path_factory.mktemp("clean-cache")
+    result = bake(_small_env(), BakeSettings(**_SMALL_BAKE), ctx=gl_ctx, cache_dir=folder)
+    assert not result.from_cache and not result.warnings
+    files = {p.name.split("-")[0]: p for p in folder.glob("*.npz")}
+    assert sorted(files) == ["ibl", "lut"]
+    return result, files
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("entry", ["ibl", "lut"])
+@pytest.mark.parametrize("kind", sorted(HOSTILE_CACHE))
+def test_hostile_cache_entry_is_discarded_and_rebuilt(ctx, tmp_path, clean_bake, entry, kind):
+    from matedit.ibl import BakeSettings, bake
+
+    clean, files = clean_bake
+    cache_dir = tmp_path / "cache"
+    cache_dir.mkdir()
+    for name, src in files.items():
+        if entry == "ibl" or name == "lut":  # a bad LUT entry is read when the bake is not
+            shutil.copyfile(src, cache_dir / src.name)
+    path = cache_dir / files[entry].name
+    HOSTILE_CACHE[kind](path, "mip1" if entry == "ibl" else "lut", tmp_path)
+
+    again = bake(_small_env(), BakeSettings(**_SMALL_BAKE), ctx=ctx, cache_dir=cache_dir)
+    assert not again.from_cache
+    assert any("discarded a damaged IBL cache entry" in w and path.name in w
+               for w in again.warnings), again.warnings
+    for a, b in zip(clean.mips, again.mips, strict=True):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(clean.lut, again.lut)
+    np.testing.assert_array_equal(clean.sh, again.sh)
+    assert not (tmp_path / "ran").exists()  # nothing in the file was executed
+    # rebuilt in place as a regular file of our own: the next bake reads it
+    st = os.lstat(path)
+    assert stat.S_ISREG(st.st_mode)
+    assert bake(_small_env(), BakeSettings(**_SMALL_BAKE), ctx=ctx,
+                cache_dir=cache_dir).from_cache
+    assert stat.S_ISCHR(os.stat("/dev/zero").st_mode)
+    if kind == "link to a valid entry elsewhere":  # what the link pointed to is untouched
+        assert (tmp_path / "decoy.npz").read_bytes() == files[entry].read_bytes()
+
+
+@GUI_TIMEOUT
+@pytest.mark.gui
+@pytest.mark.usefixtures("app_env")
+def test_launch_with_hostile_ibl_cache_entries_rebakes(qtbot, tmp_path, monkeypatch):
+    """The real editor window bakes its studio environment at launch; with its cache entry a
+    FIFO and its LUT entry a link to /dev/zero it neither hangs nor fails, and both entries
+    are rebuilt as regular files."""
+    import test_app_support
+
+    from matedit.ibl import BakeSettings, load_environment
+    from matedit.ibl.bake import cache_paths
+
+    monkeypatch.setenv("MATEDIT_CACHE_DIR", str(tmp_path / "cache"))
+    settings = BakeSettings()
+    paths = cache_paths(load_environment("studio", settings.resolved().size), settings)
+    paths["ibl"].parent.mkdir(parents=True)
+    os.mkfifo(paths["ibl"])
+    os.symlink("/dev/zero", paths["lut"])
+    w = test_app_support.make_window(qtbot, show=True)
+    renderer = test_app_support.wait_for_renderer(qtbot, w)
+    assert renderer.environment_warnings and all(
+        "discarded a damaged IBL cache entry" in m for m in renderer.environment_warnings)
+    for p in paths.values():
+        assert stat.S_ISREG(os.lstat(p).st_mode)
+    assert stat.S_ISCHR(os.stat("/dev/zero").st_mode)
+    assert math.isfinite(float(np.asarray(renderer.read_image()).sum()))

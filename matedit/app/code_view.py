@@ -50,12 +50,15 @@ class CodeView(QWidget):
                        "")
             return
         if self.compiler.current is None:
-            last = self.compiler.last_good
-            note = "does not compile; showing the last good code" if last else "does not compile"
+            last = self.compiler.last_good  # this document's own: see MaterialCompiler
             if last is not None and self.target.currentText() == last.target:
-                self._show(self._stage_text(last), note)
+                self._show(self._stage_text(last),
+                           "does not compile; showing this material's last good code")
+            elif last is not None:
+                self._show("// the material does not compile: see Diagnostics",
+                           "does not compile")
             else:
-                self._show("// the material does not compile: see Diagnostics", note)
+                self._show(self._never_compiled(), "does not compile: no code to show")
             return
         try:
             cm = self.compiler.for_target(self.target.currentText())
@@ -64,6 +67,16 @@ class CodeView(QWidget):
             return
         self._show(self._stage_text(cm), f"{len(cm.fragment_text.splitlines())} fragment lines"
                    f"  ·  hash {cm.structure_hash}")
+
+    def _never_compiled(self) -> str:
+        """What the panel says for a document that has not compiled yet: its errors."""
+        errors = [d.format() for d in self.compiler.diagnostics if d.severity.value == "error"]
+        lines = ["// This material does not compile, and it has not compiled since it was",
+                 "// opened: there is no GLSL to show. Fix the errors listed in Diagnostics:"]
+        lines += [f"//   {e}" for e in errors[:20]]
+        if len(errors) > 20:
+            lines.append(f"//   … and {len(errors) - 20} more")
+        return "\n".join(lines)
 
     def _stage_text(self, cm) -> str:
         return cm.fragment_text if self.stage.currentText() == "fragment" else cm.vertex_text

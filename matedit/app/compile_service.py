@@ -55,10 +55,14 @@ class MaterialCompiler(QObject):
     With `asynchronous` (the editor sets it; matedit.app.app.run) a structural edit compiles on
     a worker thread (matedit.app.compile_worker) and the signals come when it is done; reading
     `current`, `last_good`, `diagnostics` or `last_compile_ms` first waits for a pending result
-    (`latest` does not). `recompile()` called directly is always synchronous."""
+    (`latest` does not). `recompile()` called directly is always synchronous.
+
+    The last good material belongs to the document: opening or creating another one forgets
+    it (`documentChanged`), so a document that never compiled has none to stand in for it."""
 
     compiled = Signal(object)  # CompiledMaterial
     failed = Signal(list)  # list[Diagnostic]
+    documentChanged = Signal()  # another document: nothing compiled for it yet
     previewChanged = Signal(object)  # PreviewTarget | None: the viewport shows that socket
     asynchronous = False
     # the viewport's state for the worker's warm-up (ViewportPanel sets it): a callable giving a
@@ -76,7 +80,18 @@ class MaterialCompiler(QObject):
         self.preview: PreviewTarget | None = None
         self.worker = None
         controller.structureChanged.connect(self._structure_changed)
-        controller.documentReplaced.connect(lambda: self.set_preview(None, recompile=False))
+        controller.documentReplaced.connect(self._document_replaced)
+
+    def _document_replaced(self) -> None:
+        """Another document: what was compiled for the previous one is not its own (a pending
+        compile of it is dropped); the compile that follows starts afresh."""
+        if self.worker is not None:
+            self.worker.supersede()
+        self._current = self._last_good = None
+        self._diagnostics = []
+        self._cache.clear()
+        self.set_preview(None, recompile=False)
+        self.documentChanged.emit()
 
     # what a pending compile will replace: wait for it first
     def _settled(self, name: str):

@@ -11,6 +11,7 @@ go through replaceable callables so tests can answer them.
 from __future__ import annotations
 
 import os
+import sys
 import time
 import weakref
 from collections.abc import Callable
@@ -26,20 +27,23 @@ from matedit.app.paths import relativise_references
 from matedit.app.recovery import DISCARD as REC_DISCARD
 from matedit.app.recovery import (
     RECOVER,
+    BadRecoveryEntry,
     RecoveryEntry,
     ask_recover_all,
-    find_recoveries,
+    check_entry_file,
     meta_path,
     new_untitled_key,
     recovery_dir,  # noqa: F401 - part of this module's API (tests, the window)
     recovery_path,
     remove_recovery,
+    scan_recoveries,
+    skipped_message,
     write_meta_text,
 )
 from matedit.graph.model import MaterialDocument, Node
 from matedit.graph.nodes import Role, kind_for
 from matedit.io.atomic import atomic_write_text
-from matedit.io.document import FormatError, dumps, load, loads, save
+from matedit.io.document import FormatError, dumps, load, loads, read_document_text, save
 
 AUTOSAVE_MS = 30_000
 MAX_RECENT = 10
@@ -77,6 +81,14 @@ def no_mnemonic(text: str) -> str:
     return text.replace("&", "&&")
 
 
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file (False when either cannot be resolved)."""
+    try:
+        return a.resolve() == b
+    except (OSError, RuntimeError, ValueError):
+        return False
+
+
 class DocumentActions(QObject):
     """Owns the file-level state of one document controller inside a window."""
 
@@ -92,6 +104,7 @@ class DocumentActions(QObject):
         self.controller = controller
         self._autosaved_index: int | None = None
         self.untitled_key = new_untitled_key()  # an untitled document's own recovery file
+        self.skipped_recoveries: list[str] = []  # the start-up scan's untrusted entries
         DocumentActions._live.add(self)
         self.autosave_timer = QTimer(self)
         self.autosave_timer.setInterval(AUTOSAVE_MS)
@@ -238,8 +251,18 @@ class DocumentActions(QObject):
     def start(self, path: str | os.PathLike | None, fallback: Path | None) -> None:
         """At start-up: open `path` (or the fallback sample), and offer every recovery file
         that an editor which did not close cleanly left behind, `path`'s among them."""
-        entries = find_recoveries(skip={a.recovery_file() for a in list(DocumentActions._live)
-                                        if a is not self and shiboken6.isValid(a)})
+        try:
+            entries, skipped = scan_recoveries(
+                skip={a.recovery_file() for a in list(DocumentActions._live)
+                      if a is not self and shiboken6.isValid(a)})
+        except Exception as exc:  # noqa: BLE001 - the launch never fails for a recovery file
+            entries, skipped = [], [f"the recovery folder cannot be read ({exc})"]
+        self.skipped_recoveries = skipped
+        if skipped:  # once, as the entries are set aside: every one on stderr, the status bar
+            for line in skipped:
+                print(f"matedit: skipped a damaged recovery file: {line}", file=sys.stderr)
+            text = skipped_message(skipped)
+            QTimer.singleShot(0, self, lambda: self.message.emit(text))
         decisions = self.ask_recover_all(entries) if entries else {}
         chosen: list[tuple[RecoveryEntry, MaterialDocument]] = []
         for e in entries:
@@ -252,7 +275,7 @@ class DocumentActions(QObject):
                     chosen.append((e, doc))
         target = Path(path).resolve() if path is not None else None
         mine = next((c for c in chosen if not c[0].is_function and c[0].document is not None
-                     and target is not None and c[0].document.resolve() == target), None)
+                     and target is not None and _same_file(c[0].document, target)), None)
         if mine is None and target is None:
             mine = next((c for c in chosen if not c[0].is_function), None)
         opened = False
@@ -347,7 +370,11 @@ class DocumentActions(QObject):
     def _offer_recovery(self, path: Path) -> MaterialDocument | None:
         """The autosave of `path` if the artist wants it (declined: it is deleted)."""
         rec = recovery_path(path)
-        if not rec.is_file():
+        try:
+            if check_entry_file(rec, "recovery file") is None:
+                return None
+        except BadRecoveryEntry as exc:  # never read: set aside by the next start-up scan
+            self.message.emit(f"{rec.name} not offered: {exc}")
             return None
         if not self.ask_recover(path, rec):  # deleted only once the artist has answered
             self._remove_recovery(rec)
@@ -355,9 +382,10 @@ class DocumentActions(QObject):
         return self._read_recovery(rec, path)
 
     def _read_recovery(self, rec: Path, path: Path | None) -> MaterialDocument | None:
-        try:
-            return loads(rec.read_text(encoding="utf-8"), str(rec), path)
-        except (FormatError, OSError, UnicodeDecodeError) as exc:
+        try:  # a regular file within the document size limit, in UTF-8 (never blocks)
+            check_entry_file(rec, "recovery file")
+            return loads(read_document_text(rec), str(rec), path)
+        except (FormatError, BadRecoveryEntry, OSError, UnicodeDecodeError) as exc:
             aside = rec.with_name(rec.name + ".unreadable")
             try:  # kept for a person to look at, never offered again
                 os.replace(rec, aside)

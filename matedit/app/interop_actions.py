@@ -9,6 +9,7 @@ GLX context is never disturbed (GLVND refuses GLX on a thread with EGL current).
 
 from __future__ import annotations
 
+import os
 import threading
 from pathlib import Path
 
@@ -232,10 +233,34 @@ class InteropActions:
                                         names, 0, False)
         return bool(ok), (name if ok else None)
 
+    def _import_name(self, src: Path, material: str | None) -> Path:
+        """The file proposed for an imported material: its MaterialX name (else the .mtlx's
+        stem) as a file stem, made unique in the folder with _2, _3...: never a file that
+        exists, so never the open document's."""
+        from matedit.interop.mtlx_import import MtlxImportError, file_stem, material_names
+
+        name = material
+        if name is None:
+            try:
+                names = material_names(src)
+            except MtlxImportError:
+                names = []
+            name = names[0] if len(names) == 1 else None
+        stem = file_stem(name) if name else (file_stem(src.stem) or "imported")
+        folder = Path(self._start_dir() or src.parent)
+        taken = open_document_paths()
+        for i in range(1, 1000):
+            candidate = folder / (f"{stem}.json" if i == 1 else f"{stem}_{i}.json")
+            if not os.path.lexists(candidate) and _real(candidate) not in taken:
+                return candidate
+        return folder / f"{stem}_{os.getpid()}_{len(taken)}.json"
+
     def import_mtlx(self, src: Path | None = None, out: Path | None = None,
                     material: str | None = None) -> bool:
         """Import one material of a .mtlx (`material`, else the only one, else the one the
-        artist picks) and open it."""
+        artist picks), save it as a new file and open it. The name proposed is a new one
+        (`_import_name`); a file picked that exists is replaced only after the file dialog's
+        own confirmation, and a document open in the editor never is (refused, saying why)."""
         title = "Import MaterialX"
         if src is None:
             path, _ = file_dialogs.open_file(self.window, title, self._start_dir(),
@@ -247,15 +272,21 @@ class InteropActions:
             go, material = self._choose_material(src, title)
             if not go:
                 return False
-        from matedit.interop.mtlx_import import file_stem
-
-        default = f"{file_stem(material)}.json" if material else f"{src.stem}.json"
-        out = out or self._ask_save("Save the imported material as", "Material (*.json)",
-                                    default)
         if out is None:
-            return False
+            proposed = self._import_name(src, material)
+            path, _ = file_dialogs.save_file(self.window, "Save the imported material as",
+                                             str(proposed), "Material (*.json)")
+            if not path:
+                return False
+            QSettings().setValue(FOLDER_KEY, str(Path(path).parent))
+            out = Path(path)
         out = out.with_suffix(".json")
-        import os
+        if _real(out) in open_document_paths():
+            text = (f"{out.name} is open in the editor. An import is saved as a new file and "
+                    "never replaces an open document: choose another name.")
+            self.window.actions.show_error(title, text)
+            self.last_message = text
+            return False
 
         from matedit.interop.mtlx_import import MtlxImportError, import_mtlx
         from matedit.io.atomic import atomic_write_text
@@ -276,6 +307,25 @@ class InteropActions:
         except Exception as exc:
             return self._fail(title, exc)
         return self.window.actions.open(out, ask=False) and self._done(f"imported {src.name}")
+
+
+def _real(path: Path) -> Path:
+    """`path` with every link resolved (as far as it exists), to compare files."""
+    return Path(os.path.realpath(path))
+
+
+def open_document_paths() -> set[Path]:
+    """The files of every document open in this editor process (materials and functions, in
+    every window and tab), links resolved."""
+    import shiboken6
+
+    from matedit.app.document_actions import DocumentActions
+
+    out = set()
+    for acts in list(DocumentActions._live):
+        if shiboken6.isValid(acts) and acts.document.path is not None:
+            out.add(_real(Path(acts.document.path)))
+    return out
 
 
 def install(window, file_menu, after: QAction) -> InteropActions:

@@ -35,8 +35,10 @@ class ProblemsModel(QObject):
         self.compile: list[Problem] = []
         self.gl: list[Problem] = []
         self.status = ""
+        self.view = view
         compiler.compiled.connect(self._compiled)
         compiler.failed.connect(self._failed)
+        compiler.documentChanged.connect(self._document_changed)
         view.glErrors.connect(self._gl_errors)
         view.materialApplied.connect(self._applied)
 
@@ -45,15 +47,31 @@ class ProblemsModel(QObject):
         self.status = f"compiled in {self.compiler.last_compile_ms:.0f} ms"
         self.changed.emit()
 
+    def _document_changed(self) -> None:
+        """Another document: the previous one's compiler and driver reports are not its."""
+        self.compile, self.gl, self.status = [], [], ""
+        self.changed.emit()
+
+    def _shows_material(self) -> bool:
+        shows = getattr(self.view, "shows_material", None)
+        return bool(shows()) if callable(shows) else True
+
     def _failed(self, diagnostics) -> None:
         self.compile = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "",
                                 "compiler") for d in diagnostics]
-        self.status = "does not compile: the viewport shows the last good material"
+        if self.compiler.latest is not None:
+            self.status = "does not compile: the viewport shows this material's last good version"
+        else:
+            self.status = "does not compile: nothing to show in the viewport (see Diagnostics)"
         self.changed.emit()
 
     def _gl_errors(self, errors) -> None:
         self.gl = [Problem("error", str(msg), nid or "", "", "GL") for nid, msg in errors]
-        self.status = "GLSL failed to build: the viewport keeps the last good program"
+        if self._shows_material():
+            self.status = "GLSL failed to build: the viewport keeps this material's last good " \
+                "program"
+        else:
+            self.status = "GLSL failed to build: nothing to show in the viewport"
         self.changed.emit()
 
     def _applied(self, ok: bool) -> None:

@@ -7,6 +7,10 @@ a file. Beside each lies a `.meta` file naming the document, its kind, the time 
 the editor process that wrote it. At start-up the editor lists every recovery file
 whose writer is no longer running and asks what to do with each; a file is deleted
 only once the artist has answered for it (recovered work is deleted when it is saved).
+
+The folder's contents are untrusted input (a crash can leave half a file, anyone can plant
+one): `read_entry` checks every field and file type, and an entry that fails is skipped
+with a message and set aside as `*.unreadable`, never read again and never deleted.
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import stat
 import time
 import uuid
 from dataclasses import dataclass
@@ -29,6 +34,9 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
+
+from matedit.io.atomic import read_bounded
+from matedit.io.document import MAX_FILE_BYTES
 
 RECOVER, DISCARD, KEEP = "recover", "discard", "keep"
 
@@ -76,6 +84,19 @@ def remove_recovery(rec: Path) -> None:
             pass
 
 
+# What a recovery entry may hold; anything else is a planted or damaged file.
+META_MAX_BYTES = 64 * 1024
+MAX_PID = 2**31 - 1  # pid_t is a 32-bit signed integer on every platform matedit runs on
+MAX_TIME = 253402300799.0  # the last second of the year 9999: time.localtime() takes it
+MAX_NAME = 1000
+MAX_PATH = 4096
+UNREADABLE = ".unreadable"  # a skipped entry is renamed so, for a person to look at
+
+
+class BadRecoveryEntry(ValueError):
+    """A recovery file or its metadata that cannot be trusted; the message says why."""
+
+
 @dataclass(frozen=True)
 class RecoveryEntry:
     """One recovery file found on disk."""
@@ -93,63 +114,183 @@ class RecoveryEntry:
         return stem.removeprefix("untitled-") if self.document is None else ""
 
     def describe(self) -> str:
-        when = time.strftime("%Y-%m-%d %H:%M", time.localtime(self.time))
+        try:
+            when = time.strftime("%Y-%m-%d %H:%M", time.localtime(self.time))
+        except (OverflowError, OSError, ValueError):
+            when = "at an unknown time"
         what = str(self.document) if self.document else "never saved"
         kind = "function" if self.is_function else "material"
         older = ""
         try:
             if self.document and self.document.stat().st_mtime > self.rec.stat().st_mtime:
                 older = " (older than the file, which was saved since)"
-        except OSError:
+        except (OSError, ValueError):
             pass
         return f"{self.name} — {kind}, {what}; autosaved {when}{older}"
 
 
 def _alive(pid: int) -> bool:
-    if pid <= 0 or pid == os.getpid():
+    """Whether another process `pid` runs; False for anything that is not a process id."""
+    if not isinstance(pid, int) or isinstance(pid, bool) or not 0 < pid <= MAX_PID \
+            or pid == os.getpid():
         return False
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
+        return False
+    except (OverflowError, ValueError):  # not a pid this system can have
         return False
     except OSError:  # exists, owned by someone else
         return True
     return True
 
 
-def find_recoveries(skip: set[Path] = frozenset()) -> list[RecoveryEntry]:
-    """Every recovery file another editor left behind (not one still running), oldest first.
-    `skip`: files that documents open in this process are writing."""
-    folder = recovery_dir()
-    if not folder.is_dir():
-        return []
-    skip = {Path(p).resolve() for p in skip}
-    out = []
-    for rec in sorted(folder.glob("*.json")):
-        if rec.resolve() in skip:
-            continue
+def check_entry_file(path: Path, what: str) -> os.stat_result | None:
+    """The lstat of a recovery or metadata file, which must be a regular file and not a
+    link (matedit writes neither as a link); None when it does not exist."""
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError) as exc:
+        raise BadRecoveryEntry(f"its {what} cannot be read ({exc})") from None
+    if stat.S_ISLNK(st.st_mode):
+        raise BadRecoveryEntry(f"its {what} is a symbolic link")
+    if not stat.S_ISREG(st.st_mode):
+        raise BadRecoveryEntry(f"its {what} is not a regular file (a device, FIFO, socket "
+                               "or folder)")
+    return st
+
+
+def _read_meta(meta: Path) -> dict:
+    """The metadata beside a recovery file, parsed but not yet checked ({} when absent)."""
+    if check_entry_file(meta, "metadata") is None:
+        return {}
+    try:
+        raw = read_bounded(meta, META_MAX_BYTES)
+    except FileNotFoundError:
+        return {}
+    except (OSError, ValueError) as exc:
+        raise BadRecoveryEntry(f"its metadata cannot be read ({exc})") from None
+    try:
+        data = json.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise BadRecoveryEntry("its metadata is not UTF-8 text") from None
+    except (ValueError, RecursionError):
+        raise BadRecoveryEntry("its metadata is not valid JSON") from None
+    if not isinstance(data, dict):
+        raise BadRecoveryEntry("its metadata is not a JSON object")
+    return data
+
+
+def _real(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def read_entry(rec: Path) -> RecoveryEntry:
+    """A recovery file and its metadata, every field checked: raises BadRecoveryEntry for
+    anything an editor could not have written (a pid beyond pid_t, a time that is not a
+    finite date, wrong JSON types, files that are links, devices or FIFOs, oversized or
+    non-UTF-8 metadata). Absent metadata is allowed: the file's own date stands in."""
+    st = check_entry_file(rec, "recovery file")
+    if st is None:
+        raise BadRecoveryEntry("it went away while being read")
+    if st.st_size > MAX_FILE_BYTES:
+        raise BadRecoveryEntry(f"it is larger than {MAX_FILE_BYTES >> 20} MiB")
+    meta = _read_meta(meta_path(rec))
+    pid = meta.get("pid", 0)
+    if not isinstance(pid, int) or isinstance(pid, bool) or not 0 <= pid <= MAX_PID:
+        raise BadRecoveryEntry(f"its pid {_short(pid)} is not a process id")
+    when = meta.get("time", st.st_mtime)
+    if not _real(when) or not 0 <= when <= MAX_TIME:  # NaN and inf compare False
+        raise BadRecoveryEntry(f"its time {_short(when)} is not a date")
+    doc = meta.get("document")
+    if doc is not None and not (isinstance(doc, str) and 0 < len(doc) <= MAX_PATH
+                                and "\0" not in doc):
+        raise BadRecoveryEntry(f"its document {_short(doc)} is not a file path")
+    name = meta.get("name", "")
+    if not isinstance(name, str) or len(name) > MAX_NAME:
+        raise BadRecoveryEntry(f"its name {_short(name)} is not a document name")
+    kind = meta.get("kind", "material")
+    if kind not in ("material", "function"):
+        raise BadRecoveryEntry(f"its kind {_short(kind)} is neither material nor function")
+    document = Path(doc) if doc else None
+    name = name.strip() or (document.name if document else "Untitled")
+    return RecoveryEntry(rec, document, name, kind == "function", float(when), pid)
+
+
+def _short(value) -> str:
+    text = repr(value) if not isinstance(value, int) or isinstance(value, bool) or \
+        abs(value) < 10**30 else "(a huge number)"
+    return text if len(text) <= 40 else text[:37] + "…"
+
+
+def set_aside(rec: Path) -> Path | None:
+    """Renames an untrusted entry (and its metadata) to *.unreadable, never following a
+    link, so it is kept for a person and not offered again; the new name, or None."""
+    moved = None
+    for p in (rec, meta_path(rec)):
         try:
-            meta = json.loads(meta_path(rec).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            meta = {}
-        if not isinstance(meta, dict):
-            meta = {}
-        pid = meta.get("pid") if isinstance(meta.get("pid"), int) else 0
-        if _alive(pid):
-            continue
-        doc = meta.get("document")
-        try:
-            mtime = rec.stat().st_mtime
+            os.lstat(p)
         except OSError:
             continue
-        name = meta.get("name") if isinstance(meta.get("name"), str) else ""
-        out.append(RecoveryEntry(rec, Path(doc) if isinstance(doc, str) and doc else None,
-                                 name or (Path(doc).name if isinstance(doc, str) and doc
-                                          else "Untitled"),
-                                 meta.get("kind") == "function",
-                                 float(meta.get("time", mtime)) if isinstance(
-                                     meta.get("time", mtime), (int, float)) else mtime, pid))
-    return sorted(out, key=lambda e: e.time)
+        aside = p.with_name(p.name + UNREADABLE)
+        try:
+            os.replace(p, aside)
+        except OSError:
+            continue
+        if p == rec:
+            moved = aside
+    return moved
+
+
+def scan_recoveries(skip: set[Path] = frozenset()) -> tuple[list[RecoveryEntry], list[str]]:
+    """Every recovery file another editor left behind (not one still running), oldest
+    first, and one line for each entry skipped as untrusted (set aside, see `set_aside`).
+    `skip`: files that documents open in this process are writing."""
+    folder = recovery_dir()
+    try:
+        if not folder.is_dir():
+            return [], []
+        found = sorted(folder.glob("*.json"))
+    except (OSError, ValueError):
+        return [], [f"the recovery folder {folder} cannot be read"]
+    skip = {Path(p).resolve() for p in skip}
+    out: list[RecoveryEntry] = []
+    problems: list[str] = []
+    for rec in found:
+        try:
+            if rec.resolve() in skip:
+                continue
+        except (OSError, RuntimeError):  # a link loop: read_entry says so
+            pass
+        try:
+            entry = read_entry(rec)
+        except BadRecoveryEntry as exc:
+            aside = set_aside(rec)
+            where = f"; kept as {aside.name}" if aside is not None else ""
+            problems.append(f"{rec.name}: {exc}{where}")
+            continue
+        if _alive(entry.pid):
+            continue
+        out.append(entry)
+    return sorted(out, key=lambda e: e.time), problems
+
+
+def find_recoveries(skip: set[Path] = frozenset()) -> list[RecoveryEntry]:
+    """The entries of `scan_recoveries`, without the lines about skipped ones."""
+    return scan_recoveries(skip)[0]
+
+
+def skipped_message(problems: list[str], shown: int = 2) -> str:
+    """One status line for the recovery entries skipped at start-up: the first `shown`
+    with their reasons, then how many more ("" when none was skipped)."""
+    n = len(problems)
+    if not n:
+        return ""
+    head = f"skipped {n} damaged recovery file{'s' if n != 1 else ''}"
+    text = f"{head}: " + "; ".join(problems[:shown])
+    return text + (f"; and {n - shown} more" if n > shown else "")
 
 
 class RecoveryDialog(QDialog):

@@ -5,6 +5,10 @@ Qt's framebuffer (`detect_framebuffer(defaultFramebufferObject())`). A structura
 edit arrives as a new `CompiledMaterial` (`set_material`): when it fails to link,
 the renderer keeps its last good program, and the errors, located on nodes, go
 out through `glErrors`. A value edit only sets uniforms and redraws.
+
+The last good program belongs to the document: another document clears it
+(`clear_material`), and until that document compiles and links the view draws the scene
+without a material, under a "does not compile" notice when it fails.
 """
 
 from __future__ import annotations
@@ -193,6 +197,25 @@ class ViewportWidget(QOpenGLWidget):
                              mode=r.mode, mesh=r.mesh_name,
                              energy_compensation=r.energy_compensation,
                              show_background=r.show_background)
+
+    @property
+    def has_material(self) -> bool:
+        """Whether a material is drawn, or waits to be at initializeGL."""
+        if self.renderer is None:
+            return self._pending_material is not None
+        return bool(self.renderer.has_material)
+
+    def clear_material(self) -> None:
+        """Draw no material (another document: the previous one's program is not its own)."""
+        self._pending_material = None
+        self._pending_uniforms, self._pending_textures = None, {}
+        if self.renderer is not None:
+            self.makeCurrent()
+            try:
+                self.renderer.clear_material()
+            finally:
+                self.doneCurrent()
+            self.update()
 
     def set_material(self, compiled) -> bool | None:
         """A new program; None while GL is not up yet (applied at initializeGL)."""
@@ -472,6 +495,7 @@ class ViewportPanel(QWidget):
         self.banner.hide()
         self.view = ViewportWidget()
         lay.addWidget(self.view, 1)
+        self.failure = self._failure_notice()  # laid over the view: "does not compile"
         self._env_index = 0
         self._custom_envs: list[str] = []
         self.env_dialog = file_dialogs.open_file  # tests replace it
@@ -490,6 +514,10 @@ class ViewportPanel(QWidget):
         self.view.glErrors.connect(self.glErrors)
         self.view.materialApplied.connect(self.materialApplied)
         compiler.compiled.connect(self.on_compiled)
+        compiler.failed.connect(self._compile_failed)
+        compiler.documentChanged.connect(self._document_changed)
+        self.view.glErrors.connect(self._gl_failed)
+        self.view.materialApplied.connect(lambda ok: ok and self._hide_failure())
         compiler.viewport_state = self.view.viewport_state
         compiler.previewChanged.connect(self._preview_changed)
         self.controller.valuesChanged.connect(self.push_values)
@@ -498,6 +526,76 @@ class ViewportPanel(QWidget):
     def on_compiled(self, compiled) -> None:
         self.view.set_material(compiled)
         self.push_values()
+
+    # --- a document with nothing to draw -------------------------------------------------
+    def _failure_notice(self) -> QWidget:
+        box = QWidget(self)
+        box.setObjectName("noMaterial")
+        box.setStyleSheet("#noMaterial { background: rgba(28, 20, 22, 225);"
+                          " border: 1px solid #b04a4a; border-radius: 4px; }")
+        bl = QVBoxLayout(box)
+        bl.setContentsMargins(14, 10, 14, 12)
+        bl.setSpacing(6)
+        self.failure_title = QLabel("")
+        self.failure_title.setStyleSheet("color: #ff9c9c; font-weight: bold; font-size: 13pt;"
+                                         " background: transparent; border: none;")
+        self.failure_title.setAlignment(Qt.AlignmentFlag.AlignHCenter)
+        self.failure_text = QLabel("")
+        self.failure_text.setWordWrap(True)
+        self.failure_text.setStyleSheet("color: #e4d6d6; background: transparent;"
+                                        " border: none;")
+        bl.addWidget(self.failure_title)
+        bl.addWidget(self.failure_text)
+        box.hide()
+        return box
+
+    def shows_material(self) -> bool:
+        """Whether the view draws a material of the open document (False: the notice)."""
+        return self.view.has_material and self.failure.isHidden()
+
+    @property
+    def failure_message(self) -> str:
+        """The notice's title and text while it is shown, else ""."""
+        if self.failure.isHidden():
+            return ""
+        return f"{self.failure_title.text()}\n{self.failure_text.text()}"
+
+    def _document_changed(self) -> None:
+        self.view.clear_material()
+        self._hide_failure()
+
+    def _compile_failed(self, diagnostics) -> None:
+        """A compile failed: with an earlier good version of this document the view keeps
+        drawing it; without one it draws no material and says why."""
+        if self.compiler.latest is not None and self.view.has_material:
+            return
+        self.view.clear_material()
+        errors = [d.format() for d in diagnostics if getattr(d.severity, "value", "") == "error"]
+        self._show_failure("This material does not compile",
+                           errors or [d.format() for d in diagnostics])
+
+    def _gl_failed(self, errors) -> None:
+        if self.view.has_material:
+            return  # this document's last good program is still drawn
+        self._show_failure("This material's GLSL does not build",
+                           [f"node {nid}: {msg}" if nid else str(msg) for nid, msg in errors])
+
+    def _show_failure(self, title: str, lines: list[str]) -> None:
+        shown = [line if len(line) <= 300 else line[:297] + "…" for line in lines[:4]]
+        more = len(lines) - len(shown)
+        text = "\n".join(f"• {line}" for line in shown)
+        if more > 0:
+            text += f"\n… and {more} more"
+        text += "\n\nThe viewport shows no material until it compiles. " \
+                "The errors are listed in Diagnostics."
+        self.failure_title.setText(title)
+        self.failure_text.setText(text.strip())
+        self.failure.show()
+        self.failure.raise_()
+        self._place_banner()
+
+    def _hide_failure(self) -> None:
+        self.failure.hide()
 
     def push_values(self) -> None:
         cm = self.compiler.latest  # never waits for a compile in flight
@@ -613,6 +711,14 @@ class ViewportPanel(QWidget):
     def _place_banner(self) -> None:
         g = self.view.geometry()
         self.banner.setGeometry(g.x(), g.y(), g.width(), self.banner.sizeHint().height())
+        if not self.failure.isHidden():
+            width = max(120, min(g.width() - 24, 560))
+            height = min(g.height() - 16, self.failure.heightForWidth(width)
+                         if self.failure.hasHeightForWidth() else
+                         self.failure.sizeHint().height())
+            self.failure.setGeometry(g.x() + (g.width() - width) // 2,
+                                     g.y() + max(8, (g.height() - height) // 2),
+                                     width, max(40, height))
         self.diff_label.adjustSize()
         self.diff_label.move(g.x() + 4, g.y() + g.height() - self.diff_label.height() - 4)
 

@@ -105,16 +105,18 @@ def bake_brdf_lut(
     ctx=None,
     use_cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
+    problems: list[str] | None = None,
 ) -> np.ndarray:
     """The environment BRDF LUT (size, size, 2), from the cache when possible; a miss is
-    computed with `baker`, or in the moderngl context `ctx`."""
+    computed with `baker`, or in the moderngl context `ctx`. A damaged cache entry is
+    discarded and computed again, and why is appended to `problems`."""
     BakeSettings(lut_size=size, lut_samples=samples).resolved()  # validates
     key = cache.make_key("brdf-lut", size=size, samples=samples, method="quadrature")
     path = _cache_dir(cache_dir) / f"lut-{key}.npz"
     if use_cache:
-        hit = cache.load(path)
-        if hit is not None and hit.get("lut", np.empty(0)).shape == (size, size, 2):
-            return hit["lut"].astype(np.float32)
+        hit = cache.load(path, {"lut": cache.Spec((size, size, 2), "<f4")}, problems)
+        if hit is not None:
+            return hit["lut"]
     own = baker is None
     b = baker if baker is not None else gpu.Baker(ctx)
     try:
@@ -124,32 +126,51 @@ def bake_brdf_lut(
             b.close()
     if use_cache:
         try:
-            cache.save(path, {"lut": lut})
+            cache.save(path, {"lut": np.asarray(lut, dtype=np.float32)})
         except OSError:
             pass  # a read-only cache only costs time
     return lut
 
 
 def _pack(result: IBLBake) -> dict[str, np.ndarray]:
-    arrays = {f"mip{m}": mip for m, mip in enumerate(result.mips)}
-    arrays["lut"] = result.lut
-    arrays["sh"] = result.sh
+    arrays = {f"mip{m}": np.asarray(mip, dtype=np.float32) for m, mip in enumerate(result.mips)}
+    arrays["lut"] = np.asarray(result.lut, dtype=np.float32)
+    arrays["sh"] = np.asarray(result.sh, dtype=np.float64)
     arrays["settings"] = np.array(json.dumps(asdict(result.settings), sort_keys=True))
     return arrays
 
 
+def _schema(settings: BakeSettings) -> dict[str, cache.Spec]:
+    """What a cached bake of `settings` holds (the arrays `_pack` writes)."""
+    out = {f"mip{m}": cache.Spec((6, settings.size >> m, settings.size >> m, 3), "<f4")
+           for m in range(settings.levels)}
+    out["lut"] = cache.Spec((settings.lut_size, settings.lut_size, 2), "<f4")
+    out["sh"] = cache.Spec((9, 3), "<f8")
+    out["settings"] = cache.Spec((), "U")
+    return out
+
+
 def _unpack(arrays: dict[str, np.ndarray], settings: BakeSettings, key: str) -> IBLBake | None:
-    try:
-        mips = [arrays[f"mip{m}"].astype(np.float32) for m in range(settings.levels)]
-        lut, sh = arrays["lut"].astype(np.float32), arrays["sh"].astype(np.float64)
-    except KeyError:
+    """The bake in a cache entry that `cache.load` checked against `_schema(settings)`;
+    None when it was baked with other settings."""
+    if str(arrays["settings"]) != json.dumps(asdict(settings), sort_keys=True):
         return None
-    expected = [(6, settings.size >> m, settings.size >> m, 3) for m in range(settings.levels)]
-    if [m.shape for m in mips] != expected or lut.shape != (settings.lut_size,) * 2 + (2,):
-        return None
-    if sh.shape != (9, 3):
-        return None
-    return IBLBake(mips=mips, lut=lut, sh=sh, settings=settings, key=key, from_cache=True)
+    mips = [arrays[f"mip{m}"] for m in range(settings.levels)]
+    return IBLBake(mips=mips, lut=arrays["lut"], sh=arrays["sh"], settings=settings, key=key,
+                   from_cache=True)
+
+
+def cache_paths(env: Environment, settings: BakeSettings,
+                cache_dir: str | os.PathLike | None = None) -> dict[str, Path]:
+    """The cache files a bake of `env` with `settings` reads and writes: "ibl", "lut"."""
+    settings = settings.resolved()
+    folder = _cache_dir(cache_dir)
+    key = cache.make_key(
+        "ibl", env=env.content_hash(), settings=asdict(settings), growth=PREFILTER_GROWTH
+    )
+    lut = cache.make_key("brdf-lut", size=settings.lut_size, samples=settings.lut_samples,
+                         method="quadrature")
+    return {"ibl": folder / f"ibl-{key}.npz", "lut": folder / f"lut-{lut}.npz"}
 
 
 def bake(
@@ -172,13 +193,12 @@ def bake(
     settings = (settings or BakeSettings()).resolved()
     if not isinstance(env, Environment):
         env = load_environment(env, settings.size)
-    key = cache.make_key(
-        "ibl", env=env.content_hash(), settings=asdict(settings), growth=PREFILTER_GROWTH
-    )
     folder = _cache_dir(cache_dir)
-    path = folder / f"ibl-{key}.npz"
+    path = cache_paths(env, settings, folder)["ibl"]
+    key = path.stem.removeprefix("ibl-")
+    problems: list[str] = []  # damaged cache entries, discarded and baked again
     if use_cache:
-        hit = cache.load(path)
+        hit = cache.load(path, _schema(settings), problems)
         result = _unpack(hit, settings, key) if hit is not None else None
         if result is not None:
             result.warnings = list(env.warnings)
@@ -216,12 +236,14 @@ def bake(
             baker=baker,
             use_cache=use_cache,
             cache_dir=folder,
+            problems=problems,
         )
     finally:
         baker.close()
     sh = sh_irradiance(cube)
     result = IBLBake(
-        mips=mips, lut=lut, sh=sh, settings=settings, key=key, warnings=list(env.warnings)
+        mips=mips, lut=lut, sh=sh, settings=settings, key=key,
+        warnings=list(env.warnings) + problems,
     )
     if use_cache:
         try:

@@ -140,6 +140,17 @@ class Renderer(PreviewSettings):
         self.reset_accumulation()
         return MaterialStatus(True)
 
+    @property
+    def has_material(self) -> bool:
+        """Whether a material program is drawn on the mesh (False: the scene without it)."""
+        return self._program is not None
+
+    def clear_material(self) -> None:
+        """Draw no material until the next `set_material`: the program linked for another
+        document must not stand in for one that has none (the programs stay cached)."""
+        self._program = self.material.compiled = None
+        self.reset_accumulation()
+
     def set_energy_compensation(self, on: bool) -> None:
         """The preview's multiple-scattering compensation option (relinks once per state)."""
         if bool(on) == self.energy_compensation:
