@@ -1893,7 +1893,7 @@ def _sparse(path, size):
         f.truncate(size)
 
 
-def _set(a, value):
+def _set_element(a, value):
     a = a.copy()
     a.flat[len(a.flat) // 2] = value
     return a
@@ -1915,8 +1915,8 @@ HOSTILE_CACHE = {
         [_Unpickled(tmp / "ran")] * a.size, dtype=object).reshape(a.shape)),
     "wrong shape": _mutate_arrays(lambda a, tmp: a[..., :1].copy()),
     "wrong dtype": _mutate_arrays(lambda a, tmp: a.astype(np.float16)),
-    "a NaN": _mutate_arrays(lambda a, tmp: _set(a, np.nan)),
-    "an infinity": _mutate_arrays(lambda a, tmp: _set(a, np.inf)),
+    "a NaN": _mutate_arrays(lambda a, tmp: _set_element(a, np.nan)),
+    "an infinity": _mutate_arrays(lambda a, tmp: _set_element(a, np.inf)),
     "values changed, checksum kept": _scaled_keeping_checksum,
     "an older format version": _older_format,
 }
