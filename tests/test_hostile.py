@@ -710,9 +710,12 @@ def test_synthetic_image_readers_are_refused_before_allocating(tmp_path, name, w
     else:
         _add_texture(raw, name)
     doc = write(tmp_path / "m.json", raw)
-    script = ("import resource, sys\nfrom matedit.cli import main\n"
+    # The peak is VmHWM, this process's own: Linux carries the parent's ru_maxrss across
+    # fork and exec, so after a long pytest run getrusage would report pytest's peak.
+    script = ("import sys\nfrom matedit.cli import main\n"
               "rc = main(sys.argv[1:])\n"
-              "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)\n"
+              "hwm = [l for l in open('/proc/self/status') if l.startswith('VmHWM:')][0]\n"
+              "print(int(hwm.split()[1]) // 1024)\n"
               "raise SystemExit(rc)\n")
     import sys
 
