@@ -8,6 +8,7 @@ import json
 import os
 import stat
 
+import numpy as np
 import pytest
 from hostile import assert_clean_failure, base_material, cli, function_doc, write
 
@@ -1266,3 +1267,58 @@ def test_a_bake_killed_mid_write_leaves_a_leftover_the_next_run_removes(tmp_path
     assert sorted(p.name for p in dest.iterdir()) == ["m_base_color.png", "m_normal.png",
                                                       "m_orm.png"]
     assert signal.getsignal(signal.SIGTERM) == handler  # a command leaves it as it was
+
+
+# --- a real full disk (a small tmpfs), where root may mount one ------------------------------
+# Writers that buffer through stdio (OpenImageIO's PNG) lose ENOSPC in their close, so an
+# injected error in Python cannot stand in for this one: the disk must really be full.
+
+
+@pytest.fixture
+def tiny_disk(tmp_path):
+    import shutil as _shutil
+    import subprocess
+
+    mnt = tmp_path / "tiny"
+    mnt.mkdir()
+    mount = _shutil.which("mount")
+    if os.geteuid() != 0 or mount is None or subprocess.run(
+            [mount, "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(mnt)],
+            capture_output=True).returncode != 0:
+        pytest.skip("a 64 KiB tmpfs needs root and mount")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+@pytest.mark.parametrize("ext", [".png", ".exr", ".tif"])
+def test_an_image_that_does_not_fit_on_the_disk_is_an_error_and_keeps_the_old_file(
+        tiny_disk, ext):
+    from matedit.io.images import ImageError, write_image
+
+    target = tiny_disk / f"noise{ext}"
+    target.write_bytes(b"old")
+    noise = np.random.default_rng(1).random((256, 256, 3), dtype=np.float32)  # ~190 KiB
+    with pytest.raises(ImageError, match=rf"{target.name}: cannot write image") as info:
+        write_image(target, noise)
+    assert ".tmpdir" not in str(info.value)  # the message names the output, not a temporary
+    assert target.read_bytes() == b"old"
+    assert sorted(p.name for p in tiny_disk.iterdir()) == [target.name]
+
+
+@pytest.mark.gl
+def test_render_and_bake_to_a_full_disk_exit_2_and_keep_old_files(tiny_disk):
+    import glob
+
+    from matedit.resources import graphs_dir
+
+    sample = sorted(glob.glob(str(graphs_dir() / "materials" / "rusty_painted_metal.json")))[0]
+    old = tiny_disk / "r.png"
+    old.write_bytes(b"old")
+    rc, _, err = cli("render", sample, "-o", old, "--size", "384x384")
+    assert_clean_failure(rc, err)
+    assert "r.png" in err and old.read_bytes() == b"old"
+    rc, _, err = cli("bake", sample, "-o", tiny_disk / "maps", "--size", "256")
+    assert_clean_failure(rc, err)
+    assert sorted(p.name for p in tiny_disk.iterdir()) == ["r.png"]

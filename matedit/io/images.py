@@ -231,6 +231,24 @@ def write_image(path: str | os.PathLike, pixels: np.ndarray, *, half: bool = Fal
     write_oiio(p, spec, arr)
 
 
+def _written_problem(oname: str, spec) -> str:
+    """Why the file just written is not the whole image, or "". Some writers (PNG through
+    stdio) lose a full disk's error in their buffered close, so the file is read back."""
+    inp = oiio.ImageInput.open(oname)
+    if inp is None:
+        return _oiio_error() or "the written file cannot be read back"
+    try:
+        got = inp.spec()
+        if (got.width, got.height, got.nchannels) != (spec.width, spec.height, spec.nchannels):
+            return "the written file does not hold the whole image"
+        pixels = inp.read_image(0, 0, 0, got.nchannels, "float")
+        if pixels is None or inp.has_error:
+            return _oiio_error(inp) or "the written file is truncated (is the disk full?)"
+        return ""
+    finally:
+        inp.close()
+
+
 def write_oiio(path: Path, spec, pixels: np.ndarray) -> None:
     """Write `pixels` with OpenImageIO, atomically, through `atomic_output`."""
     name = str(path)
@@ -241,8 +259,14 @@ def write_oiio(path: Path, spec, pixels: np.ndarray) -> None:
                 raise ImageError(f"{name}: no image writer for this file type: {_oiio_error()}")
             ok = out.open(oname, spec) and out.write_image(np.ascontiguousarray(pixels))
             err = "" if ok else _oiio_error(out)
-            out.close()
+            closed = out.close()
+            if ok and not closed:
+                ok, err = False, _oiio_error(out)
+            if ok:
+                err = _written_problem(oname, spec)
+                ok = not err
             if not ok:
+                err = err.replace(str(oname), name).replace(str(tmp), name)
                 raise ImageError(f"{name}: cannot write image: {err}")
     except OSError as exc:
         raise ImageError(f"{name}: cannot write image: {exc.strerror or exc}") from exc
