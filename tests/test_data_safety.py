@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import stat
 
 import numpy as np
@@ -1322,3 +1323,32 @@ def test_render_and_bake_to_a_full_disk_exit_2_and_keep_old_files(tiny_disk):
     rc, _, err = cli("bake", sample, "-o", tiny_disk / "maps", "--size", "256")
     assert_clean_failure(rc, err)
     assert sorted(p.name for p in tiny_disk.iterdir()) == ["r.png"]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("command", ["render", "bake"])
+@pytest.mark.parametrize("where", ["through the link", "lexically"])
+def test_a_texture_reached_through_a_link_and_dotdot_is_an_input(tmp_path, command, where):
+    """`lnk/../NAME.png`, with lnk a link into another folder, names the NAME.png the system
+    reaches (beside the link's target), which the compiler reads; the one a reader that
+    tidies `..` away would open (beside the document) is guarded too."""
+    name = "albedo.png" if command == "render" else "m_base_color.png"  # a map bake writes
+    folder = tmp_path / "D"
+    (tmp_path / "far" / "sub").mkdir(parents=True)
+    folder.mkdir()
+    (folder / "lnk").symlink_to("../far/sub")
+    doc = _material_with_texture(folder)
+    raw = json.loads(doc.read_text())
+    raw["nodes"][-2]["settings"]["path"] = f"lnk/../{name}"
+    doc.write_text(json.dumps(raw))
+    physical, lexical = tmp_path / "far" / name, folder / name
+    os.replace(folder / "albedo.png", physical)
+    shutil.copyfile(physical, lexical)
+    before = {p: p.read_bytes() for p in (physical, lexical)}
+    target = physical if where == "through the link" else lexical
+    out = ["-o", target, "--size", "16x16"] if command == "render" else \
+        ["-o", target.parent, "--size", "16"]
+    rc, _, err = cli(command, doc, *out)
+    assert_clean_failure(rc, err)
+    assert "the texture" in err
+    assert {p: p.read_bytes() for p in before} == before

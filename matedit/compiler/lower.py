@@ -241,7 +241,9 @@ class _Lowerer:
         name = f"t_{pname}"
         path = str(node.settings.get("path", ""))
         if path and self.doc.path is not None and not Path(path).is_absolute():
-            path = os.path.abspath(Path(self.doc.path).parent / path)
+            # joined, not normalised: `lnk/../t.png` is the file the system reaches through
+            # the link, as validate and the overwrite check see it, not `t.png` beside it
+            path = str(Path(os.path.abspath(Path(self.doc.path).parent)) / path)
         if name not in self.ctx.textures:
             self.ctx.textures[name] = TextureInfo(name, nid, path,
                                                   bool(node.settings.get("srgb", True)), pname,

@@ -164,6 +164,8 @@ def document_inputs(doc, resolver=None, include_self: bool = True) -> dict[Path,
             target = _real(base / ref)
             kind = "the texture" if key == "path" else "the material function"
             found.setdefault(target, kind)
+            # and the file a reader that tidies `..` away first would open
+            found.setdefault(_real(os.path.abspath(base / ref)), kind)
             if key != "path" and resolver is not None and target not in seen_docs:
                 try:
                     sub = resolver.resolve(ref, d)
