@@ -46,24 +46,41 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM, raised where the program is so that every write in progress cleans up."""
 
 
-def _on_sigterm(signum, frame) -> None:
-    raise Terminated
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_STOPPING: list[int] = []  # set once a stop signal has interrupted the command
+
+
+def _on_stop_signal(signum, frame) -> None:
+    """The first SIGINT or SIGTERM interrupts the command; later ones are ignored, so a
+    second Ctrl+C cannot cut short the removal of temporaries the first one started."""
+    for s in _STOP_SIGNALS:
+        signal.signal(s, signal.SIG_IGN)
+    _STOPPING.append(signum)
+    raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
 
 
 def _catch_sigterm() -> tuple:
-    """Turn SIGTERM into `Terminated` while a command runs (not the editor, whose event loop
-    would defer it); returns what `_restore_sigterm` needs."""
+    """Turn SIGTERM into `Terminated` (and SIGINT into KeyboardInterrupt, once) while a
+    command runs (not the editor, whose event loop would defer it); returns what
+    `_restore_sigterm` needs."""
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return ()
-    previous = signal.signal(signal.SIGTERM, _on_sigterm)
-    return (signal.SIG_DFL if previous is None else previous,)
+    saved = []
+    for s in _STOP_SIGNALS:
+        previous = signal.signal(s, _on_stop_signal)
+        saved.append((s, signal.SIG_DFL if previous is None else previous))
+    return tuple(saved)
 
 
 def _restore_sigterm(saved: tuple) -> None:
-    if saved:
-        signal.signal(signal.SIGTERM, saved[0])
+    """The handlers from before the command; after a stop signal they stay ignored, since
+    the process is ending and a second signal still pending must not raise past main."""
+    if _STOPPING:
+        return
+    for s, handler in saved:
+        signal.signal(s, handler)
 
 
 class StdoutError(Exception):

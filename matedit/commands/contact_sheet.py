@@ -160,7 +160,8 @@ def run(args) -> int:
                           doc.name or path.stem)
             r, c = divmod(i, cols)
             sheet[r * n:(r + 1) * n, c * n:(c + 1) * n] = tile
-            print(f"{i + 1}/{len(docs)} {one_line(path.name)}", file=sys.stderr)
+            if sys.stderr is not None and sys.stderr.isatty():  # progress only on a terminal
+                print(f"{i + 1}/{len(docs)} {one_line(path.name)}", file=sys.stderr)
         renderer.release()
     finally:
         ctx.release()
