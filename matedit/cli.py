@@ -250,6 +250,9 @@ def main(argv: list[str] | None = None) -> int:
             return rc
         except StdoutError as exc:
             return _stdout_failed(exc)
+        except KeyboardInterrupt as exc:  # a stop signal just as the command was ending
+            report("error", "interrupted")
+            return 143 if isinstance(exc, Terminated) else 130
 
 
 def _run(argv: list[str], parser: argparse.ArgumentParser, editor: bool) -> int:
