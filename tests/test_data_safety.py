@@ -1358,3 +1358,25 @@ def test_a_texture_reached_through_a_link_and_dotdot_is_an_input(tmp_path, comma
     assert_clean_failure(rc, err)
     assert "the texture" in err
     assert {p: p.read_bytes() for p in before} == before
+
+
+@pytest.mark.gl
+def test_an_instance_texture_override_through_a_link_and_dotdot_is_an_input(tmp_path):
+    """An instance's `lnk/../tex2.png` override: the file beside the instance, as a reader
+    that tidies `..` away would open it, may not be the render's output either."""
+    src = tmp_path / "src"
+    src.mkdir()
+    doc = _material_with_texture(src)
+    folder = tmp_path / "D"
+    (tmp_path / "far" / "sub").mkdir(parents=True)
+    folder.mkdir()
+    (folder / "lnk").symlink_to(tmp_path / "far" / "sub")
+    shutil.copyfile(src / "albedo.png", folder / "tex2.png")
+    before = (folder / "tex2.png").read_bytes()
+    inst = folder / "i.json"
+    inst.write_text(json.dumps({"format": "matedit.instance", "version": 2,
+                                "parent": os.path.relpath(doc, folder),
+                                "parameters": {"albedo": "lnk/../tex2.png"}}))
+    rc, _, err = cli("render", inst, "-o", folder / "tex2.png", "--size", "16x16")
+    assert_clean_failure(rc, err)
+    assert "the texture" in err and (folder / "tex2.png").read_bytes() == before

@@ -174,6 +174,8 @@ def document_inputs(doc, resolver=None, include_self: bool = True) -> dict[Path,
                 todo.append((sub, kind))
         for parent in getattr(d, "instance_chain", ()):  # an instance's parents
             found.setdefault(_real(parent), "a parent of the instance")
+        for tex in getattr(d, "instance_textures", ()):  # its overrides, spelled as written
+            found.setdefault(_real(tex), "the texture")
         for key, what_ in (("mesh", "the preview mesh"), ("environment", "the environment")):
             f = preview_file(d, key)
             if f is None:

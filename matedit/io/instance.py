@@ -477,6 +477,7 @@ def _apply(inst: InstanceDocument, chain_docs: list[InstanceDocument], chain: li
     doc = copy.deepcopy(material)
     rebase_references(doc, anchor)
     doc.path = Path(inst.path) if inst.path else None
+    tidied: list[Path] = []
     for name, p in params.items():
         n = doc.graph.nodes[p.node]
         v = values[name]
@@ -484,6 +485,8 @@ def _apply(inst: InstanceDocument, chain_docs: list[InstanceDocument], chain: li
             if name not in texture_dirs:
                 v = n.settings.get("path", "")  # the material's own, rebased above
             elif v and not Path(v).is_absolute():
+                # the file a reader that tidies `..` away would open: guarded as an input too
+                tidied.append(Path(os.path.abspath(texture_dirs[name] / v)))
                 v = _relative(texture_dirs[name] / v, anchor.parent)
             n.settings["path"] = v
             values[name] = v
@@ -494,6 +497,7 @@ def _apply(inst: InstanceDocument, chain_docs: list[InstanceDocument], chain: li
     doc.preview = preview
     doc.name = inst.name or material.name
     doc.instance_chain = list(chain[1:])  # read by matedit.io.inputs.document_inputs
+    doc.instance_textures = tidied  # so is this
     return ResolvedInstance(inst, chain, material, params, inherited, values, doc, problems)
 
 
