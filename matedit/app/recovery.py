@@ -35,7 +35,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from matedit.io.atomic import read_bounded
+from matedit.io.atomic import pid_running, read_bounded
 from matedit.io.document import MAX_FILE_BYTES
 
 RECOVER, DISCARD, KEEP = "recover", "discard", "keep"
@@ -134,15 +134,7 @@ def _alive(pid: int) -> bool:
     if not isinstance(pid, int) or isinstance(pid, bool) or not 0 < pid <= MAX_PID \
             or pid == os.getpid():
         return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (OverflowError, ValueError):  # not a pid this system can have
-        return False
-    except OSError:  # exists, owned by someone else
-        return True
-    return True
+    return pid_running(pid)
 
 
 def check_entry_file(path: Path, what: str) -> os.stat_result | None:

@@ -120,18 +120,22 @@ def temporary_name(name: str, kind: str = "tmp") -> str:
     return f".{kept}.{os.getpid()}-{_host_tag()}.{secrets.token_hex(8)}.{kind}"
 
 
-def _process_gone(pid: int) -> bool:
-    if pid == os.getpid():
-        return False
+def pid_running(pid: int) -> bool:
+    """Whether a process `pid` runs on this machine (signal 0 probes without sending); any
+    integer may be asked, one no process can have is simply not running."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
-        return True
-    except (OverflowError, ValueError):  # no process can have that number
-        return True
-    except OSError:  # PermissionError: alive, someone else's
         return False
-    return False
+    except (OverflowError, ValueError):  # no process can have that number
+        return False
+    except OSError:  # PermissionError: alive, someone else's
+        return True
+    return True
+
+
+def _process_gone(pid: int) -> bool:
+    return pid != os.getpid() and not pid_running(pid)
 
 
 def remove_leftovers(folder: str | os.PathLike) -> list[str]:
