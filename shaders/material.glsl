@@ -10,6 +10,18 @@ struct MaterialAttributes {
     vec3 normal;    // tangent space
     vec3 emissive;
     float opacity;
+    // Beyond the talk; each default turns its lobe off (docs/shading.md, Lobes beyond the talk).
+    vec3 specularColor;        // tint of the dielectric F0
+    float ior;                 // dielectric F0 = ((ior - 1) / (ior + 1))^2 specularColor
+    float coat;                // clear coat weight
+    float coatRoughness;
+    vec3 coatColor;            // transmittance tint of the coat
+    float coatIor;
+    vec3 coatNormal;           // tangent space of the geometric normal
+    vec3 sheenColor;           // black: no sheen
+    float sheenRoughness;
+    float anisotropy;          // 0: isotropic GGX
+    vec3 anisotropyDirection;  // tangent space; +X is the mesh tangent
 };
 
 // The values an unconnected material output reads.
@@ -23,6 +35,17 @@ MaterialAttributes defaultMaterialAttributes() {
     m.normal = vec3(0.0, 0.0, 1.0);
     m.emissive = vec3(0.0);
     m.opacity = 1.0;
+    m.specularColor = vec3(1.0);
+    m.ior = 1.5;
+    m.coat = 0.0;
+    m.coatRoughness = 0.0;
+    m.coatColor = vec3(1.0);
+    m.coatIor = 1.5;
+    m.coatNormal = vec3(0.0, 0.0, 1.0);
+    m.sheenColor = vec3(0.0);
+    m.sheenRoughness = 0.3;
+    m.anisotropy = 0.0;
+    m.anisotropyDirection = vec3(1.0, 0.0, 0.0);
     return m;
 }
 
@@ -36,6 +59,25 @@ vec3 computeDiffuseColor(vec3 baseColor, float metallic) {
 vec3 computeF0(vec3 baseColor, float metallic) {
     // Karis 2013, "Real Shading in Unreal Engine 4", material model: lerp(0.04, BaseColor, Metallic)
     return mix(vec3(0.04), baseColor, metallic);
+}
+
+// F0 of a dielectric of index of refraction ior under air, tinted by specularColor.
+vec3 dielectricF0(float ior, vec3 specularColor) {
+    // Fresnel at normal incidence, ((n1 - n2) / (n1 + n2))^2 with n1 = 1; glTF
+    // KHR_materials_ior and KHR_materials_specular: ior 1.5 and white give the talk's 0.04
+    float r = (ior - 1.0) / (ior + 1.0);
+    return min(vec3(r * r) * specularColor, vec3(1.0));
+}
+
+// F0 of the material: the talk's lerp(0.04, baseColor, metallic), its 0.04 the dielectric F0
+// of ior and specularColor where the material writes either.
+vec3 materialF0(MaterialAttributes m) {
+    // Karis 2013, material model, with the dielectric F0 of glTF KHR_materials_ior/_specular
+#if defined(MATERIAL_HAS_IOR) || defined(MATERIAL_HAS_SPECULAR_COLOR)
+    return mix(dielectricF0(m.ior, m.specularColor), m.baseColor, m.metallic);
+#else
+    return computeF0(m.baseColor, m.metallic);
+#endif
 }
 
 // Tangent-space normal to world space through the (T, B, N) frame, renormalised.

@@ -62,11 +62,13 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
 }
 
 // Linear HDR colour leaving P towards the eye; N is the world-space shading normal
-// (tangentToWorldNormal of m.normal), V the unit vector to the eye.
-vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V) {
+// (tangentToWorldNormal of m.normal), V the unit vector to the eye, and (T, B, Ng) the
+// orthonormal tangent frame of the geometric normal Ng, which the coat's normal and the
+// anisotropic highlight's direction are given in.
+vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T, vec3 B) {
     // SHADING.md, output: (direct + ibl) * cavity + emissive
     vec3 diffuseColor = computeDiffuseColor(m.baseColor, m.metallic);
-    vec3 F0 = computeF0(m.baseColor, m.metallic);
+    vec3 F0 = materialF0(m);
     float roughness = saturate(m.roughness);
     ShadingContext s = makeShadingContext(P, N, V, diffuseColor, F0, roughness);
 #ifdef MATEDIT_ENERGY_COMPENSATION
@@ -87,4 +89,14 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V) {
     direct = directLighting(s);
     vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale);
     return (direct + ibl) * m.cavity + m.emissive;
+}
+
+// The talk's shading where no tangent frame is known (the deferred pass; materials with lobes
+// beyond the talk take the forward path): any frame around N.
+vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V) {
+    // matedit: the talk's model reads no tangent frame, so any one will do (sampling.glsl)
+    vec3 T;
+    vec3 B;
+    tangentFrame(N, T, B);
+    return shadeSurface(m, P, N, V, N, T, B);
 }

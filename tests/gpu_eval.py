@@ -73,8 +73,10 @@ def gpu_eval_many(
     uniform_blocks: Mapping[str, bytes] | None = None,
     textures: Mapping[str, object] | None = None,
     uniforms: Mapping[str, object] | None = None,
+    defines: tuple[str, ...] = (),
 ) -> dict[str, np.ndarray]:
     """Run `body` once per element; returns each output as float32 (n,) or (n, k).
+    `defines` are `#define NAME 1` lines placed before the includes (feature switches).
 
     `body` sees every input as a local of its type and assigns every output variable.
     `includes` are library files (``shaders/`` names); `preamble` is extra GLSL placed
@@ -105,7 +107,8 @@ def gpu_eval_many(
         [*decl, preamble, "void main() {", "    ivec2 _p = ivec2(gl_FragCoord.xy);", *reads,
          *locals_, "    {", body, "    }", *writes, "}"]
     )  # fmt: skip
-    asm = assemble(main, version="330 core", includes=includes or [], name="<gpu_eval>")
+    asm = assemble(main, version="330 core", includes=includes or [], name="<gpu_eval>",
+                   prelude="\n".join(f"#define {d} 1" for d in defines))
     try:
         prog = ctx.program(vertex_shader=_VERTEX, fragment_shader=asm.text)
     except Exception as exc:

@@ -91,6 +91,7 @@ def _safe_normalize(v: np.ndarray, fallback) -> np.ndarray:
 
 
 _Z = (0.0, 0.0, 1.0)
+_X = (1.0, 0.0, 0.0)
 
 
 def derivatives(ctx, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -362,6 +363,8 @@ def blend_material_attributes(a: Attributes, b: Attributes, t: np.ndarray) -> At
         x, y = a[name], b[name]
         out[name] = _mix(x, y, _col(t) if x.ndim == 2 else t)
     out["normal"] = _safe_normalize(out["normal"], _Z)
+    out["coatNormal"] = _safe_normalize(out["coatNormal"], _Z)
+    out["anisotropyDirection"] = _safe_normalize(out["anisotropyDirection"], _X)
     return out
 
 

@@ -30,7 +30,15 @@ from matedit.compiler.ir import (
 from matedit.graph import nodes
 from matedit.graph.model import MaterialDocument
 from matedit.graph.names import mangle
-from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, MA, MESH_UV, Role, kind_for
+from matedit.graph.nodes import (
+    ATTRIBUTE_FIELDS,
+    ATTRIBUTE_NAMES,
+    MA,
+    MESH_UV,
+    Role,
+    kind_for,
+    lobe_value_is_default,
+)
 from matedit.graph.ports import FunctionResolver, function_interface, layer_entries
 from matedit.graph.types import PortType, coerce_value
 from matedit.graph.validate import Analysis, Diagnostic, Severity, analyse
@@ -183,24 +191,36 @@ class _Lowerer:
 
     def _generic(self, nid, node) -> None:
         d = nodes.REGISTRY[node.kind]
-        args = self._inputs(nid)
         role = d.role
         if role == Role.MAKE_ATTRIBUTES:
-            # The tangent-space normal is only written when connected (MATERIAL_HAS_NORMAL).
-            idx = [f.name for f in ATTRIBUTE_FIELDS].index("normal")
-            if "normal" not in self.incoming[nid]:
-                args[idx] = Lit((0.0, 0.0, 1.0), PortType.VEC3)
+            # A field left at its default is compiled in as a literal, with no uniform.
+            unwritten = self._unwritten_fields(nid, node)
+            ins = self.a.in_types[nid]
+            args = [literal(PortType(f.type), f.default) if f.name in unwritten
+                    else self.arg(nid, f.name, ins[f.name], f.default) for f in ATTRIBUTE_FIELDS]
+        else:
+            args = self._inputs(nid)
         outs = [(p.name, self.a.out_types[nid][p.name]) for p in self.a.ports[nid].outputs]
         data = {"glsl": d.glsl} if d.glsl else {"inline": d.inline}
         self.ctx.kinds.add(node.kind)
         op = self.emit(Op(nid, nid, node.kind, args, outs, data))
         if role == Role.MAKE_ATTRIBUTES:
-            w = set(ALL_FIELDS)
-            if "normal" not in self.incoming[nid]:
-                w.discard("normal")
-            self.written[op.out("attributes").key()] = frozenset(w)
+            self.written[op.out("attributes").key()] = ALL_FIELDS - unwritten
         elif role in (Role.MASK_BLEND, Role.HEIGHT_BLEND):
             self.written[op.out("result").key()] = self._w(args[0]) | self._w(args[1])
+
+    def _unwritten_fields(self, nid: str, node) -> frozenset:
+        """Fields a Make Attributes leaves at their defaults, compiled in as literals: the
+        tangent-space normal when unconnected (MATERIAL_HAS_NORMAL), and each lobe input that
+        is unconnected at its default (its lobe compiled out; graph.commands makes moving it
+        off the default structural)."""
+        out = set()
+        for f in ATTRIBUTE_FIELDS:
+            if f.name in self.incoming[nid]:
+                continue
+            if f.name == "normal" or (f.lobe and lobe_value_is_default(node, f)):
+                out.add(f.name)
+        return frozenset(out)
 
     def _w(self, e: Expr) -> frozenset:
         if isinstance(e, Param):

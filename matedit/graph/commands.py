@@ -126,10 +126,25 @@ class SetValue(Command):
         if node is None:
             raise CommandError(f"no node {self.node_id!r}")
         self._old = copy.deepcopy(node.values.get(self.port))
-        graph._set_value(self.node_id, self.port, self.value)
+        _put_value(graph, self.node_id, self.port, self.value)
 
     def revert(self, graph):
-        graph._set_value(self.node_id, self.port, self._old)
+        _put_value(graph, self.node_id, self.port, self._old)
+
+
+def _put_value(graph, node_id: str, port: str, value: Any) -> None:
+    """A value edit is a uniform, except a lobe input of a Make Attributes moving off its
+    default or back to it: that compiles the lobe in or out (nodes.InputDef.lobe)."""
+    node = graph.nodes[node_id]
+    kind = ChangeKind.VALUE
+    fd = nodes.lobe_input(node.kind, port)
+    if fd is not None:
+        before = nodes.lobe_value_is_default(node, fd)
+        probe = copy.copy(node)
+        probe.values = {**node.values, port: fd.default if value is None else value}
+        if nodes.lobe_value_is_default(probe, fd) != before:
+            kind = ChangeKind.STRUCTURAL
+    graph._set_value(node_id, port, value, kind)
 
 
 @dataclass

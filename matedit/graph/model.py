@@ -170,13 +170,14 @@ class MaterialGraph:
         self.emit(ChangeEvent(ChangeKind.STRUCTURAL, "link_removed", (link.src, link.dst),
                               link.dst_port))
 
-    def _set_value(self, node_id: str, port: str, value: Any) -> None:
+    def _set_value(self, node_id: str, port: str, value: Any,
+                   kind: ChangeKind = ChangeKind.VALUE) -> None:
         node = self.nodes[node_id]
         if value is None:
             node.values.pop(port, None)
         else:
             node.values[port] = copy.deepcopy(value)
-        self.emit(ChangeEvent(ChangeKind.VALUE, "value", (node_id,), port))
+        self.emit(ChangeEvent(kind, "value", (node_id,), port))
 
     def _set_setting(self, node_id: str, name: str, value: Any, kind: ChangeKind) -> None:
         node = self.nodes[node_id]

@@ -18,7 +18,7 @@ rules live in `matedit.graph.ports`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum, auto
 from typing import Any
 
@@ -35,6 +35,13 @@ class InputDef:
     doc: str = ""
     range: tuple[float, float] | None = None
     required: bool = False
+    # Where an editor shows the port: ports sharing a group fold together (the material
+    # attributes: Base, Specular, Coat, Sheen, Anisotropy). Empty: ungrouped.
+    group: str = ""
+    # A lobe input of the material attributes: unconnected at its default it turns its lobe
+    # off, and the lobe's code is compiled out. Moving it off or back to its default is
+    # therefore a structural edit (one recompile), any other value edit a uniform.
+    lobe: bool = False
 
 
 @dataclass(frozen=True)
@@ -264,6 +271,10 @@ def _i(name, type_, default=0.0, doc="", rng=None, required=False) -> InputDef:
     return InputDef(name, type_, default, doc, rng, required)
 
 
+def _lobe(name, type_, default, doc, rng, group) -> InputDef:
+    return InputDef(name, type_, default, doc, rng, group=group, lobe=True)
+
+
 def _o(name, type_, doc="") -> OutputDef:
     return OutputDef(name, type_, doc)
 
@@ -287,6 +298,7 @@ def _un(category: str) -> MxNode:
 
 T = GENERIC
 UNIT = (0.0, 1.0)
+IOR_RANGE = (1.0, 3.0)
 
 # --- constants and parameters ---------------------------------------------------------------
 register(NodeDef(
@@ -543,7 +555,7 @@ register(NodeDef(
 
 # --- material attributes ---------------------------------------------------------------------
 MA = "MaterialAttributes"
-ATTRIBUTE_FIELDS: tuple[InputDef, ...] = (
+_BASE_FIELDS = (
     _i("baseColor", "vec3", [0.5, 0.5, 0.5], "albedo of dielectrics, F0 of metals", UNIT),
     _i("metallic", "float", 0.0, "0 dielectric, 1 metal", UNIT),
     _i("roughness", "float", 0.5, "perceptual roughness", UNIT),
@@ -552,10 +564,59 @@ ATTRIBUTE_FIELDS: tuple[InputDef, ...] = (
     _i("emissive", "vec3", [0.0, 0.0, 0.0], "linear HDR emission"),
     _i("opacity", "float", 1.0, "coverage", UNIT),
 )
+ATTRIBUTE_FIELDS: tuple[InputDef, ...] = tuple(replace(f, group="Base") for f in _BASE_FIELDS) + (
+    # Beyond the talk: each default turns its lobe off (docs/shading.md, Lobes beyond the talk).
+    _lobe("specularColor", "vec3", [1.0, 1.0, 1.0], "tint of the dielectric F0", UNIT,
+          "Specular"),
+    _lobe("ior", "float", 1.5, "index of refraction of dielectrics: F0 = ((ior-1)/(ior+1))^2",
+          IOR_RANGE, "Specular"),
+    _lobe("coat", "float", 0.0, "clear coat weight", UNIT, "Coat"),
+    _lobe("coatRoughness", "float", 0.0, "perceptual roughness of the coat", UNIT, "Coat"),
+    _lobe("coatColor", "vec3", [1.0, 1.0, 1.0], "transmittance tint of the coat", UNIT,
+          "Coat"),
+    _lobe("coatIor", "float", 1.5, "index of refraction of the coat", IOR_RANGE, "Coat"),
+    _lobe("coatNormal", "vec3", [0.0, 0.0, 1.0],
+          "tangent-space normal of the coat (unconnected: the geometric normal)", None, "Coat"),
+    _lobe("sheenColor", "vec3", [0.0, 0.0, 0.0], "sheen colour (black: no sheen)", UNIT,
+          "Sheen"),
+    _lobe("sheenRoughness", "float", 0.3, "sheen roughness", UNIT, "Sheen"),
+    _lobe("anisotropy", "float", 0.0, "stretch of the highlight along the direction", UNIT,
+          "Anisotropy"),
+    _lobe("anisotropyDirection", "vec3", [1.0, 0.0, 0.0],
+          "tangent-space direction the highlight stretches along (+X: the mesh tangent)",
+          None, "Anisotropy"),
+)
 ATTRIBUTE_NAMES = tuple(f.name for f in ATTRIBUTE_FIELDS)
+
+
+def _as_floats(value: Any) -> tuple[float, ...] | None:
+    try:
+        seq = value if isinstance(value, (list, tuple)) else [value]
+        return tuple(float(x) for x in seq)
+    except (TypeError, ValueError):
+        return None
+
+
+def lobe_value_is_default(node: Any, field_def: InputDef) -> bool:
+    """Whether a Make Attributes' unconnected lobe input holds its off default (the lobe is
+    then compiled out). A value that does not read as numbers counts as not default."""
+    value = node.values.get(field_def.name, field_def.default)
+    got, want = _as_floats(value), _as_floats(field_def.default)
+    if got is None or want is None:
+        return False
+    return got == want or (len(got) == 1 and got * len(want) == want)
+
+
+def lobe_input(kind: str, port: str) -> InputDef | None:
+    """The definition of a Make Attributes' lobe input (see InputDef.lobe), else None."""
+    d = REGISTRY.get(kind)
+    if d is None or d.role != Role.MAKE_ATTRIBUTES:
+        return None
+    return next((i for i in d.inputs if i.name == port and i.lobe), None)
 register(NodeDef(
     "make_attributes", "Make Material Attributes", "Material",
-    "Builds a MaterialAttributes from its seven fields.",
+    "Builds a MaterialAttributes from its fields (the talk's seven, then the lobes beyond "
+    "it, each off at its default).",
     inputs=ATTRIBUTE_FIELDS, outputs=(_o("attributes", MA),),
     glsl="node_make_attributes", role=Role.MAKE_ATTRIBUTES, thumbnail=Thumbnail.ALWAYS,
     mtlx=MxRecipe("attributes"),

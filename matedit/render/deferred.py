@@ -68,11 +68,21 @@ def may_be_translucent(ir, values: dict | None = None) -> bool:
     return False
 
 
+def writes_lobes(ir) -> bool:
+    """Whether the material writes a field beyond the talk's model (specular colour, IOR,
+    coat, sheen, anisotropy): the G-buffer holds only the talk's fields."""
+    from matedit.graph.nodes import ATTRIBUTE_FIELDS
+
+    return any(f.lobe and f.name in ir.attributes for f in ATTRIBUTE_FIELDS)
+
+
 def wants_forward(compiled, values: dict | None = None) -> bool:
     """Translucent materials are blended in draw order (every layer of the mesh), which a
     G-buffer of the nearest surface cannot reproduce: they take the forward path. A value edit
-    that makes a material translucent moves it there (one link, the first time)."""
-    return may_be_translucent(compiled.ir, values)
+    that makes a material translucent moves it there (one link, the first time). Materials
+    with lobes beyond the talk take it too, so the G-buffer and the one lighting pass stay the
+    talk's for every other material."""
+    return writes_lobes(compiled.ir) or may_be_translucent(compiled.ir, values)
 
 
 class GBuffer:

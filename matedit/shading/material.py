@@ -24,6 +24,18 @@ class MaterialAttributes:
     normal: np.ndarray = _v(0.0, 0.0, 1.0)
     emissive: np.ndarray = _v(0.0, 0.0, 0.0)
     opacity: np.ndarray | float = 1.0
+    # Beyond the talk; each default turns its lobe off.
+    specularColor: np.ndarray = _v(1.0, 1.0, 1.0)
+    ior: np.ndarray | float = 1.5
+    coat: np.ndarray | float = 0.0
+    coatRoughness: np.ndarray | float = 0.0
+    coatColor: np.ndarray = _v(1.0, 1.0, 1.0)
+    coatIor: np.ndarray | float = 1.5
+    coatNormal: np.ndarray = _v(0.0, 0.0, 1.0)
+    sheenColor: np.ndarray = _v(0.0, 0.0, 0.0)
+    sheenRoughness: np.ndarray | float = 0.3
+    anisotropy: np.ndarray | float = 0.0
+    anisotropyDirection: np.ndarray = _v(1.0, 0.0, 0.0)
 
 
 def defaultMaterialAttributes() -> MaterialAttributes:
@@ -36,6 +48,17 @@ def computeDiffuseColor(baseColor, metallic) -> np.ndarray:
 
 def computeF0(baseColor, metallic) -> np.ndarray:
     return mix(np.full(3, 0.04), f64(baseColor), f64(metallic)[..., None])
+
+
+def dielectricF0(ior, specularColor) -> np.ndarray:
+    r = (f64(ior) - 1.0) / (f64(ior) + 1.0)
+    return np.minimum((r * r)[..., None] * f64(specularColor), 1.0)
+
+
+def materialF0(m: MaterialAttributes) -> np.ndarray:
+    """The GLSL compiles the talk's 0.04 where the material writes neither ior nor
+    specularColor; at their defaults this gives 0.04 to 1e-16."""
+    return mix(dielectricF0(m.ior, m.specularColor), f64(m.baseColor), f64(m.metallic)[..., None])
 
 
 def tangentToWorldNormal(tangentNormal, T, B, N) -> np.ndarray:

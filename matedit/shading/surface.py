@@ -20,7 +20,7 @@ from matedit.shading.ibl import (
     splitSumSpecular,
 )
 from matedit.shading.lights import Light, ShadingContext, evaluateLight, makeShadingContext
-from matedit.shading.material import MaterialAttributes, computeDiffuseColor, computeF0
+from matedit.shading.material import MaterialAttributes, computeDiffuseColor, materialF0
 
 
 @dataclass
@@ -77,13 +77,15 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
 
 def shadeSurface(
     m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None,
-    energy_compensation: bool = False,
+    energy_compensation: bool = False, frame: tuple | None = None,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
-    `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019)."""
+    `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
+    `frame`: (Ng, T, B), the orthonormal tangent frame of the geometric normal that the coat
+    normal and the anisotropy direction are given in (None: the talk's model needs none)."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
-    F0 = computeF0(m.baseColor, m.metallic)
+    F0 = materialF0(m)
     roughness = saturate(m.roughness)
     s = makeShadingContext(P, N, V, diffuseColor, F0, roughness)
     if energy_compensation:

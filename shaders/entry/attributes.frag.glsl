@@ -1,12 +1,8 @@
 // ATTRIBUTES entry: the raw MaterialAttributes into four float targets (tests, `bake`).
 // Leading comment lines are documentation, not emitted.
 void main() {
-    g_surface.uv = v_uv;
-    g_surface.position = v_position;
-    g_surface.normal = normalize(v_normal);
-    g_surface.view = normalize(uFrame.cameraPosition.xyz - v_position);
-    g_surface.time = uFrame.params.x;
-    nodeSurfaceFrame(v_tangent, uFrame.model, uFrame.viewProjection);
+    nodeSetupSurface(v_position, v_normal, v_tangent, v_uv, uFrame.cameraPosition.xyz,
+                     uFrame.params.x, uFrame.model, uFrame.viewProjection);
     MaterialAttributes m = evaluateMaterial();
     out0 = vec4(m.baseColor, m.metallic);
     out1 = vec4(m.normal, m.roughness);

@@ -21,3 +21,26 @@ void nodeSurfaceFrame(vec4 tangent, mat4 model, mat4 viewProjection) {
     g_surface.model = model;
     g_surface.viewProjection = viewProjection;
 }
+
+// Fills g_surface from the interpolated vertex data: the first call of every entry's main().
+// `normal` is the interpolated geometric normal (the entries that shade pass it facing the
+// eye's side), renormalised here.
+void nodeSetupSurface(vec3 position, vec3 normal, vec4 tangent, vec2 uv, vec3 eye, float time,
+                      mat4 model, mat4 viewProjection) {
+    // matedit entry points: one setup shared by the forward, G-buffer and attributes entries
+    g_surface.uv = uv;
+    g_surface.position = position;
+    g_surface.normal = normalize(normal);
+    g_surface.view = normalize(eye - position);
+    g_surface.time = time;
+    nodeSurfaceFrame(tangent, model, viewProjection);
+}
+
+// The orthonormal tangent frame of the shaded point: the mesh tangent made orthogonal to the
+// geometric normal (Gram-Schmidt), the bitangent N x T with the tangent's handedness.
+void nodeTangentFrame(out vec3 T, out vec3 B) {
+    // Mikkelsen 2008, "Simulation of Wrinkled Surfaces Revisited": B = sign(w) (N x T)
+    vec3 Ng = g_surface.normal;
+    T = normalize(g_surface.tangent.xyz - Ng * dot(Ng, g_surface.tangent.xyz));
+    B = cross(Ng, T) * (g_surface.tangent.w < 0.0 ? -1.0 : 1.0);
+}

@@ -1,10 +1,14 @@
-// Make Material Attributes node: the struct from its seven fields.
+// Make Material Attributes node: the struct from its fields.
 #include "../material.glsl"
 
 void node_make_attributes(vec3 baseColor, float metallic, float roughness, float cavity,
-                          vec3 normal, vec3 emissive, float opacity,
+                          vec3 normal, vec3 emissive, float opacity, vec3 specularColor,
+                          float ior, float coat, float coatRoughness, vec3 coatColor,
+                          float coatIor, vec3 coatNormal, vec3 sheenColor,
+                          float sheenRoughness, float anisotropy, vec3 anisotropyDirection,
                           out MaterialAttributes attributes) {
-    // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set
+    // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set, then
+    // the lobes beyond it (docs/shading.md, Lobes beyond the talk)
     attributes.baseColor = baseColor;
     attributes.metallic = metallic;
     attributes.roughness = roughness;
@@ -12,4 +16,15 @@ void node_make_attributes(vec3 baseColor, float metallic, float roughness, float
     attributes.normal = normal;
     attributes.emissive = emissive;
     attributes.opacity = opacity;
+    attributes.specularColor = specularColor;
+    attributes.ior = ior;
+    attributes.coat = coat;
+    attributes.coatRoughness = coatRoughness;
+    attributes.coatColor = coatColor;
+    attributes.coatIor = coatIor;
+    attributes.coatNormal = coatNormal;
+    attributes.sheenColor = sheenColor;
+    attributes.sheenRoughness = sheenRoughness;
+    attributes.anisotropy = anisotropy;
+    attributes.anisotropyDirection = anisotropyDirection;
 }
