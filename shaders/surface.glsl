@@ -9,6 +9,24 @@
 #include "lights_reference.glsl"
 #endif
 
+// The lobes a view shows: MATEDIT_LOBES is a mask of LOBE_* bits (unset: every lobe). The
+// viewport's lobe views set it (base, coat, sheen, specular only); each lobe's contribution,
+// direct and image-based, is scaled by lobeOn of its bit.
+#define LOBE_DIFFUSE 1
+#define LOBE_SPECULAR 2
+#define LOBE_COAT 4
+#define LOBE_SHEEN 8
+#define LOBE_EMISSIVE 16
+#ifndef MATEDIT_LOBES
+#define MATEDIT_LOBES 31
+#endif
+
+// 1 where the view shows the lobe, 0 where it hides it (a constant: the compiler folds it).
+float lobeOn(int lobe) {
+    // matedit lobe views (docs/shading.md, Lobe views)
+    return (MATEDIT_LOBES & lobe) != 0 ? 1.0 : 0.0;
+}
+
 // Sum of all analytic lights of the block.
 vec3 directLighting(ShadingContext s) {
     // Karis 2013, "Real Shading in Unreal Engine 4", eq 9: lights add up
@@ -80,6 +98,13 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     s.diffuseColor *= diffuseScale;
     diffuseColor *= diffuseScale;
 #endif
+#if MATEDIT_LOBES != 31
+    // A lobe view: the base's diffuse and specular shown or hidden (every light and the IBL
+    // read them through diffuseColor and specularScale).
+    s.diffuseColor *= lobeOn(LOBE_DIFFUSE);
+    diffuseColor *= lobeOn(LOBE_DIFFUSE);
+    s.specularScale *= lobeOn(LOBE_SPECULAR);
+#endif
     vec3 direct;
 #ifndef MATEDIT_SPLIT_SUM_ONLY
     // uIbl.sampleOffset.z = 1: the area lights' reference (reference mode's frames)
@@ -88,7 +113,7 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
 #endif
     direct = directLighting(s);
     vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale);
-    return (direct + ibl) * m.cavity + m.emissive;
+    return (direct + ibl) * m.cavity + m.emissive * lobeOn(LOBE_EMISSIVE);
 }
 
 // The talk's shading where no tangent frame is known (the deferred pass; materials with lobes

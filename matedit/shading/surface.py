@@ -23,6 +23,15 @@ from matedit.shading.lights import Light, ShadingContext, evaluateLight, makeSha
 from matedit.shading.material import MaterialAttributes, computeDiffuseColor, materialF0
 
 
+# The lobe bits of MATEDIT_LOBES (surface.glsl).
+LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
+LOBES_ALL = 31
+
+
+def lobeOn(lobes: int, lobe: int) -> float:
+    return 1.0 if lobes & lobe else 0.0
+
+
 @dataclass
 class IblInputs:
     """What the shader reads from IblBlock and the environment textures.
@@ -77,12 +86,13 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
 
 def shadeSurface(
     m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None,
-    energy_compensation: bool = False, frame: tuple | None = None,
+    energy_compensation: bool = False, frame: tuple | None = None, lobes: int = LOBES_ALL,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
     `frame`: (Ng, T, B), the orthonormal tangent frame of the geometric normal that the coat
-    normal and the anisotropy direction are given in (None: the talk's model needs none)."""
+    normal and the anisotropy direction are given in (None: the talk's model needs none).
+    `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views)."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
@@ -95,6 +105,11 @@ def shadeSurface(
         s.specularScale, diffuse_scale = energyCompensation(F0, AB)
         s.diffuseColor = s.diffuseColor * diffuse_scale
         diffuseColor = s.diffuseColor
+    if lobes != LOBES_ALL:
+        s.diffuseColor = s.diffuseColor * lobeOn(lobes, LOBE_DIFFUSE)
+        diffuseColor = s.diffuseColor
+        s.specularScale = s.specularScale * lobeOn(lobes, LOBE_SPECULAR)
     direct = directLighting(s, lights)
     indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale)
-    return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive)
+    return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive) * lobeOn(
+        lobes, LOBE_EMISSIVE)
