@@ -837,3 +837,107 @@ def test_output_names_are_checked_identifiers_and_distinct():
     assert all(identifier_problem(s) is None for s in stems), stems
     assert all(paths[n].parent == Path("d") for n in names)
     assert len({s.lower() for s in stems}) == len(stems)
+
+
+# --- the lobes beyond the talk, both ways ----------------------------------------------------
+_LOBE_VALUES = {
+    "baseColor": [0.955, 0.638, 0.538], "metallic": 1.0, "roughness": 0.35,
+    "specularColor": [0.9, 0.8, 0.7], "ior": 1.8, "coat": 0.75, "coatRoughness": 0.08,
+    "coatColor": [0.96, 0.64, 0.54], "coatIor": 1.6, "sheenColor": [0.2, 0.3, 0.4],
+    "sheenRoughness": 0.6, "anisotropy": 0.7, "anisotropyDirection": [0.0, 1.0, 0.0],
+}
+
+
+def _lobe_material(path: Path) -> Path:
+    import json
+
+    path.write_text(json.dumps({
+        "format": "matedit.material", "version": 2, "name": "lobes",
+        "nodes": [{"id": "make", "kind": "make_attributes", "values": _LOBE_VALUES},
+                  {"id": "out", "kind": "material_output"}],
+        "links": [{"from": ["make", "attributes"], "to": ["out", "attributes"]}]}))
+    return path
+
+
+def test_every_lobe_field_exports_to_standard_surface_and_imports_back(tmp_path):
+    """Constant lobe fields survive export -> MaterialX validate() -> import, within 1e-6
+    (the direction through standard_surface's rotation in turns)."""
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    src = _lobe_material(tmp_path / "lobes.json")
+    r = cli("validate", str(src))
+    assert r.returncode == 0, r.stdout + r.stderr
+    out = tmp_path / "x" / "lobes.mtlx"
+    out.parent.mkdir()
+    r = cli("export", str(src), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    doc = load_with_stdlib(out)
+    ok, msg = doc.validate()
+    assert ok, msg
+    shader = next(n for n in doc.getNodes() if n.getCategory() == "standard_surface")
+    sets = {i.getName(): i.getValueString() for i in shader.getInputs()}
+    assert float(sets["coat"]) == pytest.approx(0.75)
+    assert float(sets["specular_rotation"]) == pytest.approx(0.25)  # +Y: a quarter turn
+    assert float(sets["sheen"]) == 1.0
+    back = tmp_path / "back.json"
+    r = cli("import", str(out), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    a = bake.attributes_cpu(lower_and_optimise(load(src), FileResolver()), 4)
+    b = bake.attributes_cpu(lower_and_optimise(load(back), FileResolver()), 4)
+    for k, v in _LOBE_VALUES.items():
+        np.testing.assert_allclose(b[k], a[k], atol=1e-6, err_msg=k)
+        np.testing.assert_allclose(a[k][0, 0], v, atol=1e-6, err_msg=k)
+
+
+def test_a_coated_copper_imports_its_coat_and_a_velvet_its_sheen(tmp_path):
+    """The way real MaterialX copper is written (white metal under a copper-tinted coat) and
+    a sheen weight times a sheen colour come in as our coat and sheenColor, not dropped."""
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    f = tmp_path / "copper.mtlx"
+    f.write_text(_doc(
+        '<standard_surface name="SR_copper" type="surfaceshader">'
+        '<input name="base_color" type="color3" value="1, 1, 1" />'
+        '<input name="metalness" type="float" value="1" />'
+        '<input name="coat" type="float" value="1" />'
+        '<input name="coat_color" type="color3" value="0.96, 0.64, 0.54" />'
+        '<input name="sheen" type="float" value="0.5" />'
+        '<input name="sheen_color" type="color3" value="0.8, 0.6, 0.4" />'
+        '<input name="specular_rotation" type="float" value="0.125" />'
+        '<input name="specular_anisotropy" type="float" value="0.5" />'
+        '</standard_surface>'
+        '<surfacematerial name="Copper" type="material">'
+        '<input name="surfaceshader" type="surfaceshader" nodename="SR_copper" />'
+        '</surfacematerial>'))
+    out = tmp_path / "copper.json"
+    r = cli("import", str(f), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    ir = lower_and_optimise(load(out), FileResolver())
+    a = bake.attributes_cpu(ir, 2)
+    assert {"coat", "coatColor", "sheenColor", "anisotropy", "anisotropyDirection"} <= set(
+        ir.attributes)
+    assert "coatRoughness" not in ir.attributes  # not set in the file: our default
+    np.testing.assert_allclose(a["coatColor"][0, 0], [0.96, 0.64, 0.54], atol=1e-6)
+    np.testing.assert_allclose(a["sheenColor"][0, 0], [0.4, 0.3, 0.2], atol=1e-6)
+    h = 0.5 ** 0.5
+    np.testing.assert_allclose(a["anisotropyDirection"][0, 0], [h, h, 0.0], atol=1e-6)
+
+
+def test_a_varying_anisotropy_direction_is_refused_on_export_with_its_name(tmp_path):
+    import json
+
+    src = tmp_path / "v.json"
+    src.write_text(json.dumps({
+        "format": "matedit.material", "version": 2, "name": "v",
+        "nodes": [{"id": "p", "kind": "world_position"},
+                  {"id": "make", "kind": "make_attributes", "values": {"anisotropy": 0.5}},
+                  {"id": "out", "kind": "material_output"}],
+        "links": [{"from": ["p", "position"], "to": ["make", "anisotropyDirection"]},
+                  {"from": ["make", "attributes"], "to": ["out", "attributes"]}]}))
+    r = cli("export", str(src), "-o", str(tmp_path / "v.mtlx"))
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert r.stderr.count("error:") == 1 and "anisotropyDirection" in r.stderr

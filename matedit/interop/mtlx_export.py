@@ -752,6 +752,9 @@ class _Exporter:
                 if name == "normal":
                     return self.node("normalize", "vector3", f"{hint}_nrm",
                                      [("in", m, "vector3")])
+                if name in ("coatNormal", "anisotropyDirection"):  # nlerp, as the shader
+                    return self.node("normalize", "vector3", f"{hint}_{name}_nrm",
+                                     [("in", m, "vector3")])
                 return m
             fields[f.name] = V(num[f.name], ft, make, a.geo or b.geo or t.geo)
         return V(num, PortType.MATERIAL, None, False, fields)
@@ -799,6 +802,7 @@ class _Exporter:
                 if c[0] == "value":
                     c = ("value", (c[1],) * 3)
                 outputs.append(("opacity", "color3", c))
+        outputs += self.lobes(f, written, color)
         for name, t, r in outputs:
             inp = shader.addInput(name, t)
             if r[0] == "value":
@@ -811,6 +815,47 @@ class _Exporter:
                 self._output(inp, name, t, r)
         mat = self.doc.addMaterialNode(mx.createValidName(f"M_{self.stem}"), shader)
         del mat
+
+    def lobes(self, f: dict, written: set, color) -> list[tuple[str, str, tuple]]:
+        """standard_surface inputs for the lobes beyond the talk the material writes: the
+        same meanings (coat colour a transmittance tint, sheen a weighted colour, IORs), the
+        tangent-space coat normal through a normalmap like the base's, and the anisotropy
+        direction as standard_surface's rotation (a fraction of a turn from the tangent),
+        which MaterialX can only take here from a constant direction."""
+        out: list[tuple[str, str, tuple]] = []
+        plain = (("specularColor", "specular_color", "color3"), ("ior", "specular_IOR", "float"),
+                 ("coat", "coat", "float"), ("coatRoughness", "coat_roughness", "float"),
+                 ("coatColor", "coat_color", "color3"), ("coatIor", "coat_IOR", "float"),
+                 ("sheenRoughness", "sheen_roughness", "float"),
+                 ("anisotropy", "specular_anisotropy", "float"))
+        # standard_surface's own defaults differ from ours where they would change the look
+        # of a lobe the material turns on: coat_roughness 0.1 (ours 0), sheen_roughness 0.3.
+        for ours, theirs, t in plain:
+            if ours in written or (ours == "coatRoughness" and "coat" in written):
+                out.append((theirs, t, color(f[ours]) if t == "color3" else f[ours].ref()))
+        if "sheenColor" in written:
+            out.append(("sheen", "float", ("value", 1.0)))
+            out.append(("sheen_color", "color3", color(f["sheenColor"])))
+            if "sheenRoughness" not in written:
+                out.append(("sheen_roughness", "float", ("value", 0.3)))
+        if "coatNormal" in written:
+            n = f["coatNormal"].ref()
+            if not (n[0] == "value" and tuple(n[1]) == (0.0, 0.0, 1.0)):
+                enc = self.node("add", "vector3", "coat_normal_encode", [
+                    ("in1", self.node("multiply", "vector3", "coat_normal_half",
+                                      [("in1", n, "vector3"), ("in2", ("value", 0.5), "float")]),
+                     "vector3"), ("in2", ("value", 0.5), "float")])
+                out.append(("coat_normal", "vector3", self.node(
+                    "normalmap", "vector3", "coat_normal_map", [("in", enc, "vector3")])))
+        if "anisotropyDirection" in written:
+            d = f["anisotropyDirection"].ref()
+            if d[0] != "value":
+                raise MtlxExportError(
+                    "anisotropyDirection: standard_surface takes the anisotropy direction as "
+                    "a rotation; a varying direction cannot be exported (use a constant)")
+            turn = math.atan2(float(d[1][1]), float(d[1][0])) / (2.0 * math.pi)
+            out.append(("specular_rotation", "float", ("value", turn % 1.0)))
+        return out
 
     def _output(self, inp, name: str, t: str, r: tuple) -> None:
         out = self.ng.addOutput(self.name(f"out_{name}"), t)

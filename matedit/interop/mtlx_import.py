@@ -16,6 +16,7 @@ must be relative and stay text in the document (they are never read here).
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -57,6 +58,40 @@ SURFACES: dict[str, dict[str, tuple[str, str | None, float]]] = {
         "normal": ("normal", None, 1.0), "emissive": ("emissiveColor", None, 1.0),
         "opacity": ("opacity", None, 1.0)},
 }
+# Surface category -> lobe attribute -> (input, weight input or None), read only where the
+# file sets the input (the surfaces' own defaults, such as standard_surface's coat_roughness
+# 0.1, would otherwise turn on code for a lobe the material does not use). A weight multiplies
+# the colour (sheen x sheen_color is our sheenColor).
+LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
+    "standard_surface": {
+        "specularColor": ("specular_color", None), "ior": ("specular_IOR", None),
+        "coat": ("coat", None), "coatRoughness": ("coat_roughness", None),
+        "coatColor": ("coat_color", None), "coatIor": ("coat_IOR", None),
+        "coatNormal": ("coat_normal", None), "sheenColor": ("sheen_color", "sheen"),
+        "sheenRoughness": ("sheen_roughness", None),
+        "anisotropy": ("specular_anisotropy", None),
+        "anisotropyDirection": ("specular_rotation", None)},
+    "open_pbr_surface": {
+        "specularColor": ("specular_color", None), "ior": ("specular_ior", None),
+        "coat": ("coat_weight", None), "coatRoughness": ("coat_roughness", None),
+        "coatColor": ("coat_color", None), "coatIor": ("coat_ior", None),
+        "coatNormal": ("geometry_coat_normal", None), "sheenColor": ("fuzz_color", "fuzz_weight"),
+        "sheenRoughness": ("fuzz_roughness", None),
+        "anisotropy": ("specular_roughness_anisotropy", None)},
+    "gltf_pbr": {
+        "ior": ("ior", None), "coat": ("clearcoat", None),
+        "coatRoughness": ("clearcoat_roughness", None), "coatNormal": ("clearcoat_normal", None),
+        "sheenColor": ("sheen_color", None), "sheenRoughness": ("sheen_roughness", None),
+        "anisotropy": ("anisotropy_strength", None),
+        "anisotropyDirection": ("anisotropy_rotation", None)},
+    "UsdPreviewSurface": {
+        "ior": ("ior", None), "coat": ("clearcoat", None),
+        "coatRoughness": ("clearcoatRoughness", None)},
+}
+# Rotations of the anisotropy direction from the tangent: standard_surface's in turns (0..1),
+# glTF's in radians.
+_ROTATION_TO_RADIANS = {"standard_surface": 2.0 * 3.141592653589793, "gltf_pbr": 1.0}
+
 # Surfaces whose normal input is world space (a normalmap node is expected there); the
 # UsdPreviewSurface normal is tangent space already.
 WORLD_NORMAL = {"standard_surface", "open_pbr_surface", "gltf_pbr"}
@@ -554,16 +589,53 @@ class _Importer:
                         self.connect(scaled, mul, "b")
                     src = Src(mul, "result", width=src.width)
             self.connect(src, make, attr)
+        self.lobes(shader, cat, make)
         return self.mat
 
-    def normal(self, shader, name: str, world: bool, make: str) -> None:
+    def lobes(self, shader, cat: str, make: str) -> None:
+        """The lobes beyond the talk that the file sets (LOBES)."""
+        where = f"node {self.name_of(shader)}"
+        for attr, (inp, weight) in LOBES.get(cat, {}).items():
+            if shader.getInput(inp) is None and (weight is None or
+                                                 shader.getInput(weight) is None):
+                continue
+            if attr == "coatNormal":
+                self.normal(shader, inp, cat in WORLD_NORMAL, make, "coatNormal")
+                continue
+            src = self.surface_input(shader, inp)
+            if src is None:
+                continue
+            if attr == "anisotropyDirection":
+                if src.node is not None:
+                    self.err(f"{where}: input {inp}: only a constant anisotropy rotation is "
+                             "supported")
+                    continue
+                angle = src.value[0] * _ROTATION_TO_RADIANS[cat]
+                src = Src(value=[math.cos(angle), math.sin(angle), 0.0], width=3)
+            if weight is not None:
+                w = self.surface_input(shader, weight)
+                if w is not None and w.node is not None:
+                    mul = self.add(f"{attr}_weight", _kind("multiply"))
+                    self.connect(src, mul, "a")
+                    self.connect(w, mul, "b")
+                    src = Src(mul, "result", width=src.width)
+                elif w is not None and src.node is None:
+                    src = Src(value=[v * w.value[0] for v in src.value], width=src.width)
+                elif w is not None and w.value[0] != 1.0:
+                    mul = self.add(f"{attr}_weight", _kind("multiply"),
+                                   values={"b": w.value[0]})
+                    self.connect(src, mul, "a")
+                    src = Src(mul, "result", width=src.width)
+            self.connect(src, make, attr)
+
+    def normal(self, shader, name: str, world: bool, make: str, port: str = "normal") -> None:
         inp = shader.getInput(name)
         if inp is None:
             return
         if not world:
             src = self.surface_input(shader, name)
             if src is not None:
-                self.connect(src, make, "normal")
+                self.connect(src, make, port)
             return
         up = None
         if inp.getNodeGraphString():
@@ -601,13 +673,13 @@ class _Importer:
             except ValueError as exc:
                 self.err(str(exc))
                 return
-            self.connect(Src(value=decoded, width=3), make, "normal")
+            self.connect(Src(value=decoded, width=3), make, port)
             return
         two = self.add(f"{up.getName()}_x2", _kind("multiply"), values={"b": [2.0, 2.0, 2.0]})
         self.connect(enc, two, "a")
         one = self.add(up.getName(), _kind("subtract"), values={"b": [1.0, 1.0, 1.0]})
         self.connect(Src(two, "result", width=3), one, "a")
-        self.connect(Src(one, "result", width=3), make, "normal")
+        self.connect(Src(one, "result", width=3), make, port)
 
 
 def _load_mtlx(path: Path):
