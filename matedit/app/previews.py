@@ -4,10 +4,11 @@ After each edit settles, the material is lowered (not optimised, so every socket
 exists) and evaluated with numpy on a small preview sphere, so that masks built
 from normals and positions read as well as those built from UVs; each shown
 node's first float, vector or MaterialAttributes output becomes a thumbnail:
-floats as grey, vectors as colour, MaterialAttributes as their base colour, all
-display-encoded (sRGB). Thumbnails show on pattern nodes (noise, checker,
-gradient, textures, function calls, layer stacks: NodeDef.thumbnail) and on the selected nodes, so
-they do not crowd the graph; large graphs skip them: previews never slow editing.
+floats as grey, vectors as colour, MaterialAttributes shaded by the numpy twin of
+the shading under a small fixed rig (matedit.shading.thumbnail), all display-encoded
+(sRGB). Thumbnails show on pattern nodes (noise, checker, gradient, textures, function
+calls, layer stacks: NodeDef.thumbnail) and on the selected nodes, so they do not crowd
+the graph; large graphs skip them: previews never slow editing.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from matedit.compiler.lower import CompileError, lower_document
 from matedit.graph import nodes
 from matedit.graph.nodes import Thumbnail
 from matedit.graph.types import PortType
+from matedit.shading import thumbnail
 
 SIZE = 48
 MAX_NODES = 400
@@ -47,9 +49,19 @@ def preview_sphere(size: int = SIZE) -> tuple[SurfaceArrays, np.ndarray]:
                          grid=(size, size)), inside  # the footprint: filtered edges, bumps
 
 
+def shaded(attrs: dict, size: int = SIZE) -> np.ndarray:
+    """A MaterialAttributes on the preview sphere, shaded by the numpy twin of the shading
+    (every lobe) under the thumbnail rig (matedit.shading.thumbnail)."""
+    surface, _ = preview_sphere(size)
+    N = surface.normal
+    T, B = thumbnail.preview_frame(N)
+    with np.errstate(all="ignore"):
+        return thumbnail.shade_attributes(attrs, N, T, B, surface.view)
+
+
 def to_image(value, inside: np.ndarray | None = None, size: int = SIZE) -> QImage | None:
     if isinstance(value, dict):
-        value = value.get("baseColor")
+        value = shaded(value, size) if "baseColor" in value else None
     if value is None:
         return None
     a = np.asarray(value, dtype=np.float64)
