@@ -55,7 +55,7 @@ def snapshot_document(doc):
 
 def viewport_textures(cm, doc) -> dict:
     """The texture files the viewport will load for `cm` (what its value push names)."""
-    from matedit.app.compile_service import texture_paths
+    from matedit.app.paths import texture_paths
 
     return {k: (str(v) if v else None) for k, v in texture_paths(cm, doc).items()}
 

@@ -37,7 +37,8 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app import file_dialogs
-from matedit.app.compile_service import MaterialCompiler, texture_paths, uniform_values
+from matedit.app.compile_service import MaterialCompiler, uniform_values
+from matedit.app.paths import texture_paths
 from matedit.app.theme import icon
 
 MESHES = ("sphere", "cube", "plane", "cylinder")

@@ -42,6 +42,12 @@ class Env:
     textures: dict[str, np.ndarray] = field(default_factory=dict)
     functions: dict[str, Scope] = field(default_factory=dict)
 
+    def call(self, function: str, args: list[Any]) -> tuple:
+        """The outputs of the material function `function` for its argument values (the op
+        table's call row evaluates through this, not through this module)."""
+        scope = self.functions[function]
+        return eval_scope(scope, dict(zip((p for p, _ in scope.params), args)), self)
+
 
 def _broadcast(value, t: PortType, n: int) -> np.ndarray:
     v = np.asarray(value, dtype=np.float64)

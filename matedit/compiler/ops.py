@@ -81,12 +81,9 @@ def _blend(op: Op, args: list, env) -> tuple:
 
 
 def _call(op: Op, args: list, env) -> tuple:
-    from matedit.compiler.cpu_eval import eval_scope
-
     if env is None:
         raise TypeError("a material function call is not folded")
-    scope = env.functions[op.data["function"]]
-    return eval_scope(scope, dict(zip((p for p, _ in scope.params), args)), env)
+    return env.call(op.data["function"], args)
 
 
 BUILTINS: dict[str, OpImpl] = {o.kind: o for o in (

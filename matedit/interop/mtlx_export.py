@@ -30,7 +30,6 @@ in lin_rec709.
 
 from __future__ import annotations
 
-import functools
 import math
 import os
 from collections.abc import Callable
@@ -44,7 +43,7 @@ from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV,
 from matedit.graph import nodes
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, Role, kind_for, role_of
 from matedit.graph.types import PortType
-from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, to_materialx
+from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, stdlib, to_materialx
 from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
 
 MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "vector3",
@@ -821,16 +820,6 @@ class _Exporter:
         inp.setOutputString(out.getName())
 
 
-@functools.lru_cache(maxsize=1)
-def stdlib():
-    """MaterialX's standard libraries, loaded once (read only)."""
-    import MaterialX as mx
-
-    lib = mx.createDocument()
-    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
-    return lib
-
-
 def validate(text: str) -> tuple[bool, str]:
     """MaterialX's own validate() on a document text, with the stdlib loaded."""
     import MaterialX as mx
@@ -861,8 +850,8 @@ def export_ir(ir: MaterialIR, out: Path, size: int, stem: str) -> MtlxExport:
 
 def export(doc, resolver, out: Path, size: int = 512) -> MtlxExport:
     """The MaterialX export of a material document (raises CompileError, MtlxExportError)."""
-    from matedit.compiler.export import stem_of
     from matedit.compiler.lower import lower_document
+    from matedit.interop.export import stem_of
 
     ir = lower_document(doc, resolver)
     return export_ir(ir, Path(out), size, stem_of(doc))
