@@ -66,6 +66,8 @@ def eval_expr(e: Expr, table: dict[str, Any], env: Env | None) -> Any:
         if e.type == PortType.MATERIAL:
             return default_attributes(n)
         return _broadcast(e.value, e.type, n)
+    if env is None:  # constant folding: nothing else has a value without a surface
+        raise TypeError(f"{e!r} has no value without a surface")
     if isinstance(e, Uni):
         if e.type == PortType.TEXTURE:
             return env.textures.get(e.name, checker_texture())

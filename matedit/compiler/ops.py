@@ -86,7 +86,7 @@ def _call(op: Op, args: list, env) -> tuple:
     return env.call(op.data["function"], args)
 
 
-BUILTINS: dict[str, OpImpl] = {o.kind: o for o in (
+BUILTINS: dict[str | Role, OpImpl] = {o.kind: o for o in (
     OpImpl(MASK, _mask, glsl="({0}).{channels}"),
     OpImpl(APPEND, _append, glsl="{T}({args})"),
     OpImpl(SET_ATTRIBUTES, _set_attributes, glsl="{0}", assigns="fields"),
@@ -123,5 +123,6 @@ def implementation(kind: str) -> OpImpl:
     impl = _CACHE.get(kind)
     if impl is None:
         role = role_of(kind)
-        impl = _CACHE[kind] = BUILTINS.get(role) or _catalogue(kind)
+        impl = _CACHE[kind] = (BUILTINS.get(role) if role is not None else None) or \
+            _catalogue(kind)
     return impl

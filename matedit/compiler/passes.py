@@ -74,12 +74,14 @@ def _fold(op: Op) -> list[Lit] | None:
             or not all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
             or not all(t.is_numeric for _, t in op.outs)):
         return None
+    lit_args = [a for a in op.args if isinstance(a, Lit)]  # all of them (checked above)
     try:
-        values = cpu_eval.eval_op(op, [_as_array(a) for a in op.args], None)
+        values = cpu_eval.eval_op(op, [_as_array(a) for a in lit_args], None)
     except Exception:  # no implementation, or it refused: keep the op
         return None
     lits = [_to_lit(v, t) for v, (_, t) in zip(values, op.outs)]
-    return lits if all(l is not None for l in lits) else None
+    kept = [l for l in lits if l is not None]
+    return kept if len(kept) == len(lits) else None
 
 
 def fold_and_merge(scope: Scope) -> None:

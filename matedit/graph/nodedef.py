@@ -8,6 +8,7 @@ not the catalogue that loads them.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from enum import Enum, auto
 from typing import Any
@@ -250,17 +251,19 @@ def categories() -> dict[str, list[NodeDef]]:
 
 # --- helpers to keep the table short -------------------------------------------------------
 
-def _i(name, type_, default=0.0, doc="", rng=None, required=False) -> InputDef:
+def _i(name: str, type_: str, default: Any = 0.0, doc: str = "",
+       rng: tuple[float, float] | None = None, required: bool = False) -> InputDef:
     return InputDef(name, type_, default, doc, rng, required)
 
 
-def _o(name, type_, doc="") -> OutputDef:
+def _o(name: str, type_: str, doc: str = "") -> OutputDef:
     return OutputDef(name, type_, doc)
 
 
-def _op(kind, title, inline, inputs, doc, out_type=GENERIC, category="Math", glsl=None,
-        mtlx=BAKE, reads=None):
-    register(NodeDef(
+def _op(kind: str, title: str, inline: str | None, inputs: Iterable[InputDef], doc: str,
+        out_type: str = GENERIC, category: str = "Math", glsl: str | None = None,
+        mtlx: Mtlx = BAKE, reads: MxNode | None = None) -> NodeDef:
+    return register(NodeDef(
         kind=kind, title=title, category=category, description=doc,
         inputs=tuple(inputs), outputs=(_o("result", out_type),),
         inline=inline if glsl is None else None, glsl=glsl, mtlx=mtlx, mtlx_reads=reads,

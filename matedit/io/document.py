@@ -209,8 +209,9 @@ def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocumen
         _expect(isinstance(text, str), file, "text must be a string", c["id"], "text")
         _expect(c["id"] not in doc.graph.comments and c["id"] not in doc.graph.nodes, file,
                 "duplicate id", c["id"], "id")
-        doc.graph.comments[c["id"]] = Comment(c["id"], text, tuple(float(x) for x in rect),
-                                              tuple(float(x) for x in color),
+        x, y, w, h = (float(v) for v in rect)
+        r, g, b = (float(v) for v in color)
+        doc.graph.comments[c["id"]] = Comment(c["id"], text, (x, y, w, h), (r, g, b),
                                               _unknown(c, COMMENT_FIELDS))
     try:  # here, not only in loads: a dict from elsewhere may hold an infinity in a kept field
         dumps(doc)

@@ -86,7 +86,8 @@ def _number(raw, file, i, name, limit: float) -> float:
 def _vec3(raw, file, i, name, limit: float = MAX_EXTENT) -> tuple[float, float, float]:
     if not (isinstance(raw, list) and len(raw) == 3):
         raise RigError(file, "must be a list of 3 finite numbers", i, name)
-    return tuple(_number(v, file, i, name, limit) for v in raw)
+    x, y, z = (_number(v, file, i, name, limit) for v in raw)
+    return x, y, z
 
 
 def _scalar(raw, file, i, name, *, positive=False, limit: float = MAX_EXTENT) -> float:
@@ -130,7 +131,7 @@ def light_from_dict(raw, file: str | None = None, index: int = 0) -> Light:
     if "name" in raw and not isinstance(raw["name"], str):
         raise RigError(file, "must be a string", index, "name")
     return Light(kind=kind, position=position,
-                 direction=tuple(v / n for v in direction), color=color,
+                 direction=(direction[0] / n, direction[1] / n, direction[2] / n), color=color,
                  intensity=intensity, influence_radius=influence,
                  source_radius=radius if kind in ("sphere", "tube") else 0.0,
                  source_length=length if kind == "tube" else 0.0)
