@@ -1,4 +1,4 @@
-"""The `matedit` command (see ARCHITECTURE.md, "Command line": a contract)."""
+"""The `matedit` command (docs/cli.md: a contract)."""
 
 from __future__ import annotations
 

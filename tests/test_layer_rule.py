@@ -56,7 +56,7 @@ def test_blocker_really_blocks():
 
 
 def test_only_render_and_app_create_gl_contexts():
-    """Nothing above matedit/render creates an OpenGL context (ARCHITECTURE.md, layers)."""
+    """Nothing above matedit/render creates an OpenGL context (docs/architecture.md#layers-and-what-each-may-import)."""
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1] / "matedit"

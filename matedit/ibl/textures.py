@@ -7,7 +7,7 @@
     prog["uPrefilteredLevels"] = float(ibl.levels)   # M; sample at roughness * (M - 1)
     prog["uIrradianceSH"].write(ibl.sh_bytes())      # uniform vec3 uIrradianceSH[9]
 
-GLSL side (SHADING.md, split sum):
+GLSL side (docs/shading.md#image-based-lighting, split sum):
 
     vec3 pre = textureLod(uPrefiltered, R, roughness * (uPrefilteredLevels - 1.0)).rgb;
     vec2 AB = texture(uBrdfLut, vec2(NoV, roughness)).rg;
