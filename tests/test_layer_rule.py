@@ -13,7 +13,7 @@ from pathlib import Path
 
 import networkx as nx
 
-from matedit.layers import LAYERS, Layer
+from matedit.layers import LAYERS, Layer, layer_of
 
 PURE = ["matedit.graph.types", "matedit.graph.nodes", "matedit.graph.model",
         "matedit.graph.ports", "matedit.graph.commands", "matedit.graph.layers",
@@ -56,7 +56,8 @@ def test_blocker_really_blocks():
 
 
 def test_only_render_and_app_create_gl_contexts():
-    """Nothing above matedit/render creates an OpenGL context (docs/architecture.md#layers-and-what-each-may-import)."""
+    """Nothing above matedit/render creates an OpenGL context
+    (docs/architecture.md#layers-and-what-each-may-import)."""
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1] / "matedit"
@@ -127,19 +128,11 @@ def read_imports(root: Path) -> dict[str, list[Imp]]:
 
 def problems(imports: dict[str, list[Imp]], layers=LAYERS, package: str = "matedit") -> list[str]:
     """Every breach of the layer table and every import cycle among the package's modules."""
-    def layer_index(module: str) -> int | None:
-        best, found = -1, None
-        for i, layer in enumerate(layers):
-            for entry in layer.modules:
-                if (module == entry or module.startswith(entry + ".")) and len(entry) > best:
-                    best, found = len(entry), i
-        return found
-
     out: list[str] = []
     graph = nx.DiGraph()
     for module, imps in sorted(imports.items()):
         graph.add_node(module)
-        mine = layer_index(module)
+        mine = layer_of(module, layers)
         if mine is None or (module != package and layers[mine].modules == (package,)):
             out.append(f"{module}: in no layer of the table")
             continue
@@ -148,7 +141,7 @@ def problems(imports: dict[str, list[Imp]], layers=LAYERS, package: str = "mated
             if top == package:
                 if imp.target == module:
                     continue
-                theirs = layer_index(imp.target)
+                theirs = layer_of(imp.target, layers)
                 graph.add_edge(module, imp.target)
                 if theirs is not None and theirs > mine:
                     out.append(f"{module}:{imp.line}: imports {imp.target} of the later layer "
@@ -187,8 +180,8 @@ def _package(tmp_path: Path, files: dict[str, str]) -> Path:
     return root
 
 
-SMALL = (Layer("base", ("pkg",), ""), Layer("low", ("pkg.low",), "", ("numpy",)),
-         Layer("high", ("pkg.high",), "", ("PySide6",)))
+SMALL = (Layer("base", ("pkg",)), Layer("low", ("pkg.low",), ("numpy",)),
+         Layer("high", ("pkg.high",), ("PySide6",)))
 
 
 def test_the_checker_reports_a_planted_breach_cycle_and_foreign_import(tmp_path):

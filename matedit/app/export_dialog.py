@@ -83,7 +83,7 @@ class ExportDialog(QDialog):
         row.addWidget(browse)
         lay.addLayout(row)
         buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Cancel)
-        self.export_button = buttons.addButton("Export", QDialogButtonBox.ButtonRole.AcceptRole)
+        buttons.addButton("Export", QDialogButtonBox.ButtonRole.AcceptRole)
         buttons.accepted.connect(self.run_export)
         buttons.rejected.connect(self.reject)
         lay.addWidget(buttons)

@@ -108,9 +108,6 @@ class InstanceEditor(QWidget):
     def value(self, name: str) -> Any:
         return self.resolved.values[name]
 
-    def is_overridden(self, name: str) -> bool:
-        return name in self.doc.parameters
-
     def _base(self) -> Path:
         return Path(self.doc.path).parent if self.doc.path else Path.cwd()
 
@@ -268,7 +265,6 @@ def install(window) -> None:
     act = QAction("New &Instance of Material…", window)
     act.setToolTip("Create a material instance of the open material (or a chosen file)")
     act.triggered.connect(lambda: _new_instance_dialog(window))
-    window.act_new_instance = act
     menu = window.menuBar().actions()[0].menu()
     menu.insertAction(menu.actions()[1], act)
 

@@ -1,7 +1,7 @@
 """`matedit brdf-lut -o OUT.exr [--size N] [--samples N]`: write the environment BRDF LUT.
 
-Layout (docs/shading.md#file-conventions): row k holds roughness (k + 0.5) / N, column i NoV (i + 0.5) / N,
-R = A (scale), G = B (bias); float32 EXR.
+Layout (docs/shading.md#file-conventions): row k holds roughness (k + 0.5) / N, column i
+NoV (i + 0.5) / N, R = A (scale), G = B (bias); float32 EXR.
 """
 
 from __future__ import annotations

@@ -35,9 +35,6 @@ from matedit.graph.ports import FunctionResolver, function_interface, layer_entr
 from matedit.graph.types import PortType, coerce_value
 from matedit.graph.validate import Analysis, Diagnostic, Severity, analyse
 
-# Kinds the compiler lowers itself (NodeDef.lowered): a `_k_<role>` method each; every other
-# kind calls its GLSL function or inline template.
-SPECIAL_KINDS = nodes.kinds_where(lambda d: d.lowered)
 ALL_FIELDS = frozenset(ATTRIBUTE_NAMES)
 
 
@@ -302,7 +299,6 @@ class _Lowerer:
     def _k_material_output(self, nid, node) -> None:
         (arg,) = self._inputs(nid)
         self.scope.outputs.append(("attributes", PortType.MATERIAL, arg))
-        self.scope_written = {"attributes": self._w(arg)}
 
     def _k_function_input(self, nid, node) -> None:
         t = self.a.out_types[nid]["value"]

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, Op, Scope, Splat, Var
 from matedit.graph.nodes import is_impure
 from matedit.graph.types import PortType
 
 # The compiler's own ops whose value depends on more than their operands; catalogue kinds
 # declare it (NodeDef.impure: geometry, time, textures, uniforms).
-IMPURE_OPS = {"call"}
+IMPURE_OPS = {ops.CALL}
 
 
 def _subst(e: Expr, table: dict[str, Expr]) -> Expr:

@@ -240,6 +240,3 @@ class MaterialDocument:
         return (self.kind, self.name, self.description, repr(sorted(self.preview.items())),
                 self.graph.snapshot())
 
-
-# A material function is a document of kind FUNCTION; the alias names the concept.
-MaterialFunction = MaterialDocument

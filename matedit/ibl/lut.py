@@ -1,4 +1,5 @@
-"""The environment BRDF LUT of the split sum (docs/shading.md#image-based-lighting), by deterministic quadrature.
+"""The environment BRDF LUT of the split sum (docs/shading.md#image-based-lighting), by
+deterministic quadrature.
 
 A(NoV, roughness) and B(NoV, roughness) are the notes' IntegrateBRDF averages over GGX
 half vectors H (k = a/2, exact (1 - VoH)^5, zero where NoL <= 0). Plain Hammersley

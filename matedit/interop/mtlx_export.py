@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from matedit.compiler import ops
 from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV, Uni, Var
 from matedit.graph import nodes
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, Role, kind_for, role_of
@@ -49,7 +50,7 @@ from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
 MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "vector3",
            PortType.VEC4: "vector4"}
 # The compiler's own ops that stand for a catalogue kind's mapping.
-IR_OP_ROLES = {"blend": Role.MASK_BLEND, "mask": Role.COMPONENT_MASK}
+IR_OP_ROLES = {ops.BLEND: Role.MASK_BLEND, ops.MASK: Role.COMPONENT_MASK}
 MTLX_VERSION = "1.39"
 
 
@@ -234,7 +235,7 @@ class _Exporter:
         from matedit.compiler.cpu_eval import eval_op
 
         hint = f"{prefix}{op.node}"
-        if op.kind == "call":
+        if op.kind == ops.CALL:
             scope = self.functions[op.data["function"]]
             return self.scope(scope, dict(zip((p for p, _ in scope.params), args)),
                               f"{hint}_")
@@ -242,7 +243,7 @@ class _Exporter:
         d = nodes.get(op.kind)
         geo = (d is not None and d.geometry) or any(a.geo for a in args)
         kind = kind_for(IR_OP_ROLES[op.kind]) if op.kind in IR_OP_ROLES else op.kind
-        entry = mapping(kind) if op.kind != "weight" else MxRecipe("weight")
+        entry = mapping(kind) if op.kind != ops.WEIGHT else MxRecipe("weight")
         if entry == MxRecipe("normalize_vector") and args[0].type == PortType.FLOAT:
             entry = BAKE  # the stdlib normalizes vectors only
         outs_t = [t for _, t in op.outs]

@@ -15,15 +15,16 @@ Format (``"format": "matedit.lightrig"``, ``"version": 1``)::
       ]
     }
 
-Fields and units (docs/shading.md#conventions): ``type`` point | directional | sphere | tube; ``position``
-metres, world space (a sphere's or tube's centre; not used by directional lights);
-``direction`` unit vector (normalised on load): the travel direction of a directional
-light, a tube's axis; ``radius`` metres (sphere and tube source radius, >= 0); ``length``
-metres (tube, >= 0); ``color`` linear RGB, each >= 0; ``intensity`` >= 0: the radiant
-intensity of point, sphere and tube lights (radiance scale times the inverse-square
-falloff, docs/shading.md#analytic-lights, eq 9), the irradiance of a directional light; ``influence_radius``
-metres (> 0, the falloff window's R). Omitted fields take the defaults below. At most 16
-lights (the shader's block). Unknown fields are errors (a typo must not pass silently).
+Fields and units (docs/shading.md#conventions): ``type`` point | directional | sphere |
+tube; ``position`` metres, world space (a sphere's or tube's centre; not used by
+directional lights); ``direction`` unit vector (normalised on load): the travel direction
+of a directional light, a tube's axis; ``radius`` metres (sphere and tube source radius,
+>= 0); ``length`` metres (tube, >= 0); ``color`` linear RGB, each >= 0; ``intensity``
+>= 0: the radiant intensity of point, sphere and tube lights (radiance scale times the
+inverse-square falloff, docs/shading.md#analytic-lights, eq 9), the irradiance of a
+directional light; ``influence_radius`` metres (> 0, the falloff window's R). Omitted
+fields take the defaults below. At most 16 lights (the shader's block). Unknown fields are
+errors (a typo must not pass silently).
 
 Numbers follow the rule of every format (finite, within float32: matedit.graph.numbers) and
 stated limits that keep the shader's squares and products finite: positions, radii, lengths
