@@ -64,7 +64,7 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
 // Linear HDR colour leaving P towards the eye; N is the world-space shading normal
 // (tangentToWorldNormal of m.normal), V the unit vector to the eye.
 vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V) {
-    // SHADING.md, output: (direct + ibl) * cavity + emissive
+    // docs/shading.md#the-material-model: (direct + ibl) * cavity + emissive
     vec3 diffuseColor = computeDiffuseColor(m.baseColor, m.metallic);
     vec3 F0 = computeF0(m.baseColor, m.metallic);
     float roughness = saturate(m.roughness);
