@@ -51,6 +51,8 @@ case "$cmd" in
     setup_system
     setup_python
     .venv/bin/ruff check matedit tests benchmarks
+    .venv/bin/mypy  # the pure layers, as [tool.mypy] in pyproject.toml says
+    .venv/bin/vulture  # dead code ([tool.vulture]; framework names: tools/vulture_whitelist.py)
     # pytest-xvfb starts a virtual X server for the GUI tests; GL tests use EGL.
     .venv/bin/python -m pytest "$@"
     ;;

@@ -51,7 +51,8 @@ class EquirectSource:
         self.radiance = img.reshape(-1, 3).astype(np.float64)
 
     def prefiltered(self, r: np.ndarray, roughness: float) -> np.ndarray:
-        """sum L D(H) NoL dOmega / sum D(H) NoL dOmega with N = V = r (SHADING.md)."""
+        """sum L D(H) NoL dOmega / sum D(H) NoL dOmega with N = V = r
+        (docs/shading.md#image-based-lighting)."""
         nol = self.dirs @ r
         keep = nol > 0
         h = self.dirs[keep] + r

@@ -10,7 +10,7 @@ radius r (Le = I / (pi r^2)) or a capsule of radius 0.02 m and length l along X 
 I / (2 r l + pi r^2)), integrated over its solid angle against the GGX albedo. Rendered:
 the representative-point lights, evaluated by matedit.shading (the numpy twin the tests hold
 to the GLSL at 1e-4; `--gpu` evaluates the GLSL itself), for the widening divisor of
-a' = a + r / (c d): c = 3 (SHADING.md's reading, before) and c = 2 (the default now).
+a' = a + r / (c d): c = 3 (docs/shading.md's reading, before) and c = 2 (the default now).
 The tests (tests/test_shading_light_energy.py) check a subset on the GPU.
 """
 

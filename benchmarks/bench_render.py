@@ -19,7 +19,14 @@ from common import machine, median_time  # noqa: E402
 
 from matedit.compiler import compile_document  # noqa: E402
 from matedit.compiler.api import CompiledMaterial  # noqa: E402
-from matedit.compiler.emit import FRAME_BLOCK, SHADE_MAIN, SourceMap, vertex_source  # noqa: E402
+from matedit.compiler.emit import (  # noqa: E402
+    FRAME_BLOCK,
+    Entry,
+    SourceMap,
+    entry_text,
+    vertex_source,
+)
+from matedit.compiler.glsl_backend import prelude  # noqa: E402
 from matedit.compiler.ir import MaterialIR, Scope  # noqa: E402
 from matedit.compiler.targets import FRAME_BINDING, TARGETS  # noqa: E402
 from matedit.glsl.include import assemble  # noqa: E402
@@ -43,7 +50,7 @@ MaterialAttributes evaluateMaterial() {{
     m.opacity = 1.0;
     return m;
 }}
-{SHADE_MAIN}
+{entry_text(Entry.FORWARD)}
 """
 
 
@@ -55,7 +62,7 @@ def floor_material() -> CompiledMaterial:
     t = TARGETS["glsl330"]
     frag = assemble(FLOOR_BODY, t.version, ["common.glsl", "material.glsl",
                                             "nodes/context.glsl", "surface.glsl"],
-                    "<floor>", prelude=t.prelude())
+                    "<floor>", prelude=prelude(t))
     ir = MaterialIR(Scope("evaluateMaterial"), [], [], [], set(), [])
     return CompiledMaterial("glsl330", vertex_source(t), frag, SourceMap(), ir, "floor")
 

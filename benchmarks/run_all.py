@@ -879,12 +879,11 @@ def main(argv=None) -> int:
         optional_section(rep, optional)
     rep.add("## Goals")
     rep.add()
+    rep.add("Each verdict is this run's measured value against the target (the report holds no "
+            "reading written before the run: a verdict that flips between runs flips here).")
+    rep.add()
     rep.table(["goal", "target", "measured", "verdict"], "llll", goals)
     profile_sections(rep, gl, results)
-    notes = HERE / "RESULTS_NOTES.md"
-    if notes.exists():
-        rep.add(notes.read_text().rstrip())
-        rep.add()
     from matedit.io.atomic import atomic_write_text
 
     atomic_write_text(Path(args.out), "\n".join(rep.lines).rstrip() + "\n")

@@ -1,4 +1,4 @@
-"""The `matedit` command (see ARCHITECTURE.md, "Command line": a contract)."""
+"""The `matedit` command (docs/cli.md: a contract)."""
 
 from __future__ import annotations
 
@@ -9,37 +9,9 @@ import os
 import signal
 import sys
 
+from matedit.cli_support import UsageError, report
+
 QUIT_AFTER_FIRST_FRAME = "MATEDIT_QUIT_AFTER_FIRST_FRAME"
-
-
-def _escaped(c: str) -> str:
-    if "\udc80" <= c <= "\udcff":  # a byte of a file name that is not UTF-8 (PEP 383)
-        return f"\\x{ord(c) - 0xdc00:02x}"
-    return c.encode("unicode_escape", errors="backslashreplace").decode("ascii")
-
-
-def one_line(text: object) -> str:
-    """Text for one line of a terminal report: line breaks and other control characters from
-    file names or fields are shown escaped (a non-UTF-8 byte of a name as \\xNN), so a message
-    is always exactly one printable line."""
-    return "".join(c if c.isprintable() or c == " " else _escaped(c) for c in str(text))
-
-
-def report(severity: str, message: object) -> None:
-    """One `severity: message` line on stderr; a stderr that cannot be written is ignored
-    (there is nowhere left to say so)."""
-    stream = sys.stderr
-    if stream is None:
-        return
-    try:
-        stream.write(f"{severity}: {one_line(message)}\n")
-        stream.flush()
-    except (OSError, ValueError):
-        pass
-
-
-class UsageError(Exception):
-    """Bad input: reported as one `error: ...` line and exit status 2."""
 
 
 class Terminated(KeyboardInterrupt):

@@ -16,7 +16,7 @@ const float MIN_ANALYTIC_ROUGHNESS = 0.03;
 // Widening of the highlight by a sphere or tube light: a' = a + sourceRadius / (DIVISOR d).
 // 2: the form most public implementations of the notes use (a + 0.5 * sourceRadius / d);
 // measured within 0.78 .. 1.20 of the true specular energy for r/d <= 0.25 at roughness >= 0.2
-// (benchmarks/LIGHTS_ENERGY.md), where 3 (SHADING.md's earlier reading) reaches x2.15.
+// (benchmarks/LIGHTS_ENERGY.md), where 3 (docs/shading.md's earlier reading) reaches x2.15.
 #ifndef MATEDIT_AREA_WIDEN_DIVISOR
 #define MATEDIT_AREA_WIDEN_DIVISOR 2.0
 #endif
@@ -110,7 +110,7 @@ float sphereNormalization(float a, float sourceRadius, float d) {
 
 // Energy conservation of a line's highlight: a / a'_line.
 float lineNormalization(float a, float sourceLength, float d) {
-    // Karis 2013, "Real Shading in Unreal Engine 4", eq 20 (form a / a'); a' as SHADING.md
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 20 (form a / a'); a' as docs/shading.md#analytic-lights
     float aPrime = saturate(a + 0.5 * sourceLength / (MATEDIT_AREA_WIDEN_DIVISOR * max(d, 1e-8)));
     return a / aPrime;
 }

@@ -26,7 +26,7 @@ struct MaterialAttributes {
 
 // The values an unconnected material output reads.
 MaterialAttributes defaultMaterialAttributes() {
-    // SHADING.md, material model: defaults of the MaterialAttributes inputs
+    // docs/file-format.md#materialattributes: defaults of the MaterialAttributes inputs
     MaterialAttributes m;
     m.baseColor = vec3(0.5);
     m.metallic = 0.0;

@@ -36,6 +36,6 @@ vec3 linearToSRGB(vec3 c) {
 
 // The whole display transform: exposure, tone curve, sRGB.
 vec3 displayTransform(vec3 hdr, float exposureEV) {
-    // SHADING.md, output: 2^exposure, ACES fit (Narkowicz 2015), sRGB encode
+    // docs/shading.md#display: 2^exposure, ACES fit (Narkowicz 2015), sRGB encode
     return linearToSRGB(tonemapACES(applyExposure(hdr, exposureEV)));
 }

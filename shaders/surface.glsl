@@ -84,7 +84,7 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
 // orthonormal tangent frame of the geometric normal Ng, which the coat's normal and the
 // anisotropic highlight's direction are given in.
 vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T, vec3 B) {
-    // SHADING.md, output: (direct + ibl) * cavity + emissive
+    // docs/shading.md#the-material-model: (direct + ibl) * cavity + emissive
     vec3 diffuseColor = computeDiffuseColor(m.baseColor, m.metallic);
     vec3 F0 = materialF0(m);
     float roughness = saturate(m.roughness);

@@ -118,7 +118,7 @@ def test_recent_files_and_new_document(qtbot, sample_copy):
 def test_export_writes_the_same_files_as_matedit_compile(qtbot, tmp_path):
     from matedit.app.export_dialog import ExportDialog
     from matedit.cli import main
-    from matedit.compiler.export import export_shaders
+    from matedit.interop.export import export_shaders
 
     w = make_window(qtbot, SAMPLE)
     ours = tmp_path / "ours"

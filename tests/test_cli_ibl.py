@@ -1,4 +1,4 @@
-"""`matedit bake-ibl` and `matedit brdf-lut` (ARCHITECTURE.md, command line contract)."""
+"""`matedit bake-ibl` and `matedit brdf-lut` (docs/cli.md, the command line contract)."""
 
 from __future__ import annotations
 

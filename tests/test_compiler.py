@@ -221,3 +221,21 @@ def test_compile_command_bad_input_exits_2(tmp_path):
     r = subprocess.run([sys.executable, "-m", "matedit", "compile", str(fn), "-o",
                         str(tmp_path / "o")], capture_output=True, text=True)
     assert r.returncode == 2 and "material function" in r.stderr
+
+
+def test_a_call_lowered_without_a_resolver_is_a_compile_error():
+    """Validation reports a call nothing can resolve; should lowering ever meet one anyway,
+    it is a CompileError on the calling node, not an AttributeError on None."""
+    from matedit.compiler.ir import Scope
+    from matedit.compiler.lower import CompileError, _Ctx, _Lowerer
+    from matedit.graph.validate import analyse
+    from matedit.io.document import FileResolver, load
+    from matedit.resources import graphs_dir
+
+    doc = load(graphs_dir() / "functions" / "scratches.json")  # calls rotate_uv.json
+    checked = analyse(doc, FileResolver(), calls=False)
+    low = _Lowerer(_Ctx(None), doc, checked, top=False, scope=Scope("fn"))
+    with pytest.raises(CompileError, match="cannot resolve function 'rotate_uv.json' without "
+                       "a resolver") as info:
+        low.lower()
+    assert info.value.diagnostics[0].node_id == "rot"

@@ -84,9 +84,74 @@ def test_link_checker_sees_a_broken_link(tmp_path):
     assert broken_links(page) == ["missing.md", "pic.png", "#nowhere (no such heading)"]
 
 
+# Documents that are not in the repository (spelled in two parts, so that this file does not
+# cite them itself).
+OUTSIDE = ("ARCHITECTURE" + ".md", "SHADING" + ".md")
+CITATION = re.compile(r"(?<![\w/.])(?:\.\./)?docs/([\w.-]+\.md)(?:#([\w-]+))?")
+
+
+def repository_files() -> list[Path]:
+    """The files of the repository: those git tracks and the untracked ones it does not
+    ignore (every file below ROOT outside SKIP_DIRS where git is missing)."""
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=ROOT,
+                             capture_output=True, check=True).stdout.decode()
+        return sorted(ROOT / n for n in out.split("\0") if n and (ROOT / n).is_file())
+    except (OSError, subprocess.CalledProcessError):
+        return sorted(p for p in ROOT.rglob("*") if p.is_file()
+                      and not set(p.relative_to(ROOT).parts) & SKIP_DIRS)
+
+
+def citation_problems(files: list[Path], root: Path = ROOT) -> list[str]:
+    """A citation of a document outside the repository, or of a page of docs/ (with or
+    without `#section`) where the page or the section heading does not exist."""
+    problems = []
+    for path in files:
+        try:
+            text = path.read_text()
+        except (UnicodeDecodeError, OSError):
+            continue  # not text
+        rel = path.relative_to(root).as_posix()
+        for n, line in enumerate(text.splitlines(), 1):
+            problems += [f"{rel}:{n}: cites {name}, which is not in the repository"
+                         for name in OUTSIDE if name in line]
+            for m in CITATION.finditer(line):
+                doc = root / "docs" / m.group(1)
+                if not doc.is_file():
+                    problems.append(f"{rel}:{n}: cites docs/{m.group(1)}, which does not exist")
+                elif m.group(2) and m.group(2) not in anchors(doc):
+                    problems.append(f"{rel}:{n}: cites docs/{m.group(1)}#{m.group(2)}: no such "
+                                    "heading")
+    return problems
+
+
+def test_no_file_cites_a_document_outside_the_repository_or_a_missing_section():
+    problems = citation_problems(repository_files())
+    assert problems == [], "\n".join(problems)
+
+
+def test_the_citation_checker_sees_bad_citations(tmp_path):
+    d = "docs" + "/"  # (so that this file does not cite the missing pages itself)
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "shading.md").write_text("# Shading\n## The material model\n")
+    good = tmp_path / "good.py"
+    good.write_text(f"# {d}shading.md#the-material-model, ../{d}shading.md, {d}shading.md\n")
+    bad = tmp_path / "bad.glsl"
+    bad.write_text(f"// {OUTSIDE[1]}, output\n// {d}shading.md#output\n"
+                   f"/* see {d}lighting.md */ {OUTSIDE[0]}\n")
+    assert citation_problems([good, bad], tmp_path) == [
+        f"bad.glsl:1: cites {OUTSIDE[1]}, which is not in the repository",
+        f"bad.glsl:2: cites {d}shading.md#output: no such heading",
+        f"bad.glsl:3: cites {OUTSIDE[0]}, which is not in the repository",
+        f"bad.glsl:3: cites {d}lighting.md, which does not exist",
+    ]
+
+
 def test_readme_points_at_nothing_outside_the_repository():
     text = (ROOT / "README.md").read_text()
-    assert "ARCHITECTURE.md" not in text and "SHADING.md" not in text
+    assert not any(name in text for name in OUTSIDE)
     assert "docs/user-guide.md" in text and "packaging/build.sh" in text
 
 

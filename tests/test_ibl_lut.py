@@ -1,4 +1,5 @@
-"""The environment BRDF LUT against an independent brute-force integration (SHADING.md)."""
+"""The environment BRDF LUT against an independent brute-force integration
+(docs/shading.md#image-based-lighting)."""
 
 from __future__ import annotations
 
@@ -60,7 +61,8 @@ def default_lut(gl_ctx) -> np.ndarray:
 
 def test_default_lut_is_within_1e3_of_brute_force_at_cell_centres(ctx, default_lut, reference):
     err = np.abs(default_lut - reference)
-    # SHADING.md: 1e-3 max absolute; we measure ~5e-5, the reference's own accuracy.
+    # docs/shading.md#measured-accuracy: 1e-3 max absolute; we measure ~5e-5, the
+    # reference's own accuracy.
     assert err.max() < 1e-3, (
         f"max error {err.max():.2e} at {np.unravel_index(err.argmax(), err.shape)}"
     )

@@ -1,4 +1,5 @@
-"""GPU prefiltering and resampling against numpy brute force (SHADING.md, split sum)."""
+"""GPU prefiltering and resampling against numpy brute force (split sum:
+docs/shading.md#image-based-lighting)."""
 
 from __future__ import annotations
 
@@ -28,7 +29,8 @@ def blob_faces(n: int, centre=(0.3, 0.5, 0.8), sigma=0.12, peak=40.0, background
 def brute_force_prefilter(faces: np.ndarray, dirs: np.ndarray, roughness: float) -> np.ndarray:
     """sum env(L) D(H) NoL dOmega / sum D(H) NoL dOmega over every source texel, N = V = R.
 
-    This is the expectation the GGX-sampled estimator of SHADING.md converges to: L has
+    This is the expectation the GGX-sampled estimator of docs/shading.md#image-based-lighting
+    converges to: L has
     pdf D NoH / (4 VoH) = D / 4 when N = V, and each sample is weighted by NoL.
     """
     n = faces.shape[1]

@@ -17,9 +17,9 @@ import sys
 
 import pytest
 
-from matedit.compiler.export import compile_targets
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING
 from matedit.interop import cross
+from matedit.interop.export import compile_targets
 from matedit.io.document import FileResolver, load
 from matedit.resources import graphs_dir
 

@@ -113,7 +113,7 @@ def test_numpy_twins_bind_registered_kinds():
 
 def test_materialx_modules_name_only_materialx_nodes():
     mx = pytest.importorskip("MaterialX")
-    from matedit.interop.mtlx_export import stdlib
+    from matedit.interop.mtlx_colorspace import stdlib
 
     categories = frozenset(nd.getNodeString() for nd in stdlib().getNodeDefs())
     assert {"add", "normalize", "image"} <= categories  # the libraries did load

@@ -1,7 +1,7 @@
 """Reference mode's Monte Carlo area lights (lights_reference.glsl) against an independent
 numpy brute force: a deterministic quadrature over the emitter's surface of
-Le f(l, v) N.l cos(theta_light) / dist^2, with the BRDF written here from SHADING.md (Lambert,
-GGX, Schlick-Smith with k = (roughness + 1)^2 / 8, spherical-Gaussian Fresnel). Nothing is
+Le f(l, v) N.l cos(theta_light) / dist^2, with the BRDF written here from docs/shading.md#brdf
+(Lambert, GGX, Schlick-Smith with k = (roughness + 1)^2 / 8, spherical-Gaussian Fresnel). Nothing is
 imported from matedit.shading. Emitters (the file's header): a sphere of radiance
 I / (pi r^2); a capsule of radiance I / (2 r l + pi r^2).
 """

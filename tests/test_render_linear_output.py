@@ -1,7 +1,7 @@
 """`matedit render` linear output: .exr is the scene-referred frame, .png its display
 transform; `--lights none|RIG.json`; `--samples`; the white furnace through the command line.
 
-The references here are written in numpy from the formulas (SHADING.md, Karis 2013, IEC
+The references here are written in numpy from the formulas (docs/shading.md#display, Karis 2013, IEC
 61966-2-1, Narkowicz 2015); nothing is imported from matedit.shading.
 """
 

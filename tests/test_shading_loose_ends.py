@@ -1,5 +1,5 @@
 """Loose ends: the sampling frame at N = +Z, environments as six cube-face files, and cavity
-multiplying all lighting (SHADING.md, material model)."""
+multiplying all lighting (docs/shading.md#the-material-model)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Physical properties of the shading layer (SHADING.md, "What the tests hold"), in numpy."""
+"""Physical properties of the shading layer (docs/shading.md#what-the-tests-hold), in numpy."""
 
 from __future__ import annotations
 

@@ -10,14 +10,12 @@ the compiler's names (`p_<parameter>`, `u_<node>_<port>`).
 from __future__ import annotations
 
 import time
-from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QObject, Signal
 
 from matedit.app.controller import DocumentController
 from matedit.app.node_preview import PreviewTarget, preview_document
-from matedit.app.paths import absolute_of
 from matedit.compiler import CompiledMaterial, CompileError, compile_document
 from matedit.graph.model import MaterialDocument
 from matedit.graph.types import PortType, coerce_value
@@ -36,16 +34,6 @@ def uniform_values(compiled: CompiledMaterial, doc: MaterialDocument) -> dict[st
             out[u.name] = coerce_value(PortType(u.type.value), value)
         except (ValueError, TypeError):
             out[u.name] = u.default
-    return out
-
-
-def texture_paths(compiled: CompiledMaterial, doc: MaterialDocument) -> dict[str, Path | None]:
-    """Each texture uniform's file, from the texture parameter's current `path` setting."""
-    out: dict[str, Path | None] = {}
-    for t in compiled.ir.textures:
-        node = doc.graph.nodes.get(t.node)
-        ref = node.settings.get("path", t.path) if node is not None else t.path
-        out[t.name] = absolute_of(doc, ref) if isinstance(ref, str) and ref else None
     return out
 
 

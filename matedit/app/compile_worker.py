@@ -33,7 +33,6 @@ class CompileResult:
     diagnostics: list = field(default_factory=list)
     error: BaseException | None = None  # a compiler bug, reported as a diagnostic
     ms: float = 0.0
-    warm_ms: float | None = None  # the warm-up's time; None when none was done
 
 
 def compile_snapshot(doc, resolver, target: str, compile_fn=None):
@@ -55,7 +54,7 @@ def snapshot_document(doc):
 
 def viewport_textures(cm, doc) -> dict:
     """The texture files the viewport will load for `cm` (what its value push names)."""
-    from matedit.app.compile_service import texture_paths
+    from matedit.app.paths import texture_paths
 
     return {k: (str(v) if v else None) for k, v in texture_paths(cm, doc).items()}
 
@@ -116,9 +115,7 @@ class CompileWorker(QObject):
             return CompileResult(gen, None, [], exc, ms=(time.perf_counter() - t0) * 1e3)
         result = CompileResult(gen, cm, ms=(time.perf_counter() - t0) * 1e3)
         if viewport is not None and gen == self.generation:  # superseded: not worth warming
-            t1 = time.perf_counter()
             self._warm(gen, cm, doc, viewport)
-            result.warm_ms = (time.perf_counter() - t1) * 1e3
         return result
 
     def prepare_warm_up(self) -> None:

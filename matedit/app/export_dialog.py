@@ -25,9 +25,9 @@ from PySide6.QtWidgets import (
 
 from matedit.app import file_dialogs
 from matedit.compiler import TARGETS, CompileError
-from matedit.compiler.export import export_shaders
 from matedit.compiler.targets import CROSS_TARGETS
 from matedit.graph.model import MaterialDocument
+from matedit.interop.export import export_shaders
 from matedit.io.document import FileResolver
 from matedit.io.inputs import OverwriteError
 
@@ -83,7 +83,7 @@ class ExportDialog(QDialog):
         row.addWidget(browse)
         lay.addLayout(row)
         buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Cancel)
-        self.export_button = buttons.addButton("Export", QDialogButtonBox.ButtonRole.AcceptRole)
+        buttons.addButton("Export", QDialogButtonBox.ButtonRole.AcceptRole)
         buttons.accepted.connect(self.run_export)
         buttons.rejected.connect(self.reject)
         lay.addWidget(buttons)

@@ -31,6 +31,7 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app import file_dialogs
+from matedit.app.library import KIND_ROLE, PATH_ROLE
 from matedit.app.parameter_panel import ParameterPanel
 from matedit.app.viewport import ViewportWidget
 from matedit.compiler import CompileError, compile_document
@@ -106,9 +107,6 @@ class InstanceEditor(QWidget):
 
     def value(self, name: str) -> Any:
         return self.resolved.values[name]
-
-    def is_overridden(self, name: str) -> bool:
-        return name in self.doc.parameters
 
     def _base(self) -> Path:
         return Path(self.doc.path).parent if self.doc.path else Path.cwd()
@@ -267,7 +265,6 @@ def install(window) -> None:
     act = QAction("New &Instance of Material…", window)
     act.setToolTip("Create a material instance of the open material (or a chosen file)")
     act.triggered.connect(lambda: _new_instance_dialog(window))
-    window.act_new_instance = act
     menu = window.menuBar().actions()[0].menu()
     menu.insertAction(menu.actions()[1], act)
 
@@ -295,6 +292,12 @@ def install(window) -> None:
     window.open_instance = open_path
     window.create_instance = lambda parent_file, path: show(create_instance(parent_file, path))
     window.library.instanceOpenRequested.connect(open_path)
+
+    def attach(files: list[Path]) -> None:  # the Library's instances, under their parents
+        attach_instances(window.library.items("material"), files, PATH_ROLE, KIND_ROLE)
+
+    window.library.refreshed.connect(attach)
+    attach(window.library.files)  # the Library listed its files before this was connected
     window.library.instanceCreateRequested.connect(lambda p: _new_instance_dialog(window, p))
 
 

@@ -1,7 +1,7 @@
 """File › Export and File › Import entries for the interchange formats: glTF 2.0 (.gltf/.glb),
 MaterialX (.mtlx), baked texture maps, HLSL/MSL, and importing a .mtlx.
 
-The work is the command line's (matedit.interop, matedit.compiler.export), on the document in
+The work is the command line's (matedit.interop), on the document in
 the editor, with its outputs checked against its inputs the same way. Baking needs a GL
 context: it runs on a worker thread with its own headless EGL context, so the GUI thread's
 GLX context is never disturbed (GLVND refuses GLX on a thread with EGL current).
@@ -89,7 +89,7 @@ class InteropActions:
         return self.window.controller.resolver
 
     def _stem(self) -> str:
-        from matedit.compiler.export import stem_of
+        from matedit.interop.export import stem_of
 
         return stem_of(self.doc)
 
@@ -208,7 +208,7 @@ class InteropActions:
         folder = folder or self._ask_folder(title)
         if folder is None:
             return False
-        from matedit.compiler.export import export_shaders
+        from matedit.interop.export import export_shaders
 
         try:
             written = export_shaders(self.doc, self.resolver, ["hlsl", "msl"], folder)

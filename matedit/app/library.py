@@ -77,6 +77,9 @@ class LibraryPanel(QWidget):
     layerAddRequested = Signal(str)
     instanceOpenRequested = Signal(str)  # see matedit.app.instance_editor
     instanceCreateRequested = Signal(str)  # a material or instance to make an instance of
+    # after each refresh, the .json files listed (matedit.app.instance_editor hangs the
+    # instances among them under their parents' items)
+    refreshed = Signal(list)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -148,10 +151,8 @@ class LibraryPanel(QWidget):
                 if kind == "layer":
                     tip += "\nDrag onto the Layers panel, or double-click, to add it"
                 it.setToolTip(0, tip)
-        from matedit.app.instance_editor import attach_instances  # under their parents
-
-        files = [p for _, r in roots if r.is_dir() for p in sorted(r.rglob("*.json"))]
-        attach_instances(self.items("material"), files, PATH_ROLE, KIND_ROLE)
+        self.files = [p for _, r in roots if r.is_dir() for p in sorted(r.rglob("*.json"))]
+        self.refreshed.emit(self.files)
         for top in sections.values():
             top.setExpanded(True)
         self.filter(self.search.text())

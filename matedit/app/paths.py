@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from matedit.graph.model import MaterialDocument
+
+if TYPE_CHECKING:
+    from matedit.compiler.api import CompiledMaterial
 
 
 def reference_for(doc: MaterialDocument, target: str | os.PathLike) -> str:
@@ -43,3 +47,13 @@ def relativise_references(doc: MaterialDocument, new_path: Path) -> None:
                 container[key] = Path(os.path.relpath(ref, base)).as_posix()
             except ValueError:
                 pass
+
+
+def texture_paths(compiled: CompiledMaterial, doc: MaterialDocument) -> dict[str, Path | None]:
+    """Each texture uniform's file, from the texture parameter's current `path` setting."""
+    out: dict[str, Path | None] = {}
+    for t in compiled.ir.textures:
+        node = doc.graph.nodes.get(t.node)
+        ref = node.settings.get("path", t.path) if node is not None else t.path
+        out[t.name] = absolute_of(doc, ref) if isinstance(ref, str) and ref else None
+    return out

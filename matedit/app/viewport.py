@@ -37,7 +37,8 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app import file_dialogs
-from matedit.app.compile_service import MaterialCompiler, texture_paths, uniform_values
+from matedit.app.compile_service import MaterialCompiler, uniform_values
+from matedit.app.paths import texture_paths
 from matedit.app.theme import icon
 
 MESHES = ("sphere", "cube", "plane", "cylinder")
@@ -454,7 +455,6 @@ class ViewportPanel(QWidget):
         self.exposure_spin.setSuffix(" EV")
         self.exposure_spin.setKeyboardTracking(False)
         self.exposure_spin.setToolTip("Exposure in EV (type a value; arrow keys step 0.1)")
-        self.exposure_label = self.exposure_spin  # the number shown beside the slider
         # Laid over the view's bottom edge (placed with the banner): its text never moves
         # anything, and it takes no room from the bar.
         self.diff_label = QLabel("", self)
@@ -497,7 +497,6 @@ class ViewportPanel(QWidget):
         lay.addWidget(self.view, 1)
         self.failure = self._failure_notice()  # laid over the view: "does not compile"
         self._env_index = 0
-        self._custom_envs: list[str] = []
         self.env_dialog = file_dialogs.open_file  # tests replace it
         self.save_dialog = file_dialogs.save_file  # tests replace it
         self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment

@@ -2,7 +2,7 @@
 
 Each module exposes `register(subparsers)`, which adds its parser and sets
 `run=` to a function of the parsed arguments returning the exit status.
-Bad input raises `matedit.cli.UsageError` (one line, exit 2).
+Bad input raises `matedit.cli_support.UsageError` (one line, exit 2).
 """
 
 from matedit.commands import bake as bake_cmd

@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError
+from matedit.cli_support import UsageError
 from matedit.io.inputs import declare_inputs
 
 MAX_SIZE = 8192
@@ -64,8 +64,8 @@ def compile_error(exc, path: Path) -> UsageError:
 
 def run(args) -> int:
     from matedit.compiler import CompileError
-    from matedit.compiler.export import stem_of
     from matedit.interop.bake import bake_document, map_paths, write_maps
+    from matedit.interop.export import stem_of
     from matedit.io.document import FileResolver
     from matedit.io.images import ImageError
     from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite

@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError, report
+from matedit.cli_support import UsageError, report
 from matedit.io.inputs import declare_inputs
 
 

@@ -1,7 +1,7 @@
 """`matedit brdf-lut -o OUT.exr [--size N] [--samples N]`: write the environment BRDF LUT.
 
-Layout (ARCHITECTURE.md): row k holds roughness (k + 0.5) / N, column i NoV (i + 0.5) / N,
-R = A (scale), G = B (bias); float32 EXR.
+Layout (docs/shading.md#file-conventions): row k holds roughness (k + 0.5) / N, column i
+NoV (i + 0.5) / N, R = A (scale), G = B (bias); float32 EXR.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError
+from matedit.cli_support import UsageError
 from matedit.io.inputs import declare_inputs
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError, report
+from matedit.cli_support import UsageError, report
 from matedit.compiler.targets import CROSS_TARGETS, TARGETS
 from matedit.io.inputs import declare_inputs
 
@@ -29,8 +29,8 @@ def register(sub) -> None:
 def run(args) -> int:
     # Imported here, not at the top, so that other subcommands start without the compiler.
     from matedit.compiler import CompileError
-    from matedit.compiler.export import compile_targets, export_shaders, shader_files
     from matedit.interop.cross import CrossCompileError, available
+    from matedit.interop.export import compile_targets, export_shaders, shader_files
     from matedit.io.document import FileResolver, FormatError
     from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
     from matedit.io.instance import InstanceError, load_effective

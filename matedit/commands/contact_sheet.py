@@ -13,7 +13,7 @@ import math
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError, one_line
+from matedit.cli_support import UsageError, one_line
 from matedit.io.inputs import declare_inputs
 
 MIN_SIZE = 16

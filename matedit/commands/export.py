@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError, report
+from matedit.cli_support import UsageError, report
 from matedit.commands.bake import compile_error, load_material, parse_size, progress_printer
 from matedit.io.inputs import declare_inputs
 
@@ -51,9 +51,9 @@ def _gltf(args, out: Path) -> int:
     import numpy as np
 
     from matedit.compiler import CompileError
-    from matedit.compiler.export import stem_of
     from matedit.interop import gltf
     from matedit.interop.bake import bake_attributes, maps_from
+    from matedit.interop.export import stem_of
     from matedit.io.document import FileResolver
     from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
     from matedit.render.context import headless

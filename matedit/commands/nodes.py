@@ -11,7 +11,7 @@ import json
 import sys
 from typing import Any
 
-from matedit.cli import UsageError
+from matedit.cli_support import UsageError
 from matedit.io.inputs import declare_inputs
 
 GLSL_TARGETS = ("glsl330", "glsl450", "essl300")

@@ -9,7 +9,7 @@ import re
 import sys
 from pathlib import Path
 
-from matedit.cli import UsageError
+from matedit.cli_support import UsageError
 from matedit.io.inputs import declare_inputs
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from matedit.cli import report
+from matedit.cli_support import report
 from matedit.graph.validate import Severity, analyse
 from matedit.io.document import FileResolver, FormatError, load
 from matedit.io.inputs import declare_inputs

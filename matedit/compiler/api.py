@@ -10,6 +10,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+from matedit.compiler import ops
 from matedit.compiler.emit import Entry, SourceMap, fragment_source, std140_layout, vertex_source
 from matedit.compiler.ir import MaterialIR, Splat, Uni
 from matedit.compiler.lower import CompileError, lower_document
@@ -147,7 +148,7 @@ def prune(ir: MaterialIR) -> None:
         for op in scope.ops:
             for a in op.args:
                 _uniforms_in(a, used)
-            fn = op.data.get("function") if op.kind == "call" else None
+            fn = op.data.get("function") if op.kind == ops.CALL else None
             if fn and fn not in called:
                 called.add(fn)
                 if fn in by_name:
@@ -172,7 +173,7 @@ ENERGY_COMPENSATION_DEFINE = "MATEDIT_ENERGY_COMPENSATION"
 
 
 def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = None,
-                     target: str = "glsl330", mode: str | Entry = "shade",
+                     target: str = "glsl330", mode: str | Entry = Entry.FORWARD,
                      ir: MaterialIR | None = None) -> CompiledMaterial:
     """Compile for one target; raises CompileError (with diagnostics) for a bad graph."""
     if target not in TARGETS:

@@ -42,6 +42,12 @@ class Env:
     textures: dict[str, np.ndarray] = field(default_factory=dict)
     functions: dict[str, Scope] = field(default_factory=dict)
 
+    def call(self, function: str, args: list[Any]) -> tuple:
+        """The outputs of the material function `function` for its argument values (the op
+        table's call row evaluates through this, not through this module)."""
+        scope = self.functions[function]
+        return eval_scope(scope, dict(zip((p for p, _ in scope.params), args)), self)
+
 
 def _broadcast(value, t: PortType, n: int) -> np.ndarray:
     v = np.asarray(value, dtype=np.float64)
@@ -60,6 +66,8 @@ def eval_expr(e: Expr, table: dict[str, Any], env: Env | None) -> Any:
         if e.type == PortType.MATERIAL:
             return default_attributes(n)
         return _broadcast(e.value, e.type, n)
+    if env is None:  # constant folding: nothing else has a value without a surface
+        raise TypeError(f"{e!r} has no value without a surface")
     if isinstance(e, Uni):
         if e.type == PortType.TEXTURE:
             return env.textures.get(e.name, checker_texture())

@@ -45,11 +45,14 @@ class SurfaceArrays:
         return len(self.uv)
 
 
-IMPLS: dict[str, Callable[..., tuple]] = {}
+# A node kind's numpy twin: fn(surface, *inputs) -> its outputs, a tuple in declaration order
+# (one output may come bare: an array, or a MaterialAttributes dict).
+NumpyTwin = Callable[..., "tuple | np.ndarray | Attributes"]
+IMPLS: dict[str, NumpyTwin] = {}
 
 
-def _impl(kind: str):
-    def register(fn):
+def _impl(kind: str) -> Callable[[NumpyTwin], NumpyTwin]:
+    def register(fn: NumpyTwin) -> NumpyTwin:
         IMPLS[kind] = fn
         return fn
 

@@ -36,11 +36,3 @@ def fragment_source(ir: MaterialIR, target: Target, mode: str | Entry = Entry.FO
     material's own (the preview's MATEDIT_SPLIT_SUM_ONLY, MATEDIT_ENERGY_COMPENSATION)."""
     return glsl_backend.fragment_source(schedule(ir, mode, defines), target)
 
-
-def __getattr__(name: str) -> str:
-    # Older names of the entries' text (benchmarks import SHADE_MAIN)
-    if name == "SHADE_MAIN":
-        return entry_text(Entry.FORWARD)
-    if name == "ATTRIBUTES_MAIN":
-        return entry_text(Entry.ATTRIBUTES)
-    raise AttributeError(name)

@@ -28,7 +28,7 @@ from matedit.compiler.ir import (
     Var,
 )
 from matedit.graph import nodes
-from matedit.graph.model import MaterialDocument
+from matedit.graph.model import Link, MaterialDocument
 from matedit.graph.names import mangle
 from matedit.graph.nodes import (
     ATTRIBUTE_FIELDS,
@@ -43,9 +43,6 @@ from matedit.graph.ports import FunctionResolver, function_interface, layer_entr
 from matedit.graph.types import PortType, coerce_value
 from matedit.graph.validate import Analysis, Diagnostic, Severity, analyse
 
-# Kinds the compiler lowers itself (NodeDef.lowered): a `_k_<role>` method each; every other
-# kind calls its GLSL function or inline template.
-SPECIAL_KINDS = nodes.kinds_where(lambda d: d.lowered)
 ALL_FIELDS = frozenset(ATTRIBUTE_NAMES)
 
 
@@ -101,7 +98,7 @@ class _Lowerer:
         self.ctx, self.doc, self.a, self.top, self.scope = ctx, doc, analysis, top, scope
         self.alias: dict[tuple[str, str], Expr] = {}
         self.written: dict[str, frozenset] = {}  # expr key -> fields written (MA values)
-        self.incoming = {nid: {} for nid in doc.graph.nodes}
+        self.incoming: dict[str, dict[str, Link]] = {nid: {} for nid in doc.graph.nodes}
         for l in doc.graph.links:
             self.incoming[l.dst][l.dst_port] = l
 
@@ -322,7 +319,6 @@ class _Lowerer:
     def _k_material_output(self, nid, node) -> None:
         (arg,) = self._inputs(nid)
         self.scope.outputs.append(("attributes", PortType.MATERIAL, arg))
-        self.scope_written = {"attributes": self._w(arg)}
 
     def _k_function_input(self, nid, node) -> None:
         t = self.a.out_types[nid]["value"]
@@ -333,8 +329,17 @@ class _Lowerer:
         name = str(node.settings.get("name", nid))
         self.scope.outputs.append((name, t, self.arg(nid, "value", t, None)))
 
+    def _resolve(self, ref: str, nid: str) -> MaterialDocument:
+        """The material function `ref` that node `nid` calls; without a resolver a
+        CompileError on that node (validation reports it first for the top document)."""
+        if self.ctx.resolver is None:
+            raise CompileError([Diagnostic(
+                Severity.ERROR, f"cannot resolve function {ref!r} without a resolver", nid,
+                None, self.file)])
+        return self.ctx.resolver.resolve(ref, self.doc)
+
     def _call(self, nid: str, var: str, ref: str, args: dict[str, Expr]) -> tuple[Op, Scope]:
-        callee_doc = self.ctx.resolver.resolve(ref, self.doc)
+        callee_doc = self._resolve(ref, nid)
         callee = lower_function(self.ctx, callee_doc)
         iface = function_interface(callee_doc)
         ordered = []
@@ -347,7 +352,7 @@ class _Lowerer:
         for name, t in outs:
             if t == PortType.MATERIAL:
                 w = fw.get(name, ALL_FIELDS)
-                resolved = set()
+                resolved: set[str] = set()
                 for f in w:
                     if f.startswith("@"):
                         resolved |= self._w(params[f[1:]]) if f[1:] in params else ALL_FIELDS
@@ -372,7 +377,7 @@ class _Lowerer:
         acc: Expr | None = None
         for i, layer in enumerate(layer_entries(node)):
             lid = layer["id"]
-            iface = function_interface(self.ctx.resolver.resolve(layer["function"], self.doc))
+            iface = function_interface(self._resolve(layer["function"], nid))
             args = {p.name: port(f"{lid}_{p.name}") for p in iface.inputs}
             op, _ = self._call(nid, f"{nid}.{lid}", layer["function"], args)
             ma_out = next(o for o, t in op.outs if t == PortType.MATERIAL)
@@ -401,7 +406,7 @@ class _Lowerer:
                          port(f"{lid}_contrast")],
                         [("result", PortType.MATERIAL)], {"glsl": hb.glsl}))
                 else:
-                    biface = function_interface(self.ctx.resolver.resolve(blend, self.doc))
+                    biface = function_interface(self._resolve(blend, nid))
                     mas = [p.name for p in biface.inputs if p.type == MA][:2]
                     bargs = {mas[0]: acc, mas[1]: value}
                     for p in biface.inputs:

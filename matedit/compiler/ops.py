@@ -81,15 +81,12 @@ def _blend(op: Op, args: list, env) -> tuple:
 
 
 def _call(op: Op, args: list, env) -> tuple:
-    from matedit.compiler.cpu_eval import eval_scope
-
     if env is None:
         raise TypeError("a material function call is not folded")
-    scope = env.functions[op.data["function"]]
-    return eval_scope(scope, dict(zip((p for p, _ in scope.params), args)), env)
+    return env.call(op.data["function"], args)
 
 
-BUILTINS: dict[str, OpImpl] = {o.kind: o for o in (
+BUILTINS: dict[str | Role, OpImpl] = {o.kind: o for o in (
     OpImpl(MASK, _mask, glsl="({0}).{channels}"),
     OpImpl(APPEND, _append, glsl="{T}({args})"),
     OpImpl(SET_ATTRIBUTES, _set_attributes, glsl="{0}", assigns="fields"),
@@ -126,5 +123,6 @@ def implementation(kind: str) -> OpImpl:
     impl = _CACHE.get(kind)
     if impl is None:
         role = role_of(kind)
-        impl = _CACHE[kind] = BUILTINS.get(role) or _catalogue(kind)
+        impl = _CACHE[kind] = (BUILTINS.get(role) if role is not None else None) or \
+            _catalogue(kind)
     return impl

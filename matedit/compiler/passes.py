@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, Op, Scope, Splat, Var
 from matedit.graph.nodes import is_impure
 from matedit.graph.types import PortType
 
 # The compiler's own ops whose value depends on more than their operands; catalogue kinds
 # declare it (NodeDef.impure: geometry, time, textures, uniforms).
-IMPURE_OPS = {"call"}
+IMPURE_OPS = {ops.CALL}
 
 
 def _subst(e: Expr, table: dict[str, Expr]) -> Expr:
@@ -74,12 +75,14 @@ def _fold(op: Op) -> list[Lit] | None:
             or not all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
             or not all(t.is_numeric for _, t in op.outs)):
         return None
+    lit_args = [a for a in op.args if isinstance(a, Lit)]  # all of them (checked above)
     try:
-        values = cpu_eval.eval_op(op, [_as_array(a) for a in op.args], None)
+        values = cpu_eval.eval_op(op, [_as_array(a) for a in lit_args], None)
     except Exception:  # no implementation, or it refused: keep the op
         return None
     lits = [_to_lit(v, t) for v, (_, t) in zip(values, op.outs)]
-    return lits if all(l is not None for l in lits) else None
+    kept = [l for l in lits if l is not None]
+    return kept if len(kept) == len(lits) else None
 
 
 def fold_and_merge(scope: Scope) -> None:

@@ -15,6 +15,7 @@ from enum import Enum
 
 from matedit.compiler import ops
 from matedit.compiler.ir import Expr, MaterialIR, Op, Scope, Splat, Var
+from matedit.glsl.layout import BINDINGS, Block, Member
 from matedit.graph import nodes
 from matedit.graph.types import PortType
 
@@ -122,10 +123,8 @@ class Entry(Enum):
 
     @classmethod
     def of(cls, mode: str | Entry) -> Entry:
-        """An Entry from itself or an older mode name ("shade" is FORWARD)."""
-        if isinstance(mode, Entry):
-            return mode
-        return {"shade": cls.FORWARD}.get(mode) or cls(mode)
+        """An Entry from itself or its value ("forward", "gbuffer", "attributes")."""
+        return mode if isinstance(mode, Entry) else cls(mode)
 
 
 # Output variables of each entry (location order); the entry file writes them.
@@ -178,17 +177,11 @@ def schedule(ir: MaterialIR, mode: str | Entry = Entry.FORWARD,
                     ENTRY_OUTPUTS[entry])
 
 
-_STD140 = {PortType.FLOAT: (4, 4), PortType.VEC2: (8, 8), PortType.VEC3: (16, 12),
-           PortType.VEC4: (16, 16)}
-
-
 def std140_layout(ir: MaterialIR) -> tuple[dict[str, int], int]:
     """Byte offsets of the MaterialParams members (in name order) and the block size, by the
-    std140 rules."""
-    offsets, off = {}, 0
-    for u in ir.uniforms:
-        align, size = _STD140[u.type]
-        off = (off + align - 1) // align * align
-        offsets[u.name] = off
-        off += size
-    return offsets, (off + 15) // 16 * 16
+    std140 rules of matedit.glsl.layout (the one implementation of them)."""
+    if not ir.uniforms:
+        return {}, 0
+    block = Block("MaterialParams", "", BINDINGS["MATERIAL"],
+                  tuple(Member(u.name, u.type.value) for u in ir.uniforms))
+    return block.offsets(), block.size

@@ -20,22 +20,12 @@ FIRST_TEXTURE_BINDING = BINDINGS["FIRST_TEXTURE"]
 
 @dataclass(frozen=True)
 class Target:
+    """A dialect, as data: the GLSL back-end (`glsl_backend.prelude`, `varying`) writes it."""
+
     name: str
     version: str
     vulkan: bool = False
     es: bool = False
-
-    def prelude(self) -> str:
-        """What follows `#version` in every stage (the GLSL back-end writes it)."""
-        from matedit.compiler.glsl_backend import prelude
-
-        return prelude(self)
-
-    def varying(self, direction: str, location: int, decl: str) -> str:
-        """An interface variable between stages (the GLSL back-end writes it)."""
-        from matedit.compiler.glsl_backend import varying
-
-        return varying(self, direction, location, decl)
 
 
 TARGETS = {

@@ -100,7 +100,7 @@ class LayerStack:
             else:
                 gone = any(link.dst_port.startswith(f"{lid}_") for lid in drop_ports_of) or (
                     on_base and link.dst_port.endswith(BLEND_SUFFIXES))
-            if gone and on_base:
+            if gone and on_base and base is not None and base_id is not None:
                 base.setdefault("parked", []).append(
                     {"port": link.dst_port[len(base_id) + 1:],
                      "from": [link.src, link.src_port]})

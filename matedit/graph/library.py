@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from matedit.graph.nodes import (
+from matedit.graph.nodedef import (
     BAKE,
     GENERIC,
     MESH_UV,

@@ -227,6 +227,11 @@ class MaterialDocument:
     # and per link (links are plain tuples, so theirs are held here, keyed by the link).
     extra: dict[str, Any] = field(default_factory=dict)
     link_extra: dict[Link, dict[str, Any]] = field(default_factory=dict)
+    # An instance's effective material (matedit.io.instance.resolve) remembers the files it
+    # was made from, for matedit.io.inputs.document_inputs: its parents (real paths), and
+    # its texture overrides as spelled. Empty for any other document; never saved.
+    instance_chain: list[Path] = field(default_factory=list, compare=False, repr=False)
+    instance_textures: list[Path] = field(default_factory=list, compare=False, repr=False)
 
     @property
     def is_function(self) -> bool:
@@ -236,6 +241,3 @@ class MaterialDocument:
         return (self.kind, self.name, self.description, repr(sorted(self.preview.items())),
                 self.graph.snapshot())
 
-
-# A material function is a document of kind FUNCTION; the alias names the concept.
-MaterialFunction = MaterialDocument

@@ -62,10 +62,6 @@ def identifier_problem(name: object) -> str | None:
     return None
 
 
-def is_identifier(name: object) -> bool:
-    return identifier_problem(name) is None
-
-
 def mangle(text: str, limit: int = 48) -> str:
     """A readable ASCII identifier fragment from any text (for generated names only)."""
     s = re.sub(r"[^A-Za-z0-9]+", "_", text, flags=re.ASCII).strip("_")[:limit].strip("_")

@@ -7,7 +7,7 @@ Material functions are found through a `FunctionResolver` the caller provides
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -32,6 +32,8 @@ class PortSpec:
 class NodePorts:
     inputs: tuple[PortSpec, ...]
     outputs: tuple[PortSpec, ...]
+    _by_input: dict[str, PortSpec] = field(init=False, repr=False, compare=False)
+    _by_output: dict[str, PortSpec] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # first match wins, as a linear scan would (duplicates are reported elsewhere)
@@ -154,16 +156,16 @@ def node_ports(
         return NodePorts((), (PortSpec("value", t.value),))
     if rule == PortsRule.FUNCTION_INPUT:
         try:
-            t = parse_type(str(s["type"])).value
+            type_name = parse_type(str(s["type"])).value
         except ValueError as exc:
             raise PortError(node.id, "type", str(exc)) from None
-        return NodePorts((), (PortSpec("value", t),))
+        return NodePorts((), (PortSpec("value", type_name),))
     if rule == PortsRule.FUNCTION_OUTPUT:
         try:
-            t = parse_type(str(s["type"])).value
+            type_name = parse_type(str(s["type"])).value
         except ValueError as exc:
             raise PortError(node.id, "type", str(exc)) from None
-        return NodePorts((PortSpec("value", t, None, required=True),), ())
+        return NodePorts((PortSpec("value", type_name, None, required=True),), ())
     if rule == PortsRule.ATTRIBUTE_FIELDS:
         fields = s.get("fields")
         if not isinstance(fields, list) or not all(isinstance(f, str) for f in fields):
@@ -197,7 +199,7 @@ def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
             raise PortError(node.id, f"layers[{index}]", "a layer must be an object")
         lid = layer.get("id")
         why = identifier_problem(lid)
-        if why or lid in seen:
+        if why or not isinstance(lid, str) or lid in seen:
             raise PortError(node.id, f"layers[{index}].id",
                             f"layer id {lid!r} {why}" if why else f"duplicate layer id {lid!r}")
         seen.add(lid)
@@ -314,9 +316,8 @@ def resolve_types(
     generic_inputs = [p for p in ports.inputs if p.type == GENERIC]
     widest: PortType | None = None
     for p in generic_inputs:
-        t = connected.get(p.name)
-        if t is None:
-            t = _default_type(node.values.get(p.name, p.default))
+        found = connected.get(p.name)
+        t = found if found is not None else _default_type(node.values.get(p.name, p.default))
         if not t.is_numeric:
             raise ValueError(f"{p.name} takes a float or a vector, got {t}")
         if t == PortType.FLOAT:

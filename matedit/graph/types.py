@@ -36,7 +36,6 @@ class PortType(str, Enum):
 
 _COMPONENTS = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4, "MaterialAttributes": 0,
                "texture2d": 0}
-VECTOR_BY_SIZE = {1: PortType.FLOAT, 2: PortType.VEC2, 3: PortType.VEC3, 4: PortType.VEC4}
 NUMERIC = (PortType.FLOAT, PortType.VEC2, PortType.VEC3, PortType.VEC4)
 
 
@@ -64,14 +63,6 @@ def conversion_reason(src: PortType, dst: PortType) -> str | None:
             f"use a Component Mask or Append node"
         )
     return f"cannot connect {src} to {dst}"
-
-
-def default_value(t: PortType) -> float | list[float] | None:
-    """The zero value of a numeric type as stored in files (None for struct/texture)."""
-    n = t.components
-    if n == 0:
-        return None
-    return 0.0 if n == 1 else [0.0] * n
 
 
 def coerce_value(t: PortType, value: object) -> float | list[float]:

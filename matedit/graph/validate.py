@@ -203,7 +203,7 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
                 if blocked:
                     continue
                 passes_on = nodes.role_of(node.kind) in _NO_DEFAULT
-                fallback = None if passes_on else _UNCONNECTED_DEFAULT.get(t)
+                fallback = None if passes_on or t is None else _UNCONNECTED_DEFAULT.get(t)
                 if fallback is not None:  # the rest of the graph keeps compiling
                     diags.append(warning(f"input {spec.name!r} ({t}) is not connected: it "
                                          f"uses {fallback}", nid, spec.name, f))

@@ -1,4 +1,5 @@
-"""The environment BRDF LUT of the split sum (SHADING.md), by deterministic quadrature.
+"""The environment BRDF LUT of the split sum (docs/shading.md#image-based-lighting), by
+deterministic quadrature.
 
 A(NoV, roughness) and B(NoV, roughness) are the notes' IntegrateBRDF averages over GGX
 half vectors H (k = a/2, exact (1 - VoH)^5, zero where NoL <= 0). Plain Hammersley
@@ -28,9 +29,9 @@ max |error| over A and B:
     notes' Hammersley estimator, 1024 ............... 3.1e-2
     notes' Hammersley estimator, 16384 .............. 5.8e-3
 
-(The Hammersley figures are worse than SHADING.md's 6e-3 / 1.1e-3 because the notes'
-tangent frame for N = +Z turns the point set by 90 degrees against V's azimuth; with
-phi measured from V they match SHADING.md.) A 128 x 128 LUT takes ~0.05 s on llvmpipe.
+(The Hammersley figures are this poor partly because the notes' tangent frame for N = +Z
+turns the point set by 90 degrees against V's azimuth; docs/shading.md#measured-accuracy
+has the generators side by side.) A 128 x 128 LUT takes ~0.05 s on llvmpipe.
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ DIR/brdf_lut.exr             the environment BRDF LUT (layout below)
 DIR/sh.json                  nine irradiance SH coefficients (matedit/ibl/sh.py)
 DIR/ibl.json                 what the files are: sizes, roughness per mip, settings
 
-LUT EXR (ARCHITECTURE.md): N x N, channels R = A and G = B; row k (row 0 the first
+LUT EXR (docs/shading.md#file-conventions): N x N, channels R = A and G = B; row k (row 0 the first
 OpenImageIO reads) holds roughness (k + 0.5) / N, column i holds NoV = (i + 0.5) / N.
 """
 

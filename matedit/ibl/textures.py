@@ -5,9 +5,9 @@
     ibl.use(prefiltered=5, lut=6)          # texture units
     prog["uPrefiltered"] = 5; prog["uBrdfLut"] = 6
     prog["uPrefilteredLevels"] = float(ibl.levels)   # M; sample at roughness * (M - 1)
-    prog["uIrradianceSH"].write(ibl.sh_bytes())      # uniform vec3 uIrradianceSH[9]
+    prog["uIrradianceSH"].write(ibl.sh.astype("f4").tobytes())  # uniform vec3 [9]
 
-GLSL side (SHADING.md, split sum):
+GLSL side (docs/shading.md#image-based-lighting, split sum):
 
     vec3 pre = textureLod(uPrefiltered, R, roughness * (uPrefilteredLevels - 1.0)).rgb;
     vec2 AB = texture(uBrdfLut, vec2(NoV, roughness)).rg;
@@ -52,10 +52,6 @@ class IBLTextures:
         """Bind the cube and the LUT to the given texture units."""
         self.prefiltered.use(location=prefiltered)
         self.brdf_lut.use(location=lut)
-
-    def sh_bytes(self) -> bytes:
-        """The nine irradiance coefficients as float32 for a `uniform vec3[9]`."""
-        return np.ascontiguousarray(self.sh, dtype=np.float32).tobytes()
 
     def release(self) -> None:
         self.prefiltered.release()

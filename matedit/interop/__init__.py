@@ -1,5 +1,5 @@
-"""Interchange with other tools: HLSL and MSL through SPIR-V, baked texture maps, glTF 2.0
-and MaterialX documents (export and import).
+"""Interchange with other tools: the compiled-shader files (`export`), HLSL and MSL through
+SPIR-V, baked texture maps, glTF 2.0 and MaterialX documents (export and import).
 
 Nothing here imports Qt; only `bake` creates a GL context (headless, EGL).
 """

@@ -150,11 +150,6 @@ def cross_compile_many(base, targets: list[str]) -> dict[str, CrossCompiled]:
     return out
 
 
-def cross_compile(base, target: str) -> CrossCompiled:
-    """`base` is a glsl450 CompiledMaterial; returns its HLSL or MSL translation."""
-    return cross_compile_many(base, [target])[target]
-
-
 def check_hlsl(cc: CrossCompiled) -> None:
     """Compile the HLSL back to SPIR-V with glslang's HLSL front end and validate it."""
     with tempfile.TemporaryDirectory(prefix="matedit-hlsl-") as tmp:

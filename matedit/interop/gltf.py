@@ -12,7 +12,6 @@ from __future__ import annotations
 import os
 import tempfile
 import urllib.parse
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -20,11 +19,6 @@ import pygltflib as g
 
 from matedit.interop.bake import BakedMap, encode_file
 from matedit.io.atomic import atomic_write_bytes, read_bounded, staged_outputs
-
-
-@dataclass
-class GltfFiles:
-    files: dict[Path, bytes]  # every output, path -> bytes
 
 
 def _png_bytes(m: BakedMap) -> bytes:

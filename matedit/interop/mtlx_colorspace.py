@@ -22,10 +22,18 @@ SRGB_TEXTURE = "srgb_texture"
 
 
 @functools.lru_cache(maxsize=1)
+def stdlib():
+    """MaterialX's standard libraries, loaded once (read only)."""
+    import MaterialX as mx
+
+    lib = mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
+    return lib
+
+
+@functools.lru_cache(maxsize=1)
 def materialx_spaces() -> frozenset[str]:
     """The colour spaces MaterialX's cmlib converts to lin_rec709, and lin_rec709 itself."""
-    from matedit.interop.mtlx_export import stdlib
-
     suffix = f"_to_{WORKING}_color3"
     names = {WORKING}
     for nd in stdlib().getNodeDefs():

@@ -30,7 +30,6 @@ in lin_rec709.
 
 from __future__ import annotations
 
-import functools
 import math
 import os
 from collections.abc import Callable
@@ -40,17 +39,18 @@ from typing import Any
 
 import numpy as np
 
+from matedit.compiler import ops
 from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV, Uni, Var
 from matedit.graph import nodes
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, Role, kind_for, role_of
 from matedit.graph.types import PortType
-from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, to_materialx
+from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, stdlib, to_materialx
 from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
 
 MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "vector3",
            PortType.VEC4: "vector4"}
 # The compiler's own ops that stand for a catalogue kind's mapping.
-IR_OP_ROLES = {"blend": Role.MASK_BLEND, "mask": Role.COMPONENT_MASK}
+IR_OP_ROLES = {ops.BLEND: Role.MASK_BLEND, ops.MASK: Role.COMPONENT_MASK}
 MTLX_VERSION = "1.39"
 
 
@@ -235,7 +235,7 @@ class _Exporter:
         from matedit.compiler.cpu_eval import eval_op
 
         hint = f"{prefix}{op.node}"
-        if op.kind == "call":
+        if op.kind == ops.CALL:
             scope = self.functions[op.data["function"]]
             return self.scope(scope, dict(zip((p for p, _ in scope.params), args)),
                               f"{hint}_")
@@ -243,7 +243,7 @@ class _Exporter:
         d = nodes.get(op.kind)
         geo = (d is not None and d.geometry) or any(a.geo for a in args)
         kind = kind_for(IR_OP_ROLES[op.kind]) if op.kind in IR_OP_ROLES else op.kind
-        entry = mapping(kind) if op.kind != "weight" else MxRecipe("weight")
+        entry = mapping(kind) if op.kind != ops.WEIGHT else MxRecipe("weight")
         if entry == MxRecipe("normalize_vector") and args[0].type == PortType.FLOAT:
             entry = BAKE  # the stdlib normalizes vectors only
         outs_t = [t for _, t in op.outs]
@@ -866,16 +866,6 @@ class _Exporter:
         inp.setOutputString(out.getName())
 
 
-@functools.lru_cache(maxsize=1)
-def stdlib():
-    """MaterialX's standard libraries, loaded once (read only)."""
-    import MaterialX as mx
-
-    lib = mx.createDocument()
-    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
-    return lib
-
-
 def validate(text: str) -> tuple[bool, str]:
     """MaterialX's own validate() on a document text, with the stdlib loaded."""
     import MaterialX as mx
@@ -906,8 +896,8 @@ def export_ir(ir: MaterialIR, out: Path, size: int, stem: str) -> MtlxExport:
 
 def export(doc, resolver, out: Path, size: int = 512) -> MtlxExport:
     """The MaterialX export of a material document (raises CompileError, MtlxExportError)."""
-    from matedit.compiler.export import stem_of
     from matedit.compiler.lower import lower_document
+    from matedit.interop.export import stem_of
 
     ir = lower_document(doc, resolver)
     return export_ir(ir, Path(out), size, stem_of(doc))

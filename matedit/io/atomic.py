@@ -147,7 +147,7 @@ def remove_leftovers(folder: str | os.PathLike) -> list[str]:
         return removed
     host, uid = _host_tag(), os.geteuid()
     try:
-        entries = list(os.scandir(folder))
+        entries = list(os.scandir(os.fsdecode(folder)))
     except OSError:
         return removed
     for entry in entries:

@@ -17,27 +17,13 @@ from typing import Any
 from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.nodes import Role, role_of
 from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
+from matedit.io.errors import FormatError
 from matedit.io.jsontext import JSONTextError, check_json_value, parse_json
 from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
 
 FORMATS = {"matedit.material": DocumentKind.MATERIAL, "matedit.function": DocumentKind.FUNCTION}
 FORMAT_OF = {v: k for k, v in FORMATS.items()}
 MAX_FILE_BYTES = 64 * 1024 * 1024
-
-
-class FormatError(ValueError):
-    """A file that cannot be read as a matedit document."""
-
-    def __init__(self, file: str | None, message: str, node: str | None = None,
-                 field: str | None = None) -> None:
-        self.file, self.node, self.field, self.reason = file, node, field, message
-        where = []
-        if node:
-            where.append(f"node {node}")
-        if field:
-            where.append(f"field {field}")
-        loc = (", ".join(where) + ": ") if where else ""
-        super().__init__(f"{file or '<document>'}: {loc}{message}")
 
 
 def _where(raw: Any, path: list) -> tuple[str | None, str]:
@@ -223,8 +209,9 @@ def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocumen
         _expect(isinstance(text, str), file, "text must be a string", c["id"], "text")
         _expect(c["id"] not in doc.graph.comments and c["id"] not in doc.graph.nodes, file,
                 "duplicate id", c["id"], "id")
-        doc.graph.comments[c["id"]] = Comment(c["id"], text, tuple(float(x) for x in rect),
-                                              tuple(float(x) for x in color),
+        x, y, w, h = (float(v) for v in rect)
+        r, g, b = (float(v) for v in color)
+        doc.graph.comments[c["id"]] = Comment(c["id"], text, (x, y, w, h), (r, g, b),
                                               _unknown(c, COMMENT_FIELDS))
     try:  # here, not only in loads: a dict from elsewhere may hold an infinity in a kept field
         dumps(doc)

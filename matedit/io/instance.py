@@ -521,17 +521,6 @@ def new_instance(parent: str | os.PathLike, path: str | os.PathLike,
     return InstanceDocument(parent=rel, name=name or path.stem.replace("_", " "), path=path)
 
 
-def load_any(path: str | os.PathLike) -> MaterialDocument | InstanceDocument:
-    """A material, function or instance file, by its `format`."""
-    p = Path(path)
-    text = read_document_text(p)
-    if is_instance_text(text):
-        return loads(text, str(p), p)
-    from matedit.io.document import loads as material_loads
-
-    return material_loads(text, str(p), p)
-
-
 def load_effective(path: str | os.PathLike) -> tuple[MaterialDocument, list[Problem]]:
     """What the commands build from a file: a material (or function) as loaded, or an
     instance's effective material with its warnings. Raises FormatError, or InstanceError

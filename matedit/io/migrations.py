@@ -52,6 +52,8 @@ MIGRATIONS: dict[int, Callable[[dict], dict]] = {1: _v1_to_v2}
 def migrate(doc: dict) -> dict:
     """Bring a document dict up to CURRENT_VERSION, one step at a time."""
     version = doc.get("version")
+    if not isinstance(version, int):
+        raise MigrationError(f"'version' must be an integer, got {version!r}")
     while version < CURRENT_VERSION:
         step = MIGRATIONS.get(version)
         if step is None:

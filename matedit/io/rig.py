@@ -15,15 +15,16 @@ Format (``"format": "matedit.lightrig"``, ``"version": 1``)::
       ]
     }
 
-Fields and units (SHADING.md): ``type`` point | directional | sphere | tube; ``position``
-metres, world space (a sphere's or tube's centre; not used by directional lights);
-``direction`` unit vector (normalised on load): the travel direction of a directional
-light, a tube's axis; ``radius`` metres (sphere and tube source radius, >= 0); ``length``
-metres (tube, >= 0); ``color`` linear RGB, each >= 0; ``intensity`` >= 0: the radiant
-intensity of point, sphere and tube lights (radiance scale times the inverse-square
-falloff, SHADING.md eq 9), the irradiance of a directional light; ``influence_radius``
-metres (> 0, the falloff window's R). Omitted fields take the defaults below. At most 16
-lights (the shader's block). Unknown fields are errors (a typo must not pass silently).
+Fields and units (docs/shading.md#conventions): ``type`` point | directional | sphere |
+tube; ``position`` metres, world space (a sphere's or tube's centre; not used by
+directional lights); ``direction`` unit vector (normalised on load): the travel direction
+of a directional light, a tube's axis; ``radius`` metres (sphere and tube source radius,
+>= 0); ``length`` metres (tube, >= 0); ``color`` linear RGB, each >= 0; ``intensity``
+>= 0: the radiant intensity of point, sphere and tube lights (radiance scale times the
+inverse-square falloff, docs/shading.md#analytic-lights, eq 9), the irradiance of a
+directional light; ``influence_radius`` metres (> 0, the falloff window's R). Omitted
+fields take the defaults below. At most 16 lights (the shader's block). Unknown fields are
+errors (a typo must not pass silently).
 
 Numbers follow the rule of every format (finite, within float32: matedit.graph.numbers) and
 stated limits that keep the shader's squares and products finite: positions, radii, lengths
@@ -86,7 +87,8 @@ def _number(raw, file, i, name, limit: float) -> float:
 def _vec3(raw, file, i, name, limit: float = MAX_EXTENT) -> tuple[float, float, float]:
     if not (isinstance(raw, list) and len(raw) == 3):
         raise RigError(file, "must be a list of 3 finite numbers", i, name)
-    return tuple(_number(v, file, i, name, limit) for v in raw)
+    x, y, z = (_number(v, file, i, name, limit) for v in raw)
+    return x, y, z
 
 
 def _scalar(raw, file, i, name, *, positive=False, limit: float = MAX_EXTENT) -> float:
@@ -130,7 +132,7 @@ def light_from_dict(raw, file: str | None = None, index: int = 0) -> Light:
     if "name" in raw and not isinstance(raw["name"], str):
         raise RigError(file, "must be a string", index, "name")
     return Light(kind=kind, position=position,
-                 direction=tuple(v / n for v in direction), color=color,
+                 direction=(direction[0] / n, direction[1] / n, direction[2] / n), color=color,
                  intensity=intensity, influence_radius=influence,
                  source_radius=radius if kind in ("sphere", "tube") else 0.0,
                  source_length=length if kind == "tube" else 0.0)

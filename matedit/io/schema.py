@@ -15,6 +15,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from matedit.io.errors import FormatError
+
 SCHEMA_DIR = Path(__file__).resolve().parent.parent / "schemas"
 SCHEMA_FILES = {
     "matedit.material": "material.schema.json",
@@ -71,8 +73,6 @@ def _located(raw: dict, path: list) -> tuple[str | None, str | None, list]:
 
 def check_document_shape(raw: Any, file: str | None = None) -> None:
     """Raise FormatError when `raw` does not have the shape its format's schema describes."""
-    from matedit.io.document import FormatError
-
     if not isinstance(raw, dict):
         raise FormatError(file, "top level must be a JSON object")
     fmt = raw.get("format")

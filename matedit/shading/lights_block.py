@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from matedit.glsl import layout as _layout
-from matedit.shading.lights import Light
+from matedit.shading.lights import Light, LightKind
 
 # from the one layout source (matedit/glsl/layout.py), like the shader's defines
 MAX_LIGHTS = _layout.MAX_LIGHTS
@@ -39,7 +39,7 @@ def unpack_lights(data: bytes) -> list[Light]:
     """Inverse of pack_lights (for tests and debugging)."""
     count = int(np.frombuffer(data, dtype="<i4", count=1)[0])
     body = np.frombuffer(data, dtype="<f4", offset=LIGHTS_HEADER).reshape(-1, 4, 4)
-    kinds = {0: "point", 1: "directional", 2: "sphere", 3: "tube"}
+    kinds: dict[int, LightKind] = {0: "point", 1: "directional", 2: "sphere", 3: "tube"}
     out = []
     for row in body[:count].astype(np.float64):
         out.append(

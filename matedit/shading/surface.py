@@ -11,6 +11,7 @@ from matedit.shading.common import dot, f64, reflect, saturate
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
     IBL_MODE_REFERENCE,
+    Environment,
     diffuseIrradianceSH9,
     energyCompensation,
     environmentBRDF,
@@ -46,7 +47,7 @@ class IblInputs:
     mip_count: float = 1.0
     brdf_lut: object = field(default_factory=lambda: np.zeros((1, 1, 2)))
     lut_values: bool = False
-    environment: object = None
+    environment: Environment | None = None
     intensity: float = 1.0
     samples: int = 64
     sample_offset: tuple[float, float] = (0.0, 0.0)
@@ -66,6 +67,8 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(N.shape, V.shape))
     if ibl.mode == IBL_MODE_REFERENCE:
+        if ibl.environment is None:
+            raise ValueError("the reference mode samples IblInputs.environment: none given")
         count = max(int(ibl.samples), 1)
         color = (referenceDiffuseIBL(ibl.environment, diffuseColor, N, count, ibl.sample_offset)
                  + referenceSpecularIBL(ibl.environment, F0, roughness, N, V, count,
@@ -107,7 +110,7 @@ def shadeSurface(
     if lobes != LOBES_ALL:
         s.diffuseColor = s.diffuseColor * lobeOn(lobes, LOBE_DIFFUSE)
         diffuseColor = s.diffuseColor
-        s.specularScale = s.specularScale * lobeOn(lobes, LOBE_SPECULAR)
+        s.specularScale = f64(s.specularScale) * lobeOn(lobes, LOBE_SPECULAR)
     direct = directLighting(s, lights)
     indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale)
     return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive) * lobeOn(

@@ -26,7 +26,7 @@ Methods on the view:
     ``open_palette(scene_pos=None)``          the searchable node palette.
     Also, for menus: ``delete_selection()``, ``copy_selection()``, ``cut_selection()``,
     ``paste(scene_pos=None)``, ``duplicate_selection()``, ``comment_selection()``,
-    ``selected_ids()``, ``set_minimap_visible(bool)``.
+    ``selected_ids()``, ``toggle_minimap()``.
 
 Commands (menus, context menu, keys) are the action table's (``canvas.actions``, see
 ``matedit.app.canvas.actions``). Keys (while the canvas has focus): Tab palette;

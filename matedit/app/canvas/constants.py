@@ -72,11 +72,9 @@ WARNING = QColor("#e0a43a")
 ALLOWED = QColor("#5ad17a")
 REFUSED = QColor("#e5534b")
 WIRE_SELECTED = QColor("#ffffff")
-RUBBER_BAND = QColor(122, 162, 247, 40)
 TOAST_BG = "#3a2326"
 TOAST_FG = "#ffd9d6"
 MINIMAP_BG = QColor(20, 22, 27, 215)
-MINIMAP_NODE = QColor("#5b6373")
 MINIMAP_VIEW = QColor("#7aa2f7")
 
 PORT_COLORS: dict[str, QColor] = {

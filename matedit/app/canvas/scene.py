@@ -112,12 +112,6 @@ class NodeScene(QGraphicsScene):
     def node_item(self, node_id: str) -> NodeItem | None:
         return self.node_items.get(node_id)
 
-    def wire_item(self, link: Link) -> WireItem | None:
-        return self.wire_items.get(link)
-
-    def wires_of(self, node_id: str) -> list[WireItem]:
-        return [self.wire_items[l] for l in self._wires_of.get(node_id, ())]
-
     def selected_node_ids(self) -> list[str]:
         return sorted(it.node_id for it in self.selectedItems() if isinstance(it, NodeItem))
 

@@ -204,9 +204,6 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self.previewRequested.emit(node_id, port)
         return True
 
-    def set_minimap_visible(self, visible: bool) -> None:
-        self.minimap.setVisible(visible)
-
     def toggle_minimap(self) -> None:
         self.minimap.setVisible(not self.minimap.isVisible())
 

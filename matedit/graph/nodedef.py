@@ -1,0 +1,285 @@
+"""The data of a node kind (`NodeDef` and its parts) and the registry of kinds.
+
+`matedit.graph.nodes` (the basic kinds) and `matedit.graph.library` (the rest) build the
+catalogue from these and register it; code reads the catalogue through `matedit.graph.nodes`,
+which exports every name here. Two modules, so that the library's kinds import this one and
+not the catalogue that loads them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from enum import Enum, auto
+from typing import Any
+
+GENERIC = "T"
+# Default marker: an unconnected input with this default reads the mesh's first UV set.
+MESH_UV = "mesh_uv"
+
+
+@dataclass(frozen=True)
+class InputDef:
+    name: str
+    type: str
+    default: Any = 0.0
+    doc: str = ""
+    range: tuple[float, float] | None = None
+    required: bool = False
+    # Where an editor shows the port: ports sharing a group fold together (the material
+    # attributes: Base, Specular, Coat, Sheen, Anisotropy). Empty: ungrouped.
+    group: str = ""
+    # A lobe input of the material attributes: unconnected at its default it turns its lobe
+    # off, and the lobe's code is compiled out. Moving it off or back to its default is
+    # therefore a structural edit (one recompile), any other value edit a uniform.
+    lobe: bool = False
+
+
+@dataclass(frozen=True)
+class OutputDef:
+    name: str
+    type: str
+    doc: str = ""
+
+
+@dataclass(frozen=True)
+class SettingDef:
+    """A node property that is not a port: a parameter's name, a mask's channels, a path.
+
+    `structural` settings change the generated code; the others (a texture's
+    file, a slider's range) are value edits and never recompile.
+    """
+
+    name: str
+    kind: str  # "string" | "type" | "channels" | "path" | "bool" | "number" | "value" | "list"
+    default: Any = None
+    doc: str = ""
+    structural: bool = True
+    choices: tuple[str, ...] = ()
+
+
+class Role(Enum):
+    """The structural kinds whose meaning code must know (most kinds have no role)."""
+
+    CONSTANT = auto()
+    SCALAR_PARAMETER = auto()
+    VECTOR_PARAMETER = auto()
+    COLOR_PARAMETER = auto()
+    TEXTURE_PARAMETER = auto()
+    STATIC_SWITCH = auto()
+    COMPONENT_MASK = auto()
+    APPEND = auto()
+    REROUTE = auto()
+    TEXTURE_SAMPLE = auto()
+    COLOR_RAMP = auto()
+    MAKE_ATTRIBUTES = auto()
+    SET_ATTRIBUTES = auto()
+    MASK_BLEND = auto()  # blends two MaterialAttributes by a mask
+    HEIGHT_BLEND = auto()  # ... by height
+    FUNCTION_INPUT = auto()
+    FUNCTION_OUTPUT = auto()
+    FUNCTION_CALL = auto()
+    LAYER_STACK = auto()
+    MATERIAL_OUTPUT = auto()
+
+
+class Thumbnail(Enum):
+    """When the canvas shows a node's live preview thumbnail."""
+
+    NEVER = auto()  # the same everywhere, or not an image
+    SELECTED = auto()  # only while selected (most kinds: they would crowd the graph)
+    ALWAYS = auto()  # patterns, textures, materials
+
+
+class PortsRule(str, Enum):
+    """Ports that depend on a node's settings, a material function or its connections
+    (the rules live in `matedit.graph.ports`)."""
+
+    TYPE_SETTING = "type setting"  # one output of the type the settings name
+    FUNCTION_INPUT = "function input"
+    FUNCTION_OUTPUT = "function output"
+    FUNCTION_SIGNATURE = "function signature"  # the called function's inputs and outputs
+    LAYERS = "layers"  # one input per layer mask and layer input
+    ATTRIBUTE_FIELDS = "attribute fields"  # one input per overridden field
+    CHANNELS = "channels"  # output width from the chosen channels
+    COMPONENTS = "components"  # a float per component of the input
+    CONCATENATION = "concatenation"  # output width: the sum of the input widths
+    PASSTHROUGH = "passthrough"  # the output has the input's type
+
+    def __str__(self) -> str:
+        return self.value
+
+
+@dataclass(frozen=True)
+class MxNode:
+    """A MaterialX 1.39 stdlib node of `category`: `ports` maps our inputs to its inputs in
+    order, `fixed` adds constant inputs, `output` names its output. The exporter converts
+    every input to the op's result type first, so the same-type node definition is chosen."""
+
+    category: str
+    ports: tuple[tuple[str, str], ...]  # (our input, MaterialX input)
+    fixed: tuple[tuple[str, float], ...] = field(default_factory=tuple)
+    output: str = "out"
+
+
+@dataclass(frozen=True)
+class MxRecipe:
+    """A few stdlib nodes, built by `matedit.interop.mtlx_export` (the recipe of that name)
+    and read back by `matedit.interop.mtlx_import`."""
+
+    name: str
+
+
+# A kind's MaterialX mapping when no stdlib node or recipe expresses it: the exporter bakes
+# its outputs over UV space into images read by `image` nodes.
+BAKE = "bake"
+# ... when the compiler lowers the kind away before export (parameters become interface
+# inputs, constants values, functions inlined, layer stacks blends).
+LOWERED = "lowered"
+Mtlx = MxNode | MxRecipe | str
+
+
+@dataclass(frozen=True)
+class NodeDef:
+    kind: str
+    title: str
+    category: str
+    description: str
+    inputs: tuple[InputDef, ...] = ()
+    outputs: tuple[OutputDef, ...] = ()
+    settings: tuple[SettingDef, ...] = ()
+    glsl: str | None = None  # GLSL function name in shaders/nodes/<kind>.glsl
+    inline: str | None = None  # inline GLSL template, e.g. "({a} + {b})"
+    ports_rule: PortsRule | None = None  # dynamic ports, see matedit.graph.ports
+    # Extra value fields that are not ports (a parameter's value): edits are value edits.
+    values: tuple[InputDef, ...] = ()
+    # MaterialX: an MxNode, an MxRecipe, BAKE (not expressible node for node) or LOWERED.
+    mtlx: Mtlx = BAKE
+    # Where `mtlx` is a recipe: the one stdlib node the importer also reads back as this
+    # kind (MaterialX's dotproduct as our dot, say).
+    mtlx_reads: MxNode | None = None
+    role: Role | None = None
+    # The compiler lowers the kind from the graph itself: no GLSL function, no numpy twin.
+    lowered: bool = False
+    # Its value depends on more than its inputs (geometry, time, textures, uniforms), so
+    # it is never constant-folded.
+    impure: bool = False
+    # It reads the surface's position, normal, view or time (not only its inputs and UVs).
+    geometry: bool = False
+    thumbnail: Thumbnail = Thumbnail.SELECTED
+    # A named parameter an instance may override: its instance type ("scalar", "vector",
+    # "color", "texture", "switch"); None: not a parameter.
+    parameter: str | None = None
+
+    def input(self, name: str) -> InputDef | None:
+        return next((i for i in self.inputs if i.name == name), None)
+
+    def output(self, name: str) -> OutputDef | None:
+        return next((o for o in self.outputs if o.name == name), None)
+
+    def setting(self, name: str) -> SettingDef | None:
+        return next((s for s in self.settings if s.name == name), None)
+
+    def setting_defaults(self) -> dict[str, Any]:
+        return {s.name: s.default for s in self.settings}
+
+
+REGISTRY: dict[str, NodeDef] = {}
+
+
+def register(defn: NodeDef) -> NodeDef:
+    if defn.kind in REGISTRY:
+        raise ValueError(f"node kind {defn.kind!r} registered twice")
+    if (defn.glsl is None) == (defn.inline is None) and not defn.lowered:
+        raise ValueError(f"node kind {defn.kind!r} needs exactly one of glsl= or inline=")
+    if defn.role is not None and any(d.role == defn.role for d in REGISTRY.values()):
+        raise ValueError(f"node kind {defn.kind!r}: role {defn.role.name} taken")
+    REGISTRY[defn.kind] = defn
+    return defn
+
+
+def get(kind: str) -> NodeDef | None:
+    return REGISTRY.get(kind)
+
+
+def definition(kind: str) -> NodeDef:
+    """The definition of a registered kind (KeyError names an unknown one)."""
+    try:
+        return REGISTRY[kind]
+    except KeyError:
+        raise KeyError(f"unknown node kind {kind!r}") from None
+
+
+def role_of(kind: str) -> Role | None:
+    """The role of `kind`; None for kinds without one and for names that are no kind (the
+    compiler's own op names, say)."""
+    d = REGISTRY.get(kind)
+    return d.role if d is not None else None
+
+
+def kind_for(role: Role) -> str:
+    """The kind that plays `role`, to create a node of it (a new material's output, say)."""
+    for d in REGISTRY.values():
+        if d.role == role:
+            return d.kind
+    raise LookupError(f"no node kind has role {role.name}")
+
+
+def is_parameter(kind: str) -> bool:
+    """A named parameter an instance may override (static switches included)."""
+    d = REGISTRY.get(kind)
+    return d is not None and d.parameter is not None
+
+
+def is_value_parameter(kind: str) -> bool:
+    """A parameter that compiles to a uniform or a texture (not a static switch)."""
+    d = REGISTRY.get(kind)
+    return d is not None and d.parameter is not None and d.role != Role.STATIC_SWITCH
+
+
+def is_impure(kind: str) -> bool:
+    """Never constant-folded; names that are no kind (the compiler's ops) are pure."""
+    d = REGISTRY.get(kind)
+    return d is not None and d.impure
+
+
+def kinds_where(test) -> frozenset[str]:
+    """The kinds whose definition passes `test`."""
+    return frozenset(k for k, d in REGISTRY.items() if test(d))
+
+
+def categories() -> dict[str, list[NodeDef]]:
+    """Node kinds by palette category, sorted by title."""
+    out: dict[str, list[NodeDef]] = {}
+    for d in sorted(REGISTRY.values(), key=lambda d: (d.category, d.title)):
+        out.setdefault(d.category, []).append(d)
+    return out
+
+
+# --- helpers to keep the table short -------------------------------------------------------
+
+def _i(name: str, type_: str, default: Any = 0.0, doc: str = "",
+       rng: tuple[float, float] | None = None, required: bool = False) -> InputDef:
+    return InputDef(name, type_, default, doc, rng, required)
+
+
+def _o(name: str, type_: str, doc: str = "") -> OutputDef:
+    return OutputDef(name, type_, doc)
+
+
+def _op(kind: str, title: str, inline: str | None, inputs: Iterable[InputDef], doc: str,
+        out_type: str = GENERIC, category: str = "Math", glsl: str | None = None,
+        mtlx: Mtlx = BAKE, reads: MxNode | None = None) -> NodeDef:
+    return register(NodeDef(
+        kind=kind, title=title, category=category, description=doc,
+        inputs=tuple(inputs), outputs=(_o("result", out_type),),
+        inline=inline if glsl is None else None, glsl=glsl, mtlx=mtlx, mtlx_reads=reads,
+    ))
+
+
+def _bin(category: str) -> MxNode:
+    return MxNode(category, (("a", "in1"), ("b", "in2")))
+
+
+def _un(category: str) -> MxNode:
+    return MxNode(category, (("value", "in"),))

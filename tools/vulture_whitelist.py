@@ -1,0 +1,40 @@
+"""Names vulture cannot see used: frameworks call them, or set them for a library to read.
+
+Read by `vulture` (pyproject.toml [tool.vulture], run by ./dev.sh test), never imported or
+run. Each line names an attribute (`_.name`) another program uses; add a name here only with
+the framework that uses it. Dead code is deleted, not listed.
+"""
+
+# ruff: noqa
+# mypy: ignore-errors
+_ = object()
+
+# Qt calls these overrides of QGraphicsScene, QGraphicsView, QOpenGLWidget, QTreeWidget,
+# QUndoCommand and QWidget by name.
+_.drawBackground
+_.wheelEvent
+_.contextMenuEvent
+_.mergeWith
+_.mimeTypes
+_.initializeGL
+_.resizeGL
+_.paintGL
+
+# moderngl reads these attributes of its textures and contexts when they are set.
+_.repeat_x
+_.repeat_y
+_.blend_func
+
+# pygltflib writes this material field; MaterialX's XmlReadOptions reads this option.
+_.emissiveFactor
+_.readXIncludeFunction
+_.hwSpecularEnvironmentMethod  # MaterialX GenOptions (benchmarks/bench_materialx.py)
+_.targetColorSpaceOverride  # MaterialX GenOptions (tests/mtlx_gpu.py)
+
+# Python calls a module's __getattr__ for a missing name (PEP 562: matedit.compiler's lazy
+# names), and a test replaces an object's __class__ to give it a subclass's methods.
+_.__getattr__
+_.__class__
+
+# written through a property (MaterialCompiler.last_compile_ms), which vulture does not follow
+_._last_compile_ms
