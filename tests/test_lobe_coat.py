@@ -356,9 +356,9 @@ def test_coat_split_sum_against_its_brute_force_integral(coat_roughness):
         # the twin computes exactly that product (weight 1, no base light)
         c = coat.makeCoatContext(np.array([0.0, 0.0, 1.0]), Vv, 1.0, coat_roughness, 0.03,
                                  np.ones(3), 1.5)
+        ab = np.array([A, Bs])
         twin = coat.coatImageBasedLighting(
-            c, Vv, np.zeros(3), lambda _r, _lod, p=pref: p,
-            lambda _nov, _r, ab=np.array([A, Bs]): ab, 2.0, 1.0)
+            c, Vv, np.zeros(3), lambda _r, _lod, p=pref: p, lambda _nov, _r, ab=ab: ab, 2.0, 1.0)
         assert np.allclose(twin, split, rtol=1e-12)
 
 
