@@ -34,6 +34,7 @@ from light_energy_ref import (  # noqa: E402
     tube_view_grid,
 )
 
+import matedit.shading.coat as coat  # noqa: E402
 import matedit.shading.lights as lights  # noqa: E402
 
 D = 2.0
@@ -48,6 +49,26 @@ def _twin(V, kind, radius, length, rough, tilt=0.0):
     n = len(V)
     s = lights.makeShadingContext(np.zeros((n, 3)), np.tile([0.0, 0.0, 1.0], (n, 1)), V,
                                   np.zeros((n, 3)), np.ones((n, 3)), np.full(n, rough))
+    pos = (D * math.sin(tilt), 0.0, D * math.cos(tilt))
+    light = lights.Light(kind, position=pos, direction=(1.0, 0.0, 0.0),
+                         intensity=1.0, influence_radius=1e4, source_radius=radius,
+                         source_length=length)
+    return lights.evaluateLight(s, light)[:, 0]
+
+
+def _twin_coat(V, kind, radius, length, rough, tilt=0.0):
+    """The coat lobe alone (issue 23): the base black (no diffuse, its specular scaled to 0,
+    its roughness 0.9 so a coat reading the base's alpha would show), the coat over it with
+    weight 1, roughness `rough` and, for this measurement only, F0 = 1 (F = 1, the white
+    metal's definition of the true energy), on the same N = +Z."""
+    n = len(V)
+    N = np.tile([0.0, 0.0, 1.0], (n, 1))
+    s = lights.makeShadingContext(np.zeros((n, 3)), N, V, np.zeros((n, 3)), np.zeros((n, 3)),
+                                  np.full(n, 0.9))
+    s.specularScale = 0.0
+    s.coat = coat.makeCoatContext(N, V, np.ones(n), np.full(n, rough),
+                                  lights.MIN_ANALYTIC_ROUGHNESS, np.ones(3), 1.5)
+    s.coat.F0 = np.ones(n)
     pos = (D * math.sin(tilt), 0.0, D * math.cos(tilt))
     light = lights.Light(kind, position=pos, direction=(1.0, 0.0, 0.0),
                          intensity=1.0, influence_radius=1e4, source_radius=radius,
@@ -146,6 +167,16 @@ def main() -> int:
             label = "before" if c == 3.0 else "now (default)"
             print(markdown(f"rendered / true specular energy, a' = a + r / ({c:g} d), {label}, "
                            f"{'GLSL' if ctx else 'numpy twin'}", spheres, tilted, tubes))
+            print()
+            print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
+            print()
+        if ctx is None:
+            # the clear coat's lobe: its own representative point and widening (its alpha)
+            t0 = time.perf_counter()
+            spheres, tilted, tubes = table(_twin_coat, args.quick)
+            print(markdown(f"clear coat lobe: rendered / true specular energy, a' = a + r / "
+                           f"({saved:g} d), coat roughness in the columns, numpy twin",
+                           spheres, tilted, tubes))
             print()
             print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
             print()

@@ -3,6 +3,7 @@
 // Each light returns outgoing radiance: diffuse + specular, times NoL, colour and intensity.
 #include "common.glsl"
 #include "brdf.glsl"
+#include "coat.glsl"
 
 #define LIGHT_TYPE_POINT 0
 #define LIGHT_TYPE_DIRECTIONAL 1
@@ -44,6 +45,9 @@ struct ShadingContext {
     float a;                // roughness^2
     float k;                // Schlick-Smith k for analytic lights
     vec3 specularScale;     // 1, or the multiple-scattering compensation (ibl.glsl)
+#if defined(MATERIAL_HAS_COAT)
+    CoatContext coat;       // the clear coat over the base (coat.glsl; set by shadeSurface)
+#endif
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -122,6 +126,9 @@ vec3 pointLight(ShadingContext s, Light light) {
     vec3 L = Lc / max(d, 1e-8);
     float NoL = saturate(dot(s.N, L));
     vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_COAT)
+    radiance = coatLayer(s.coat, s.V, L, radiance);  // the base through the coat, its highlight
+#endif
     return radiance * light.color * (light.intensity * distanceFalloff(d, light.influenceRadius));
 }
 
@@ -130,6 +137,9 @@ vec3 directionalLight(ShadingContext s, Light light) {
     vec3 L = -light.direction;
     float NoL = saturate(dot(s.N, L));
     vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_COAT)
+    radiance = coatLayer(s.coat, s.V, L, radiance);  // the base through the coat, its highlight
+#endif
     return radiance * light.color * light.intensity;
 }
 
@@ -145,6 +155,16 @@ vec3 sphereLight(ShadingContext s, Light light) {
     vec3 R = reflect(-s.V, s.N);
     vec3 L = normalize(sphereRepresentativePoint(Lc, R, light.sourceRadius));
     vec3 specular = specularTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d);
+#if defined(MATERIAL_HAS_COAT)
+    // The base through the coat towards the centre; the coat's highlight by its own
+    // representative point (its reflection vector) and widening (its alpha).
+    vec3 Lcoat = normalize(sphereRepresentativePoint(Lc, reflect(-s.V, s.coat.N),
+                                                     light.sourceRadius));
+    return ((diffuse + specular) * coatTransmittance(s.coat, dot(s.coat.N, Lc) / max(d, 1e-8))
+            + coatSpecularTowards(s.coat, s.V, Lcoat)
+              * sphereNormalization(s.coat.a, light.sourceRadius, d))
+           * light.color * (light.intensity * falloff);
+#endif
     return (diffuse + specular) * light.color * (light.intensity * falloff);
 }
 
@@ -192,6 +212,19 @@ vec3 tubeLight(ShadingContext s, Light light) {
                  * sphereNormalization(s.a, light.sourceRadius, dp);
     float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
     vec3 specular = specularTowards(s, L) * (energy / (dp * dp + eps2));
+#if defined(MATERIAL_HAS_COAT)
+    // The base through the coat towards the centre; the coat's highlight by the same steps
+    // along its own reflection vector, with its own alpha.
+    vec3 Rc = reflect(-s.V, s.coat.N);
+    vec3 Lpc = tubeRepresentativePoint(L0, L1, Rc);
+    float dpc = length(Lpc);
+    vec3 Lcoat = normalize(sphereRepresentativePoint(Lpc, Rc, light.sourceRadius));
+    float coatEnergy = lineNormalization(s.coat.a, light.sourceLength, d)
+                     * sphereNormalization(s.coat.a, light.sourceRadius, dpc);
+    return ((diffuse + specular) * coatTransmittance(s.coat, dot(s.coat.N, Lc) / max(d, 1e-8))
+            + coatSpecularTowards(s.coat, s.V, Lcoat) * (coatEnergy / (dpc * dpc + eps2)))
+           * light.color * (light.intensity * window);
+#endif
     return (diffuse + specular) * light.color * (light.intensity * window);
 }
 

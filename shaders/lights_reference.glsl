@@ -20,6 +20,10 @@
 vec3 brdfCosine(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4": diffuse + D Vis F, times NoL
     float NoL = saturate(dot(s.N, L));
+#if defined(MATERIAL_HAS_COAT)
+    // the base through the clear coat, plus the coat's lobe (coat.glsl)
+    return coatLayer(s.coat, s.V, L, diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L));
+#endif
     return diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
 }
 

@@ -87,8 +87,21 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     // docs/shading.md#the-material-model: (direct + ibl) * cavity + emissive
     vec3 diffuseColor = computeDiffuseColor(m.baseColor, m.metallic);
     vec3 F0 = materialF0(m);
+#if defined(MATERIAL_HAS_COAT)
+    // Under the coat the base's interface is base | coat: its F0 against the coat's IOR.
+    F0 = mix(F0, f0UnderCoat(F0, m.coatIor), saturate(m.coat));
+#endif
     float roughness = saturate(m.roughness);
     ShadingContext s = makeShadingContext(P, N, V, diffuseColor, F0, roughness);
+#if defined(MATERIAL_HAS_COAT)
+    // The coat's normal is given in the geometric normal's frame, not the base's normal map.
+    vec3 Nc = Ng;
+#if defined(MATERIAL_HAS_COAT_NORMAL)
+    Nc = tangentToWorldNormal(m.coatNormal, T, B, Ng);
+#endif
+    s.coat = makeCoatContext(Nc, V, m.coat, m.coatRoughness, MIN_ANALYTIC_ROUGHNESS,
+                             m.coatColor, m.coatIor, lobeOn(LOBE_COAT));
+#endif
 #ifdef MATEDIT_ENERGY_COMPENSATION
     // Beyond the talk (off by default): multiple-scattering compensation of the specular,
     // the diffuse keeping what the specular leaves (ibl.glsl, energyCompensation)
@@ -113,6 +126,20 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
 #endif
     direct = directLighting(s);
     vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale);
+#if defined(MATERIAL_HAS_COAT)
+    // The coat's image-based light, and the base's seen through the coat (coat.glsl).
+    int coatMode = int(uIbl.params.w + 0.5);
+    if (coatMode == IBL_MODE_SPLIT_SUM) {
+        ibl = coatImageBasedLighting(s.coat, V, ibl, uPrefilteredEnv, uBrdfLut, uIbl.params.x,
+                                     uIbl.params.y);
+    }
+#ifndef MATEDIT_SPLIT_SUM_ONLY
+    if (coatMode == IBL_MODE_REFERENCE) {
+        ibl = coatReferenceIBL(s.coat, V, ibl, uEnvironment, uint(max(uIbl.params.z, 1.0)),
+                               uIbl.sampleOffset.xy, uIbl.params.y);
+    }
+#endif
+#endif
     return (direct + ibl) * m.cavity + m.emissive * lobeOn(LOBE_EMISSIVE);
 }
 

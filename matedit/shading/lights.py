@@ -7,6 +7,7 @@ from typing import Literal
 
 import numpy as np
 
+from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
 
@@ -59,6 +60,7 @@ class ShadingContext:
     a: np.ndarray
     k: np.ndarray
     specularScale: object = 1.0  # or the multiple-scattering compensation, (..., 3)
+    coat: coat.CoatContext | None = None  # where the material has a coat (MATERIAL_HAS_COAT)
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -125,6 +127,8 @@ def pointLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = Lc / np.maximum(d, 1e-8)[..., None]
     NoL = saturate(dot(s.N, L))
     radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.coat is not None:
+        radiance = coat.coatLayer(s.coat, s.V, L, radiance)
     return radiance * _scale(light, distanceFalloff(d, light.influence_radius))
 
 
@@ -132,6 +136,8 @@ def directionalLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = np.broadcast_to(-f64(light.direction), s.N.shape)
     NoL = saturate(dot(s.N, L))
     radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.coat is not None:
+        radiance = coat.coatLayer(s.coat, s.V, L, radiance)
     return radiance * _scale(light, 1.0)
 
 
@@ -145,6 +151,13 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = normalize(sphereRepresentativePoint(Lc, R, light.source_radius))
     norm = sphereNormalization(s.a, light.source_radius, d)
     specular = specularTowards(s, L) * norm[..., None]
+    if s.coat is not None:
+        c = s.coat
+        Lcoat = normalize(sphereRepresentativePoint(Lc, reflect(-s.V, c.N), light.source_radius))
+        through = coat.coatTransmittance(c, dot(c.N, Lc) / np.maximum(d, 1e-8))
+        highlight = coat.coatSpecularTowards(c, s.V, Lcoat) * sphereNormalization(
+            c.a, light.source_radius, d)
+        return ((diffuse + specular) * through + highlight[..., None]) * _scale(light, falloff)
     return (diffuse + specular) * _scale(light, falloff)
 
 
@@ -182,6 +195,18 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
         s.a, light.source_radius, dp
     )
     specular = specularTowards(s, L) * (energy / (dp * dp + LIGHT_FALLOFF_EPS**2))[..., None]
+    if s.coat is not None:
+        c = s.coat
+        Rc = reflect(-s.V, c.N)
+        Lpc = tubeRepresentativePoint(L0, L1, Rc)
+        dpc = length(Lpc)
+        Lcoat = normalize(sphereRepresentativePoint(Lpc, Rc, light.source_radius))
+        coat_energy = lineNormalization(c.a, light.source_length, d) * sphereNormalization(
+            c.a, light.source_radius, dpc)
+        through = coat.coatTransmittance(c, dot(c.N, Lc) / np.maximum(d, 1e-8))
+        highlight = coat.coatSpecularTowards(c, s.V, Lcoat) * (
+            coat_energy / (dpc * dpc + LIGHT_FALLOFF_EPS**2))
+        return ((diffuse + specular) * through + highlight[..., None]) * _scale(light, window)
     return (diffuse + specular) * _scale(light, window)
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, diffuseLobe
 from matedit.shading.common import PI, dot, f64, length, saturate, sq
 from matedit.shading.ibl import rotatedHammersley
@@ -26,7 +27,10 @@ from matedit.shading.sampling import importanceSampleGGX, tangentFrame
 
 def brdfCosine(s: ShadingContext, L) -> np.ndarray:
     NoL = saturate(dot(s.N, L))
-    return diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    base = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.coat is not None:
+        return coat.coatLayer(s.coat, s.V, L, base)
+    return base
 
 
 def ggxDirectionPdf(s: ShadingContext, L) -> np.ndarray:

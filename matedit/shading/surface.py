@@ -7,10 +7,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from matedit.shading.common import dot, f64, reflect, saturate
+from matedit.shading import coat as _coat
+from matedit.shading.common import dot, f64, mix, reflect, saturate
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
     IBL_MODE_REFERENCE,
+    IBL_MODE_SPLIT_SUM,
     Environment,
     diffuseIrradianceSH9,
     energyCompensation,
@@ -20,8 +22,19 @@ from matedit.shading.ibl import (
     referenceSpecularIBL,
     splitSumSpecular,
 )
-from matedit.shading.lights import Light, ShadingContext, evaluateLight, makeShadingContext
-from matedit.shading.material import MaterialAttributes, computeDiffuseColor, materialF0
+from matedit.shading.lights import (
+    MIN_ANALYTIC_ROUGHNESS,
+    Light,
+    ShadingContext,
+    evaluateLight,
+    makeShadingContext,
+)
+from matedit.shading.material import (
+    MaterialAttributes,
+    computeDiffuseColor,
+    materialF0,
+    tangentToWorldNormal,
+)
 
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
@@ -52,6 +65,10 @@ class IblInputs:
     samples: int = 64
     sample_offset: tuple[float, float] = (0.0, 0.0)
     mode: int = 0
+    # The coat's own lookups where `prefiltered` / `brdf_lut` hold already looked-up values
+    # (the coat reads them along its own reflection vector, NoV and roughness); None: the same.
+    coat_prefiltered: object = None
+    coat_brdf_lut: object = None
 
 
 def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
@@ -89,17 +106,29 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
 def shadeSurface(
     m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None,
     energy_compensation: bool = False, frame: tuple | None = None, lobes: int = LOBES_ALL,
+    coat: bool | None = None,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
     `frame`: (Ng, T, B), the orthonormal tangent frame of the geometric normal that the coat
     normal and the anisotropy direction are given in (None: the talk's model needs none).
-    `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views)."""
+    `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views).
+    `coat`: the GLSL's MATERIAL_HAS_COAT (None: where m.coat is not 0 anywhere)."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
+    if coat is None:
+        coat = bool(np.any(f64(m.coat) != 0.0))
+    if coat:
+        F0 = mix(F0, _coat.f0UnderCoat(F0, m.coatIor), saturate(m.coat)[..., None])
     roughness = saturate(m.roughness)
     s = makeShadingContext(P, N, V, diffuseColor, F0, roughness)
+    if coat:
+        # the coat normal in the geometric normal's frame (its default (0, 0, 1) is Ng)
+        Nc = f64(N) if frame is None else tangentToWorldNormal(m.coatNormal, frame[1],
+                                                                 frame[2], frame[0])
+        s.coat = _coat.makeCoatContext(Nc, V, m.coat, m.coatRoughness, MIN_ANALYTIC_ROUGHNESS,
+                                       m.coatColor, m.coatIor, lobeOn(lobes, LOBE_COAT))
     if energy_compensation:
         NoV = saturate(dot(f64(N), f64(V)))
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
@@ -113,5 +142,14 @@ def shadeSurface(
         s.specularScale = f64(s.specularScale) * lobeOn(lobes, LOBE_SPECULAR)
     direct = directLighting(s, lights)
     indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale)
+    if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
+        indirect = _coat.coatImageBasedLighting(
+            s.coat, V, indirect, ibl.coat_prefiltered if ibl.coat_prefiltered is not None
+            else ibl.prefiltered, ibl.coat_brdf_lut if ibl.coat_brdf_lut is not None
+            else ibl.brdf_lut, ibl.mip_count, ibl.intensity, ibl.lut_values)
+    elif coat and s.coat is not None and ibl.mode == IBL_MODE_REFERENCE:
+        indirect = _coat.coatReferenceIBL(s.coat, V, indirect, ibl.environment,
+                                          max(int(ibl.samples), 1), ibl.sample_offset,
+                                          ibl.intensity)
     return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive) * lobeOn(
         lobes, LOBE_EMISSIVE)
