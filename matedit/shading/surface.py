@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from matedit.shading import anisotropy as _aniso
 from matedit.shading.common import dot, f64, reflect, saturate
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
@@ -21,7 +22,7 @@ from matedit.shading.ibl import (
 )
 from matedit.shading.lights import Light, ShadingContext, evaluateLight, makeShadingContext
 from matedit.shading.material import MaterialAttributes, computeDiffuseColor, materialF0
-
+from matedit.shading.sampling import tangentFrame
 
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
@@ -62,7 +63,8 @@ def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
 
 
 def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
-                       specularScale=1.0) -> np.ndarray:
+                       specularScale=1.0, aniso=None) -> np.ndarray:
+    """`aniso`: the anisotropic lobe (MATERIAL_HAS_ANISOTROPY), None where it is off."""
     N, V = f64(N), f64(V)
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(N.shape, V.shape))
@@ -74,6 +76,8 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
     else:
         NoV = saturate(dot(N, V))
         R = reflect(-V, N)
+        if aniso is not None:
+            R = _aniso.anisotropicReflection(aniso, N, V)
         if callable(ibl.prefiltered):
             pref = prefilteredRadiance(ibl.prefiltered, R, roughness, ibl.mip_count)
         else:
@@ -87,17 +91,27 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
 def shadeSurface(
     m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None,
     energy_compensation: bool = False, frame: tuple | None = None, lobes: int = LOBES_ALL,
+    anisotropic: bool = False,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
     `frame`: (Ng, T, B), the orthonormal tangent frame of the geometric normal that the coat
     normal and the anisotropy direction are given in (None: the talk's model needs none).
-    `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views)."""
+    `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views).
+    `anisotropic`: the GLSL's MATERIAL_HAS_ANISOTROPY (anisotropic GGX from m.anisotropy and
+    m.anisotropyDirection in `frame`; without a frame, tangentFrame(N) as the GLSL's
+    4-argument overload)."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
     roughness = saturate(m.roughness)
     s = makeShadingContext(P, N, V, diffuseColor, F0, roughness)
+    if anisotropic:
+        if frame is None:
+            T, B = tangentFrame(f64(N))
+        else:
+            _, T, B = frame
+        s.aniso = _aniso.makeAnisotropicLobe(s.a, m.anisotropy, m.anisotropyDirection, T, B, N)
     if energy_compensation:
         NoV = saturate(dot(f64(N), f64(V)))
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
@@ -110,6 +124,7 @@ def shadeSurface(
         diffuseColor = s.diffuseColor
         s.specularScale = s.specularScale * lobeOn(lobes, LOBE_SPECULAR)
     direct = directLighting(s, lights)
-    indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale)
+    indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
+                                  s.aniso)
     return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive) * lobeOn(
         lobes, LOBE_EMISSIVE)
