@@ -6,9 +6,8 @@
 // along, so the roughness along it, at, is the larger one. Physically that is ACROSS the
 // grooves: brushing along a direction leaves grooves along it, whose normals tilt across it,
 // so a brushed surface's highlight is stretched perpendicular to the brushing.
-#include "common.glsl"
-#include "brdf.glsl"
-#include "sampling.glsl"
+// Included by lights.glsl inside its #if, after common.glsl and brdf.glsl: it includes
+// nothing itself (a file spliced first inside an #if would be missing where it is off).
 
 // Smallest alpha across the stretch: anisotropy 1 would make ab = 0, a mirror in one axis.
 const float ANISOTROPY_MIN_ALPHA = 1e-3;
@@ -35,7 +34,8 @@ void anisotropicAlphas(float a, float anisotropy, out float at, out float ab) {
 // The stretch direction in world space: the tangent-space direction (+X = T, +Y = B of the
 // geometric normal's frame; z ignored) projected onto the plane of the shading normal N and
 // normalised (Gram-Schmidt), so it stays a tangent after normal mapping. A direction with
-// nothing left in the plane falls back to the projected mesh tangent, then to any tangent.
+// nothing left in the plane falls back to the projected mesh tangent, then to the projected
+// bitangent turned a quarter (T and B are orthogonal: both cannot lie along N).
 vec3 anisotropicTangent(vec3 direction, vec3 T, vec3 B, vec3 N) {
     // Gram-Schmidt against N, as Mikkelsen 2008, "Simulation of Wrinkled Surfaces Revisited"
     vec3 w = T * direction.x + B * direction.y;
@@ -46,12 +46,10 @@ vec3 anisotropicTangent(vec3 direction, vec3 T, vec3 B, vec3 N) {
         tt = dot(t, t);
     }
     if (tt < 1e-12) {
-        vec3 t2;
-        vec3 b2;
-        tangentFrame(N, t2, b2);
-        return t2;
+        t = cross(B - N * dot(N, B), N);
+        tt = dot(t, t);
     }
-    return t * inversesqrt(tt);
+    return t * inversesqrt(max(tt, 1e-30));
 }
 
 // The lobe of a material at a point: alphas from a = roughness^2 and the world stretch
@@ -135,6 +133,8 @@ vec3 anisotropicReflection(AnisotropicLobe l, vec3 N, vec3 V) {
     // Revie 2011, "Implementing Fur Using Deferred Shading" (GPU Pro 2) and McAuley 2015,
     // "Rendering the World of Far Cry 4", as Filament's documentation (anisotropic IBL):
     // n_a = (B x V) x B, bent = normalize(mix(N, n_a, anisotropy)), R = reflect(-V, bent)
+    // At anisotropy 0 the bent normal is N itself, not renormalised: today's R bit for bit.
+    if (l.anisotropy <= 0.0) return reflect(-V, N);
     vec3 anisotropicNormal = cross(cross(l.B, V), l.B);
     vec3 bent = mix(N, anisotropicNormal, l.anisotropy);
     float bb = dot(bent, bent);

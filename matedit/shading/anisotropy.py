@@ -14,7 +14,6 @@ import numpy as np
 
 from matedit.shading.brdf import F_Schlick, F_SchlickExact, k_Analytic, k_IBL
 from matedit.shading.common import PI, cross, dot, f64, reflect, saturate
-from matedit.shading.sampling import tangentFrame
 
 ANISOTROPY_MIN_ALPHA = 1e-3
 
@@ -47,7 +46,7 @@ def anisotropicAlphas(a, anisotropy) -> tuple[np.ndarray, np.ndarray]:
 
 def anisotropicTangent(direction, T, B, N) -> np.ndarray:
     """Gram-Schmidt of the tangent-space direction (z ignored) against N (Mikkelsen 2008);
-    falls back to the projected T, then to tangentFrame(N)."""
+    falls back to the projected T, then to the projected B turned a quarter about N."""
     d, T, B, N = f64(direction), f64(T), f64(B), f64(N)
     w = T * d[..., 0:1] + B * d[..., 1:2]
     t = w - N * dot(N, w)[..., None]
@@ -55,10 +54,10 @@ def anisotropicTangent(direction, T, B, N) -> np.ndarray:
     tT = T - N * dot(N, T)[..., None]
     t = np.where((tt < 1e-12)[..., None], tT, t)
     tt = dot(t, t)
-    t_any, _ = tangentFrame(np.broadcast_to(N, t.shape))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        unit = t / np.sqrt(tt)[..., None]
-    return np.where((tt < 1e-12)[..., None], t_any, unit)
+    tB = cross(B - N * dot(N, B)[..., None], N)
+    t = np.where((tt < 1e-12)[..., None], tB, t)
+    tt = dot(t, t)
+    return t / np.sqrt(np.maximum(tt, 1e-30))[..., None]
 
 
 def makeAnisotropicLobe(a, anisotropy, direction, T, B, N) -> AnisotropicLobe:
@@ -135,6 +134,8 @@ def anisotropicReflection(l: AnisotropicLobe, N, V) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         unit = bent / np.sqrt(bb)[..., None]
     bent = np.where((bb > 1e-12)[..., None], unit, np.broadcast_to(N, unit.shape))
+    # at anisotropy 0, N itself (not renormalised), as the GLSL
+    bent = np.where((an > 0.0), bent, np.broadcast_to(N, bent.shape))
     return reflect(-V, bent)
 
 
