@@ -65,15 +65,16 @@ AnisotropicLobe makeAnisotropicLobe(float a, float anisotropy, vec3 direction, v
     return l;
 }
 
-// Anisotropic GGX, 1 / (pi at ab (ToH^2/at^2 + BoH^2/ab^2 + NoH^2)^2), written with
-// BoH^2 = |N x H|^2 - ToH^2 and multiplied through by ab^2:
-// (ab / at) ab^2 / (pi (|N x H|^2 + ToH^2 (ab^2/at^2 - 1) + NoH^2 ab^2)^2). At at = ab the
-// middle term is exactly 0 and the rest is D_GGX's own arithmetic: the isotropic value.
-float D_GGXAnisotropic(float NoH, float ToH, float oneMinusNoH2, float at, float ab) {
+// Anisotropic GGX, 1 / (pi at ab (ToH^2/at^2 + BoH^2/ab^2 + NoH^2)^2), multiplied through
+// by ab^2: (ab / at) ab^2 / (pi (ToH^2 ab^2/at^2 + BoH^2 + NoH^2 ab^2)^2). ToH and BoH are
+// used directly: BoH^2 from |N x H|^2 - ToH^2 cancels catastrophically when ab << at. At
+// at = ab it is D_GGX's own arithmetic on |N x H|^2 (the isotropic value bit for bit).
+float D_GGXAnisotropic(float NoH, float ToH, float BoH, float oneMinusNoH2, float at,
+                       float ab) {
     // Burley 2012, "Physically-Based Shading at Disney", appendix B.2, eq 13 (GTR2 aniso)
     float ab2 = ab * ab;
-    float ToH2 = min(ToH * ToH, oneMinusNoH2);
-    float d = oneMinusNoH2 + ToH2 * (ab2 / (at * at) - 1.0) + NoH * NoH * ab2;
+    float d = at == ab ? oneMinusNoH2 + NoH * NoH * ab2
+                       : ToH * ToH * (ab2 / (at * at)) + BoH * BoH + NoH * NoH * ab2;
     return (ab / at) * (ab2 / (PI * d * d));
 }
 
@@ -118,7 +119,7 @@ vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, ve
     vec3 NxH = cross(N, H);
     vec3 NxV = cross(N, V);
     vec3 NxL = cross(N, L);
-    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(NxH, NxH), l.at, l.ab);
+    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
     float kV = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)));
     float kL = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, L), dot(NxL, NxL)));
     return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_Schlick(F0, VoH) * NoL;
@@ -186,7 +187,8 @@ float ggxAnisotropicDirectionPdf(AnisotropicLobe l, vec3 N, vec3 V, vec3 L) {
     if (VoH <= 0.0) return 0.0;
     float NoH = saturate(dot(N, H));
     vec3 NxH = cross(N, H);
-    return D_GGXAnisotropic(NoH, dot(l.T, H), dot(NxH, NxH), l.at, l.ab) * NoH / (4.0 * VoH);
+    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
+    return D * NoH / (4.0 * VoH);
 }
 
 // An anisotropic-GGX-sampled direction for the point Xi (may lie below the horizon).
@@ -212,7 +214,7 @@ vec3 anisotropicBrdfCosineIBL(AnisotropicLobe l, vec3 N, vec3 V, vec3 F0, vec3 L
     vec3 NxH = cross(N, H);
     vec3 NxV = cross(N, V);
     vec3 NxL = cross(N, L);
-    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(NxH, NxH), l.at, l.ab);
+    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
     float kV = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)));
     float kL = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, L), dot(NxL, NxL)));
     return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_SchlickExact(F0, VoH) * NoL;

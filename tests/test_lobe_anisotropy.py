@@ -110,8 +110,8 @@ def test_anisotropic_D_is_normalised(an, r):
     T_, P_ = np.meshgrid(th, phi, indexing="ij")
     h = np.stack([np.sin(T_) * np.cos(P_), np.sin(T_) * np.sin(P_), np.cos(T_)], -1)
     # the twin's form, fed the same half vectors, against the paper's
-    D = anisotropy.D_GGXAnisotropic(h[..., 2], h[..., 0], h[..., 0] ** 2 + h[..., 1] ** 2,
-                                    at, ab)  # fmt: skip
+    D = anisotropy.D_GGXAnisotropic(h[..., 2], h[..., 0], h[..., 1],
+                                    h[..., 0] ** 2 + h[..., 1] ** 2, at, ab)  # fmt: skip
     np.testing.assert_allclose(D, ref_D(h, at, ab), rtol=1e-9)
     integrand = D * h[..., 2] * np.sin(T_) * (t / (1 + t * t))[:, None]
     total = np.trapezoid(integrand.mean(axis=1) * 2 * np.pi, logt)
@@ -135,7 +135,8 @@ def test_zero_anisotropy_is_the_isotropic_D_and_visibility(rng):
     H /= np.linalg.norm(H, axis=1, keepdims=True)
     NoH = np.sum(N * H, 1)
     oneMinus = np.sum(np.cross(N, H) ** 2, 1)
-    D = anisotropy.D_GGXAnisotropic(NoH, np.sum(lobe.T * H, 1), oneMinus, lobe.at, lobe.ab)
+    D = anisotropy.D_GGXAnisotropic(NoH, np.sum(lobe.T * H, 1), np.sum(lobe.B * H, 1),
+                                    oneMinus, lobe.at, lobe.ab)
     np.testing.assert_allclose(D, brdf.D_GGX(NoH, a, oneMinus), rtol=1e-12)
     for X in (V, L):
         ao = anisotropy.projectedAlpha(lobe.at, lobe.ab, np.sum(lobe.T * X, 1),
@@ -218,7 +219,8 @@ def test_lobe_terms_gpu_equal_twin(ctx, rng):
     body = _MAKE + """
         lobe = vec4(l.T, l.at); lobeB = vec4(l.B, l.ab);
         vec3 h = normalize(L + V); vec3 NxH = cross(N, h); vec3 NxV = cross(N, V);
-        terms = vec4(D_GGXAnisotropic(saturate(dot(N, h)), dot(l.T, h), dot(NxH, NxH), l.at, l.ab),
+        terms = vec4(D_GGXAnisotropic(saturate(dot(N, h)), dot(l.T, h), dot(l.B, h), dot(NxH, NxH),
+                                     l.at, l.ab),
                      projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)),
                      anisotropicSphereNormalization(l.at, l.ab, 0.3 * an, 1.0 + rough),
                      anisotropicLineNormalization(l, N, L, 2.0 * an, 1.0 + rough));
@@ -243,7 +245,8 @@ def test_lobe_terms_gpu_equal_twin(ctx, rng):
         h = (L + V) / np.linalg.norm(L + V, axis=1, keepdims=True)
         return np.stack([
             anisotropy.D_GGXAnisotropic(np.clip(np.sum(N * h, 1), 0, 1), np.sum(lo.T * h, 1),
-                                        np.sum(np.cross(N, h) ** 2, 1), lo.at, lo.ab),
+                                        np.sum(lo.B * h, 1), np.sum(np.cross(N, h) ** 2, 1),
+                                        lo.at, lo.ab),
             anisotropy.projectedAlpha(lo.at, lo.ab, np.sum(lo.T * V, 1),
                                       np.sum(np.cross(N, V) ** 2, 1)),
             anisotropy.anisotropicSphereNormalization(lo.at, lo.ab, 0.3 * v["an"],

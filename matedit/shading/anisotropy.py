@@ -68,13 +68,14 @@ def makeAnisotropicLobe(a, anisotropy, direction, T, B, N) -> AnisotropicLobe:
     return AnisotropicLobe(T=t, B=cross(f64(N), t), anisotropy=an, at=at, ab=ab)
 
 
-def D_GGXAnisotropic(NoH, ToH, oneMinusNoH2, at, ab) -> np.ndarray:
-    """Burley 2012, "Physically-Based Shading at Disney", B.2 eq 13, in the form
-    (ab / at) ab^2 / (pi (|NxH|^2 + ToH^2 (ab^2/at^2 - 1) + NoH^2 ab^2)^2)."""
-    NoH, ToH, om, at, ab = map(f64, (NoH, ToH, oneMinusNoH2, at, ab))
+def D_GGXAnisotropic(NoH, ToH, BoH, oneMinusNoH2, at, ab) -> np.ndarray:
+    """Burley 2012, "Physically-Based Shading at Disney", B.2 eq 13, multiplied through by
+    ab^2: (ab / at) ab^2 / (pi (ToH^2 ab^2/at^2 + BoH^2 + NoH^2 ab^2)^2); at at = ab, D_GGX's
+    arithmetic on |N x H|^2."""
+    NoH, ToH, BoH, om, at, ab = map(f64, (NoH, ToH, BoH, oneMinusNoH2, at, ab))
     ab2 = ab * ab
-    ToH2 = np.minimum(ToH * ToH, om)
-    d = om + ToH2 * (ab2 / (at * at) - 1.0) + NoH * NoH * ab2
+    d = np.where(at == ab, om + NoH * NoH * ab2,
+                 ToH * ToH * (ab2 / (at * at)) + BoH * BoH + NoH * NoH * ab2)
     return (ab / at) * (ab2 / (PI * d * d))
 
 
@@ -116,7 +117,7 @@ def anisotropicSpecularTowards(l: AnisotropicLobe, N, V, NoV, F0, L) -> np.ndarr
     NoH = saturate(dot(N, H))
     VoH = saturate(dot(V, H))
     with np.errstate(divide="ignore", invalid="ignore"):
-        D = D_GGXAnisotropic(NoH, dot(l.T, H), _onemx2(N, H), l.at, l.ab)
+        D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), _onemx2(N, H), l.at, l.ab)
         kV = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, V), _onemx2(N, V)))
         kL = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, L), _onemx2(N, L)))
         lobe = np.where(NoL > 0.0, D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
@@ -173,7 +174,8 @@ def ggxAnisotropicDirectionPdf(l: AnisotropicLobe, N, V, L) -> np.ndarray:
         H = h / np.sqrt(np.maximum(hh, 1e-30))[..., None]
         VoH = dot(V, H)
         NoH = saturate(dot(N, H))
-        pdf = D_GGXAnisotropic(NoH, dot(l.T, H), _onemx2(N, H), l.at, l.ab) * NoH / (4.0 * VoH)
+        D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), _onemx2(N, H), l.at, l.ab)
+        pdf = D * NoH / (4.0 * VoH)
     return np.where((hh >= 1e-12) & (VoH > 0.0), pdf, 0.0)
 
 
@@ -192,7 +194,7 @@ def anisotropicBrdfCosineIBL(l: AnisotropicLobe, N, V, F0, L) -> np.ndarray:
     NoH = saturate(dot(N, H))
     VoH = saturate(dot(V, H))
     with np.errstate(divide="ignore", invalid="ignore"):
-        D = D_GGXAnisotropic(NoH, dot(l.T, H), _onemx2(N, H), l.at, l.ab)
+        D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), _onemx2(N, H), l.at, l.ab)
         kV = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, V), _onemx2(N, V)))
         kL = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, L), _onemx2(N, L)))
         lobe = np.where(NoL > 0.0, D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
