@@ -21,6 +21,9 @@ const float MIN_ANALYTIC_ROUGHNESS = 0.03;
 #ifndef MATEDIT_AREA_WIDEN_DIVISOR
 #define MATEDIT_AREA_WIDEN_DIVISOR 2.0
 #endif
+#if defined(MATERIAL_HAS_ANISOTROPY)
+#include "anisotropy.glsl"
+#endif
 
 struct Light {
     int type;               // LIGHT_TYPE_*
@@ -48,6 +51,9 @@ struct ShadingContext {
 #if defined(MATERIAL_HAS_COAT)
     CoatContext coat;       // the clear coat over the base (coat.glsl; set by shadeSurface)
 #endif
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    AnisotropicLobe aniso;  // anisotropic GGX (anisotropy.glsl), set by shadeSurface
+#endif
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -64,6 +70,10 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
     s.a = s.roughness * s.roughness;
     s.k = k_Analytic(s.roughness);
     s.specularScale = vec3(1.0);
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    // isotropic until shadeSurface sets the material's direction and anisotropy
+    s.aniso = makeAnisotropicLobe(s.a, 0.0, vec3(1.0, 0.0, 0.0), N, N, N);
+#endif
     return s;
 }
 
@@ -84,6 +94,9 @@ float distanceFalloff(float d, float influenceRadius) {
 // Specular lobe times NoL towards the unit direction L.
 vec3 specularTowards(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4", specular D Vis F, times NoL
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    return anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, s.F0, L) * s.specularScale;
+#endif
     float NoL = saturate(dot(s.N, L));
     // Below the horizon nothing is reflected; this also skips L = -V, where H is undefined
     // (a representative point behind the surface can land exactly there).
@@ -153,8 +166,16 @@ vec3 sphereLight(ShadingContext s, Light light) {
     vec3 diffuse = diffuseLobe(s.diffuseColor) * NoLc;
     // Specular: the point of the sphere closest to the reflection ray, energy renormalised.
     vec3 R = reflect(-s.V, s.N);
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    R = anisotropicReflection(s.aniso, s.N, s.V);  // bent reflection, anisotropy.glsl
+#endif
     vec3 L = normalize(sphereRepresentativePoint(Lc, R, light.sourceRadius));
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    vec3 specular = specularTowards(s, L)
+                  * anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.sourceRadius, d);
+#else
     vec3 specular = specularTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d);
+#endif
 #if defined(MATERIAL_HAS_COAT)
     // The base through the coat towards the centre; the coat's highlight by its own
     // representative point (its reflection vector) and widening (its alpha).
@@ -205,11 +226,20 @@ vec3 tubeLight(ShadingContext s, Light light) {
     // Specular: the sphere step around the closest point on the segment; our choice of
     // falloff is the inverse square to that point (the tube's limit is the sphere light).
     vec3 R = reflect(-s.V, s.N);
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    R = anisotropicReflection(s.aniso, s.N, s.V);  // bent reflection, anisotropy.glsl
+#endif
     vec3 Lp = tubeRepresentativePoint(L0, L1, R);
     float dp = length(Lp);
     vec3 L = normalize(sphereRepresentativePoint(Lp, R, light.sourceRadius));
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    float energy = anisotropicLineNormalization(s.aniso, s.N, light.direction,
+                                                light.sourceLength, d)
+                 * anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.sourceRadius, dp);
+#else
     float energy = lineNormalization(s.a, light.sourceLength, d)
                  * sphereNormalization(s.a, light.sourceRadius, dp);
+#endif
     float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
     vec3 specular = specularTowards(s, L) * (energy / (dp * dp + eps2));
 #if defined(MATERIAL_HAS_COAT)

@@ -17,6 +17,8 @@
 #include "lights.glsl"
 
 // f(l, v) N.l of the whole BRDF (Lambert + specular lobe) towards the unit direction L.
+// The specular lobe is specularTowards', anisotropic GGX where the material writes
+// anisotropy (MATERIAL_HAS_ANISOTROPY, anisotropy.glsl).
 vec3 brdfCosine(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4": diffuse + D Vis F, times NoL
     float NoL = saturate(dot(s.N, L));
@@ -30,6 +32,9 @@ vec3 brdfCosine(ShadingContext s, vec3 L) {
 // Solid-angle density of the direction L under GGX half-vector sampling around N.
 float ggxDirectionPdf(ShadingContext s, vec3 L) {
     // Walter et al. 2007, "Microfacet Models for Refraction": p(l) = D(h) NoH / (4 VoH)
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    return ggxAnisotropicDirectionPdf(s.aniso, s.N, s.V, L);
+#endif
     vec3 h = L + s.V;
     float hh = dot(h, h);
     if (hh < 1e-12) return 0.0;
@@ -44,6 +49,9 @@ float ggxDirectionPdf(ShadingContext s, vec3 L) {
 // A GGX-sampled direction for the point Xi (may lie below the horizon).
 vec3 ggxSampleDirection(ShadingContext s, vec2 Xi) {
     // Karis 2013, ImportanceSampleGGX, then L = 2 (V.H) H - V
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    return ggxAnisotropicSampleDirection(s.aniso, s.N, s.V, Xi);
+#endif
     vec3 H = importanceSampleGGX(Xi, s.a, s.N);
     return 2.0 * dot(s.V, H) * H - s.V;
 }

@@ -55,7 +55,11 @@ vec3 directLightingReference(ShadingContext s) {
 
 // Image-based lighting from the block's environment, split sum or reference by uIbl.params.w.
 vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughness,
-                        vec3 specularScale) {
+                        vec3 specularScale
+#if defined(MATERIAL_HAS_ANISOTROPY)
+                        , AnisotropicLobe aniso  // the split sum's bent lookup (anisotropy.glsl)
+#endif
+                        ) {
     // Karis 2013, "Real Shading in Unreal Engine 4", image-based lighting (eq 6-8, reference)
     int mode = int(uIbl.params.w + 0.5);
     if (mode == IBL_MODE_NONE) return vec3(0.0);
@@ -72,6 +76,11 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
     for (int i = 0; i < 9; i++) sh[i] = uIbl.sh[i].xyz;
     float NoV = saturate(dot(N, V));
     vec3 R = reflect(-V, N);
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    // anisotropic split sum: the bent reflection (anisotropy.glsl); the prefiltered lookup
+    // and the environment BRDF stay at the base roughness (docs/shading.md, Anisotropy)
+    R = anisotropicReflection(aniso, N, V);
+#endif
     vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
     vec2 AB = environmentBRDF(uBrdfLut, NoV, roughness);
     vec3 color = diffuseIrradianceSH9(sh, N, diffuseColor)
@@ -102,6 +111,10 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     s.coat = makeCoatContext(Nc, V, m.coat, m.coatRoughness, MIN_ANALYTIC_ROUGHNESS,
                              m.coatColor, m.coatIor, lobeOn(LOBE_COAT));
 #endif
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    // anisotropic GGX: the material's direction (tangent space of (T, B, Ng)) in N's plane
+    s.aniso = makeAnisotropicLobe(s.a, m.anisotropy, m.anisotropyDirection, T, B, N);
+#endif
 #ifdef MATEDIT_ENERGY_COMPENSATION
     // Beyond the talk (off by default): multiple-scattering compensation of the specular,
     // the diffuse keeping what the specular leaves (ibl.glsl, energyCompensation)
@@ -125,7 +138,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     else
 #endif
     direct = directLighting(s);
-    vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale);
+    vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale
+#if defined(MATERIAL_HAS_ANISOTROPY)
+                                  , s.aniso
+#endif
+                                  );
 #if defined(MATERIAL_HAS_COAT)
     // The coat's image-based light, and the base's seen through the coat (coat.glsl).
     int coatMode = int(uIbl.params.w + 0.5);

@@ -7,6 +7,7 @@ from typing import Literal
 
 import numpy as np
 
+from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
@@ -61,6 +62,8 @@ class ShadingContext:
     k: np.ndarray
     specularScale: object = 1.0  # or the multiple-scattering compensation, (..., 3)
     coat: coat.CoatContext | None = None  # where the material has a coat (MATERIAL_HAS_COAT)
+    # MATERIAL_HAS_ANISOTROPY: the anisotropic lobe (anisotropy.AnisotropicLobe); None: off
+    aniso: _aniso.AnisotropicLobe | None = None
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -84,6 +87,9 @@ def distanceFalloff(d, influenceRadius) -> np.ndarray:
 
 
 def specularTowards(s: ShadingContext, L) -> np.ndarray:
+    if s.aniso is not None:
+        return _aniso.anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, s.F0, L) * f64(
+            s.specularScale)
     NoL = saturate(dot(s.N, L))
     h = f64(L) + s.V
     H = h / np.sqrt(np.maximum(dot(h, h), 1e-30))[..., None]
@@ -148,8 +154,13 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
     NoLc = saturate(dot(s.N, Lc / np.maximum(d, 1e-8)[..., None]))
     diffuse = diffuseLobe(s.diffuseColor) * NoLc[..., None]
     R = reflect(-s.V, s.N)
+    if s.aniso is not None:
+        R = _aniso.anisotropicReflection(s.aniso, s.N, s.V)
     L = normalize(sphereRepresentativePoint(Lc, R, light.source_radius))
     norm = sphereNormalization(s.a, light.source_radius, d)
+    if s.aniso is not None:
+        norm = _aniso.anisotropicSphereNormalization(s.aniso.at, s.aniso.ab,
+                                                     light.source_radius, d)
     specular = specularTowards(s, L) * norm[..., None]
     if s.coat is not None:
         c = s.coat
@@ -188,12 +199,18 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
     window = distanceWindow(d, light.influence_radius)
     diffuse = diffuseLobe(s.diffuseColor) * tubeIrradiance(s.N, L0, L1)[..., None]
     R = reflect(-s.V, s.N)
+    if s.aniso is not None:
+        R = _aniso.anisotropicReflection(s.aniso, s.N, s.V)
     Lp = tubeRepresentativePoint(L0, L1, R)
     dp = length(Lp)
     L = normalize(sphereRepresentativePoint(Lp, R, light.source_radius))
     energy = lineNormalization(s.a, light.source_length, d) * sphereNormalization(
         s.a, light.source_radius, dp
     )
+    if s.aniso is not None:
+        energy = _aniso.anisotropicLineNormalization(
+            s.aniso, s.N, light.direction, light.source_length, d
+        ) * _aniso.anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.source_radius, dp)
     specular = specularTowards(s, L) * (energy / (dp * dp + LIGHT_FALLOFF_EPS**2))[..., None]
     if s.coat is not None:
         c = s.coat

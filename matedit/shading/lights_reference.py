@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, diffuseLobe
 from matedit.shading.common import PI, dot, f64, length, saturate, sq
@@ -34,6 +35,8 @@ def brdfCosine(s: ShadingContext, L) -> np.ndarray:
 
 
 def ggxDirectionPdf(s: ShadingContext, L) -> np.ndarray:
+    if s.aniso is not None:
+        return _aniso.ggxAnisotropicDirectionPdf(s.aniso, s.N, s.V, L)
     h = f64(L) + s.V
     hh = dot(h, h)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -46,6 +49,8 @@ def ggxDirectionPdf(s: ShadingContext, L) -> np.ndarray:
 
 
 def ggxSampleDirection(s: ShadingContext, Xi) -> np.ndarray:
+    if s.aniso is not None:
+        return _aniso.ggxAnisotropicSampleDirection(s.aniso, s.N, s.V, Xi)
     H = importanceSampleGGX(Xi, s.a, s.N)
     return 2.0 * dot(s.V, H)[..., None] * H - s.V
 

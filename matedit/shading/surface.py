@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat as _coat
 from matedit.shading.common import dot, f64, mix, reflect, saturate
 from matedit.shading.ibl import (
@@ -35,6 +36,7 @@ from matedit.shading.material import (
     materialF0,
     tangentToWorldNormal,
 )
+from matedit.shading.sampling import tangentFrame
 
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
@@ -79,7 +81,8 @@ def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
 
 
 def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
-                       specularScale=1.0) -> np.ndarray:
+                       specularScale=1.0, aniso=None) -> np.ndarray:
+    """`aniso`: the anisotropic lobe (MATERIAL_HAS_ANISOTROPY), None where it is off."""
     N, V = f64(N), f64(V)
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(N.shape, V.shape))
@@ -93,6 +96,8 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
     else:
         NoV = saturate(dot(N, V))
         R = reflect(-V, N)
+        if aniso is not None:
+            R = _aniso.anisotropicReflection(aniso, N, V)
         if callable(ibl.prefiltered):
             pref = prefilteredRadiance(ibl.prefiltered, R, roughness, ibl.mip_count)
         else:
@@ -107,13 +112,17 @@ def shadeSurface(
     m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None,
     energy_compensation: bool = False, frame: tuple | None = None, lobes: int = LOBES_ALL,
     coat: bool | None = None,
+    anisotropic: bool = False,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
     `frame`: (Ng, T, B), the orthonormal tangent frame of the geometric normal that the coat
     normal and the anisotropy direction are given in (None: the talk's model needs none).
     `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views).
-    `coat`: the GLSL's MATERIAL_HAS_COAT (None: where m.coat is not 0 anywhere)."""
+    `coat`: the GLSL's MATERIAL_HAS_COAT (None: where m.coat is not 0 anywhere).
+    `anisotropic`: the GLSL's MATERIAL_HAS_ANISOTROPY (anisotropic GGX from m.anisotropy and
+    m.anisotropyDirection in `frame`; without a frame, tangentFrame(N) as the GLSL's
+    4-argument overload)."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
@@ -129,6 +138,12 @@ def shadeSurface(
                                                                  frame[2], frame[0])
         s.coat = _coat.makeCoatContext(Nc, V, m.coat, m.coatRoughness, MIN_ANALYTIC_ROUGHNESS,
                                        m.coatColor, m.coatIor, lobeOn(lobes, LOBE_COAT))
+    if anisotropic:
+        if frame is None:
+            T, B = tangentFrame(f64(N))
+        else:
+            _, T, B = frame
+        s.aniso = _aniso.makeAnisotropicLobe(s.a, m.anisotropy, m.anisotropyDirection, T, B, N)
     if energy_compensation:
         NoV = saturate(dot(f64(N), f64(V)))
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
@@ -141,7 +156,8 @@ def shadeSurface(
         diffuseColor = s.diffuseColor
         s.specularScale = f64(s.specularScale) * lobeOn(lobes, LOBE_SPECULAR)
     direct = directLighting(s, lights)
-    indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale)
+    indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
+                                  s.aniso)
     if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
         indirect = _coat.coatImageBasedLighting(
             s.coat, V, indirect, ibl.coat_prefiltered if ibl.coat_prefiltered is not None

@@ -1,0 +1,235 @@
+// Anisotropic GGX (issue 23, beyond the talk): the base specular lobe with one roughness
+// along a tangent direction and another across it. Everything here is reached only from
+// `#if defined(MATERIAL_HAS_ANISOTROPY)` blocks of lights.glsl, lights_reference.glsl and
+// surface.glsl: a material that does not write `anisotropy` compiles none of it.
+// Convention (the field's documentation): the direction is the one the highlight stretches
+// along, so the roughness along it, at, is the larger one. Physically that is ACROSS the
+// grooves: brushing along a direction leaves grooves along it, whose normals tilt across it,
+// so a brushed surface's highlight is stretched perpendicular to the brushing.
+// Included by lights.glsl inside its #if, after common.glsl and brdf.glsl: it includes
+// nothing itself (a file spliced first inside an #if would be missing where it is off).
+
+// Smallest alpha across the stretch: anisotropy 1 would make ab = 0, a mirror in one axis.
+const float ANISOTROPY_MIN_ALPHA = 1e-3;
+
+// The lobe's frame and roughnesses at one shading point.
+struct AnisotropicLobe {
+    vec3 T;            // unit, in the plane of N: the direction the highlight stretches along
+    vec3 B;            // N x T
+    float anisotropy;  // 0..1
+    float at;          // alpha along T
+    float ab;          // alpha along B
+};
+
+// The two alphas from the isotropic alpha and the anisotropy: at grows and ab shrinks by
+// the same factor, so the lobe's solid angle (at ab) stays near a^2 at small anisotropy and
+// anisotropy 0 is exactly the isotropic alpha. ab is kept at or above min(a, 1e-3).
+void anisotropicAlphas(float a, float anisotropy, out float at, out float ab) {
+    // Kulla and Conty 2017, "Revisiting Physically Based Shading at Imageworks", anisotropy:
+    // at = a (1 + anisotropy), ab = a (1 - anisotropy)
+    at = min(a * (1.0 + anisotropy), 1.0);
+    ab = max(a * (1.0 - anisotropy), min(a, ANISOTROPY_MIN_ALPHA));
+}
+
+// The stretch direction in world space: the tangent-space direction (+X = T, +Y = B of the
+// geometric normal's frame; z ignored) projected onto the plane of the shading normal N and
+// normalised (Gram-Schmidt), so it stays a tangent after normal mapping. A direction with
+// nothing left in the plane falls back to the projected mesh tangent, then to the projected
+// bitangent turned a quarter (T and B are orthogonal: both cannot lie along N).
+vec3 anisotropicTangent(vec3 direction, vec3 T, vec3 B, vec3 N) {
+    // Gram-Schmidt against N, as Mikkelsen 2008, "Simulation of Wrinkled Surfaces Revisited"
+    vec3 w = T * direction.x + B * direction.y;
+    vec3 t = w - N * dot(N, w);
+    float tt = dot(t, t);
+    if (tt < 1e-12) {
+        t = T - N * dot(N, T);
+        tt = dot(t, t);
+    }
+    if (tt < 1e-12) {
+        t = cross(B - N * dot(N, B), N);
+        tt = dot(t, t);
+    }
+    return t * inversesqrt(max(tt, 1e-30));
+}
+
+// The lobe of a material at a point: alphas from a = roughness^2 and the world stretch
+// direction; (T, B) is the geometric normal's tangent frame, N the shading normal.
+AnisotropicLobe makeAnisotropicLobe(float a, float anisotropy, vec3 direction, vec3 T, vec3 B,
+                                    vec3 N) {
+    // Kulla and Conty 2017 (alphas); bitangent N x T' of the projected tangent
+    AnisotropicLobe l;
+    l.anisotropy = saturate(anisotropy);
+    l.T = anisotropicTangent(direction, T, B, N);
+    l.B = cross(N, l.T);
+    anisotropicAlphas(a, l.anisotropy, l.at, l.ab);
+    return l;
+}
+
+// Anisotropic GGX, 1 / (pi at ab (ToH^2/at^2 + BoH^2/ab^2 + NoH^2)^2), multiplied through
+// by ab^2: (ab / at) ab^2 / (pi (ToH^2 ab^2/at^2 + BoH^2 + NoH^2 ab^2)^2). ToH and BoH are
+// used directly: BoH^2 from |N x H|^2 - ToH^2 cancels catastrophically when ab << at. At
+// at = ab it is D_GGX's own arithmetic on |N x H|^2 (the isotropic value bit for bit).
+float D_GGXAnisotropic(float NoH, float ToH, float BoH, float oneMinusNoH2, float at,
+                       float ab) {
+    // Burley 2012, "Physically-Based Shading at Disney", appendix B.2, eq 13 (GTR2 aniso)
+    float ab2 = ab * ab;
+    float d = at == ab ? oneMinusNoH2 + NoH * NoH * ab2
+                       : ToH * ToH * (ab2 / (at * at)) + BoH * BoH + NoH * NoH * ab2;
+    return (ab / at) * (ab2 / (PI * d * d));
+}
+
+// Roughness of the lobe projected on the plane of N and the direction X:
+// sqrt(cos^2(phi) at^2 + sin^2(phi) ab^2), phi the azimuth of X from T, written
+// sqrt(ab^2 + (at^2 - ab^2) cos^2(phi)) so at = ab gives sqrt(a^2) = a exactly.
+// oneMinusNoX2 = |N x X|^2; at the normal (no azimuth) cos^2 is bounded by 1.
+float projectedAlpha(float at, float ab, float ToX, float oneMinusNoX2) {
+    // Heitz 2014, "Understanding the Masking-Shadowing Function in Microfacet-Based BRDFs",
+    // eq 80 (anisotropic GGX: Lambda of the projected roughness alpha_o)
+    float cos2 = min(ToX * ToX / max(oneMinusNoX2, 1e-12), 1.0);
+    return sqrt(ab * ab + (at * at - ab * ab) * cos2);
+}
+
+// Schlick-Smith visibility with its own k for each direction (the k of that direction's
+// projected roughness): G1(V) G1(L) / (4 NoV NoL) with the NoV NoL folded out.
+float V_SchlickSmithAnisotropic(float NoV, float NoL, float kV, float kL) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 4, with Heitz 2014's projected
+    // roughness per direction (eq 80)
+    float gv = NoV * (1.0 - kV) + kV;
+    float gl = NoL * (1.0 - kL) + kL;
+    return 0.25 / (gv * gl);
+}
+
+// k for analytic lights from a projected alpha: the talk's (roughness + 1)^2 / 8 with the
+// perceptual roughness sqrt(alpha_o); at anisotropy 0 sqrt(a) is the roughness itself.
+float k_AnalyticProjected(float alphaO) {
+    // Karis 2013, eq 4 (Disney's remapping) of Heitz 2014's projected roughness (eq 80)
+    return k_Analytic(sqrt(alphaO));
+}
+
+// Anisotropic D Vis F NoL towards the unit direction L for analytic lights (Fresnel by the
+// spherical Gaussian, k remapped): the form of lights.glsl's specularTowards, same H.
+vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, vec3 F0, vec3 L) {
+    // Burley 2012 appendix B.2 eq 13 (D); Heitz 2014 eq 80 with Karis 2013 eq 4 (Vis); eq 5 (F)
+    float NoL = saturate(dot(N, L));
+    if (NoL <= 0.0) return vec3(0.0);
+    vec3 h = L + V;
+    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
+    float NoH = saturate(dot(N, H));
+    float VoH = saturate(dot(V, H));
+    vec3 NxH = cross(N, H);
+    vec3 NxV = cross(N, V);
+    vec3 NxL = cross(N, L);
+    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
+    float kV = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)));
+    float kL = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, L), dot(NxL, NxL)));
+    return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_Schlick(F0, VoH) * NoL;
+}
+
+// The bent reflection vector of the split sum and the area lights' representative point:
+// the "anisotropic normal" is V with its component across the stretch (along B) removed,
+// the normal a lobe infinitely long along T would reflect V about; N is bent towards it by
+// the anisotropy. An approximation: it moves the lookup along the stretch, it does not
+// widen it (the prefiltered lookup stays isotropic).
+vec3 anisotropicReflection(AnisotropicLobe l, vec3 N, vec3 V) {
+    // Revie 2011, "Implementing Fur Using Deferred Shading" (GPU Pro 2) and McAuley 2015,
+    // "Rendering the World of Far Cry 4", as Filament's documentation (anisotropic IBL):
+    // n_a = (B x V) x B, bent = normalize(mix(N, n_a, anisotropy)), R = reflect(-V, bent)
+    // At anisotropy 0 the bent normal is N itself, not renormalised: today's R bit for bit.
+    if (l.anisotropy <= 0.0) return reflect(-V, N);
+    vec3 anisotropicNormal = cross(cross(l.B, V), l.B);
+    vec3 bent = mix(N, anisotropicNormal, l.anisotropy);
+    float bb = dot(bent, bent);
+    bent = bb > 1e-12 ? bent * inversesqrt(bb) : N;
+    return reflect(-V, bent);
+}
+
+// Energy kept by a sphere light's widened anisotropic highlight: each alpha is widened by
+// the source as the isotropic one is, a' = saturate(a + r / (DIVISOR d)), and the peak of
+// D, 1 / (pi at ab), is renormalised by (at ab) / (at' ab'); at = ab gives (a / a')^2.
+float anisotropicSphereNormalization(float at, float ab, float sourceRadius, float d) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 10, 14, applied per axis
+    float widen = sourceRadius / (MATEDIT_AREA_WIDEN_DIVISOR * max(d, 1e-8));
+    return (at * ab) / (saturate(at + widen) * saturate(ab + widen));
+}
+
+// Energy kept by a line's highlight: the line widens the lobe along its own direction only,
+// so the alpha widened is the lobe's alpha projected on the tube's axis (projectedAlpha);
+// a' = saturate(a_axis + 0.5 l / (DIVISOR d)), energy a_axis / a'. At at = ab: a / a'.
+float anisotropicLineNormalization(AnisotropicLobe l, vec3 N, vec3 axis, float sourceLength,
+                                   float d) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 20 (form a / a'), of the projected alpha
+    vec3 NxA = cross(N, axis);
+    float aAxis = projectedAlpha(l.at, l.ab, dot(l.T, axis), dot(NxA, NxA));
+    float widen = 0.5 * sourceLength / (MATEDIT_AREA_WIDEN_DIVISOR * max(d, 1e-8));
+    return aAxis / saturate(aAxis + widen);
+}
+
+// Anisotropic GGX half vector for a uniform point Xi, in the lobe's frame (T, B, N): a
+// slope drawn from unit-roughness GGX (tan = sqrt(y / (1 - y))) and stretched by (at, ab).
+// Its density is D(H) NoH.
+vec3 importanceSampleGGXAnisotropic(vec2 Xi, float at, float ab, vec3 N, vec3 T, vec3 B) {
+    // Burley 2012, "Physically-Based Shading at Disney", appendix B.2, eq 16:
+    // h = normalize(sqrt(y / (1 - y)) (at cos(2 pi x) T + ab sin(2 pi x) B) + N)
+    float phi = 2.0 * PI * Xi.x;
+    float tanTheta = sqrt(Xi.y / max(1.0 - Xi.y, 1e-12));
+    vec3 h = tanTheta * (at * cos(phi) * T + ab * sin(phi) * B) + N;
+    return normalize(h);
+}
+
+// Solid-angle density of L under anisotropic GGX half-vector sampling: D(H) NoH / (4 VoH).
+float ggxAnisotropicDirectionPdf(AnisotropicLobe l, vec3 N, vec3 V, vec3 L) {
+    // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38: p(l) = p(h) / (4 VoH)
+    vec3 h = L + V;
+    float hh = dot(h, h);
+    if (hh < 1e-12) return 0.0;
+    vec3 H = h * inversesqrt(hh);
+    float VoH = dot(V, H);
+    if (VoH <= 0.0) return 0.0;
+    float NoH = saturate(dot(N, H));
+    vec3 NxH = cross(N, H);
+    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
+    return D * NoH / (4.0 * VoH);
+}
+
+// An anisotropic-GGX-sampled direction for the point Xi (may lie below the horizon).
+vec3 ggxAnisotropicSampleDirection(AnisotropicLobe l, vec3 N, vec3 V, vec2 Xi) {
+    // Burley 2012 appendix B.2 eq 16, then L = 2 (V.H) H - V
+    vec3 H = importanceSampleGGXAnisotropic(Xi, l.at, l.ab, N, l.T, l.B);
+    return 2.0 * dot(V, H) * H - V;
+}
+
+// --- For the image-based reference (its estimator adds these mechanically) --------------
+
+// f(l, v) NoL of the anisotropic lobe as the IBL reference integrates it: k = alpha_o / 2
+// per direction (the talk's IBL k of the projected roughness) and the exact Fresnel power.
+vec3 anisotropicBrdfCosineIBL(AnisotropicLobe l, vec3 N, vec3 V, vec3 F0, vec3 L) {
+    // Burley 2012 B.2 eq 13; Heitz 2014 eq 80 with Karis 2013 eq 4 (k = alpha / 2); Schlick 1994
+    float NoL = saturate(dot(N, L));
+    if (NoL <= 0.0) return vec3(0.0);
+    float NoV = max(dot(N, V), 1e-4);
+    vec3 h = L + V;
+    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
+    float NoH = saturate(dot(N, H));
+    float VoH = saturate(dot(V, H));
+    vec3 NxH = cross(N, H);
+    vec3 NxV = cross(N, V);
+    vec3 NxL = cross(N, L);
+    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
+    float kV = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)));
+    float kL = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, L), dot(NxL, NxL)));
+    return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_SchlickExact(F0, VoH) * NoL;
+}
+
+// An importance-sampled direction of the anisotropic lobe and its solid-angle density.
+vec3 anisotropicSampleIBL(AnisotropicLobe l, vec3 N, vec3 V, vec2 Xi, out float pdf) {
+    // Burley 2012 appendix B.2 eq 16; Walter et al. 2007 eq 14, 38
+    vec3 L = ggxAnisotropicSampleDirection(l, N, V, Xi);
+    pdf = ggxAnisotropicDirectionPdf(l, N, V, L);
+    return L;
+}
+
+// Solid-angle density of L under anisotropicSampleIBL.
+float anisotropicPdfIBL(AnisotropicLobe l, vec3 N, vec3 V, vec3 L) {
+    // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38
+    return ggxAnisotropicDirectionPdf(l, N, V, L);
+}
