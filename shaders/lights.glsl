@@ -44,6 +44,13 @@ struct ShadingContext {
     float a;                // roughness^2
     float k;                // Schlick-Smith k for analytic lights
     vec3 specularScale;     // 1, or the multiple-scattering compensation (ibl.glsl)
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    vec3 sheenColor;        // as drawn (lobe views); set by setupSheen (sheen_shading.glsl)
+    float sheenRoughness;   // clamped to MIN_SHEEN_ROUGHNESS
+    float sheenAlpha;
+    float sheenMax;         // max component of the material's sheenColor
+    float sheenScaleV;      // the base's albedo scaling towards the eye
+#endif
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -62,6 +69,10 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
     s.specularScale = vec3(1.0);
     return s;
 }
+
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+#include "sheen_shading.glsl"
+#endif
 
 // The smooth window that takes the falloff to exactly 0 at the influence radius.
 float distanceWindow(float d, float influenceRadius) {
@@ -122,6 +133,9 @@ vec3 pointLight(ShadingContext s, Light light) {
     vec3 L = Lc / max(d, 1e-8);
     float NoL = saturate(dot(s.N, L));
     vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    radiance = sheenLayer(s, radiance, L, NoL);
+#endif
     return radiance * light.color * (light.intensity * distanceFalloff(d, light.influenceRadius));
 }
 
@@ -130,6 +144,9 @@ vec3 directionalLight(ShadingContext s, Light light) {
     vec3 L = -light.direction;
     float NoL = saturate(dot(s.N, L));
     vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    radiance = sheenLayer(s, radiance, L, NoL);
+#endif
     return radiance * light.color * light.intensity;
 }
 
@@ -145,6 +162,11 @@ vec3 sphereLight(ShadingContext s, Light light) {
     vec3 R = reflect(-s.V, s.N);
     vec3 L = normalize(sphereRepresentativePoint(Lc, R, light.sourceRadius));
     vec3 specular = specularTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // Sheen: a wide lobe, taken towards the centre like the diffuse (sheen_shading.glsl).
+    diffuse = sheenLayer(s, diffuse + specular, Lc / max(d, 1e-8), NoLc);
+    specular = vec3(0.0);
+#endif
     return (diffuse + specular) * light.color * (light.intensity * falloff);
 }
 
@@ -192,6 +214,11 @@ vec3 tubeLight(ShadingContext s, Light light) {
                  * sphereNormalization(s.a, light.sourceRadius, dp);
     float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
     vec3 specular = specularTowards(s, L) * (energy / (dp * dp + eps2));
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // Sheen: a wide lobe, towards the centre times the segment's irradiance, like the diffuse.
+    diffuse = sheenLayer(s, diffuse + specular, Lc / max(d, 1e-8), tubeIrradiance(s.N, L0, L1));
+    specular = vec3(0.0);
+#endif
     return (diffuse + specular) * light.color * (light.intensity * window);
 }
 

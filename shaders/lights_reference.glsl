@@ -20,6 +20,9 @@
 vec3 brdfCosine(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4": diffuse + D Vis F, times NoL
     float NoL = saturate(dot(s.N, L));
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    return sheenLayerCosine(s, diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L), L);
+#endif
     return diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
 }
 

@@ -105,6 +105,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     diffuseColor *= lobeOn(LOBE_DIFFUSE);
     s.specularScale *= lobeOn(LOBE_SPECULAR);
 #endif
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // The sheen over the base (sheen_shading.glsl): every light layers it; the IBL's base
+    // is scaled by the view's albedo scaling and the sheen's own term added.
+    setupSheen(s, m.sheenColor, m.sheenRoughness, m.sheenColor * lobeOn(LOBE_SHEEN));
+#endif
     vec3 direct;
 #ifndef MATEDIT_SPLIT_SUM_ONLY
     // uIbl.sampleOffset.z = 1: the area lights' reference (reference mode's frames)
@@ -113,6 +118,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
 #endif
     direct = directLighting(s);
     vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // The base's IBL is linear in its diffuse colour and specular scale: scaling the sum is
+    // scaling both by the view's albedo scaling.
+    ibl = ibl * s.sheenScaleV + sheenImageBasedLighting(s);
+#endif
     return (direct + ibl) * m.cavity + m.emissive * lobeOn(LOBE_EMISSIVE);
 }
 

@@ -9,6 +9,7 @@ import numpy as np
 
 from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
+from matedit.shading.sheen import sheenLayer
 
 LIGHT_TYPE_POINT = 0
 LIGHT_TYPE_DIRECTIONAL = 1
@@ -59,6 +60,14 @@ class ShadingContext:
     a: np.ndarray
     k: np.ndarray
     specularScale: object = 1.0  # or the multiple-scattering compensation, (..., 3)
+    # The sheen (the GLSL's fields under MATERIAL_HAS_SHEEN_COLOR): None = no sheen;
+    # matedit.shading.sheen.setupSheen sets them and sheenLut, the LUT the lights read.
+    sheenColor: object = None
+    sheenRoughness: object = None
+    sheenAlpha: object = None
+    sheenMax: object = None
+    sheenScaleV: object = None
+    sheenLut: object = None
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -125,6 +134,8 @@ def pointLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = Lc / np.maximum(d, 1e-8)[..., None]
     NoL = saturate(dot(s.N, L))
     radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.sheenColor is not None:
+        radiance = sheenLayer(s, radiance, L, NoL)
     return radiance * _scale(light, distanceFalloff(d, light.influence_radius))
 
 
@@ -132,6 +143,8 @@ def directionalLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = np.broadcast_to(-f64(light.direction), s.N.shape)
     NoL = saturate(dot(s.N, L))
     radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.sheenColor is not None:
+        radiance = sheenLayer(s, radiance, L, NoL)
     return radiance * _scale(light, 1.0)
 
 
@@ -145,6 +158,9 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = normalize(sphereRepresentativePoint(Lc, R, light.source_radius))
     norm = sphereNormalization(s.a, light.source_radius, d)
     specular = specularTowards(s, L) * norm[..., None]
+    if s.sheenColor is not None:  # towards the centre, like the diffuse
+        diffuse = sheenLayer(s, diffuse + specular, Lc / np.maximum(d, 1e-8)[..., None], NoLc)
+        specular = 0.0
     return (diffuse + specular) * _scale(light, falloff)
 
 
@@ -182,6 +198,10 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
         s.a, light.source_radius, dp
     )
     specular = specularTowards(s, L) * (energy / (dp * dp + LIGHT_FALLOFF_EPS**2))[..., None]
+    if s.sheenColor is not None:  # towards the centre times the segment's irradiance
+        diffuse = sheenLayer(s, diffuse + specular, Lc / np.maximum(d, 1e-8)[..., None],
+                             tubeIrradiance(s.N, L0, L1))
+        specular = 0.0
     return (diffuse + specular) * _scale(light, window)
 
 

@@ -22,10 +22,14 @@ from matedit.shading.lights import (
     tubeLight,
 )
 from matedit.shading.sampling import importanceSampleGGX, tangentFrame
+from matedit.shading.sheen import sheenLayerCosine
 
 
 def brdfCosine(s: ShadingContext, L) -> np.ndarray:
     NoL = saturate(dot(s.N, L))
+    if s.sheenColor is not None:
+        return sheenLayerCosine(s, diffuseLobe(s.diffuseColor) * NoL[..., None]
+                                + specularTowards(s, L), L)
     return diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
 
 

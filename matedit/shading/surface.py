@@ -21,7 +21,7 @@ from matedit.shading.ibl import (
 )
 from matedit.shading.lights import Light, ShadingContext, evaluateLight, makeShadingContext
 from matedit.shading.material import MaterialAttributes, computeDiffuseColor, materialF0
-
+from matedit.shading.sheen import lut_of, setupSheen, sheenImageBasedLighting
 
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
@@ -87,13 +87,17 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
 def shadeSurface(
     m: MaterialAttributes, P, N, V, lights: Sequence[Light] = (), ibl: IblInputs | None = None,
     energy_compensation: bool = False, frame: tuple | None = None, lobes: int = LOBES_ALL,
+    sheen: bool | None = None,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
     `frame`: (Ng, T, B), the orthonormal tangent frame of the geometric normal that the coat
     normal and the anisotropy direction are given in (None: the talk's model needs none).
-    `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views)."""
+    `lobes`: the GLSL's MATEDIT_LOBES, a mask of LOBE_* bits (the viewport's lobe views).
+    `sheen`: the GLSL's MATERIAL_HAS_SHEEN_COLOR; None: where any sheenColor is not 0."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
+    if sheen is None:
+        sheen = bool(np.any(f64(m.sheenColor) != 0.0))
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
     roughness = saturate(m.roughness)
@@ -109,7 +113,12 @@ def shadeSurface(
         s.diffuseColor = s.diffuseColor * lobeOn(lobes, LOBE_DIFFUSE)
         diffuseColor = s.diffuseColor
         s.specularScale = s.specularScale * lobeOn(lobes, LOBE_SPECULAR)
+    if sheen:
+        setupSheen(s, m.sheenColor, m.sheenRoughness,
+                   f64(m.sheenColor) * lobeOn(lobes, LOBE_SHEEN), lut_of(ibl))
     direct = directLighting(s, lights)
     indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale)
+    if sheen:  # the base's IBL is linear in diffuseColor and specularScale
+        indirect = indirect * s.sheenScaleV[..., None] + sheenImageBasedLighting(s, ibl)
     return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive) * lobeOn(
         lobes, LOBE_EMISSIVE)
