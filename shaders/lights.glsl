@@ -71,7 +71,10 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
 }
 
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
-#include "sheen_shading.glsl"
+// The sheen over the base, defined in sheen_shading.glsl (surface.glsl includes it, after the
+// IBL inputs it reads).
+vec3 sheenLayer(ShadingContext s, vec3 base, vec3 L, float cosine);
+vec3 sheenLayerCosine(ShadingContext s, vec3 base, vec3 L);
 #endif
 
 // The smooth window that takes the falloff to exactly 0 at the influence radius.

@@ -47,8 +47,9 @@ float sheenLambdaFit(float x, float alpha) {
 float sheenLambda(float NoX, float alpha) {
     // Estevez and Kulla 2017, "Production Friendly Microfacet Sheen BRDF", fitted Lambda:
     // exp(L(cos)) for cos < 0.5, else exp(2 L(0.5) - L(1 - cos))
+    // 1 - NoX saturated: a cosine rounded just above 1 must not reach pow of a negative.
     return NoX < 0.5 ? exp(sheenLambdaFit(NoX, alpha))
-                     : exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(1.0 - NoX, alpha));
+                     : exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(saturate(1.0 - NoX), alpha));
 }
 
 // Visibility of the sheen, G2 / (4 NoL NoV) with the height-correlated Smith G2 of the fitted

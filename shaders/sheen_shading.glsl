@@ -1,11 +1,12 @@
 // The sheen lobe in the shading: its ShadingContext set-up, its layering over the base for
-// every light, and its image-based term. lights.glsl includes this file after the
-// ShadingContext struct, only where the material writes sheenColor (MATERIAL_HAS_SHEEN_COLOR);
-// the maths is sheen.glsl's.
+// every light (lights.glsl declares sheenLayer and calls it), and its image-based term.
+// surface.glsl includes this file after the IBL inputs, only where the material writes
+// sheenColor (MATERIAL_HAS_SHEEN_COLOR); the maths is sheen.glsl's.
 #include "common.glsl"
-#include "sheen.glsl"
+#include "lights.glsl"
 #include "ibl_inputs.glsl"
 #include "ibl.glsl"
+#include "sheen.glsl"
 
 // The sheen fields of the context: shownColor is the colour drawn (the material's sheenColor
 // times the lobe view's lobeOn(LOBE_SHEEN)), sheenColor the material's own, which scales the

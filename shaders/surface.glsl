@@ -5,6 +5,11 @@
 #include "lights_block.glsl"
 #include "ibl_inputs.glsl"
 #include "ibl.glsl"
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+// Only its own sheen.glsl is new to the assembly here (an include under #if must not be the
+// first of a shared file, which the assembler splices once).
+#include "sheen_shading.glsl"
+#endif
 #ifndef MATEDIT_SPLIT_SUM_ONLY
 #include "lights_reference.glsl"
 #endif

@@ -50,7 +50,7 @@ def sheenLambda(NoX, alpha) -> np.ndarray:
     """Estevez and Kulla 2017: exp(L(cos)) below 0.5, exp(2 L(0.5) - L(1 - cos)) above."""
     NoX = f64(NoX)
     low = np.exp(sheenLambdaFit(np.minimum(NoX, 0.5), alpha))
-    high = np.exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(1.0 - np.maximum(NoX, 0.5),
+    high = np.exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(saturate(1.0 - np.maximum(NoX, 0.5)),
                                                                      alpha))  # fmt: skip
     return np.where(NoX < 0.5, low, high)
 
@@ -161,9 +161,10 @@ def sheenLayerCosine(s, base, L) -> np.ndarray:
 def referenceSheenIBL(env, s, sampleCount: int, offset) -> np.ndarray:
     """Uniform hemisphere estimate of the sheen under `env`: mean of L(l) f NoL / pdf."""
     Xi = _sample_points(sampleCount, offset)
-    N = np.broadcast_to(s.N[..., None, :], Xi.shape[:-1] + (3,))
-    V = np.broadcast_to(s.V[..., None, :], N.shape)
-    L, pdf = sheenSampleDirection(Xi, N)
+    shape = np.broadcast_shapes(s.N[..., None, :].shape[:-1], Xi.shape[:-1])
+    N = np.broadcast_to(s.N[..., None, :], shape + (3,))
+    V = np.broadcast_to(s.V[..., None, :], shape + (3,))
+    L, pdf = sheenSampleDirection(np.broadcast_to(Xi, shape + (2,)), N)
     alpha = f64(s.sheenAlpha)[..., None] if np.ndim(s.sheenAlpha) else s.sheenAlpha
     f = sheenBrdfCosine(N, V, L, s.sheenColor[..., None, :], alpha)
     return (f64(env(L)) * f / pdf[..., None]).sum(axis=-2) / sampleCount
