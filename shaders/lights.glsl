@@ -219,7 +219,8 @@ vec3 tubeLight(ShadingContext s, Light light) {
     vec3 specular = specularTowards(s, L) * (energy / (dp * dp + eps2));
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
     // Sheen: a wide lobe, towards the centre times the segment's irradiance, like the diffuse.
-    diffuse = sheenLayer(s, diffuse + specular, Lc / max(d, 1e-8), tubeIrradiance(s.N, L0, L1));
+    vec3 Lcn = Lc / max(d, 1e-8);
+    diffuse = sheenLayer(s, diffuse + specular, Lcn, tubeIrradiance(s.N, L0, L1));
     specular = vec3(0.0);
 #endif
     return (diffuse + specular) * light.color * (light.intensity * window);

@@ -1,6 +1,6 @@
-// The sheen lobe (beyond the talk): the Charlie microfacet distribution of Estevez and Kulla
-// with their fitted Smith Lambda for the visibility, the lobe's directional albedo E(NoV, roughness) from the
-// B channel of the environment BRDF LUT (shaders/bake/brdf_lut.frag), the albedo scaling of
+// The sheen lobe (beyond the talk): the Charlie microfacet distribution of Estevez and
+// Kulla with their fitted Smith Lambda for the visibility, the lobe's directional albedo
+// E(NoV, roughness) from the blue channel of the environment BRDF LUT (shaders/bake/brdf_lut.frag), the albedo scaling of
 // the layer under it (glTF KHR_materials_sheen) and the sheen's split-sum and sampling terms.
 // No ShadingContext here: sheen_shading.glsl wires these into the lights and the IBL.
 // Functions take their textures as arguments, like ibl.glsl.
@@ -48,8 +48,9 @@ float sheenLambda(float NoX, float alpha) {
     // Estevez and Kulla 2017, "Production Friendly Microfacet Sheen BRDF", fitted Lambda:
     // exp(L(cos)) for cos < 0.5, else exp(2 L(0.5) - L(1 - cos))
     // 1 - NoX saturated: a cosine rounded just above 1 must not reach pow of a negative.
+    float mirrored = saturate(1.0 - NoX);
     return NoX < 0.5 ? exp(sheenLambdaFit(NoX, alpha))
-                     : exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(saturate(1.0 - NoX), alpha));
+                     : exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(mirrored, alpha));
 }
 
 // Visibility of the sheen, G2 / (4 NoL NoV) with the height-correlated Smith G2 of the fitted

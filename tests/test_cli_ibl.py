@@ -72,7 +72,7 @@ def test_bake_ibl_writes_mips_lut_and_sh(tmp_path):
         cross = read_image(out / f"prefiltered_mip{m}.exr").pixels
         assert cross.shape == (3 * size, 4 * size, 3)
         assert np.isfinite(cross).all()
-    assert read_image(out / "brdf_lut.exr").pixels.shape == (128, 128, 2)
+    assert read_image(out / "brdf_lut.exr").pixels.shape == (128, 128, 3)  # A, B, sheen E
     sh = json.loads((out / "sh.json").read_text())
     coeffs = np.array(sh["coefficients"])
     assert coeffs.shape == (9, 3) and coeffs[0].min() > 0

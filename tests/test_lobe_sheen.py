@@ -269,15 +269,14 @@ def test_shade_surface_with_sheen_gpu_twin(ctx, rng, mode):
 
 
 def test_sheen_split_sum_against_brute_force():
-    """A sky-like environment L(w) = 1 + 0.8 w.z + 0.3 w.x (smooth, as the prefiltered
-    mips are at these roughnesses). Split sum: prefiltered(R) x sheenColor x E, with the
-    prefiltered radiance computed here as the normalised Charlie-lobe-free GGX average the
-    bake uses at that roughness; brute force: the integral of L(l) f(l) NoL itself."""
+    """A sky-like environment L(w) = 1 + 0.8 w.z + 0.3 w.x. Split sum: prefiltered(N) x E
+    (white sheen), the prefiltered radiance computed here as the bake's GGX-weighted average
+    at the sheen roughness; brute force: the integral of L(l) f(l) NoL itself."""
 
     def env(w):
         return 1.0 + 0.8 * w[..., 2] + 0.3 * w[..., 0]
 
-    worst = 0.0
+    worst = {}
     rows = []
     for r in (0.3, 0.7, 1.0):
         alpha = r * r
@@ -297,19 +296,21 @@ def test_sheen_split_sum_against_brute_force():
             brute = float((env(L) * fcos).sum() * dw)
             E = float(fcos.sum() * dw)
             # prefiltered GGX at roughness r around R (Karis's NoL-weighted, N = V = R)
-            R = np.array([-V[0], 0.0, V[2]])
-            pref = _ggx_prefiltered(env, R, r)
+            # sheen_shading.glsl looks the prefiltered environment up around N (a wide lobe)
+            pref = _ggx_prefiltered(env, np.array([0.0, 0.0, 1.0]), r)
             split = pref * E
             rel = abs(split - brute) / brute
-            worst = max(worst, rel)
+            if brute > 0.01:  # NoV = 1 at roughness 0.3 reflects 1e-3: relative error moot
+                worst[r] = max(worst.get(r, 0.0), rel)
             rows.append((r, NoV, brute, split, rel))
     print("\nsheen split sum vs brute force (roughness, NoV, brute, split, rel):")
     for row in rows:
-        print("  %.1f %.2f %.4f %.4f %.3f" % row)
-    # The split sum's error for a wide lobe under a linear-gradient sky: measured worst
-    # 0.16 (roughness 0.3 at NoV = 0.05: the lobe looks at the horizon, R at the horizon
-    # too, but the prefiltered GGX lobe sees the upper hemisphere more); bound 0.2.
-    assert worst < 0.2
+        print("  {:.1f} {:.2f} {:.4f} {:.4f} {:.3f}".format(*row))
+    # The split sum's error under a gradient sky, measured (relative, where the sheen
+    # reflects > 0.01): roughness 0.3: 0.29, 0.7: 0.13, 1.0: 0.07, worst at grazing views
+    # (a GGX lobe of the sheen roughness is not the Charlie lobe's shape). Around R instead
+    # of N the same cases measured 0.45, 0.44, 0.42. Bounds: measured + ~0.05.
+    assert worst[0.3] < 0.35 and worst[0.7] < 0.18 and worst[1.0] < 0.12, worst
 
 
 def _ggx_prefiltered(env, R, roughness, n=200000):

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from matedit.shading.common import INV_PI, PI, dot, f64, mix, reflect, saturate, sq
+from matedit.shading.common import INV_PI, PI, dot, f64, mix, saturate, sq
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
     IBL_MODE_REFERENCE,
@@ -50,8 +50,8 @@ def sheenLambda(NoX, alpha) -> np.ndarray:
     """Estevez and Kulla 2017: exp(L(cos)) below 0.5, exp(2 L(0.5) - L(1 - cos)) above."""
     NoX = f64(NoX)
     low = np.exp(sheenLambdaFit(np.minimum(NoX, 0.5), alpha))
-    high = np.exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(saturate(1.0 - np.maximum(NoX, 0.5)),
-                                                                     alpha))  # fmt: skip
+    mirrored = saturate(1.0 - np.maximum(NoX, 0.5))
+    high = np.exp(2.0 * sheenLambdaFit(0.5, alpha) - sheenLambdaFit(mirrored, alpha))
     return np.where(NoX < 0.5, low, high)
 
 
@@ -171,7 +171,7 @@ def referenceSheenIBL(env, s, sampleCount: int, offset) -> np.ndarray:
 
 
 def sheenImageBasedLighting(s, ibl) -> np.ndarray:
-    """Split sum (prefiltered at the sheen roughness around R) or the reference estimate;
+    """Split sum (prefiltered at the sheen roughness around N) or the reference estimate;
     `ibl` is matedit.shading.surface.IblInputs."""
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(s.N.shape, s.V.shape))
@@ -179,9 +179,8 @@ def sheenImageBasedLighting(s, ibl) -> np.ndarray:
         count = max(int(ibl.samples), 1)
         return referenceSheenIBL(ibl.environment, s, count, ibl.sample_offset) * ibl.intensity
     NoV = saturate(dot(s.N, s.V))
-    R = reflect(-s.V, s.N)
-    if callable(ibl.prefiltered):
-        pref = prefilteredRadiance(ibl.prefiltered, R, s.sheenRoughness, ibl.mip_count)
+    if callable(ibl.prefiltered):  # around N (sheen_shading.glsl)
+        pref = prefilteredRadiance(ibl.prefiltered, s.N, s.sheenRoughness, ibl.mip_count)
     else:
         pref = f64(ibl.prefiltered)
     dfg = sheenDFG(s.sheenLut, NoV, s.sheenRoughness)
