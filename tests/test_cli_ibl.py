@@ -50,7 +50,7 @@ def test_brdf_lut_writes_the_documented_layout(tmp_path):
     result = run_cli("brdf-lut", "-o", out, "--size", 16, cache_dir=tmp_path / "cache")
     assert result.returncode == 0, result.stderr
     image = read_image(out)
-    assert image.pixels.shape == (16, 16, 2) and image.channel_names == ("R", "G")
+    assert image.pixels.shape == (16, 16, 3) and image.channel_names == ("R", "G", "B")
     # Row k = roughness (k + .5)/N, column i = NoV (i + .5)/N, as OpenImageIO reads it.
     for k, i in [(1, 15), (12, 2), (8, 8)]:
         expected = ggx_lut_cell((i + 0.5) / 16, (k + 0.5) / 16)
