@@ -54,6 +54,13 @@ struct ShadingContext {
 #if defined(MATERIAL_HAS_ANISOTROPY)
     AnisotropicLobe aniso;  // anisotropic GGX (anisotropy.glsl), set by shadeSurface
 #endif
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    vec3 sheenColor;        // as drawn (lobe views); set by setupSheen (sheen_shading.glsl)
+    float sheenRoughness;   // clamped to MIN_SHEEN_ROUGHNESS
+    float sheenAlpha;
+    float sheenMax;         // max component of the material's sheenColor
+    float sheenScaleV;      // the base's albedo scaling towards the eye
+#endif
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -76,6 +83,13 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
 #endif
     return s;
 }
+
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+// The sheen over the base, defined in sheen_shading.glsl (surface.glsl includes it, after the
+// IBL inputs it reads).
+vec3 sheenLayer(ShadingContext s, vec3 base, vec3 L, float cosine);
+vec3 sheenLayerCosine(ShadingContext s, vec3 base, vec3 L);
+#endif
 
 // The smooth window that takes the falloff to exactly 0 at the influence radius.
 float distanceWindow(float d, float influenceRadius) {
@@ -139,6 +153,9 @@ vec3 pointLight(ShadingContext s, Light light) {
     vec3 L = Lc / max(d, 1e-8);
     float NoL = saturate(dot(s.N, L));
     vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    radiance = sheenLayer(s, radiance, L, NoL);
+#endif
 #if defined(MATERIAL_HAS_COAT)
     radiance = coatLayer(s.coat, s.V, L, radiance);  // the base through the coat, its highlight
 #endif
@@ -150,6 +167,9 @@ vec3 directionalLight(ShadingContext s, Light light) {
     vec3 L = -light.direction;
     float NoL = saturate(dot(s.N, L));
     vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    radiance = sheenLayer(s, radiance, L, NoL);
+#endif
 #if defined(MATERIAL_HAS_COAT)
     radiance = coatLayer(s.coat, s.V, L, radiance);  // the base through the coat, its highlight
 #endif
@@ -175,6 +195,11 @@ vec3 sphereLight(ShadingContext s, Light light) {
                   * anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.sourceRadius, d);
 #else
     vec3 specular = specularTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d);
+#endif
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // Sheen: a wide lobe, taken towards the centre like the diffuse (sheen_shading.glsl).
+    diffuse = sheenLayer(s, diffuse + specular, Lc / max(d, 1e-8), NoLc);
+    specular = vec3(0.0);
 #endif
 #if defined(MATERIAL_HAS_COAT)
     // The base through the coat towards the centre; the coat's highlight by its own
@@ -242,6 +267,12 @@ vec3 tubeLight(ShadingContext s, Light light) {
 #endif
     float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
     vec3 specular = specularTowards(s, L) * (energy / (dp * dp + eps2));
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // Sheen: a wide lobe, towards the centre times the segment's irradiance, like the diffuse.
+    vec3 Lcn = Lc / max(d, 1e-8);
+    diffuse = sheenLayer(s, diffuse + specular, Lcn, tubeIrradiance(s.N, L0, L1));
+    specular = vec3(0.0);
+#endif
 #if defined(MATERIAL_HAS_COAT)
     // The base through the coat towards the centre; the coat's highlight by the same steps
     // along its own reflection vector, with its own alpha.

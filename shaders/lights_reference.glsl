@@ -22,11 +22,15 @@
 vec3 brdfCosine(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4": diffuse + D Vis F, times NoL
     float NoL = saturate(dot(s.N, L));
-#if defined(MATERIAL_HAS_COAT)
-    // the base through the clear coat, plus the coat's lobe (coat.glsl)
-    return coatLayer(s.coat, s.V, L, diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L));
+    vec3 base = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    base = sheenLayerCosine(s, base, L);  // the sheen over the base (sheen_shading.glsl)
 #endif
-    return diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+#if defined(MATERIAL_HAS_COAT)
+    // the base (and its sheen) through the clear coat, plus the coat's lobe (coat.glsl)
+    base = coatLayer(s.coat, s.V, L, base);
+#endif
+    return base;
 }
 
 // Solid-angle density of the direction L under GGX half-vector sampling around N.

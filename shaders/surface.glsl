@@ -5,6 +5,11 @@
 #include "lights_block.glsl"
 #include "ibl_inputs.glsl"
 #include "ibl.glsl"
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+// Only its own sheen.glsl is new to the assembly here (an include under #if must not be the
+// first of a shared file, which the assembler splices once).
+#include "sheen_shading.glsl"
+#endif
 #ifndef MATEDIT_SPLIT_SUM_ONLY
 #include "lights_reference.glsl"
 #endif
@@ -131,6 +136,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     diffuseColor *= lobeOn(LOBE_DIFFUSE);
     s.specularScale *= lobeOn(LOBE_SPECULAR);
 #endif
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // The sheen over the base (sheen_shading.glsl): every light layers it; the IBL's base
+    // is scaled by the view's albedo scaling and the sheen's own term added.
+    setupSheen(s, m.sheenColor, m.sheenRoughness, m.sheenColor * lobeOn(LOBE_SHEEN));
+#endif
     vec3 direct;
 #ifndef MATEDIT_SPLIT_SUM_ONLY
     // uIbl.sampleOffset.z = 1: the area lights' reference (reference mode's frames)
@@ -143,6 +153,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                                   , s.aniso
 #endif
                                   );
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // The base's IBL is linear in its diffuse colour and specular scale: scaling the sum is
+    // scaling both by the view's albedo scaling.
+    ibl = ibl * s.sheenScaleV + sheenImageBasedLighting(s);
+#endif
 #if defined(MATERIAL_HAS_COAT)
     // The coat's image-based light, and the base's seen through the coat (coat.glsl).
     int coatMode = int(uIbl.params.w + 0.5);

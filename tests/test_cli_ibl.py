@@ -50,11 +50,11 @@ def test_brdf_lut_writes_the_documented_layout(tmp_path):
     result = run_cli("brdf-lut", "-o", out, "--size", 16, cache_dir=tmp_path / "cache")
     assert result.returncode == 0, result.stderr
     image = read_image(out)
-    assert image.pixels.shape == (16, 16, 2) and image.channel_names == ("R", "G")
+    assert image.pixels.shape == (16, 16, 3) and image.channel_names == ("R", "G", "B")
     # Row k = roughness (k + .5)/N, column i = NoV (i + .5)/N, as OpenImageIO reads it.
     for k, i in [(1, 15), (12, 2), (8, 8)]:
         expected = ggx_lut_cell((i + 0.5) / 16, (k + 0.5) / 16)
-        np.testing.assert_allclose(image.pixels[k, i], expected, atol=3e-3)
+        np.testing.assert_allclose(image.pixels[k, i, :2], expected, atol=3e-3)  # A, B
 
 
 def test_bake_ibl_writes_mips_lut_and_sh(tmp_path):
@@ -72,7 +72,7 @@ def test_bake_ibl_writes_mips_lut_and_sh(tmp_path):
         cross = read_image(out / f"prefiltered_mip{m}.exr").pixels
         assert cross.shape == (3 * size, 4 * size, 3)
         assert np.isfinite(cross).all()
-    assert read_image(out / "brdf_lut.exr").pixels.shape == (128, 128, 2)
+    assert read_image(out / "brdf_lut.exr").pixels.shape == (128, 128, 3)  # A, B, sheen E
     sh = json.loads((out / "sh.json").read_text())
     coeffs = np.array(sh["coefficients"])
     assert coeffs.shape == (9, 3) and coeffs[0].min() > 0

@@ -27,6 +27,9 @@ Progress = Callable[[float, str], None]
 # lobes converge with few samples: (2, 4) measured 0.7-1.3 % mean error at roughness >= 1/3
 # for half the time of (4, 16) (benchmarks/bench_ibl.py).
 PREFILTER_GROWTH = (2, 4)
+# Channels of the environment BRDF LUT: A, B and the Charlie sheen's albedo (brdf_lut.frag);
+# in the cache keys, so entries of the two-channel LUT are never read as this one.
+LUT_CHANNELS = 3
 
 
 @dataclass(frozen=True)
@@ -72,7 +75,7 @@ class IBLBake:
     mips[m]: (6, size >> m, size >> m, 3) float32 cube faces in OpenGL face order
         (+X -X +Y -Y +Z -Z, rows as `TextureCube.write` takes them), prefiltered for
         roughness m / (len(mips) - 1); mips[0] is the environment itself.
-    lut: (N, N, 2) float32, lut[k, i] = (A, B) at roughness (k + 0.5) / N and
+    lut: (N, N, 3) float32, lut[k, i] = (A, B, E_sheen) at roughness (k + 0.5) / N and
         NoV (i + 0.5) / N; upload as is and sample with texture(lut, vec2(NoV, roughness)).
     sh: (9, 3) irradiance coefficients: E(N) = sum_i sh[i] * Y_i(N) (matedit.ibl.sh).
     """
@@ -107,14 +110,15 @@ def bake_brdf_lut(
     cache_dir: str | os.PathLike | None = None,
     problems: list[str] | None = None,
 ) -> np.ndarray:
-    """The environment BRDF LUT (size, size, 2), from the cache when possible; a miss is
+    """The environment BRDF LUT (size, size, 3), from the cache when possible; a miss is
     computed with `baker`, or in the moderngl context `ctx`. A damaged cache entry is
     discarded and computed again, and why is appended to `problems`."""
     BakeSettings(lut_size=size, lut_samples=samples).resolved()  # validates
-    key = cache.make_key("brdf-lut", size=size, samples=samples, method="quadrature")
+    key = cache.make_key("brdf-lut", size=size, samples=samples, method="quadrature",
+                         channels=LUT_CHANNELS)
     path = _cache_dir(cache_dir) / f"lut-{key}.npz"
     if use_cache:
-        hit = cache.load(path, {"lut": cache.Spec((size, size, 2), "<f4")}, problems)
+        hit = cache.load(path, {"lut": cache.Spec((size, size, LUT_CHANNELS), "<f4")}, problems)
         if hit is not None:
             return hit["lut"]
     own = baker is None
@@ -144,7 +148,7 @@ def _schema(settings: BakeSettings) -> dict[str, cache.Spec]:
     """What a cached bake of `settings` holds (the arrays `_pack` writes)."""
     out = {f"mip{m}": cache.Spec((6, settings.size >> m, settings.size >> m, 3), "<f4")
            for m in range(settings.levels)}
-    out["lut"] = cache.Spec((settings.lut_size, settings.lut_size, 2), "<f4")
+    out["lut"] = cache.Spec((settings.lut_size, settings.lut_size, LUT_CHANNELS), "<f4")
     out["sh"] = cache.Spec((9, 3), "<f8")
     out["settings"] = cache.Spec((), "U")
     return out
@@ -166,10 +170,11 @@ def cache_paths(env: Environment, settings: BakeSettings,
     settings = settings.resolved()
     folder = _cache_dir(cache_dir)
     key = cache.make_key(
-        "ibl", env=env.content_hash(), settings=asdict(settings), growth=PREFILTER_GROWTH
+        "ibl", env=env.content_hash(), settings=asdict(settings), growth=PREFILTER_GROWTH,
+        lut_channels=LUT_CHANNELS,
     )
     lut = cache.make_key("brdf-lut", size=settings.lut_size, samples=settings.lut_samples,
-                         method="quadrature")
+                         method="quadrature", channels=LUT_CHANNELS)
     return {"ibl": folder / f"ibl-{key}.npz", "lut": folder / f"lut-{lut}.npz"}
 
 

@@ -226,27 +226,29 @@ class Baker:
     # -- environment BRDF LUT -------------------------------------------------------------------
 
     def brdf_lut(self, size: int, samples: int, method: str = "quadrature") -> np.ndarray:
-        """The (size, size, 2) LUT: [k, i] = (A, B) at roughness (k+.5)/size, NoV (i+.5)/size.
+        """The (size, size, 3) LUT: [k, i] = (A, B, E_sheen) at roughness (k+.5)/size, NoV
+        (i+.5)/size; E_sheen is the Charlie sheen's directional albedo (brdf_lut.frag).
 
         `samples` is the number of integrand evaluations per texel: with the default
         "quadrature" method it sets the number of panels (samples / 32); "hammersley" is
         the notes' Monte Carlo estimator with that many points, kept for comparison.
         """
+        defines = f"#define S_NODES {LUT_S_NODES}\n#define PHI_NODES {LUT_PHI_NODES}\n"
         if method == "hammersley":
-            prog, vao = self._vao("brdf_lut.frag", "#define LUT_HAMMERSLEY\n")
+            prog, vao = self._vao("brdf_lut.frag", defines + "#define LUT_HAMMERSLEY\n")
             self._set(prog, "uSamples", int(samples))
         elif method == "quadrature":
-            defines = f"#define S_NODES {LUT_S_NODES}\n#define PHI_NODES {LUT_PHI_NODES}\n"
             prog, vao = self._vao("brdf_lut.frag", defines)
             panels = max(2, round(samples / (LUT_S_NODES * LUT_PHI_NODES)))
-            xs, ws = _gauss_legendre01(LUT_S_NODES)
-            xp, wp = _gauss_legendre01(LUT_PHI_NODES)
-            prog["uNodeS"].write(xs.tobytes())
-            prog["uWeightS"].write(ws.tobytes())
-            prog["uNodePhi"].write(xp.tobytes())
-            prog["uWeightPhi"].write(wp.tobytes())
             self._set(prog, "uPanels", panels)
         else:
             raise ValueError(f"unknown LUT method {method!r}")
+        # The Gauss-Legendre rules of the quadrature; the sheen channel uses them either way.
+        xs, ws = _gauss_legendre01(LUT_S_NODES)
+        xp, wp = _gauss_legendre01(LUT_PHI_NODES)
+        for name, values in (("uNodeS", xs), ("uWeightS", ws), ("uNodePhi", xp),
+                             ("uWeightPhi", wp)):
+            if name in prog:
+                prog[name].write(values.tobytes())
         self._set(prog, "uSize", int(size))
-        return self._draw(vao, size, size)[..., :2].copy()
+        return self._draw(vao, size, size)[..., :3].copy()

@@ -11,7 +11,8 @@ DIR/brdf_lut.exr             the environment BRDF LUT (layout below)
 DIR/sh.json                  nine irradiance SH coefficients (matedit/ibl/sh.py)
 DIR/ibl.json                 what the files are: sizes, roughness per mip, settings
 
-LUT EXR (docs/shading.md#file-conventions): N x N, channels R = A and G = B; row k (row 0 the first
+LUT EXR (docs/shading.md#file-conventions): N x N, channels R = A, G = B and B = the
+Charlie sheen's directional albedo E (brdf_lut.frag); row k (row 0 the first
 OpenImageIO reads) holds roughness (k + 0.5) / N, column i holds NoV = (i + 0.5) / N.
 """
 
@@ -43,9 +44,9 @@ SH_BASIS_NAMES = (
 
 
 def write_lut(path: str | os.PathLike, lut: np.ndarray) -> Path:
-    """Write a (N, N, 2) LUT as a two-channel (R = A, G = B) float32 EXR."""
+    """Write a (N, N, 3) LUT as a float32 EXR: R = A, G = B, B = the sheen's albedo E."""
     path = Path(path)
-    write_image(path, np.asarray(lut, dtype=np.float32)[..., :2])
+    write_image(path, np.asarray(lut, dtype=np.float32)[..., :3])
     return path
 
 

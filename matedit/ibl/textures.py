@@ -17,7 +17,7 @@ GLSL side (docs/shading.md#image-based-lighting, split sum):
 
 The cube is RGB32F with levels 0..M-1 (GL_TEXTURE_MAX_LEVEL = M - 1), trilinear, and
 `upload` enables GL_TEXTURE_CUBE_MAP_SEAMLESS on the context (core profile default is off).
-The LUT is RG32F, bilinear, clamped to edge.
+The LUT is RGB32F (A, B, the Charlie sheen's albedo E), bilinear, clamped to edge.
 """
 
 from __future__ import annotations
@@ -128,10 +128,11 @@ def upload_cube(ctx: moderngl.Context, mips: list[np.ndarray], unit: int | None 
 
 
 def upload_lut(ctx: moderngl.Context, lut: np.ndarray) -> moderngl.Texture:
-    """The (N, N, 2) LUT as an RG32F texture; texture coordinates (NoV, roughness)."""
+    """The (N, N, 3) LUT as an RGB32F texture (a two-channel one as RG32F: its blue, the
+    sheen's albedo, then reads 0); texture coordinates (NoV, roughness)."""
     h, w = lut.shape[:2]
     tex = ctx.texture(
-        (w, h), 2, data=np.ascontiguousarray(lut, dtype=np.float32).tobytes(), dtype="f4"
+        (w, h), lut.shape[2], data=np.ascontiguousarray(lut, dtype=np.float32).tobytes(), dtype="f4"
     )
     tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
     tex.repeat_x = tex.repeat_y = False

@@ -11,6 +11,7 @@ from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
+from matedit.shading.sheen import sheenLayer
 
 LIGHT_TYPE_POINT = 0
 LIGHT_TYPE_DIRECTIONAL = 1
@@ -64,6 +65,14 @@ class ShadingContext:
     coat: coat.CoatContext | None = None  # where the material has a coat (MATERIAL_HAS_COAT)
     # MATERIAL_HAS_ANISOTROPY: the anisotropic lobe (anisotropy.AnisotropicLobe); None: off
     aniso: _aniso.AnisotropicLobe | None = None
+    # The sheen (the GLSL's fields under MATERIAL_HAS_SHEEN_COLOR): None = no sheen;
+    # matedit.shading.sheen.setupSheen sets them and sheenLut, the LUT the lights read.
+    sheenColor: object = None
+    sheenRoughness: object = None
+    sheenAlpha: object = None
+    sheenMax: object = None
+    sheenScaleV: object = None
+    sheenLut: object = None
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -133,6 +142,8 @@ def pointLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = Lc / np.maximum(d, 1e-8)[..., None]
     NoL = saturate(dot(s.N, L))
     radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.sheenColor is not None:
+        radiance = sheenLayer(s, radiance, L, NoL)
     if s.coat is not None:
         radiance = coat.coatLayer(s.coat, s.V, L, radiance)
     return radiance * _scale(light, distanceFalloff(d, light.influence_radius))
@@ -142,6 +153,8 @@ def directionalLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = np.broadcast_to(-f64(light.direction), s.N.shape)
     NoL = saturate(dot(s.N, L))
     radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.sheenColor is not None:
+        radiance = sheenLayer(s, radiance, L, NoL)
     if s.coat is not None:
         radiance = coat.coatLayer(s.coat, s.V, L, radiance)
     return radiance * _scale(light, 1.0)
@@ -162,6 +175,9 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
         norm = _aniso.anisotropicSphereNormalization(s.aniso.at, s.aniso.ab,
                                                      light.source_radius, d)
     specular = specularTowards(s, L) * norm[..., None]
+    if s.sheenColor is not None:  # towards the centre, like the diffuse
+        diffuse = sheenLayer(s, diffuse + specular, Lc / np.maximum(d, 1e-8)[..., None], NoLc)
+        specular = 0.0
     if s.coat is not None:
         c = s.coat
         Lcoat = normalize(sphereRepresentativePoint(Lc, reflect(-s.V, c.N), light.source_radius))
@@ -212,6 +228,10 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
             s.aniso, s.N, light.direction, light.source_length, d
         ) * _aniso.anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.source_radius, dp)
     specular = specularTowards(s, L) * (energy / (dp * dp + LIGHT_FALLOFF_EPS**2))[..., None]
+    if s.sheenColor is not None:  # towards the centre times the segment's irradiance
+        diffuse = sheenLayer(s, diffuse + specular, Lc / np.maximum(d, 1e-8)[..., None],
+                             tubeIrradiance(s.N, L0, L1))
+        specular = 0.0
     if s.coat is not None:
         c = s.coat
         Rc = reflect(-s.V, c.N)

@@ -24,11 +24,14 @@ from matedit.shading.lights import (
     tubeLight,
 )
 from matedit.shading.sampling import importanceSampleGGX, tangentFrame
+from matedit.shading.sheen import sheenLayerCosine
 
 
 def brdfCosine(s: ShadingContext, L) -> np.ndarray:
     NoL = saturate(dot(s.N, L))
     base = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    if s.sheenColor is not None:
+        base = sheenLayerCosine(s, base, L)
     if s.coat is not None:
         return coat.coatLayer(s.coat, s.V, L, base)
     return base

@@ -37,6 +37,7 @@ from matedit.shading.material import (
     tangentToWorldNormal,
 )
 from matedit.shading.sampling import tangentFrame
+from matedit.shading.sheen import lut_of, setupSheen, sheenImageBasedLighting
 
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
@@ -113,6 +114,7 @@ def shadeSurface(
     energy_compensation: bool = False, frame: tuple | None = None, lobes: int = LOBES_ALL,
     coat: bool | None = None,
     anisotropic: bool = False,
+    sheen: bool | None = None,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
@@ -122,8 +124,11 @@ def shadeSurface(
     `coat`: the GLSL's MATERIAL_HAS_COAT (None: where m.coat is not 0 anywhere).
     `anisotropic`: the GLSL's MATERIAL_HAS_ANISOTROPY (anisotropic GGX from m.anisotropy and
     m.anisotropyDirection in `frame`; without a frame, tangentFrame(N) as the GLSL's
-    4-argument overload)."""
+    4-argument overload).
+    `sheen`: the GLSL's MATERIAL_HAS_SHEEN_COLOR; None: where any sheenColor is not 0."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
+    if sheen is None:
+        sheen = bool(np.any(f64(m.sheenColor) != 0.0))
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
     if coat is None:
@@ -155,9 +160,14 @@ def shadeSurface(
         s.diffuseColor = s.diffuseColor * lobeOn(lobes, LOBE_DIFFUSE)
         diffuseColor = s.diffuseColor
         s.specularScale = f64(s.specularScale) * lobeOn(lobes, LOBE_SPECULAR)
+    if sheen:
+        setupSheen(s, m.sheenColor, m.sheenRoughness,
+                   f64(m.sheenColor) * lobeOn(lobes, LOBE_SHEEN), lut_of(ibl))
     direct = directLighting(s, lights)
     indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
                                   s.aniso)
+    if sheen:  # the base's IBL is linear in diffuseColor and specularScale
+        indirect = indirect * f64(s.sheenScaleV)[..., None] + sheenImageBasedLighting(s, ibl)
     if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
         indirect = _coat.coatImageBasedLighting(
             s.coat, V, indirect, ibl.coat_prefiltered if ibl.coat_prefiltered is not None

@@ -1,8 +1,10 @@
 // Environment BRDF LUT (split sum, right factor): A in R, B in G; x = NoV, y = roughness.
+// Third (blue) channel: the Charlie sheen's directional albedo and DFG term, integrateSheen.
 // The quadrature is explained in matedit/ibl/lut.py; with LUT_HAMMERSLEY defined, the notes'
 // plain Monte Carlo estimator is used instead (kept for comparison).
 #include "common.glsl"
 #include "sampling.glsl"
+#include "sheen.glsl"
 
 #ifndef S_NODES
 #define S_NODES 4
@@ -138,6 +140,45 @@ vec2 integrateHammersley(float NoV, float roughness) {
     return AB / float(n);
 }
 
+// Gauss-Legendre panels of the sheen quadrature along y, where NoL = y^2, and nodes in phi.
+const int SHEEN_PANELS = 24;
+const int SHEEN_PHI_NODES = 24;
+
+// Directional albedo of the white Charlie sheen (sheen.glsl's D_Charlie V_Charlie), the blue
+// channel: E(NoV) = integral over L of D V NoL. The integrand is smooth in L but, for a small
+// alpha, peaked where NoL and NoV both approach 0 (half vectors near the tangent plane):
+// NoL = y^2 puts the nodes there (dNoL = 2 y dy), and azimuths phi and -phi are equal, so
+// phi runs over [0, pi] with weight 2. Uses the same 4- and 8-point rules as A and B (four
+// sets of PHI_NODES in phi): 96 x 32 evaluations a texel, independent of uSamples.
+float integrateSheen(float NoV, float roughness) {
+    // Estevez and Kulla 2017, "Production Friendly Microfacet Sheen BRDF" (Charlie D and the
+    // fitted Lambda); alpha = clamp(roughness, MIN_SHEEN_ROUGHNESS, 1)^2 (sheen.glsl)
+    float alpha = sheenAlpha(roughness);
+    float sinV = sqrt(max(1.0 - NoV * NoV, 0.0));
+    float lambdaV = sheenLambda(NoV, alpha);
+    float E = 0.0;
+    float h = 1.0 / float(SHEEN_PANELS);
+    for (int p = 0; p < SHEEN_PANELS; ++p) {
+        for (int j = 0; j < S_NODES; ++j) {
+            float y = (float(p) + uNodeS[j]) * h;
+            float NoL = y * y;
+            float wy = uWeightS[j] * h * 2.0 * y;
+            float sinL = sqrt(max(1.0 - NoL * NoL, 0.0));
+            // V NoL = G2 / (4 NoV): finite as NoL -> 0
+            float visNoL = 1.0 / ((1.0 + lambdaV + sheenLambda(NoL, alpha)) * 4.0 * NoV);
+            for (int q = 0; q < 4 * PHI_NODES; ++q) {
+                float phi = PI * (float(q / PHI_NODES) + uNodePhi[q % PHI_NODES]) * 0.25;
+                float wphi = uWeightPhi[q % PHI_NODES] * 0.25 * 2.0 * PI;
+                // |V + L|^2 = 2 + 2 V.L; NoH^2 = (NoV + NoL)^2 / |V + L|^2
+                float VoL = NoV * NoL + sinV * sinL * cos(phi);
+                float sin2h = 1.0 - sq(NoV + NoL) / max(2.0 + 2.0 * VoL, 1e-12);
+                E += wy * wphi * D_Charlie(sin2h, alpha) * visNoL;
+            }
+        }
+    }
+    return E;
+}
+
 void main() {
     float NoV = gl_FragCoord.x / float(uSize);
     float roughness = gl_FragCoord.y / float(uSize);
@@ -146,5 +187,5 @@ void main() {
 #else
     vec2 AB = integrateQuadrature(NoV, roughness);
 #endif
-    fragColor = vec4(AB, 0.0, 1.0);
+    fragColor = vec4(AB, integrateSheen(NoV, roughness), 1.0);
 }

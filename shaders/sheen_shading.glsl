@@ -1,0 +1,84 @@
+// The sheen lobe in the shading: its ShadingContext set-up, its layering over the base for
+// every light (lights.glsl declares sheenLayer and calls it), and its image-based term.
+// surface.glsl includes this file after the IBL inputs, only where the material writes
+// sheenColor (MATERIAL_HAS_SHEEN_COLOR); the maths is sheen.glsl's.
+#include "common.glsl"
+#include "lights.glsl"
+#include "ibl_inputs.glsl"
+#include "ibl.glsl"
+#include "sheen.glsl"
+
+// The sheen fields of the context: shownColor is the colour drawn (the material's sheenColor
+// times the lobe view's lobeOn(LOBE_SHEEN)), sheenColor the material's own, which scales the
+// base whether the view shows the sheen or not (the base keeps what it has in the full image).
+void setupSheen(inout ShadingContext s, vec3 sheenColor, float sheenRoughness, vec3 shownColor) {
+    // glTF KHR_materials_sheen, albedo-scaling: 1 - max3(sheenColor) E(NoV) for the view
+    s.sheenColor = shownColor;
+    s.sheenRoughness = clamp(sheenRoughness, MIN_SHEEN_ROUGHNESS, 1.0);
+    s.sheenAlpha = sheenAlpha(sheenRoughness);
+    s.sheenMax = max(max(sheenColor.r, sheenColor.g), sheenColor.b);
+    s.sheenScaleV = sheenAlbedoScaling(s.sheenMax, sheenDFG(uBrdfLut, s.NoV, s.sheenRoughness));
+}
+
+// Scale of the base for light arriving from a direction with cosine NoL: the smaller of the
+// view's and the light's albedo scalings, so neither direction sees more than the sheen left.
+float sheenBaseScale(ShadingContext s, float NoL) {
+    // glTF KHR_materials_sheen, albedo-scaling: min(1 - max3(c) E(NoV), 1 - max3(c) E(NoL))
+    float EL = sheenDFG(uBrdfLut, saturate(NoL), s.sheenRoughness);
+    float scaleL = sheenAlbedoScaling(s.sheenMax, EL);
+    return min(s.sheenScaleV, scaleL);
+}
+
+// The base's radiance from one light, scaled, plus the sheen towards L; `cosine` is what the
+// sheen BRDF is multiplied by (NoL for a direction, the segment's irradiance factor for a tube).
+vec3 sheenLayer(ShadingContext s, vec3 base, vec3 L, float cosine) {
+    // glTF KHR_materials_sheen: sheen f + base * sheen_albedo_scaling
+    float NoL = saturate(dot(s.N, L));
+    return base * sheenBaseScale(s, NoL)
+         + s.sheenColor * (sheenBRDF(s.N, s.V, L, s.sheenAlpha) * cosine);
+}
+
+// The sheen's f NoL towards L with the base's scaling, for the area lights' reference:
+// base is the base's f NoL towards L.
+vec3 sheenLayerCosine(ShadingContext s, vec3 base, vec3 L) {
+    // glTF KHR_materials_sheen, as sheenLayer with cosine = NoL
+    return sheenLayer(s, base, L, saturate(dot(s.N, L)));
+}
+
+#ifndef MATEDIT_SPLIT_SUM_ONLY
+// Monte Carlo estimate of the sheen under the unfiltered environment (reference mode), by
+// sheenSampleDirection; the reference IBL's estimator can take the same three functions.
+vec3 referenceSheenIBL(samplerCube env, ShadingContext s, uint sampleCount, vec2 offset) {
+    // Uniform hemisphere sampling: the estimator is L(l) f NoL / pdf
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < sampleCount; i++) {
+        float pdf;
+        vec3 L = sheenSampleDirection(rotatedHammersley(i, sampleCount, offset), s.N, pdf);
+        sum += textureLod(env, L, 0.0).rgb
+             * sheenBrdfCosine(s.N, s.V, L, s.sheenColor, s.sheenAlpha) / pdf;
+    }
+    return sum / float(sampleCount);
+}
+#endif
+
+// The sheen's image-based light: split sum (the environment prefiltered at the sheen
+// roughness around N, times sheenColor and the DFG term) or the reference estimate.
+vec3 sheenImageBasedLighting(ShadingContext s) {
+    // Filament's cloth IBL, after Karis 2013 eq 6-8: prefiltered(r) sheenColor DFG_charlie
+    int mode = int(uIbl.params.w + 0.5);
+    if (mode == IBL_MODE_NONE) return vec3(0.0);
+#ifndef MATEDIT_SPLIT_SUM_ONLY
+    if (mode == IBL_MODE_REFERENCE) {
+        uint count = uint(max(uIbl.params.z, 1.0));
+        return referenceSheenIBL(uEnvironment, s, count, uIbl.sampleOffset.xy) * uIbl.params.y;
+    }
+#endif
+    // Around N, not R: the Charlie lobe is wide and spreads over the hemisphere at grazing
+    // views, where R lies on the horizon (tests/test_lobe_sheen.py: worst 0.29 / 0.13 / 0.07
+    // relative at roughness 0.3 / 0.7 / 1.0 around N under a gradient sky, 0.45 / 0.44 /
+    // 0.42 around R).
+    float NoV = saturate(dot(s.N, s.V));
+    vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, s.N, s.sheenRoughness, uIbl.params.x);
+    float dfg = sheenDFG(uBrdfLut, NoV, s.sheenRoughness);
+    return sheenSplitSum(prefiltered, s.sheenColor, dfg) * uIbl.params.y;
+}
