@@ -79,6 +79,8 @@ SURFACE_INPUTS = {
     "base_color": "baseColor", "base": "cavity", "specular": "cavity",
     "metalness": "metallic", "specular_roughness": "roughness",
     "normal": "normal", "emission_color": "emissive", "opacity": "opacity",
+    "coat": "coat", "coat_color": "coatColor", "coat_roughness": "coatRoughness",
+    "coat_IOR": "coatIor",
 }
 
 

@@ -38,7 +38,11 @@ SURFACES: dict[str, dict[str, tuple[str, str | None, float]]] = {
         "baseColor": ("base_color", None, 1.0), "metallic": ("metalness", None, 1.0),
         "roughness": ("specular_roughness", None, 1.0), "cavity": ("base", None, 1.0),
         "normal": ("normal", None, 1.0), "emissive": ("emission_color", "emission", 1.0),
-        "opacity": ("opacity", None, 1.0)},
+        "opacity": ("opacity", None, 1.0),
+        # read only where the shader sets `coat` (COAT_GATE): the defaults of coat_roughness
+        # (0.1) would otherwise turn a coat on in every import's fields
+        "coat": ("coat", None, 1.0), "coatColor": ("coat_color", None, 1.0),
+        "coatRoughness": ("coat_roughness", None, 1.0), "coatIor": ("coat_IOR", None, 1.0)},
     "open_pbr_surface": {
         "baseColor": ("base_color", None, 1.0), "metallic": ("base_metalness", None, 1.0),
         "roughness": ("specular_roughness", None, 1.0), "cavity": ("base_weight", None, 1.0),
@@ -57,6 +61,8 @@ SURFACES: dict[str, dict[str, tuple[str, str | None, float]]] = {
         "normal": ("normal", None, 1.0), "emissive": ("emissiveColor", None, 1.0),
         "opacity": ("opacity", None, 1.0)},
 }
+# The coat attributes are read from a surface only where it has this input of its own.
+COAT_GATE = "coat"
 # Surfaces whose normal input is world space (a normalmap node is expected there); the
 # UsdPreviewSurface normal is tangent space already.
 WORLD_NORMAL = {"standard_surface", "open_pbr_surface", "gltf_pbr"}
@@ -518,10 +524,13 @@ class _Importer:
             if attr == "normal":
                 self.normal(shader, inp, cat in WORLD_NORMAL, make)
                 continue
+            if attr.startswith("coat") and shader.getInput(COAT_GATE) is None:
+                continue
             src = self.surface_input(shader, inp)
             if src is None:
                 continue
-            if src.width == 3 and attr in ("metallic", "roughness", "cavity", "opacity"):
+            if src.width == 3 and attr in ("metallic", "roughness", "cavity", "opacity", "coat",
+                                           "coatRoughness", "coatIor"):
                 if src.node is None:
                     src = Src(value=src.value[:1], width=1)
                 else:
