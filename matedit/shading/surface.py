@@ -22,7 +22,6 @@ from matedit.shading.ibl import (
 from matedit.shading.lights import Light, ShadingContext, evaluateLight, makeShadingContext
 from matedit.shading.material import MaterialAttributes, computeDiffuseColor, materialF0
 
-
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
 LOBES_ALL = 31
