@@ -12,7 +12,7 @@ from pathlib import Path
 from matedit.cli import UsageError
 from matedit.io.inputs import declare_inputs
 
-# matedit.render.views.VIEWS, spelled here so parsing the command line imports no GL
+# matedit.shading.views.VIEWS, spelled here so parsing the command line imports no numpy
 # (tests/test_views.py checks the two agree)
 VIEW_NAMES = ("lit", "base", "coat", "sheen", "specular", "roughness", "normal", "coat-weight",
               "anisotropy")

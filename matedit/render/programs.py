@@ -18,7 +18,7 @@ from matedit.compiler.emit import Entry
 from matedit.glsl.layout import BINDINGS
 from matedit.render.deferred import ENERGY_COMPENSATION, SPLIT_SUM_ONLY
 from matedit.render.fullscreen import set_uniform
-from matedit.render.views import view_defines
+from matedit.shading.views import view_defines
 
 # uniform blocks and samplers a program may declare -> their binding (matedit/glsl/layout.py)
 _BLOCKS = (("LightsBlock", "LIGHTS"), ("IblBlock", "IBL"), ("FrameBlock", "FRAME"),
@@ -87,7 +87,7 @@ class ProgramCache:
                  view: str = "lit") -> moderngl.Program:
         """The program a material draws with (raises moderngl.Error): its GBUFFER entry, or
         forward its split-sum FORWARD variant (with the preview's compensation option and the
-        viewport's view, matedit.render.views; the deferred path's lobe views are the
+        viewport's view, matedit.shading.views; the deferred path's lobe views are the
         lighting pass's)."""
         return self.get(compiled, *self._variant(forward, compensation, view))[0]
 

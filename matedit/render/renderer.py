@@ -26,9 +26,9 @@ from matedit.render.mesh import GpuMesh, mesh_from_spec
 from matedit.render.programs import MaterialStatus, ProgramCache
 from matedit.render.scene import ScenePass
 from matedit.render.settings import MODES, PreviewSettings
-from matedit.render.views import check_view, is_attribute_view
 from matedit.shading.ibl import IBL_MODE_REFERENCE
 from matedit.shading.lights import Light
+from matedit.shading.views import check_view, is_attribute_view
 
 __all__ = ["MODES", "MaterialStatus", "Renderer", "r2_offset"]
 
@@ -148,7 +148,7 @@ class Renderer(PreviewSettings):
             wants_forward(compiled, values)
 
     def set_view(self, view: str) -> None:
-        """The viewport's view (matedit.render.views; ValueError for an unknown one): a lobe
+        """The viewport's view (matedit.shading.views; ValueError for an unknown one): a lobe
         view relinks the material's FORWARD variant (or uses the lighting pass's, deferred),
         an attribute view its FORWARD variant; each is linked once and then cached. On a link
         failure the view stays as it was (and the error is raised)."""

@@ -21,8 +21,8 @@ from matedit.render.mesh import GpuMesh
 from matedit.render.programs import bind_program
 from matedit.render.settings import PreviewSettings
 from matedit.render.uniforms import SceneUniforms
-from matedit.render.views import lobe_mask
 from matedit.shading.ibl import IBL_MODE_REFERENCE
+from matedit.shading.views import lobe_mask
 
 
 class ScenePass:

@@ -1,6 +1,7 @@
-"""The viewport's views: the shaded image with some lobes only (a MATEDIT_LOBES mask of the
-LOBE_* bits of shaders/surface.glsl), or one material field drawn in place of the shading
-(MATEDIT_ATTRIBUTE_VIEW of shaders/attribute_view.glsl, FORWARD entry only).
+"""The viewport's views, a table with no GL (the editor's tool bar reads it too): the shaded
+image with some lobes only (a MATEDIT_LOBES mask of the LOBE_* bits of shaders/surface.glsl),
+or one material field drawn in place of the shading (MATEDIT_ATTRIBUTE_VIEW of
+shaders/attribute_view.glsl, FORWARD entry only).
 
 `lit` adds no define at all, so its programs are the ones the preview always drew (the same
 text and structure hash, the program cache's key).
@@ -8,10 +9,10 @@ text and structure hash, the program cache's key).
 
 from __future__ import annotations
 
-# the define of the FORWARD entry's attribute view (matedit.compiler.schedule.ATTRIBUTE_VIEW;
-# spelled here so the CLI's argument parser can list the views without the compiler)
+from matedit.shading.surface import LOBE_COAT, LOBE_DIFFUSE, LOBE_SHEEN, LOBE_SPECULAR
+
+# the define of the FORWARD entry's attribute view (matedit.compiler.schedule.ATTRIBUTE_VIEW)
 ATTRIBUTE_VIEW = "MATEDIT_ATTRIBUTE_VIEW"
-LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
 ALL_LOBES = 31
 LOBES_DEFINE = "MATEDIT_LOBES"
 
