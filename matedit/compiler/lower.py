@@ -372,7 +372,7 @@ class _Lowerer:
         colour replaced by the catalogue's Blend node of that mode (blend_<mode>) of the
         layer's base colour over the stack's, mixed by the same weight: what a painting
         program's layer mode does to colour; roughness, normal and the rest stay the mask's."""
-        brk = nodes.definition("break_attributes")
+        brk = nodes.definition(nodes.BREAK_ATTRIBUTES)
         fields = [(f.name, PortType(f.type)) for f in ATTRIBUTE_FIELDS]
         self.ctx.kinds.add(brk.kind)
         below = self.emit(Op(f"{nid}.{lid}.below", nid, brk.kind, [acc], fields,
