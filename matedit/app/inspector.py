@@ -233,7 +233,8 @@ class InspectorPanel(QScrollArea):
         return lab
 
     def _build_settings(self, lay, node: Node, d) -> None:
-        shown = [s for s in d.settings if s.name != "layers"]
+        # the canvas's pin groups are view state, toggled on the node itself
+        shown = [s for s in d.settings if s.name not in ("layers", nodes.EXPANDED_GROUPS)]
         if role_of(node.kind) == Role.TEXTURE_PARAMETER:
             shown = [s for s in shown if s.name != "path"]
         if not shown and role_of(node.kind) not in (Role.TEXTURE_PARAMETER, Role.LAYER_STACK):
@@ -397,7 +398,7 @@ class InspectorPanel(QScrollArea):
                 if isinstance(e, dict) and isinstance(e.get("id"), str):
                     layer_names[e["id"]] = str(e.get("name") or e["id"])
         for p in ports.inputs:
-            group = "Inputs"
+            group = nodes.port_group(node.kind, p.name) or "Inputs"
             if layer_names:
                 lid = next((lid for lid in sorted(layer_names, key=len, reverse=True)
                             if p.name.startswith(lid + "_")), None)

@@ -44,12 +44,34 @@ from matedit.graph.commands import (
 from matedit.graph.layers import Layer, LayerStack, parked_wires
 from matedit.graph.model import ChangeEvent, ChangeKind, Link, Node
 from matedit.graph.nodes import Role, kind_for, role_of
-from matedit.graph.ports import LAYER_BLENDS
+from matedit.graph.ports import COLOR_LAYER_BLENDS, LAYER_BLENDS
 from matedit.io.document import FormatError, load
 from matedit.resources import graphs_dir
 
 LAYER_MIME = "application/x-matedit-layer"  # absolute path of a layer file (from the library)
 ROW_MIME = "application/x-matedit-layer-row"  # id of a layer being reordered
+
+
+STRUCTURAL_BLENDS = {
+    "alpha": ("Alpha", "Lerps every field by mask × opacity"),
+    "height": ("Height", "Shows the layer where its height rises above the base's"),
+    "coat": ("Coat", "Lays the layer over the ones below as a clear coat: its roughness, "
+             "colour, IOR and normal become the coat's, mask × opacity its weight"),
+}
+
+
+def blend_modes() -> list[tuple[str, str, str]]:
+    """(mode, title, tooltip) of every layer blend mode, in the menu's order: alpha, height,
+    coat, then the catalogue's colour Blend nodes (their titles and descriptions)."""
+    from matedit.graph import nodes
+
+    out = [(m, *STRUCTURAL_BLENDS[m]) for m in LAYER_BLENDS if m in STRUCTURAL_BLENDS]
+    for mode in COLOR_LAYER_BLENDS:
+        d = nodes.definition(f"blend_{mode}")
+        title = d.title.split(":", 1)[-1].strip()
+        out.append((mode, title, f"Base colour: {d.description.split(' Mixed')[0]} "
+                    "Other fields by mask × opacity"))
+    return out
 
 
 def layer_files() -> list[Path]:
@@ -122,12 +144,20 @@ class _LayerRow(QWidget):
             self.blend.setEnabled(False)
             self.blend.setToolTip("The bottom layer is the base: nothing to blend over")
         else:
-            self.blend.addItems(list(LAYER_BLENDS))
-            if layer.blend not in LAYER_BLENDS:
-                self.blend.addItem(layer.blend)
-            self.blend.setCurrentText(layer.blend)
+            for i, (mode, title, tip) in enumerate(blend_modes()):
+                if i == len(STRUCTURAL_BLENDS):
+                    self.blend.insertSeparator(self.blend.count())
+                self.blend.addItem(title, mode)
+                self.blend.setItemData(self.blend.count() - 1, tip, Qt.ItemDataRole.ToolTipRole)
+            if layer.blend not in LAYER_BLENDS:  # a blend function file
+                self.blend.insertSeparator(self.blend.count())
+                self.blend.addItem(Path(str(layer.blend)).stem.replace("_", " "), layer.blend)
+                self.blend.setItemData(self.blend.count() - 1, str(layer.blend),
+                                       Qt.ItemDataRole.ToolTipRole)
+            self.blend.setCurrentIndex(self.blend.findData(layer.blend))
             self.blend.setToolTip("How this layer blends over the ones below")
-            self.blend.currentTextChanged.connect(lambda b: panel.set_blend(layer.id, b))
+            self.blend.currentIndexChanged.connect(
+                lambda i: panel.set_blend(layer.id, self.blend.itemData(i)))
         top.addWidget(self.blend)
         lay.addLayout(top)
         self.parked = None
@@ -382,7 +412,9 @@ class LayersPanel(QWidget):
     def set_visible(self, layer_id: str, on: bool) -> None:
         self._push(lambda s: s.set(layer_id, visible=bool(on)))
 
-    def set_blend(self, layer_id: str, blend: str) -> None:
+    def set_blend(self, layer_id: str, blend: str | None) -> None:
+        if not isinstance(blend, str) or not blend:  # a separator row
+            return
         self._push(lambda s: s.set(layer_id, blend=blend))
 
     def rename(self, layer_id: str, name: str) -> None:

@@ -40,8 +40,21 @@ from matedit.app import file_dialogs
 from matedit.app.compile_service import MaterialCompiler, uniform_values
 from matedit.app.paths import texture_paths
 from matedit.app.theme import icon
+from matedit.shading.views import VIEWS
 
 MESHES = ("sphere", "cube", "plane", "cylinder")
+VIEW_TIPS = {
+    "lit": "Every lobe",
+    "base": "The base's diffuse and specular only",
+    "coat": "The clear coat's reflection only",
+    "sheen": "The sheen only",
+    "specular": "Every specular reflection: the base's and the coat's",
+    "roughness": "Roughness as a grey level (linear)",
+    "normal": "The world shading normal, N / 2 + 1/2",
+    "coat-weight": "The clear coat's weight as a grey level (linear)",
+    "anisotropy": "Stripes along the anisotropy direction over the dimmed surface; grey to "
+                  "amber with the anisotropy",
+}
 MODES = {"Split-sum": "splitsum", "Reference": "reference", "Difference": "difference"}
 ENVIRONMENTS = {"Studio": "studio", "Sky": "sky"}
 OPEN_ENV = "Open HDR/EXR…"
@@ -93,6 +106,7 @@ class ViewportWidget(QOpenGLWidget):
         self._mesh = "sphere"
         self._environment = "studio"
         self._mode = "splitsum"
+        self._view = "lit"  # matedit.shading.views: lit, a lobe view or an attribute view
         self._exposure = 0.0
         self._lights = None
         self._last = QPointF()
@@ -141,6 +155,7 @@ class ViewportWidget(QOpenGLWidget):
         r.set_mesh(self._mesh)
         r.mode = self._mode
         r.exposure = self._exposure
+        self._set_renderer_view(r, self._view)
         self._apply_settings(r)
         if self._lights is not None:
             r.set_lights(list(self._lights))
@@ -281,6 +296,29 @@ class ViewportWidget(QOpenGLWidget):
         if self.renderer is not None:
             self.renderer.mode = mode
             self.update()
+
+    @property
+    def shading_view(self) -> str:
+        return self._view
+
+    def set_view(self, view: str) -> None:
+        """The view chooser's view (matedit.shading.views): one relink the first time each
+        view is shown for a material (the programs are cached), a redraw after."""
+        self._view = view
+        if self.renderer is not None:
+            self.makeCurrent()
+            try:
+                self._set_renderer_view(self.renderer, view)
+            finally:
+                self.doneCurrent()
+            self.update()
+
+    def _set_renderer_view(self, r, view: str) -> None:
+        try:
+            r.set_view(view)
+        except Exception as exc:  # a link failure keeps the view the renderer had
+            self._view = r.view
+            self.statusMessage.emit(f"view {view}: {type(exc).__name__}: {exc}")
 
     def set_exposure(self, ev: float) -> None:
         self._exposure = float(ev)
@@ -439,6 +477,16 @@ class ViewportPanel(QWidget):
         self.mode_combo.addItems(list(MODES))
         self.mode_combo.setToolTip("Image-based lighting: split-sum approximation, brute-force "
                                    "reference, or their difference")
+        self.view_combo = QComboBox()
+        self.view_combo.setObjectName("viewChooser")
+        for i, (name, (title, _, attribute)) in enumerate(VIEWS.items()):
+            if attribute is not None and VIEWS[list(VIEWS)[i - 1]][2] is None:
+                self.view_combo.insertSeparator(self.view_combo.count())
+            self.view_combo.addItem(title, name)
+            self.view_combo.setItemData(self.view_combo.count() - 1, VIEW_TIPS[name],
+                                        Qt.ItemDataRole.ToolTipRole)
+        self.view_combo.setToolTip("What the viewport shows: the lit material, some of its "
+                                   "lobes only, or one of its fields")
         self.env_combo = QComboBox()
         self.env_combo.addItems([*ENVIRONMENTS, OPEN_ENV])
         self.env_combo.setToolTip("Environment lighting")
@@ -471,7 +519,7 @@ class ViewportPanel(QWidget):
         reset = QToolButton()
         reset.setIcon(icon("reset"))
         reset.setToolTip("Reset the camera (or double-click the view)")
-        for w in (self.mesh_combo, self.mode_combo, self.env_combo):
+        for w in (self.mesh_combo, self.mode_combo, self.view_combo, self.env_combo):
             bl.addWidget(w)
         bl.addWidget(self.exposure, 1)
         bl.addWidget(self.exposure_spin)
@@ -502,6 +550,7 @@ class ViewportPanel(QWidget):
         self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment
         self.mesh_combo.currentTextChanged.connect(self.view.set_mesh)
         self.mode_combo.currentTextChanged.connect(self._mode_changed)
+        self.view_combo.currentIndexChanged.connect(self._view_changed)
         self.exposure.valueChanged.connect(self._exposure_changed)
         self.exposure_spin.valueChanged.connect(
             lambda ev: self.exposure.setValue(int(round(ev * 10))))
@@ -730,6 +779,17 @@ class ViewportPanel(QWidget):
         self.view.set_mode(MODES[text])
         self.diff_label.setText("")
         self.diff_label.setVisible(MODES[text] != "splitsum")
+
+    def _view_changed(self, index: int) -> None:
+        view = self.view_combo.itemData(index)
+        if isinstance(view, str):  # not a separator
+            self.view.set_view(view)
+            if self.view.shading_view != view:  # refused (a failed link): show what is drawn
+                self.set_view(self.view.shading_view)
+
+    def set_view(self, view: str) -> None:
+        """Chooses a view (matedit.shading.views name) as the chooser does."""
+        self.view_combo.setCurrentIndex(self.view_combo.findData(view))
 
     def _exposure_changed(self, tenths: int) -> None:
         ev = tenths / 10.0

@@ -1,6 +1,6 @@
 """`matedit render FILE -o OUT.png|OUT.exr [--size WxH] [--mesh ...] [--env PATH|studio]
-[--ibl ...] [--exposure EV] [--lights default|none|RIG.json] [--samples N]`: a headless,
-deterministic preview render. A .png is display-referred (exposure, ACES, sRGB); an .exr
+[--ibl ...] [--exposure EV] [--lights default|none|RIG.json] [--samples N] [--view VIEW]`:
+a headless, deterministic preview render. A .png is display-referred (exposure, ACES, sRGB); an .exr
 holds the scene-referred linear radiance of the same frame, before exposure and display."""
 
 from __future__ import annotations
@@ -11,6 +11,11 @@ from pathlib import Path
 
 from matedit.cli_support import UsageError
 from matedit.io.inputs import declare_inputs
+
+# matedit.shading.views.VIEWS, spelled here so parsing the command line imports no numpy
+# (tests/test_views.py checks the two agree)
+VIEW_NAMES = ("lit", "base", "coat", "sheen", "specular", "roughness", "normal", "coat-weight",
+              "anisotropy")
 
 
 def register(sub) -> None:
@@ -40,6 +45,10 @@ def register(sub) -> None:
                    "(format matedit.lightrig)")
     p.add_argument("--samples", type=int, default=None, metavar="N",
                    help="reference-mode samples a pixel (default 2048)")
+    p.add_argument("--view", default="lit", choices=VIEW_NAMES, metavar="VIEW",
+                   help="what the mesh shows: lit (default), a lobe view (base, coat, sheen, "
+                   "specular) or an attribute view (roughness, normal, coat-weight, "
+                   "anisotropy); see docs/cli.md")
     p.add_argument("--half", action="store_true", help="EXR output as half floats")
     p.add_argument("--energy-compensation", action="store_true",
                    help="multiple-scattering specular compensation (Fdez-Aguera 2019), beyond "
@@ -213,6 +222,7 @@ def run(args) -> int:
                 from None
         if tty:
             print(file=sys.stderr)
+        renderer.set_view(args.view)  # before the material: one link, of the view's variant
         status = renderer.set_material(compiled)
         if not status.ok:
             node, msg = status.errors[0]

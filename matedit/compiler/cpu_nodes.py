@@ -371,6 +371,32 @@ def blend_material_attributes(a: Attributes, b: Attributes, t: np.ndarray) -> At
     return out
 
 
+def coat_layer_share(below: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """coatLayerShare (shaders/nodes/layer_blend.glsl): the new coat's share w / coverage of
+    the coverage w + (1 - w) a of a coat of weight w over one of weight a (independent
+    presences, OpenPBR's coat_weight); 0 where w = 0, so the coat below is kept exactly.
+    OpenPBR 2024, "OpenPBR Surface Specification", coat_weight"""
+    coverage = w + (1.0 - w) * below
+    return w / np.maximum(coverage, 1e-6)
+
+
+def coat_material_attributes(base: Attributes, layer: Attributes, w: np.ndarray) -> Attributes:
+    """coatMaterialAttributes (shaders/nodes/layer_blend.glsl): the `coat` layer blend. The
+    base's fields are kept; the layer's roughness, base colour, IOR and normal become the
+    coat's roughness, tint, IOR and normal by the new coat's share, and the weights combine
+    as coverages, 1 - (1 - a)(1 - w).
+    glTF KHR_materials_clearcoat; OpenPBR 2024, "OpenPBR Surface Specification", coat_*"""
+    out = {name: np.array(base[name], copy=True) for name in ATTRIBUTE_NAMES}
+    w = np.asarray(w, dtype=base["coat"].dtype)
+    s = coat_layer_share(base["coat"], w)
+    out["coat"] = 1.0 - (1.0 - base["coat"]) * (1.0 - w)
+    out["coatRoughness"] = _mix(base["coatRoughness"], layer["roughness"], s)
+    out["coatColor"] = _mix(base["coatColor"], layer["baseColor"], _col(s))
+    out["coatIor"] = _mix(base["coatIor"], layer["ior"], s)
+    out["coatNormal"] = _safe_normalize(_mix(base["coatNormal"], layer["normal"], _col(s)), _Z)
+    return out
+
+
 @_impl("layer_blend")
 def _layer_blend(ctx, base, layer, mask):
     return (blend_material_attributes(base, layer, mask),)

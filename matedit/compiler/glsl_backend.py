@@ -183,14 +183,45 @@ def vertex_source(target: Target) -> Assembly:
 
 
 @cache
-def entry_text(entry: Entry) -> str:
-    """The entry file's `main`, without its leading comment lines (the file's documentation)."""
+def _define_line(define: str) -> str:
+    """`NAME 1` for a bare name, `NAME value` for NAME=value (schedule checked the form)."""
+    name, _, value = define.partition("=")
+    return f"{name} {value or 1}"
+
+
+# Preview-only blocks of an entry file, `#ifdef NAME ... #else ... #endif` (no nesting):
+# emitted only when the caller defines NAME, so the default program text is the same as if
+# the block were not there (the exported shader and its structure hash do not change).
+PREVIEW_BLOCKS = ("MATEDIT_ATTRIBUTE_VIEW",)
+
+
+def _strip_preview_blocks(lines: list[str], defines: tuple[str, ...]) -> list[str]:
+    names = {d.partition("=")[0] for d in defines}
+    out: list[str] = []
+    state = None  # None outside a block; "if" / "else" inside one that is not defined
+    for line in lines:
+        word = line.strip().split()
+        if state is None and word[:1] == ["#ifdef"] and len(word) == 2 and \
+                word[1] in PREVIEW_BLOCKS and word[1] not in names:
+            state = "if"
+        elif state is not None and word[:1] == ["#else"]:
+            state = "else"
+        elif state is not None and word[:1] == ["#endif"]:
+            state = None
+        elif state != "if":
+            out.append(line)
+    return out
+
+
+def entry_text(entry: Entry, defines: tuple[str, ...] = ()) -> str:
+    """The entry file's `main`, without its leading comment lines (the file's documentation)
+    and without the preview blocks the caller's `defines` do not ask for."""
     from matedit.resources import shaders_dir
 
     lines = (shaders_dir() / "entry" / f"{entry.value}.frag.glsl").read_text().split("\n")
     while lines and lines[0].startswith("//"):
         lines.pop(0)
-    return "\n".join(lines).rstrip("\n")
+    return "\n".join(_strip_preview_blocks(lines, tuple(defines))).rstrip("\n")
 
 
 def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap]:
@@ -211,10 +242,10 @@ def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap
         w.add(f"layout(location = {i}) out vec4 {name};")
     for scope in plan.scopes:
         _scope(w, scope)
-    w.add(entry_text(plan.entry))
+    w.add(entry_text(plan.entry, tuple(plan.extra_defines)))
     includes = [f"{unit}.glsl" for unit in plan.units]
     lines = "\n".join(f"#define {d} 1" for d in plan.defines)
-    lines += "".join(f"\n#define {d} 1" for d in plan.extra_defines)
+    lines += "".join(f"\n#define {_define_line(d)}" for d in plan.extra_defines)
     asm = assemble("\n".join(w.lines), target.version, includes, "<material>",
                    prelude=prelude(target) + "\n" + lines)
     return asm, SourceMap(w.map, len(asm.sources) - 1)

@@ -39,7 +39,12 @@ from matedit.graph.nodes import (
     kind_for,
     lobe_value_is_default,
 )
-from matedit.graph.ports import FunctionResolver, function_interface, layer_entries
+from matedit.graph.ports import (
+    COLOR_LAYER_BLENDS,
+    FunctionResolver,
+    function_interface,
+    layer_entries,
+)
 from matedit.graph.types import PortType, coerce_value
 from matedit.graph.validate import Analysis, Diagnostic, Severity, analyse
 
@@ -367,6 +372,29 @@ class _Lowerer:
                 for p in self.a.ports[nid].inputs}
         self._call(nid, nid, node.settings["function"], args)
 
+    def _color_layer(self, nid, lid, mode, acc, value, blended, w) -> Op:
+        """A layer in a colour blend mode: `blended` (every field by the mask) with its base
+        colour replaced by the catalogue's Blend node of that mode (blend_<mode>) of the
+        layer's base colour over the stack's, mixed by the same weight: what a painting
+        program's layer mode does to colour; roughness, normal and the rest stay the mask's."""
+        brk = nodes.definition(nodes.BREAK_ATTRIBUTES)
+        fields = [(f.name, PortType(f.type)) for f in ATTRIBUTE_FIELDS]
+        self.ctx.kinds.add(brk.kind)
+        below = self.emit(Op(f"{nid}.{lid}.below", nid, brk.kind, [acc], fields,
+                             {"glsl": brk.glsl}))
+        above = self.emit(Op(f"{nid}.{lid}.above", nid, brk.kind, [value], fields,
+                             {"glsl": brk.glsl}))
+        d = nodes.definition(f"blend_{mode}")
+        self.ctx.kinds.add(d.kind)
+        color = self.emit(Op(f"{nid}.{lid}.color", nid, d.kind,
+                             [below.out("baseColor"), above.out("baseColor"), w],
+                             [("result", PortType.VEC3)], {"glsl": d.glsl}))
+        set_kind = kind_for(Role.SET_ATTRIBUTES)
+        self.ctx.kinds.add(set_kind)
+        return self.emit(Op(f"{nid}.{lid}.mode", nid, set_kind,
+                            [blended.out("result"), color.out("result")],
+                            [("attributes", PortType.MATERIAL)], {"fields": ("baseColor",)}))
+
     def _k_layer_stack(self, nid, node) -> None:
         ins = self.a.in_types[nid]
         specs = {p.name: p for p in self.a.ports[nid].inputs}
@@ -390,12 +418,22 @@ class _Lowerer:
                 continue
             blend = layer.get("blend", "alpha")
             opacity = port(f"{lid}_opacity")
-            if blend == "alpha":
+            written = self._w(acc) | self._w(value)
+            if blend in ("alpha", "coat") or blend in COLOR_LAYER_BLENDS:
                 w = self.emit(Op(f"{nid}.{lid}.w", nid, "weight", [port(f"{lid}_mask"), opacity],
                                  [("result", PortType.FLOAT)], {}))
-                blended = self.emit(Op(f"{nid}.{lid}.blend", nid, "blend",
-                                       [acc, value, w.out("result")],
-                                       [("result", PortType.MATERIAL)], {}))
+                if blend == "coat":
+                    blended = self.emit(Op(f"{nid}.{lid}.blend", nid, "coat",
+                                           [acc, value, w.out("result")],
+                                           [("result", PortType.MATERIAL)], {}))
+                    written = self._w(acc) | _coat_written(self._w(value))
+                else:
+                    blended = self.emit(Op(f"{nid}.{lid}.blend", nid, "blend",
+                                           [acc, value, w.out("result")],
+                                           [("result", PortType.MATERIAL)], {}))
+                if blend in COLOR_LAYER_BLENDS:
+                    blended = self._color_layer(nid, lid, blend, acc, value, blended,
+                                                w.out("result"))
             else:
                 if blend == "height":
                     hb = nodes.definition(kind_for(Role.HEIGHT_BLEND))
@@ -419,14 +457,29 @@ class _Lowerer:
                                                                            PortType.FLOAT)],
                                        [("result", PortType.MATERIAL)], {}))
             self.ctx.kinds.add(kind_for(Role.MASK_BLEND))
-            self.written[blended.out("result").key()] = self._w(acc) | self._w(value)
-            acc = blended.out("result")
+            out = blended.outs[0][0]
+            self.written[blended.out(out).key()] = written
+            acc = blended.out(out)
         if acc is None:
             acc = Lit(None, PortType.MATERIAL)
         self.alias[(nid, "attributes")] = acc
         # keep "written" for the alias
         if isinstance(acc, Var):
             self.written.setdefault(acc.key(), ALL_FIELDS)
+
+
+def _coat_written(layer: frozenset) -> frozenset:
+    """The fields a `coat` layer writes, from those its layer function writes: the coat's
+    weight, roughness and tint always (the layer's roughness and base colour are values even at
+    their defaults); its normal and IOR where the layer writes a normal or an IOR (or may:
+    a field it passes through from a function input, `@name`)."""
+    out = {"coat", "coatRoughness", "coatColor"}
+    unknown = any(f.startswith("@") for f in layer)
+    if unknown or "normal" in layer:
+        out.add("coatNormal")
+    if unknown or "ior" in layer:
+        out.add("coatIor")
+    return frozenset(out)
 
 
 def _check(doc: MaterialDocument, resolver, top: bool = True) -> Analysis:

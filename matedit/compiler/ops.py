@@ -2,8 +2,8 @@
 
 An `Op` of the IR is either a catalogue node kind (its GLSL function or inline template comes
 with the op's data from the catalogue, its numpy function is `cpu_nodes.IMPLS[kind]`) or one of
-the compiler's own ops below (swizzle, construction, field assignment, layer weight and blend,
-material-function call). `implementation(kind)` answers both the same way, so the emitter and
+the compiler's own ops below (swizzle, construction, field assignment, layer weight, blend and
+coat, material-function call). `implementation(kind)` answers both the same way, so the emitter and
 the evaluator each dispatch once, from here, and cannot disagree on what an op means.
 
 A row's `glsl` is a value template read only by the GLSL back-end
@@ -33,6 +33,7 @@ APPEND = Role.APPEND  # a vector built from its operands, in order
 SET_ATTRIBUTES = Role.SET_ATTRIBUTES  # a MaterialAttributes with op.data["fields"] replaced
 WEIGHT = "weight"  # a layer's alpha weight: saturate(mask * opacity)
 BLEND = "blend"  # blendMaterialAttributes(base, layer, weight)
+COAT = "coat"  # coatMaterialAttributes(base, layer, weight): a layer laid on as a clear coat
 CALL = "call"  # a material function, op.data["function"]
 
 # The numpy column: fn(op, operand values, env) -> output values in `op.outs` order; env is a
@@ -80,6 +81,12 @@ def _blend(op: Op, args: list, env) -> tuple:
     return (blend_material_attributes(args[0], args[1], np.asarray(args[2])),)
 
 
+def _coat(op: Op, args: list, env) -> tuple:
+    from matedit.compiler.cpu_nodes import coat_material_attributes
+
+    return (coat_material_attributes(args[0], args[1], np.asarray(args[2])),)
+
+
 def _call(op: Op, args: list, env) -> tuple:
     if env is None:
         raise TypeError("a material function call is not folded")
@@ -92,6 +99,7 @@ BUILTINS: dict[str | Role, OpImpl] = {o.kind: o for o in (
     OpImpl(SET_ATTRIBUTES, _set_attributes, glsl="{0}", assigns="fields"),
     OpImpl(WEIGHT, _weight, glsl="clamp({0} * {1}, 0.0, 1.0)"),
     OpImpl(BLEND, _blend, glsl="blendMaterialAttributes({args})", units=("nodes/layer_blend",)),
+    OpImpl(COAT, _coat, glsl="coatMaterialAttributes({args})", units=("nodes/layer_blend",)),
     OpImpl(CALL, _call),  # the back-end's call convention, on op.data["function"]
 )}
 

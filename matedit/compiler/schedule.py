@@ -137,7 +137,9 @@ ENTRY_OUTPUTS = {
 BASE_UNITS = ("common", "material", "nodes/context")
 ENTRY_UNITS = {Entry.FORWARD: ("surface",), Entry.GBUFFER: (), Entry.ATTRIBUTES: ()}
 
-_DEFINE = re.compile(r"MATEDIT_[A-Z0-9_]+")
+ATTRIBUTE_VIEW = "MATEDIT_ATTRIBUTE_VIEW"  # =<ATTRIBUTE_VIEW_*> of shaders/attribute_view.glsl
+# A caller's define: a name (defined as 1), or NAME=<integer> (a view's mask or number).
+_DEFINE = re.compile(r"MATEDIT_[A-Z0-9_]+(=[0-9]{1,9})?")
 
 
 def has_defines(ir: MaterialIR) -> list[str]:
@@ -172,6 +174,8 @@ def schedule(ir: MaterialIR, mode: str | Entry = Entry.FORWARD,
         for op in s.ops:
             needed.update(ops.implementation(op.kind).units)
     units = [*BASE_UNITS, *sorted(needed), *ENTRY_UNITS[entry]]
+    if entry == Entry.FORWARD and any(d.partition("=")[0] == ATTRIBUTE_VIEW for d in defines):
+        units.append("attribute_view")  # the viewport's attribute views (preview only)
     extra = [d for d in defines if d not in ir.defines]
     return Schedule(ir, entry, scopes, units, has_defines(ir) + list(ir.defines), extra,
                     ENTRY_OUTPUTS[entry])

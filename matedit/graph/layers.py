@@ -181,4 +181,5 @@ class LayerStack:
 
 def _check_blend(blend: str) -> None:
     if blend not in LAYER_BLENDS and not (isinstance(blend, str) and blend.endswith(".json")):
-        raise CommandError(f"unknown blend {blend!r}: alpha, height or a blend function file")
+        raise CommandError(f"unknown blend {blend!r}: {', '.join(LAYER_BLENDS)} "
+                           "or a blend function file")

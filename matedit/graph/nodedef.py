@@ -40,6 +40,7 @@ class OutputDef:
     name: str
     type: str
     doc: str = ""
+    group: str = ""  # as InputDef.group (Break Material Attributes' fields)
 
 
 @dataclass(frozen=True)
@@ -263,8 +264,8 @@ def _i(name: str, type_: str, default: Any = 0.0, doc: str = "",
     return InputDef(name, type_, default, doc, rng, required)
 
 
-def _o(name: str, type_: str, doc: str = "") -> OutputDef:
-    return OutputDef(name, type_, doc)
+def _o(name: str, type_: str, doc: str = "", group: str = "") -> OutputDef:
+    return OutputDef(name, type_, doc, group)
 
 
 def _op(kind: str, title: str, inline: str | None, inputs: Iterable[InputDef], doc: str,

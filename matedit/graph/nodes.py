@@ -376,11 +376,37 @@ def lobe_input(kind: str, port: str) -> InputDef | None:
     if d is None or d.role != Role.MAKE_ATTRIBUTES:
         return None
     return next((i for i in d.inputs if i.name == port and i.lobe), None)
+# The pin groups (InputDef.group) a Make / Break / Set Material Attributes shows expanded on
+# the canvas; the others fold into a header row. View state kept with the document: changing
+# it is undoable and never recompiles. A new node shows only Base.
+EXPANDED_GROUPS = "expanded_groups"
+EXPANDED_GROUPS_SETTING = SettingDef(EXPANDED_GROUPS, "list", ["Base"],
+                                     "pin groups shown expanded on the canvas",
+                                     structural=False)
+ATTRIBUTE_GROUPS = ("Base", "Specular", "Coat", "Sheen", "Anisotropy")
+BREAK_ATTRIBUTES = "break_attributes"  # the kind that splits a MaterialAttributes (no role)
+
+
+def attribute_group(name: str) -> str:
+    """The pin group of a material attribute field ("" for any other name)."""
+    return next((f.group for f in ATTRIBUTE_FIELDS if f.name == name), "")
+
+
+def port_group(kind: str, port: str) -> str:
+    """The pin group a port of `kind` folds into ("" where the kind has no groups): the
+    attribute fields of Make, Break and Set Material Attributes."""
+    if kind != BREAK_ATTRIBUTES and role_of(kind) not in (Role.MAKE_ATTRIBUTES,
+                                                         Role.SET_ATTRIBUTES):
+        return ""
+    return attribute_group(port) if port != "attributes" else ""
+
+
 register(NodeDef(
     "make_attributes", "Make Material Attributes", "Material",
     "Builds a MaterialAttributes from its fields (the talk's seven, then the lobes beyond "
     "it, each off at its default).",
     inputs=ATTRIBUTE_FIELDS, outputs=(_o("attributes", MA),),
+    settings=(EXPANDED_GROUPS_SETTING,),
     glsl="node_make_attributes", role=Role.MAKE_ATTRIBUTES, thumbnail=Thumbnail.ALWAYS,
     mtlx=MxRecipe("attributes"),
 ))
@@ -388,7 +414,8 @@ register(NodeDef(
     "break_attributes", "Break Material Attributes", "Material",
     "Splits a MaterialAttributes into its fields.",
     inputs=(_i("attributes", MA, None, required=True),),
-    outputs=tuple(_o(f.name, f.type) for f in ATTRIBUTE_FIELDS),
+    outputs=tuple(_o(f.name, f.type, group=f.group) for f in ATTRIBUTE_FIELDS),
+    settings=(EXPANDED_GROUPS_SETTING,),
     glsl="node_break_attributes", mtlx=MxRecipe("attributes"),
 ))
 register(NodeDef(
@@ -396,7 +423,8 @@ register(NodeDef(
     "Overrides the chosen fields of a MaterialAttributes, keeping the others.",
     inputs=(_i("attributes", MA, None, required=True),),
     outputs=(_o("attributes", MA),),
-    settings=(SettingDef("fields", "list", ["baseColor"], "fields to override"),),
+    settings=(SettingDef("fields", "list", ["baseColor"], "fields to override"),
+              EXPANDED_GROUPS_SETTING),
     ports_rule=PortsRule.ATTRIBUTE_FIELDS, role=Role.SET_ATTRIBUTES, lowered=True,
     mtlx=MxRecipe("attributes"),
 ))

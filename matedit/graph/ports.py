@@ -68,7 +68,14 @@ def _spec(d: nodes.InputDef | nodes.OutputDef) -> PortSpec:
     return PortSpec(d.name, d.type, None, None, d.doc)
 
 
-LAYER_BLENDS = ("alpha", "height")
+# The catalogue's colour Blend nodes (blend_<mode>: base, blend, opacity) as layer blend
+# modes: the layer's base colour is composited over the stack's by that node, the other
+# fields blend by the mask (matedit.compiler.lower). In catalogue order.
+COLOR_LAYER_BLENDS = tuple(
+    kind[len("blend_"):] for kind, d in nodes.REGISTRY.items()
+    if kind.startswith("blend_") and [i.name for i in d.inputs] == ["base", "blend", "opacity"])
+# alpha: a lerp by mask x opacity; height: by the heights; coat: laid over as a clear coat.
+LAYER_BLENDS = ("alpha", "height", "coat", *COLOR_LAYER_BLENDS)
 _VALID_CHANNELS = "xyzw"
 _CHANNEL_ALIASES = str.maketrans("rgba", "xyzw")
 
@@ -221,9 +228,12 @@ def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
         label = layer.get("name", lid)
         ports.append(PortSpec(f"{lid}_opacity", "float", 1.0, (0.0, 1.0),
                               f"{label}: overall strength"))
-        if blend == "alpha":
+        if blend == "alpha" or blend in COLOR_LAYER_BLENDS:
             ports.append(PortSpec(f"{lid}_mask", "float", 1.0, (0.0, 1.0),
                                   f"{label}: where the layer covers the ones below"))
+        elif blend == "coat":
+            ports.append(PortSpec(f"{lid}_mask", "float", 1.0, (0.0, 1.0),
+                                  f"{label}: where the coat lies (its weight)"))
         elif blend == "height":
             ports.append(PortSpec(f"{lid}_mask", "float", 0.5, (0.0, 1.0),
                                   f"{label}: layer height"))
@@ -246,7 +256,8 @@ def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
                                           f"{label}: {p.name}"))
         else:
             raise PortError(node.id, f"layers[{index}].blend",
-                            f"unknown blend {blend!r} (alpha, height, or a blend function file)")
+                            f"unknown blend {blend!r} ({', '.join(LAYER_BLENDS)}, "
+                            "or a blend function file)")
     names: set[str] = set()
     for p in ports:
         if p.name in names:

@@ -240,6 +240,8 @@ class _Exporter:
             return self.scope(scope, dict(zip((p for p, _ in scope.params), args)),
                               f"{hint}_")
         nums = eval_op(op, [a.num for a in args], self.env)
+        if op.kind == "coat":
+            return [self.coat(args, nums[0], hint)]
         d = nodes.get(op.kind)
         geo = (d is not None and d.geometry) or any(a.geo for a in args)
         kind = kind_for(IR_OP_ROLES[op.kind]) if op.kind in IR_OP_ROLES else op.kind
@@ -757,6 +759,51 @@ class _Exporter:
                                      [("in", m, "vector3")])
                 return m
             fields[f.name] = V(num[f.name], ft, make, a.geo or b.geo or t.geo)
+        return V(num, PortType.MATERIAL, None, False, fields)
+
+    def coat(self, args, num, hint) -> V:
+        """The `coat` layer blend (coatMaterialAttributes, shaders/nodes/layer_blend.glsl)
+        node for node: the coverage w + (1 - w) a is the new coat weight (equal to
+        1 - (1 - a)(1 - w)), its share s = w / max(coverage, 1e-6) mixes the coat fields
+        towards the layer's roughness, base colour, IOR and normal (the last normalised)."""
+        a, b, w = args
+        geo = a.geo or b.geo or w.geo
+        f = a.fields
+        shared: dict[str, tuple] = {}
+
+        def cover():
+            if "cover" not in shared:
+                rest = self.node("subtract", "float", f"{hint}_rest",
+                                 [("in1", ("value", 1.0), "float"), ("in2", w.ref(), "float")])
+                below = self.node("multiply", "float", f"{hint}_below",
+                                  [("in1", rest, "float"), ("in2", f["coat"].ref(), "float")])
+                shared["cover"] = self.node("add", "float", f"{hint}_cover",
+                                            [("in1", w.ref(), "float"), ("in2", below, "float")])
+            return shared["cover"]
+
+        def share():
+            if "share" not in shared:
+                floor = self.node("max", "float", f"{hint}_floor",
+                                  [("in1", cover(), "float"), ("in2", ("value", 1e-6), "float")])
+                shared["share"] = self.node("divide", "float", f"{hint}_share",
+                                            [("in1", w.ref(), "float"), ("in2", floor, "float")])
+            return shared["share"]
+
+        fields = dict(f)
+        fields["coat"] = V(num["coat"], PortType.FLOAT, cover, geo)
+        for name, src in (("coatRoughness", "roughness"), ("coatColor", "baseColor"),
+                          ("coatIor", "ior"), ("coatNormal", "normal")):
+            ft = PortType(next(x.type for x in ATTRIBUTE_FIELDS if x.name == name))
+
+            def make(x=f[name], y=b.fields[src], ft=ft, name=name):
+                m = self.node("mix", MX_TYPE[ft], f"{hint}_{name}",
+                              [("fg", y.ref(), MX_TYPE[ft]), ("bg", x.ref(), MX_TYPE[ft]),
+                               ("mix", share(), "float")])
+                if name == "coatNormal":
+                    return self.node("normalize", "vector3", f"{hint}_cnrm",
+                                     [("in", m, "vector3")])
+                return m
+            fields[name] = V(num[name], ft, make, geo)
         return V(num, PortType.MATERIAL, None, False, fields)
 
     # --- the surface -----------------------------------------------------------------------

@@ -556,7 +556,8 @@ class _Importer:
             src = self.surface_input(shader, inp)
             if src is None:
                 continue
-            if src.width == 3 and attr in ("metallic", "roughness", "cavity", "opacity"):
+            if src.width == 3 and attr in ("metallic", "roughness", "cavity", "opacity", "coat",
+                                           "coatRoughness", "coatIor"):
                 if src.node is None:
                     src = Src(value=src.value[:1], width=1)
                 else:

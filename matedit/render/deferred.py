@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import moderngl
 
-from matedit.render.fullscreen import FullscreenQuad, render_program
+from matedit.render.fullscreen import FullscreenQuad, render_program, set_uniform
 from matedit.resources import shaders_dir
 
 GBUFFER_TARGETS = 4
@@ -101,29 +101,32 @@ class GBuffer:
 
 
 class LightingPass:
-    """The lighting programs, keyed by (split sum only, energy compensation), each linked on
-    first use and then kept for the renderer's lifetime."""
+    """The lighting programs, keyed by (split sum only, energy compensation, edges once, lobe
+    mask), each linked on first use and then kept for the renderer's lifetime."""
 
     def __init__(self, ctx: moderngl.Context, samples: int, bind, quad: FullscreenQuad) -> None:
         self.ctx = ctx
         self.samples = max(1, samples)
         self._bind = bind
         self._quad = quad
-        self._programs: dict[tuple[bool, bool, bool], moderngl.Program] = {}
+        self._programs: dict[tuple[bool, bool, bool, int], moderngl.Program] = {}
         self.link_count = 0
         self.edges_once = False  # benchmarks only (see program)
 
-    def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False
-                ) -> moderngl.Program:
+    def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False,
+                lobes: int = 31) -> moderngl.Program:
         """`edges_once` (benchmarks only) shades every pixel once, edges too: no anti-aliasing
-        of the lighting, to measure what lighting edges per sample costs."""
-        key = (bool(split_sum_only), bool(compensation), bool(edges_once))
+        of the lighting, to measure what lighting edges per sample costs. `lobes`: the lobe
+        view's MATEDIT_LOBES mask (31, every lobe, adds no define)."""
+        key = (bool(split_sum_only), bool(compensation), bool(edges_once), int(lobes))
         prog = self._programs.get(key)
         if prog is None:
             defines = ([SPLIT_SUM_ONLY] if split_sum_only else []) + \
                       ([ENERGY_COMPENSATION] if compensation else []) + \
                       (["MATEDIT_EDGES_ONCE"] if edges_once else [])
             lines = [f"#define {d} 1" for d in defines]
+            if int(lobes) != 31:
+                lines.append(f"#define MATEDIT_LOBES {int(lobes)}")
             lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")
             prog = render_program(self.ctx, "fullscreen.vert", "lighting.frag",
                                   "\n".join(lines), [shaders_dir() / "render", shaders_dir()],
@@ -137,13 +140,15 @@ class LightingPass:
         return prog
 
     def draw(self, gbuffer: GBuffer, background: moderngl.Texture, eye,
-             split_sum_only: bool, compensation: bool) -> None:
-        """Shades the G-buffer over `background` into every sample of the bound target."""
+             split_sum_only: bool, compensation: bool, lobes: int = 31) -> None:
+        """Shades the G-buffer over `background` into every sample of the bound target, with
+        the lobes of the `lobes` mask."""
         for i, t in enumerate(gbuffer.textures):
             t.use(location=GBUFFER_FIRST_UNIT + i)
         background.use(location=GBUFFER_FIRST_UNIT + GBUFFER_TARGETS)
-        prog = self.program(split_sum_only, compensation, self.edges_once)
-        prog["uCameraPosition"].value = tuple(float(x) for x in eye)
+        prog = self.program(split_sum_only, compensation, self.edges_once, lobes)
+        # (a lobe view that shades nothing, coat only on a talk material, drops the uniform)
+        set_uniform(prog, "uCameraPosition", tuple(float(x) for x in eye))
         self._quad.draw(prog)
 
     def release(self) -> None:

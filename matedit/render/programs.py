@@ -18,6 +18,7 @@ from matedit.compiler.emit import Entry
 from matedit.glsl.layout import BINDINGS
 from matedit.render.deferred import ENERGY_COMPENSATION, SPLIT_SUM_ONLY
 from matedit.render.fullscreen import set_uniform
+from matedit.shading.views import view_defines
 
 # uniform blocks and samplers a program may declare -> their binding (matedit/glsl/layout.py)
 _BLOCKS = (("LightsBlock", "LIGHTS"), ("IblBlock", "IBL"), ("FrameBlock", "FRAME"),
@@ -82,33 +83,38 @@ class ProgramCache:
             self.table[variant.structure_hash] = prog
         return prog, variant
 
-    def material(self, compiled: CompiledMaterial, forward: bool, compensation: bool = False
-                 ) -> moderngl.Program:
+    def material(self, compiled: CompiledMaterial, forward: bool, compensation: bool = False,
+                 view: str = "lit") -> moderngl.Program:
         """The program a material draws with (raises moderngl.Error): its GBUFFER entry, or
-        forward its split-sum FORWARD variant (with the preview's compensation option)."""
-        return self.get(compiled, *self._variant(forward, compensation))[0]
+        forward its split-sum FORWARD variant (with the preview's compensation option and the
+        viewport's view, matedit.shading.views; the deferred path's lobe views are the
+        lighting pass's)."""
+        return self.get(compiled, *self._variant(forward, compensation, view))[0]
 
     def reference(self, compiled: CompiledMaterial, compensation: bool = False,
-                  fallback: moderngl.Program | None = None) -> moderngl.Program | None:
+                  fallback: moderngl.Program | None = None, view: str = "lit"
+                  ) -> moderngl.Program | None:
         """The FORWARD variant with the reference estimator (reference mode, forward path), or
         `fallback` if it fails to link (which the split-sum variant linking rules out)."""
         try:
-            return self.get(compiled, Entry.FORWARD, forward_defines(False, compensation))[0]
+            return self.get(compiled, Entry.FORWARD,
+                            forward_defines(False, compensation) + view_defines(view))[0]
         except moderngl.Error:
             return fallback
 
-    def link(self, compiled: CompiledMaterial, forward: bool, compensation: bool = False
-             ) -> moderngl.Program | MaterialStatus:
+    def link(self, compiled: CompiledMaterial, forward: bool, compensation: bool = False,
+             view: str = "lit") -> moderngl.Program | MaterialStatus:
         """`material`, or the failed status located in the variant that failed."""
         try:
-            return self.material(compiled, forward, compensation)
+            return self.material(compiled, forward, compensation, view)
         except moderngl.Error as exc:
-            return failure(compiled.variant(*self._variant(forward, compensation)), exc)
+            return failure(compiled.variant(*self._variant(forward, compensation, view)), exc)
 
     @staticmethod
-    def _variant(forward: bool, compensation: bool) -> tuple[Entry, tuple[str, ...]]:
+    def _variant(forward: bool, compensation: bool, view: str = "lit"
+                 ) -> tuple[Entry, tuple[str, ...]]:
         if forward:
-            return Entry.FORWARD, forward_defines(True, compensation)
+            return Entry.FORWARD, forward_defines(True, compensation) + view_defines(view)
         return Entry.GBUFFER, ()
 
     def release(self, forget=None) -> None:

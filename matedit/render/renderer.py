@@ -28,6 +28,7 @@ from matedit.render.scene import ScenePass
 from matedit.render.settings import MODES, PreviewSettings
 from matedit.shading.ibl import IBL_MODE_REFERENCE
 from matedit.shading.lights import Light
+from matedit.shading.views import check_view, is_attribute_view
 
 __all__ = ["MODES", "MaterialStatus", "Renderer", "r2_offset"]
 
@@ -131,14 +132,40 @@ class Renderer(PreviewSettings):
         """Structural edit: link (or reuse) the material's program, its GBUFFER entry when
         deferred; keep the last good one on failure."""
         values = {u.name: u.default for u in compiled.ir.uniforms}
-        forward = not self.deferred or wants_forward(compiled, values)
-        prog = self.programs.link(compiled, forward, self.energy_compensation)
+        forward = self._forward(compiled, values)
+        prog = self.programs.link(compiled, forward, self.energy_compensation, self.view)
         if isinstance(prog, MaterialStatus):  # located in the variant that failed
             return prog
         self._program, self.is_forward = prog, forward
         self.material.load(compiled, values)
         self.reset_accumulation()
         return MaterialStatus(True)
+
+    def _forward(self, compiled: CompiledMaterial, values: dict) -> bool:
+        """The path a material takes: forward when not deferred, when the material wants it
+        (translucent, lobes beyond the talk) or in an attribute view (FORWARD entry only)."""
+        return not self.deferred or is_attribute_view(self.view) or \
+            wants_forward(compiled, values)
+
+    def set_view(self, view: str) -> None:
+        """The viewport's view (matedit.shading.views; ValueError for an unknown one): a lobe
+        view relinks the material's FORWARD variant (or uses the lighting pass's, deferred),
+        an attribute view its FORWARD variant; each is linked once and then cached. On a link
+        failure the view stays as it was (and the error is raised)."""
+        check_view(view)
+        if view == self.view:
+            return
+        old, self.view = self.view, view
+        if self._compiled is not None:
+            forward = self._forward(self._compiled, self.material.values)
+            try:
+                self._program = self.programs.material(self._compiled, forward,
+                                                       self.energy_compensation, view)
+            except moderngl.Error:
+                self.view = old
+                raise
+            self.is_forward = forward
+        self.reset_accumulation()
 
     @property
     def has_material(self) -> bool:
@@ -157,7 +184,8 @@ class Renderer(PreviewSettings):
             return
         self.energy_compensation = bool(on)
         if self._compiled is not None:
-            self._program = self.programs.material(self._compiled, self.is_forward, bool(on))
+            self._program = self.programs.material(self._compiled, self.is_forward, bool(on),
+                                                   self.view)
         self.reset_accumulation()
 
     def set_uniforms(self, values: dict[str, Any]) -> None:
@@ -166,11 +194,11 @@ class Renderer(PreviewSettings):
         if self._compiled is None:
             return
         self.material.set_values(values)
-        forward = not self.deferred or wants_forward(self._compiled, self.material.values)
+        forward = self._forward(self._compiled, self.material.values)
         if forward != self.is_forward:
             try:
                 self._program = self.programs.material(self._compiled, forward,
-                                                       self.energy_compensation)
+                                                       self.energy_compensation, self.view)
                 self.is_forward = forward
             except moderngl.Error:
                 pass  # keeps the current path: the variants share the material's code
@@ -203,7 +231,7 @@ class Renderer(PreviewSettings):
         program = self._program
         if ibl_mode == IBL_MODE_REFERENCE and self.is_forward and self._compiled is not None:
             program = self.programs.reference(self._compiled, self.energy_compensation,
-                                              fallback=program)
+                                              fallback=program, view=self.view)
         self.scene.draw(self, self.targets, self._mesh, program, self.is_forward,
                         self.material, ibl_mode, offset)
 

@@ -22,6 +22,7 @@ from matedit.render.programs import bind_program
 from matedit.render.settings import PreviewSettings
 from matedit.render.uniforms import SceneUniforms
 from matedit.shading.ibl import IBL_MODE_REFERENCE
+from matedit.shading.views import lobe_mask
 
 
 class ScenePass:
@@ -69,7 +70,8 @@ class ScenePass:
                 compensation = view.energy_compensation or \
                     ENERGY_COMPENSATION in material.compiled.ir.defines
                 self.lighting.draw(targets.gbuffer, targets.background.color_attachments[0],
-                                   np.array(view.camera.eye, "f4"), not reference, compensation)
+                                   np.array(view.camera.eye, "f4"), not reference, compensation,
+                                   lobe_mask(getattr(view, "view", "lit")))
         if view.show_gizmos:
             ctx.enable(moderngl.DEPTH_TEST)
             self.gizmos.draw(vp, view.lights)

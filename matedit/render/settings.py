@@ -47,3 +47,6 @@ class PreviewSettings:
         # of materials that ask for it themselves (preview "energy_compensation": true);
         # change through Renderer.set_energy_compensation
         self.energy_compensation = False
+        # the viewport's view (matedit.shading.views): lit, a lobe view or an attribute view;
+        # change through Renderer.set_view
+        self.view = "lit"

@@ -11,6 +11,12 @@ void main() {
 #ifdef MATERIAL_HAS_NORMAL
     N = tangentToWorldNormal(m.normal, T, B, g_surface.normal);
 #endif
+#ifdef MATEDIT_ATTRIBUTE_VIEW
+    // The viewport's attribute view (preview only: the block is left out of the text
+    // unless asked for): a field drawn in place of the shading, opaque.
+    fragColor = vec4(attributeView(MATEDIT_ATTRIBUTE_VIEW, m, g_surface.uv, N), 1.0);
+#else
     fragColor = vec4(shadeSurface(m, g_surface.position, N, g_surface.view, g_surface.normal,
                                   T, B), clamp(m.opacity, 0.0, 1.0));
+#endif
 }

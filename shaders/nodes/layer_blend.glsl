@@ -39,3 +39,36 @@ void node_layer_blend(MaterialAttributes base, MaterialAttributes layer, float m
     // Karis 2013, "Real Shading in Unreal Engine 4", material layering: lerp by a mask
     result = blendMaterialAttributes(base, layer, mask);
 }
+
+// The share of the combined coat that the new coat layer holds, where the layer of weight w
+// lies over a coat of weight a: coverage w + (1 - w) a, the new coat's share w / coverage.
+float coatLayerShare(float below, float w) {
+    // Independent coverage of two partial coats (the union of two events): the layer covers
+    // w, the coat below shows through the rest (1 - w) with its weight; 0 where w = 0 so the
+    // stack's own coat is kept exactly. The weight is the coat's presence, as OpenPBR's
+    // coat_weight (a mix of the coated and the uncoated surface), so two presences combine
+    // as independent coverages. OpenPBR 2024, "OpenPBR Surface Specification", coat_weight
+    float coverage = w + (1.0 - w) * below;
+    return w / max(coverage, 1e-6);
+}
+
+// The `coat` layer blend: the layer lies over the stack as a clear coat (vertical layering);
+// the stack's own fields stay as they are, the layer's become the coat's.
+MaterialAttributes coatMaterialAttributes(MaterialAttributes base, MaterialAttributes layer,
+                                          float w) {
+    // A layer as a coat, not a lerp of the two: its roughness is the coat's roughness, its
+    // base colour the coat's transmittance tint, its (tangent-space) normal the coat's normal,
+    // its IOR the coat's IOR; its weight w = mask x opacity joins a coat already below by
+    // coverage, 1 - (1 - a)(1 - w), and the coat fields by the new coat's share of it.
+    // glTF KHR_materials_clearcoat (clearcoatFactor, clearcoatRoughness, clearcoatNormal);
+    // OpenPBR 2024, "OpenPBR Surface Specification", coat_weight, coat_color, coat_ior
+    MaterialAttributes m = base;
+    float s = coatLayerShare(base.coat, w);
+    m.coat = 1.0 - (1.0 - base.coat) * (1.0 - w);
+    m.coatRoughness = mix(base.coatRoughness, layer.roughness, s);
+    m.coatColor = mix(base.coatColor, layer.baseColor, s);
+    m.coatIor = mix(base.coatIor, layer.ior, s);
+    m.coatNormal = nodeSafeNormalize(mix(base.coatNormal, layer.normal, s),
+                                     vec3(0.0, 0.0, 1.0));
+    return m;
+}
