@@ -37,6 +37,7 @@ OPTIONAL_BENCHES = (
     ("bench_editor.py", "Editor responsiveness"),
     ("bench_instances.py", "Material instances and static switches"),
     ("bench_interop.py", "Interop: bake, glTF and MaterialX export"),
+    ("bench_lobes.py", "Lobes beyond the talk: pre-lobe samples, old tree vs this one"),
 )
 OPTIONAL_TIMEOUT_S = 240
 IMPORT_ROWS = ("matedit.commands", "matedit.commands.validate", "matedit.graph.validate",

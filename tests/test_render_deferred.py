@@ -12,7 +12,7 @@ from matedit.compiler.emit import Entry, entry_text
 from matedit.ibl import BakeSettings
 from matedit.io.document import FileResolver, load
 from matedit.render import Renderer
-from matedit.render.deferred import may_be_translucent
+from matedit.render.deferred import may_be_translucent, writes_lobes
 from matedit.resources import graphs_dir, shaders_dir
 
 MATERIALS = sorted((graphs_dir() / "materials").glob("*.json"))
@@ -111,7 +111,6 @@ def test_every_entry_of_every_sample_links(gl_ctx):
 
 @pytest.mark.parametrize("path", MATERIALS, ids=[p.stem for p in MATERIALS])
 def test_deferred_equals_forward_split_sum(pair, path):
-    from matedit.render.deferred import writes_lobes
 
     cm = compile_document(load(path), FileResolver())
     a, b = _both(pair, cm)
@@ -221,7 +220,8 @@ def test_render_command_uses_the_deferred_path(gl_ctx):
     r = _renderer(gl_ctx, (48, 48), Renderer)
     try:
         assert r.deferred == (r.samples >= 2)
-        r.set_material(compile_document(load(MATERIALS[0]), FileResolver()))
+        talk_only = graphs_dir() / "materials" / "worn_painted_steel.json"  # writes no lobe
+        r.set_material(compile_document(load(talk_only), FileResolver()))
         assert r.is_forward == (not r.deferred)
     finally:
         r.release()
