@@ -70,7 +70,9 @@ def shade_attributes(attrs: dict, N: np.ndarray, T: np.ndarray, B: np.ndarray,
     Ns = tangentToWorldNormal(n, T, B, N) if "normal" in attrs else N
     ibl = IblInputs(sh=environment_sh9(), prefiltered=environment_radiance, mip_count=1.0,
                     brdf_lut=environment_brdf_fit, intensity=1.0, mode=IBL_MODE_SPLIT_SUM)
-    return shadeSurface(m, np.zeros_like(N), Ns, V, LIGHTS, ibl, frame=(N, T, B))
+    # A lobe is shaded where its weight is not 0 anywhere (at 0 it equals the talk's model).
+    return shadeSurface(m, np.zeros_like(N), Ns, V, LIGHTS, ibl, frame=(N, T, B),
+                        anisotropic=bool(np.any(m.anisotropy != 0.0)))
 
 
 def preview_frame(N: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
