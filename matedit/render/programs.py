@@ -23,7 +23,7 @@ from matedit.render.fullscreen import set_uniform
 _BLOCKS = (("LightsBlock", "LIGHTS"), ("IblBlock", "IBL"), ("FrameBlock", "FRAME"),
            ("MaterialParams", "MATERIAL"))
 _SAMPLERS = (("uPrefilteredEnv", "PREFILTERED_ENV"), ("uBrdfLut", "BRDF_LUT"),
-             ("uEnvironment", "ENVIRONMENT"))
+             ("uEnvironment", "ENVIRONMENT"), ("uEnvDistribution", "ENV_DISTRIBUTION"))
 
 
 @dataclass
