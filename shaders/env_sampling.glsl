@@ -22,9 +22,10 @@ vec3 equirectDirection(vec2 uv) {
 
 // Equirect coordinates of a unit direction (inverse of equirectDirection).
 vec2 directionToEquirect(vec3 d) {
-    // matedit.ibl.cubemap.direction_to_equirect_uv
+    // matedit.ibl.cubemap.direction_to_equirect_uv; theta by atan, not acos (acos loses
+    // ~1e-4 near the poles in float32 drivers)
     float u = 0.5 + atan(d.x, -d.z) * (0.5 * INV_PI);
-    float v = acos(clamp(d.y, -1.0, 1.0)) * INV_PI;
+    float v = atan(length(d.xz), d.y) * INV_PI;
     return vec2(u, v);
 }
 
