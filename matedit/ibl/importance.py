@@ -142,11 +142,24 @@ def cube_luminance_equirect(faces: np.ndarray, width: int, height: int) -> np.nd
     return out.reshape(height, width)
 
 
+def dilate(lum: np.ndarray) -> np.ndarray:
+    """The maximum of each pixel's 3 x 3 neighbourhood (columns wrap around, rows clamp)."""
+    out = np.maximum(lum, np.maximum(np.roll(lum, 1, axis=1), np.roll(lum, -1, axis=1)))
+    up = np.concatenate([out[:1], out[:-1]])
+    down = np.concatenate([out[1:], out[-1:]])
+    return np.maximum(out, np.maximum(up, down))
+
+
 def distribution_from_cube(faces: np.ndarray, max_width: int = MAX_WIDTH
                            ) -> EnvironmentDistribution:
-    """The sampling table of cube faces (6, n, n, 3), e.g. mip 0 of an IBL bake."""
+    """The sampling table of cube faces (6, n, n, 3), e.g. mip 0 of an IBL bake.
+
+    The pixel means are dilated (`dilate`): a texel straddles pixels, and the shader reads
+    the cube filtered, so a bright texel's light reaches the pixels around the one its
+    centre falls in. Without this, directions there would be drawn with the density of
+    their dim pixel and carry a bright texel's radiance: rare, huge samples (fireflies)."""
     faces = np.asarray(faces)
     if faces.ndim != 4 or faces.shape[0] != 6 or faces.shape[1] != faces.shape[2]:
         raise ValueError(f"cube faces must be (6, n, n, c), not {faces.shape}")
     w, h = table_size(faces.shape[1], max_width)
-    return build_distribution(cube_luminance_equirect(faces, w, h))
+    return build_distribution(dilate(cube_luminance_equirect(faces, w, h)))
