@@ -168,10 +168,14 @@ vec3 referenceBrdfCosine(ReferenceSurface s, vec3 L) {
     vec3 diffuse = s.diffuseColor * (INV_PI * NoL);
     if (hh < 1e-12) return diffuse;
     vec3 H = h * inversesqrt(hh);
+    // V below the shading horizon (normal maps): no specular where GGX sampling cannot
+    // reach (V.H <= 0, or a half vector below the surface, N.H <= 0, where D is 0 and the
+    // cross-product form of D would not be), which above the horizon never happens
+    float VoH = dot(s.V, H);
+    float NoH = dot(s.N, H);
+    if (VoH <= 0.0 || NoH <= 0.0) return diffuse;
     float a = referenceAlpha(s);
     float NoV = max(dot(s.N, s.V), 1e-4);
-    float NoH = saturate(dot(s.N, H));
-    float VoH = saturate(dot(s.V, H));
     vec3 NxH = cross(s.N, H);
     float D = D_GGX(NoH, a, dot(NxH, NxH));
     float Vis = V_SchlickSmith(NoV, NoL, k_IBL(a));
