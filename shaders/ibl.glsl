@@ -5,6 +5,7 @@
 #include "common.glsl"
 #include "brdf.glsl"
 #include "sampling.glsl"
+#include "env_sampling.glsl"
 
 // Radiance of the environment prefiltered for this roughness, around the reflection vector.
 vec3 prefilteredRadiance(samplerCube prefilteredEnv, vec3 R, float roughness, float mipCount) {
@@ -104,4 +105,150 @@ vec3 referenceIBL(samplerCube env, vec3 diffuseColor, vec3 F0, float roughness, 
     // Karis 2013, "Real Shading in Unreal Engine 4", image-based lighting: reference
     return referenceDiffuseIBL(env, diffuseColor, N, sampleCount, offset)
          + referenceSpecularIBL(env, F0, roughness, N, V, sampleCount, offset);
+}
+
+// --- Reference with multiple importance sampling -------------------------------------------
+// The reflected radiance integral of the full BRDF over the environment, estimated with two
+// strategies a sample: a direction from the BRDF (a one-sample mixture of the cosine lobe
+// and GGX) and one from the environment's luminance distribution (env_sampling.glsl),
+// combined by the balance heuristic (Veach 1997). The BRDF is behind the three functions
+// below and their struct, so further lobes only extend those.
+
+// The surface the reference integrates: normal, view, Lambert albedo, specular F0,
+// perceptual roughness and a scale of the specular (energy compensation).
+struct ReferenceSurface {
+    vec3 N;
+    vec3 V;
+    vec3 diffuseColor;
+    vec3 F0;
+    float roughness;
+    vec3 specularScale;
+};
+
+ReferenceSurface makeReferenceSurface(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
+                                      float roughness, vec3 specularScale) {
+    // matedit reference mode: the BRDF's inputs in one struct
+    ReferenceSurface s;
+    s.N = N;
+    s.V = V;
+    s.diffuseColor = diffuseColor;
+    s.F0 = F0;
+    s.roughness = roughness;
+    s.specularScale = specularScale;
+    return s;
+}
+
+// alpha of the reference's GGX: roughness^2, at least 1e-3 (a mirror's delta lobe is
+// approximated by a lobe of about 0.06 degrees, narrower than an environment texel).
+float referenceAlpha(ReferenceSurface s) {
+    // Karis 2013, "Real Shading in Unreal Engine 4": alpha = roughness^2
+    return max(s.roughness * s.roughness, 1e-3);
+}
+
+// Probability of drawing the GGX lobe rather than the cosine lobe: the lobes' estimated
+// weights, luminance of F(NoV) times the specular scale against the diffuse albedo.
+float referenceSpecularChance(ReferenceSurface s) {
+    // one-sample model of Veach 1997: choose a lobe by its approximate share of the energy
+    float NoV = saturate(dot(s.N, s.V));
+    const vec3 Y = vec3(0.2126, 0.7152, 0.0722);
+    float spec = dot(F_SchlickExact(s.F0, NoV) * s.specularScale, Y);
+    float diff = dot(s.diffuseColor, Y);
+    float total = spec + diff;
+    return total > 0.0 ? saturate(spec / total) : 0.5;
+}
+
+// f(l, v) N.l of the whole BRDF towards the unit direction L: Lambert plus D Vis F with
+// Schlick-Smith k = alpha / 2 and the exact Schlick Fresnel, as referenceSpecularIBL.
+vec3 referenceBrdfCosine(ReferenceSurface s, vec3 L) {
+    // Karis 2013, "Real Shading in Unreal Engine 4": c_diff / pi + D G F / (4 NoL NoV), k = a/2
+    float NoL = dot(s.N, L);
+    if (NoL <= 0.0) return vec3(0.0);
+    vec3 h = L + s.V;
+    float hh = dot(h, h);
+    vec3 diffuse = s.diffuseColor * (INV_PI * NoL);
+    if (hh < 1e-12) return diffuse;
+    vec3 H = h * inversesqrt(hh);
+    // V below the shading horizon (normal maps): no specular where GGX sampling cannot
+    // reach (V.H <= 0, or a half vector below the surface, N.H <= 0, where D is 0 and the
+    // cross-product form of D would not be), which above the horizon never happens
+    float VoH = dot(s.V, H);
+    float NoH = dot(s.N, H);
+    if (VoH <= 0.0 || NoH <= 0.0) return diffuse;
+    float a = referenceAlpha(s);
+    float NoV = max(dot(s.N, s.V), 1e-4);
+    vec3 NxH = cross(s.N, H);
+    float D = D_GGX(NoH, a, dot(NxH, NxH));
+    float Vis = V_SchlickSmith(NoV, NoL, k_IBL(a));
+    return diffuse + (D * Vis * NoL) * F_SchlickExact(s.F0, VoH) * s.specularScale;
+}
+
+// Solid-angle density of L under referenceBrdfSample: the mixture of NoL / pi and the GGX
+// half-vector density D NoH / (4 VoH) (Walter et al. 2007).
+float referenceBrdfPdf(ReferenceSurface s, vec3 L) {
+    // the one-sample mixture's density: (1 - c) p_cos + c p_ggx
+    float c = referenceSpecularChance(s);
+    float cosine = max(dot(s.N, L), 0.0) * INV_PI;
+    float ggx = 0.0;
+    vec3 h = L + s.V;
+    float hh = dot(h, h);
+    if (hh >= 1e-12) {
+        vec3 H = h * inversesqrt(hh);
+        float VoH = dot(s.V, H);
+        if (VoH > 0.0) {
+            float NoH = saturate(dot(s.N, H));
+            vec3 NxH = cross(s.N, H);
+            ggx = D_GGX(NoH, referenceAlpha(s), dot(NxH, NxH)) * NoH / (4.0 * VoH);
+        }
+    }
+    return (1.0 - c) * cosine + c * ggx;
+}
+
+// A direction drawn from the BRDF for the uniform point Xi (may lie below the horizon);
+// `pdf` receives referenceBrdfPdf of it.
+vec3 referenceBrdfSample(ReferenceSurface s, vec2 Xi, out float pdf) {
+    // Xi.x picks the lobe and is stretched back to [0, 1) for it
+    float c = referenceSpecularChance(s);
+    vec3 L;
+    if (Xi.x < c) {
+        vec2 X = vec2(min(Xi.x / c, 0.99999994), Xi.y);
+        vec3 H = importanceSampleGGX(X, referenceAlpha(s), s.N);
+        L = 2.0 * dot(s.V, H) * H - s.V;
+    } else {
+        vec2 X = vec2(min((Xi.x - c) / (1.0 - c), 0.99999994), Xi.y);
+        L = importanceSampleCosine(X, s.N);
+    }
+    pdf = referenceBrdfPdf(s, L);
+    return L;
+}
+
+// The environment sample's point of a pair: the Hammersley point swapped and shifted, so
+// that the two strategies' samples are not aligned.
+vec2 environmentSamplePoint(vec2 Xi) {
+    // Cranley-Patterson rotation of the swapped point
+    return fract(Xi.yx + vec2(0.5, 0.25));
+}
+
+// Full reference (diffuse and specular) of the environment `env` with its distribution
+// `dist`: per sample, one BRDF and one environment direction, balance heuristic.
+vec3 referenceEnvironmentIBL(samplerCube env, sampler2D dist, ReferenceSurface s,
+                             uint sampleCount, vec2 offset) {
+    // Veach 1997, "Robust Monte Carlo Methods for Light Transport Simulation", ch. 9:
+    // sum over strategies of f L / (p_brdf + p_env), one sample of each
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < sampleCount; i++) {
+        vec2 Xi = rotatedHammersley(i, sampleCount, offset);
+        float pb;
+        vec3 Lb = referenceBrdfSample(s, Xi, pb);
+        if (pb > 0.0 && dot(s.N, Lb) > 0.0) {
+            vec3 f = referenceBrdfCosine(s, Lb);
+            sum += f * textureLod(env, Lb, 0.0).rgb / (pb + environmentPdf(dist, Lb));
+        }
+        float pe;
+        vec3 Le = sampleEnvironmentDirection(dist, environmentSamplePoint(Xi), pe);
+        if (pe > 0.0 && dot(s.N, Le) > 0.0) {
+            vec3 f = referenceBrdfCosine(s, Le);
+            sum += f * textureLod(env, Le, 0.0).rgb / (pe + referenceBrdfPdf(s, Le));
+        }
+    }
+    return sum / float(sampleCount);
 }

@@ -1,7 +1,8 @@
 // Inputs of image-based lighting: environment textures and one std140 uniform block.
 //
 // Bindings (Vulkan: set 0; in GL the renderer assigns units and block bindings by name):
-//   0 LightsBlock (lights_block.glsl), 1 IblBlock, 2 uPrefilteredEnv, 3 uBrdfLut, 4 uEnvironment.
+//   0 LightsBlock (lights_block.glsl), 1 IblBlock, 2 uPrefilteredEnv, 3 uBrdfLut, 4 uEnvironment,
+//   7 uEnvDistribution (5 and 6 are the compiler's FrameBlock and MaterialParams).
 // std140 layout of block `IblBlock` (instance `uIbl`), float32 unless said otherwise:
 //   offset   0: vec4 sh[9]   xyz = order-2 SH coefficient of the environment radiance, w = 0;
 //                            order L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (real SH basis,
@@ -28,3 +29,4 @@ MATEDIT_UBO(MATEDIT_IBL_BINDING) uniform IblBlock {
 MATEDIT_BINDING(MATEDIT_PREFILTERED_ENV_BINDING) uniform samplerCube uPrefilteredEnv;  // GGX-prefiltered, mip m: roughness m/(M-1)
 MATEDIT_BINDING(MATEDIT_BRDF_LUT_BINDING) uniform sampler2D uBrdfLut;           // (NoV, roughness) -> (A, B) in (R, G)
 MATEDIT_BINDING(MATEDIT_ENVIRONMENT_BINDING) uniform samplerCube uEnvironment;     // unfiltered, for reference mode
+MATEDIT_BINDING(MATEDIT_ENV_DISTRIBUTION_BINDING) uniform sampler2D uEnvDistribution;  // luminance CDFs and density (env_sampling.glsl), reference mode

@@ -71,10 +71,12 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
 #ifndef MATEDIT_SPLIT_SUM_ONLY
     // The reference estimator is a large loop; the preview's split-sum programs leave it out.
     if (mode == IBL_MODE_REFERENCE) {
+        // BRDF and environment sampling, balance heuristic (ibl.glsl, referenceEnvironmentIBL)
         uint count = uint(max(uIbl.params.z, 1.0));
-        return (referenceDiffuseIBL(uEnvironment, diffuseColor, N, count, uIbl.sampleOffset.xy)
-              + referenceSpecularIBL(uEnvironment, F0, roughness, N, V, count,
-                                     uIbl.sampleOffset.xy) * specularScale) * uIbl.params.y;
+        ReferenceSurface rs = makeReferenceSurface(N, V, diffuseColor, F0, roughness,
+                                                   specularScale);
+        return referenceEnvironmentIBL(uEnvironment, uEnvDistribution, rs, count,
+                                       uIbl.sampleOffset.xy) * uIbl.params.y;
     }
 #endif
     vec3 sh[9];

@@ -17,7 +17,18 @@ import zlib
 import numpy as np
 import pytest
 
-from matedit.shading import brdf, common, ibl, lights, material, output, sampling, surface
+from matedit.ibl.importance import build_distribution
+from matedit.shading import (
+    brdf,
+    common,
+    env_sampling,
+    ibl,
+    lights,
+    material,
+    output,
+    sampling,
+    surface,
+)
 from matedit.shading.lights import Light
 from matedit.shading.lights_block import pack_lights
 from tests.gpu_eval import constant_cubemap as _constant_cube
@@ -520,6 +531,173 @@ def test_reference_ibl_under_constant_environment(ctx, rng):
           slack=perturbation_spread(twin, inputs, rng))  # fmt: skip
 
 
+# --- env_sampling.glsl, and the reference with multiple importance sampling ---------------
+
+
+def _random_distribution(rng, h=16, w=32):
+    """A sampling table of a lumpy luminance image: a few bright pixels, black rows."""
+    lum = 10.0 ** rng.uniform(-2, 1, (h, w))
+    lum[3] = 0.0  # a black row: zero width in the marginal CDF
+    lum[5, :7] = 0.0  # zero-width columns
+    lum[9, 20] = 5e4  # a "sun"
+    return build_distribution(lum).table
+
+
+def _distribution_texture(ctx, table):
+    tex = ctx.texture((table.shape[1], table.shape[0]), 2,
+                      np.ascontiguousarray(table, np.float32).tobytes(), dtype="f4")
+    tex.filter = (ctx.NEAREST, ctx.NEAREST)
+    tex.repeat_x = tex.repeat_y = False
+    return tex
+
+
+def test_environment_sampling(ctx, rng):
+    n = N_ELEMS
+    table = _random_distribution(rng)
+    tex = _distribution_texture(ctx, table)
+    u = f32(rng.uniform(0, 1, (n, 2)))
+    u[:8] = [[0, 0], [0, 0.99999994], [0.99999994, 0], [0.5, 0.5], [0.25, 0.1], [0.9, 0.7],
+             [0.1, 0.999], [0.999, 0.4]]
+    L = f32(unit_vectors(rng, n))
+    try:
+        out = gpu_eval_many(
+            ctx, "d = sampleEnvironmentDirection(dist, u, p); back = environmentPdf(dist, d);"
+                 "q = environmentPdf(dist, L); e = equirectDirection(u);"
+                 "uv = directionToEquirect(L);",
+            {"u": u, "L": L}, {"d": "vec3", "p": "float", "back": "float", "q": "float",
+                               "e": "vec3", "uv": "vec2"},
+            includes=["env_sampling.glsl"], preamble="uniform sampler2D dist;",
+            textures={"dist": tex},
+        )  # fmt: skip
+    finally:
+        tex.release()
+    d, p = env_sampling.sampleEnvironmentDirection(table, u)
+    check("equirectDirection", out["e"], env_sampling.equirectDirection(u), atol=2e-6)
+    # atan and acos of float32 inputs: a few ulps of pi
+    check("directionToEquirect", out["uv"], env_sampling.directionToEquirect(L), rtol=0,
+          atol=2e-6)
+    check("sampleEnvironmentDirection", out["d"], d, rtol=0, atol=2e-6)
+    # pdf: p(u, v) / sin(theta), float32 sin of a float32 angle; near the poles a float32
+    # v (ulp 6e-8) moves sin(theta) by pi ulp(v) / sin(theta) relatively: slack 8 times that
+    sin_t = np.sin(np.pi * env_sampling.directionToEquirect(d)[:, 1])
+    check("sampleEnvironmentDirection.pdf", out["p"], p, rtol=2e-5, atol=1e-6,
+          slack=8.0 * p * np.pi * 6e-8 / np.maximum(sin_t, 1e-7))
+    # the pdf of the sample itself, by the other function: the same pixel and Jacobian,
+    # except where the sample lies on a pixel edge (u = 0 is the seam u = 1)
+    seam = np.abs(out["back"] - p) > 1e-4 * p + 1e-6
+    assert seam.mean() < 2e-3, seam.sum()
+    check("environmentPdf(sample)", out["back"][~seam], p[~seam], rtol=1e-4, atol=1e-6)
+    # directions near a pixel edge may land in the neighbour in float32: allow a few
+    q = env_sampling.environmentPdf(table, L)
+    mismatched = np.abs(out["q"] - q) > 1e-4 * np.abs(q) + 1e-6
+    assert mismatched.mean() < 2e-3, mismatched.sum()
+    check("environmentPdf", out["q"][~mismatched], q[~mismatched])
+
+
+def _reference_surface_inputs(rng, n):
+    N, V = normal_and_view(rng, n)
+    return {"N": N, "V": V, "dc": f32(rng.uniform(0, 1, (n, 3))),
+            "F0": f32(rng.uniform(0, 1, (n, 3))), "r": roughness(rng, n, lo=0.0),
+            "ss": f32(rng.uniform(1, 1.5, (n, 3)))}
+
+
+_SURFACE = "ReferenceSurface s = makeReferenceSurface(N, V, dc, F0, r, ss);"
+
+
+def test_reference_brdf(ctx, rng):
+    n = N_ELEMS
+    inputs = _reference_surface_inputs(rng, n)
+    inputs["Xi"] = f32(rng.uniform(0, 1, (n, 2)))
+    inputs["Lr"] = f32(unit_vectors(rng, n))
+    out = gpu_eval_many(
+        ctx, _SURFACE + "float ps; Ls = referenceBrdfSample(s, Xi, ps); pdf = ps;"
+        "fL = referenceBrdfCosine(s, Lr); pL = referenceBrdfPdf(s, Lr);"
+        "c = referenceSpecularChance(s);",
+        inputs, {"Ls": "vec3", "pdf": "float", "fL": "vec3", "pL": "float", "c": "float"},
+        includes=["ibl.glsl"],
+    )  # fmt: skip
+
+    def surf(v):
+        return ibl.makeReferenceSurface(v["N"], v["V"], v["dc"], v["F0"], v["r"], v["ss"])
+
+    def cosine(**v):
+        return ibl.referenceBrdfCosine(surf(v), v["Lr"])
+
+    def pdf(**v):
+        return ibl.referenceBrdfPdf(surf(v), v["Lr"])
+
+    def sample(**v):
+        return ibl.referenceBrdfSample(surf(v), v["Xi"])[0]
+
+    check("referenceSpecularChance", out["c"], ibl.referenceSpecularChance(surf(inputs)),
+          atol=1e-6)
+    # GGX of narrow lobes (alpha down to 1e-3) on half vectors: perturbation slack
+    check("referenceBrdfCosine", out["fL"], cosine(**inputs), rtol=1e-4, atol=1e-6,
+          slack=perturbation_spread(cosine, inputs, rng))
+    check("referenceBrdfPdf", out["pL"], pdf(**inputs), rtol=1e-4, atol=1e-6,
+          slack=perturbation_spread(pdf, inputs, rng))
+    # the lobe choice Xi.x < c may differ where they are within float32 rounding
+    c = ibl.referenceSpecularChance(surf(inputs))
+    clear = np.abs(inputs["Xi"][:, 0] - c) > 1e-5
+    Ls = sample(**inputs)
+    check("referenceBrdfSample", out["Ls"][clear], Ls[clear], rtol=1e-4, atol=1e-5,
+          slack=perturbation_spread(sample, inputs, rng)[clear])
+    pdf_s = ibl.referenceBrdfPdf(surf(inputs), f32(out["Ls"]))
+    assert np.all(np.isfinite(out["pdf"]))
+    # the sample's pdf is referenceBrdfPdf of it (evaluated here at the GPU's direction)
+    check("referenceBrdfSample.pdf", out["pdf"][clear], pdf_s[clear], rtol=2e-3, atol=1e-5)
+
+
+def test_reference_environment_ibl(ctx, rng):
+    """The MIS estimator under a constant environment with a lumpy distribution: the
+    distribution changes where samples go and their weights, not the value's expectation."""
+    n = 1024
+    c = np.float32([0.8, 1.0, 1.3])
+    cube = _constant_cube(ctx, [c])
+    cube.filter = (ctx.LINEAR, ctx.LINEAR)
+    table = _random_distribution(rng)
+    tex = _distribution_texture(ctx, table)
+    inputs = _reference_surface_inputs(rng, n)
+    inputs["off"] = f32(rng.uniform(0, 1, (n, 2)))
+    try:
+        out = gpu_eval_many(
+            ctx, _SURFACE + "ref = referenceEnvironmentIBL(env, dist, s, 64u, off);",
+            inputs, {"ref": "vec3"}, includes=["ibl.glsl"],
+            preamble="uniform samplerCube env; uniform sampler2D dist;",
+            textures={"env": cube, "dist": tex},
+        )  # fmt: skip
+    finally:
+        cube.release()
+        tex.release()
+
+    def env(d):
+        return np.broadcast_to(c, np.shape(d))
+
+    def twin(**v):
+        s = ibl.makeReferenceSurface(v["N"], v["V"], v["dc"], v["F0"], v["r"], v["ss"])
+        return ibl.referenceEnvironmentIBL(env, table, s, 64, v["off"])
+
+    ref = twin(**inputs)
+    # 128 weighted samples a pixel. A lobe choice, a CDF comparison or a sample's side of
+    # the horizon that float32 rounding flips moves one whole sample; at grazing view
+    # (NoV ~ 1e-4) a GGX sample's weight is ~1 / NoV, so one flip there changes the pixel
+    # by any amount. Elsewhere: perturbation slack, or one flipped sample's share (1 %).
+    check_monte_carlo("referenceEnvironmentIBL", out["ref"], ref,
+                      perturbation_spread(twin, inputs, rng), inputs["N"], inputs["V"])
+
+
+def check_monte_carlo(name, got, ref, spread, N, V):
+    """`check` for the MIS estimator, but a few pixels (< 3 %) may differ by one flipped
+    sample: anything at grazing view (NoV < 1e-3), else under 1 %."""
+    err = np.abs(got - ref)
+    flipped = (err > 1e-4 * np.abs(ref) + 1e-5 + spread).any(axis=1)
+    assert flipped.mean() < 0.03, flipped.sum()
+    grazing = np.sum(N * V, axis=1) < 1e-3
+    rel = (err / (np.abs(ref) + 1e-5)).max(axis=1)
+    assert np.all(grazing[flipped] | (rel[flipped] < 0.01)), rel[flipped & ~grazing]
+    check(name, got[~flipped], ref[~flipped], rtol=1e-4, atol=1e-5, slack=spread[~flipped])
+
+
 @pytest.mark.parametrize("mode", [ibl.IBL_MODE_SPLIT_SUM, ibl.IBL_MODE_REFERENCE,
                                   ibl.IBL_MODE_NONE])  # fmt: skip
 def test_shade_surface(ctx, rng, mode):
@@ -534,6 +712,8 @@ def test_shade_surface(ctx, rng, mode):
                                sample_offset=(0.25, 0.6))  # fmt: skip
     env = _constant_cube(ctx, [env_c])
     env.filter = (ctx.LINEAR, ctx.LINEAR)
+    table = _random_distribution(rng)
+    dist = _distribution_texture(ctx, table)
     pref = _constant_cube(ctx, [pref_c] * 5)
     lut = _lut_texture(ctx, np.broadcast_to(ab, (4, 4, 2)).copy())
     N, V = normal_and_view(rng, n)
@@ -553,15 +733,17 @@ def test_shade_surface(ctx, rng, mode):
         got = gpu_eval_many(
             ctx, body, inputs, {"result": "vec3"}, includes=["surface.glsl"],
             uniform_blocks={"LightsBlock": pack_lights(scene), "IblBlock": block},
-            textures={"uPrefilteredEnv": pref, "uBrdfLut": lut, "uEnvironment": env},
+            textures={"uPrefilteredEnv": pref, "uBrdfLut": lut, "uEnvironment": env,
+                      "uEnvDistribution": dist},
         )["result"]  # fmt: skip
     finally:
-        for t in (env, pref, lut):
+        for t in (env, pref, lut, dist):
             t.release()
 
     ibl_in = surface.IblInputs(
         sh=sh, prefiltered=pref_c, mip_count=5, brdf_lut=ab, lut_values=True,
-        environment=lambda d: np.broadcast_to(env_c, np.shape(d)), intensity=1.7,
+        environment=lambda d: np.broadcast_to(env_c, np.shape(d)),
+        environment_distribution=table, intensity=1.7,
         samples=32, sample_offset=(0.25, 0.6), mode=mode,
     )  # fmt: skip
 
@@ -574,6 +756,10 @@ def test_shade_surface(ctx, rng, mode):
     packed = [_f32_light(l) for l in scene]
     scene[:] = packed  # numpy sees the float32 values the block holds
     ref = twin(**inputs)
+    if mode == ibl.IBL_MODE_REFERENCE:  # Monte Carlo: see check_monte_carlo
+        check_monte_carlo(f"shadeSurface[mode {mode}]", got, ref,
+                          perturbation_spread(twin, inputs, rng), N, V)
+        return
     check(f"shadeSurface[mode {mode}]", got, ref, rtol=1e-4, atol=1e-5,
           slack=perturbation_spread(twin, inputs, rng))  # fmt: skip
 

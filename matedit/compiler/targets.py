@@ -3,7 +3,8 @@
 Bindings (Vulkan: set 0; desktop GL and WebGL2 assign block bindings and texture
 units by name at link time): 0 LightsBlock, 1 IblBlock, 2 prefiltered
 environment, 3 BRDF LUT, 4 unfiltered environment (see shaders/ibl_inputs.glsl),
-5 FrameBlock, 6 MaterialParams, 7 and up the material's textures: matedit/glsl/layout.py,
+5 FrameBlock, 6 MaterialParams, 7 the environment's sampling table (reference mode),
+8 and up the material's textures: matedit/glsl/layout.py,
 the one source of these numbers.
 """
 

@@ -1,6 +1,8 @@
 """Environment lighting on the GPU: the baked environment (prefiltered cube, BRDF LUT, SH
 irradiance; baked and cached by matedit.ibl), the unfiltered cube behind the mesh and for
-reference mode, the IblBlock uniform buffer, and the background pass."""
+reference mode with its importance-sampling table (matedit.ibl.importance, built when an
+environment is set: ~0.1 s for a 256² cube), the IblBlock uniform buffer, and the
+background pass."""
 
 from __future__ import annotations
 
@@ -11,14 +13,26 @@ import moderngl
 import numpy as np
 
 from matedit.glsl.layout import BINDINGS, IBL_BLOCK
+from matedit.ibl.importance import distribution_from_cube
 from matedit.render.fullscreen import FullscreenQuad, mat_bytes, render_program
 from matedit.shading.ibl import IBL_MODE_NONE, pack_ibl_block
 
-PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT = (
-    BINDINGS[k] for k in ("PREFILTERED_ENV", "BRDF_LUT", "ENVIRONMENT"))
+PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT, DISTRIBUTION_UNIT = (
+    BINDINGS[k] for k in ("PREFILTERED_ENV", "BRDF_LUT", "ENVIRONMENT", "ENV_DISTRIBUTION"))
 # SH irradiance coefficients -> radiance coefficients: divide by the cosine lobe's A_l
 # (Ramamoorthi and Hanrahan 2001): pi, 2pi/3, pi/4 for bands 0, 1, 2.
 SH_BAND_SCALE = np.array([math.pi] + [2 * math.pi / 3] * 3 + [math.pi / 4] * 5)
+
+
+def upload_distribution(ctx: moderngl.Context, faces: np.ndarray) -> moderngl.Texture:
+    """The importance-sampling table of cube faces (6, n, n, 3) as an RG32F texture,
+    (W + 1) x H texels, read with texelFetch (matedit.ibl.importance for the layout)."""
+    table = distribution_from_cube(faces).table
+    h, w1 = table.shape[:2]
+    tex = ctx.texture((w1, h), 2, np.ascontiguousarray(table, dtype="f4").tobytes(), dtype="f4")
+    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    tex.repeat_x = tex.repeat_y = False
+    return tex
 
 
 class EnvironmentLighting:
@@ -31,6 +45,7 @@ class EnvironmentLighting:
         self._block = ctx.buffer(reserve=IBL_BLOCK.size)
         self._ibl = None  # matedit.ibl.IBLTextures
         self._cube: moderngl.TextureCube | None = None
+        self._distribution: moderngl.Texture | None = None  # env_sampling.glsl's table
         self.levels = 1
         self.sh = np.zeros((9, 3))  # radiance coefficients
         self.warnings: list[str] = []
@@ -56,6 +71,7 @@ class EnvironmentLighting:
         cube.build_mipmaps()
         cube.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
         self._cube = cube
+        self._distribution = upload_distribution(self.ctx, base)
         self.levels = result.levels
         self.sh = np.asarray(result.sh, dtype=np.float64) / SH_BAND_SCALE[:, None]
         self.warnings = list(result.warnings)
@@ -64,6 +80,7 @@ class EnvironmentLighting:
         self._ibl.prefiltered.use(location=PREFILTERED_UNIT)
         self._ibl.brdf_lut.use(location=LUT_UNIT)
         self._cube.use(location=ENVIRONMENT_UNIT)
+        self._distribution.use(location=DISTRIBUTION_UNIT)
 
     def draw_background(self, view_projection: np.ndarray, blur: float,
                         intensity: float) -> None:
@@ -95,7 +112,8 @@ class EnvironmentLighting:
         if self._ibl is not None:
             self._ibl.release()
             self._cube.release()
-        self._ibl = self._cube = None
+            self._distribution.release()
+        self._ibl = self._cube = self._distribution = None
 
     def release(self) -> None:
         self._release_textures()

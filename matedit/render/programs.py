@@ -24,7 +24,7 @@ from matedit.shading.views import view_defines
 _BLOCKS = (("LightsBlock", "LIGHTS"), ("IblBlock", "IBL"), ("FrameBlock", "FRAME"),
            ("MaterialParams", "MATERIAL"))
 _SAMPLERS = (("uPrefilteredEnv", "PREFILTERED_ENV"), ("uBrdfLut", "BRDF_LUT"),
-             ("uEnvironment", "ENVIRONMENT"))
+             ("uEnvironment", "ENVIRONMENT"), ("uEnvDistribution", "ENV_DISTRIBUTION"))
 
 
 @dataclass

@@ -9,12 +9,14 @@ a prefiltered environment ``env(directions, lod) -> rgb``; the BRDF LUT is an ar
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from matedit.glsl import layout as _layout
-from matedit.shading.brdf import F_SchlickExact, G1_Schlick, k_IBL
-from matedit.shading.common import INV_PI, dot, f64, saturate, sq
+from matedit.shading.brdf import D_GGX, F_SchlickExact, G1_Schlick, V_SchlickSmith, k_IBL
+from matedit.shading.common import INV_PI, cross, dot, f64, saturate, sq
+from matedit.shading.env_sampling import environmentPdf, sampleEnvironmentDirection
 from matedit.shading.sampling import hammersley, importanceSampleCosine, importanceSampleGGX
 
 Environment = Callable[[np.ndarray], np.ndarray]
@@ -154,6 +156,138 @@ def referenceIBL(env, diffuseColor, F0, roughness, N, V, sampleCount: int, offse
     return referenceDiffuseIBL(env, diffuseColor, N, sampleCount, offset) + referenceSpecularIBL(
         env, F0, roughness, N, V, sampleCount, offset
     )
+
+
+# --- Reference with multiple importance sampling (twin of ibl.glsl's) ------------------------
+# `dist` is the environment's sampling table, the array matedit.ibl.importance builds and the
+# renderer uploads (env_sampling.py); `env` a callable directions -> rgb as above.
+
+_LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+_ONE_BELOW = float(np.float32(0.99999994))
+
+
+@dataclass
+class ReferenceSurface:
+    """The struct of ibl.glsl: arrays broadcasting like the other twins' inputs."""
+
+    N: np.ndarray
+    V: np.ndarray
+    diffuseColor: np.ndarray
+    F0: np.ndarray
+    roughness: np.ndarray
+    specularScale: np.ndarray
+
+
+def makeReferenceSurface(N, V, diffuseColor, F0, roughness, specularScale=1.0):
+    N, V = f64(N), f64(V)
+    shape = np.broadcast_shapes(N.shape, V.shape)
+    return ReferenceSurface(N, V, f64(diffuseColor), f64(F0), f64(roughness),
+                            np.broadcast_to(f64(specularScale), shape[:-1] + (3,)))
+
+
+def _with_sample_axis(s: ReferenceSurface) -> ReferenceSurface:
+    """The surface with an axis before the components, to broadcast against samples."""
+    def vec(x):
+        return f64(x)[..., None, :]
+
+    return ReferenceSurface(vec(s.N), vec(s.V), vec(s.diffuseColor), vec(s.F0),
+                            f64(s.roughness)[..., None], vec(s.specularScale))
+
+
+def referenceAlpha(s: ReferenceSurface) -> np.ndarray:
+    return np.maximum(sq(s.roughness), 1e-3)
+
+
+def referenceSpecularChance(s: ReferenceSurface) -> np.ndarray:
+    NoV = saturate(dot(s.N, s.V))
+    spec = (F_SchlickExact(s.F0, NoV) * f64(s.specularScale)) @ _LUMINANCE
+    diff = f64(s.diffuseColor) @ _LUMINANCE
+    total = spec + diff
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0.0, saturate(spec / total), 0.5)
+
+
+def _half(s: ReferenceSurface, L):
+    """(H, valid): the unit half vector of L and V, valid where |L + V|^2 >= 1e-12."""
+    h = f64(L) + s.V
+    hh = dot(h, h)
+    valid = hh >= 1e-12
+    return h / np.sqrt(np.where(valid, hh, 1.0))[..., None], valid
+
+
+def referenceBrdfCosine(s: ReferenceSurface, L) -> np.ndarray:
+    """f(l, v) N.l of the whole BRDF towards unit directions L (..., 3)."""
+    L = f64(L)
+    NoL = dot(s.N, L)
+    H, valid = _half(s, L)
+    a = referenceAlpha(s)
+    NoV = np.maximum(dot(s.N, s.V), 1e-4)
+    NoH = dot(s.N, H)
+    VoH = dot(s.V, H)
+    # no specular where GGX sampling cannot reach (ibl.glsl)
+    valid = valid & (VoH > 0.0) & (NoH > 0.0)
+    NoH, VoH = saturate(NoH), saturate(VoH)
+    NxH = cross(s.N, H)
+    D = D_GGX(NoH, a, dot(NxH, NxH))
+    Vis = V_SchlickSmith(NoV, np.maximum(NoL, 0.0), k_IBL(a))
+    spec = (D * Vis * NoL)[..., None] * F_SchlickExact(s.F0, VoH) * f64(s.specularScale)
+    out = f64(s.diffuseColor) * (INV_PI * NoL)[..., None] + np.where(valid[..., None], spec, 0.0)
+    return np.where((NoL > 0.0)[..., None], out, 0.0)
+
+
+def referenceBrdfPdf(s: ReferenceSurface, L) -> np.ndarray:
+    L = f64(L)
+    c = referenceSpecularChance(s)
+    cosine = np.maximum(dot(s.N, L), 0.0) * INV_PI
+    H, valid = _half(s, L)
+    VoH = dot(s.V, H)
+    NoH = saturate(dot(s.N, H))
+    NxH = cross(s.N, H)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ggx = D_GGX(NoH, referenceAlpha(s), dot(NxH, NxH)) * NoH / (4.0 * VoH)
+    ggx = np.where(valid & (VoH > 0.0), ggx, 0.0)
+    return (1.0 - c) * cosine + c * ggx
+
+
+def referenceBrdfSample(s: ReferenceSurface, Xi) -> tuple[np.ndarray, np.ndarray]:
+    """(L, pdf) for uniform points Xi (..., 2); the GLSL returns pdf through `out`."""
+    Xi = f64(Xi)
+    c = referenceSpecularChance(s)
+    x = Xi[..., 0]
+    spec = x < c
+    with np.errstate(invalid="ignore", divide="ignore"):
+        xs = np.minimum(np.where(spec, x / np.where(c > 0, c, 1.0), 0.0), _ONE_BELOW)
+        xd = np.minimum(np.where(spec, 0.0, (x - c) / np.where(c < 1, 1.0 - c, 1.0)),
+                        _ONE_BELOW)
+    H = importanceSampleGGX(np.stack(np.broadcast_arrays(xs, Xi[..., 1]), -1),
+                            referenceAlpha(s), s.N)
+    Ls = 2.0 * dot(s.V, H)[..., None] * H - s.V
+    Ld = importanceSampleCosine(np.stack(np.broadcast_arrays(xd, Xi[..., 1]), -1), s.N)
+    L = np.where(spec[..., None], Ls, Ld)
+    return L, referenceBrdfPdf(s, L)
+
+
+def environmentSamplePoint(Xi) -> np.ndarray:
+    Xi = f64(Xi)
+    return np.mod(Xi[..., ::-1] + np.array([0.5, 0.25]), 1.0)
+
+
+def referenceEnvironmentIBL(env: Environment, dist, s: ReferenceSurface, sampleCount: int,
+                            offset) -> np.ndarray:
+    """Vectorised over pixels (leading axes of the surface's arrays) and samples."""
+    t = _with_sample_axis(s)
+    Xi = _sample_points(sampleCount, offset)
+    Lb, pb = referenceBrdfSample(t, Xi)
+    ok = (pb > 0.0) & (dot(t.N, Lb) > 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wb = np.where(ok, 1.0 / (pb + environmentPdf(dist, Lb)), 0.0)
+    Le, pe = sampleEnvironmentDirection(dist, environmentSamplePoint(Xi))
+    ok = (pe > 0.0) & (dot(t.N, Le) > 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        we = np.where(ok, 1.0 / (pe + referenceBrdfPdf(t, Le)), 0.0)
+    total = (referenceBrdfCosine(t, Lb) * f64(env(Lb)) * wb[..., None]
+             + referenceBrdfCosine(t, Le) * f64(env(Le)) * we[..., None])
+    return total.sum(axis=-2) / sampleCount
 
 
 def pack_ibl_block(

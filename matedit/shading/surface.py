@@ -18,9 +18,9 @@ from matedit.shading.ibl import (
     diffuseIrradianceSH9,
     energyCompensation,
     environmentBRDF,
+    makeReferenceSurface,
     prefilteredRadiance,
-    referenceDiffuseIBL,
-    referenceSpecularIBL,
+    referenceEnvironmentIBL,
     splitSumSpecular,
 )
 from matedit.shading.lights import (
@@ -55,7 +55,8 @@ class IblInputs:
     `prefiltered`: callable (R, lod) -> rgb, or an array of radiance values broadcasting
     over pixels (already looked up). `brdf_lut`: LUT array, callable, or an array of
     (A, B) values (shape (..., 2), already looked up) when `lut_values` is true.
-    `environment`: callable directions -> rgb, for the reference mode.
+    `environment`: callable directions -> rgb, and `environment_distribution` its sampling
+    table (matedit.ibl.importance, the array the renderer uploads), for the reference mode.
     """
 
     sh: np.ndarray = field(default_factory=lambda: np.zeros((9, 3)))
@@ -64,6 +65,7 @@ class IblInputs:
     brdf_lut: object = field(default_factory=lambda: np.zeros((1, 1, 2)))
     lut_values: bool = False
     environment: Environment | None = None
+    environment_distribution: object = None
     intensity: float = 1.0
     samples: int = 64
     sample_offset: tuple[float, float] = (0.0, 0.0)
@@ -91,9 +93,11 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
         if ibl.environment is None:
             raise ValueError("the reference mode samples IblInputs.environment: none given")
         count = max(int(ibl.samples), 1)
-        color = (referenceDiffuseIBL(ibl.environment, diffuseColor, N, count, ibl.sample_offset)
-                 + referenceSpecularIBL(ibl.environment, F0, roughness, N, V, count,
-                                        ibl.sample_offset) * f64(specularScale))
+        if ibl.environment_distribution is None:
+            raise ValueError("reference mode needs IblInputs.environment_distribution")
+        rs = makeReferenceSurface(N, V, diffuseColor, F0, roughness, specularScale)
+        color = referenceEnvironmentIBL(ibl.environment, ibl.environment_distribution, rs,
+                                        count, ibl.sample_offset)
     else:
         NoV = saturate(dot(N, V))
         R = reflect(-V, N)
