@@ -20,8 +20,11 @@ from tests.gpu_eval import constant_cubemap as _constant_cube
 from tests.gpu_eval import gpu_eval_many
 from tests.test_shading_gpu_twin import (
     _all_kinds,
+    _distribution_texture,
     _f32_light,
+    _random_distribution,
     check,
+    check_monte_carlo,
     f32,
     normal_and_view,
     perturbation_spread,
@@ -209,20 +212,24 @@ def _shade(ctx, rng, mode, sheen_on, sheen_black, n=1024, lut_rgb=(0.7, 0.05, 0.
         m.sheenColor = sc; m.sheenRoughness = sr;
         result = shadeSurface(m, P, N, V);
     """
+    table = _random_distribution(rng)  # the reference's environment sampling (any table)
+    dist = _distribution_texture(ctx, table)
     try:
         got = gpu_eval_many(
             ctx, body, inputs, {"result": "vec3"}, includes=["surface.glsl"],
             defines=("MATERIAL_HAS_SHEEN_COLOR",) if sheen_on else (),
             uniform_blocks={"LightsBlock": pack_lights(scene), "IblBlock": block},
-            textures={"uPrefilteredEnv": pref, "uBrdfLut": lut, "uEnvironment": env},
+            textures={"uPrefilteredEnv": pref, "uBrdfLut": lut, "uEnvironment": env,
+                      "uEnvDistribution": dist},
         )["result"]  # fmt: skip
     finally:
-        for t in (env, pref, lut):
+        for t in (env, pref, lut, dist):
             t.release()
     scene[:] = [_f32_light(l) for l in scene]
     ibl_in = surface.IblInputs(
         sh=sh, prefiltered=pref_c, mip_count=5, brdf_lut=lut_v, lut_values=True,
-        environment=lambda d: np.broadcast_to(env_c, np.shape(d)), intensity=1.7,
+        environment=lambda d: np.broadcast_to(env_c, np.shape(d)),
+        environment_distribution=table, intensity=1.7,
         samples=32, sample_offset=(0.25, 0.6), mode=mode,
     )  # fmt: skip
 
@@ -259,8 +266,13 @@ def test_shade_surface_with_sheen_gpu_twin(ctx, rng, mode):
     ref = twin(**inputs)
     # as test_shading_gpu_twin's shadeSurface: 1e-4 relative, 1e-5 absolute, perturbation
     # slack for the sharp highlights and the sheen's grazing 1 / (NoV NoL)
-    check(f"shadeSurface+sheen[mode {mode}]", got, ref, rtol=2e-4, atol=1e-5,
-          slack=perturbation_spread(twin, inputs, rng))  # fmt: skip
+    spread = perturbation_spread(twin, inputs, rng)
+    if mode == ibl.IBL_MODE_REFERENCE:  # MIS: a few pixels flip one sample (see the helper)
+        check_monte_carlo(f"shadeSurface+sheen[mode {mode}]", got, ref, spread, inputs["N"],
+                          inputs["V"])
+    else:
+        check(f"shadeSurface+sheen[mode {mode}]", got, ref, rtol=2e-4, atol=1e-5,
+              slack=spread)  # fmt: skip
     # the sheen does something here
     assert np.abs(ref - twin(False, **inputs)).max() > 1e-2
 
