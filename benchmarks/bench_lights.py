@@ -34,6 +34,7 @@ from light_energy_ref import (  # noqa: E402
     tube_view_grid,
 )
 
+import matedit.shading.brdf as brdf  # noqa: E402
 import matedit.shading.coat as coat  # noqa: E402
 import matedit.shading.lights as lights  # noqa: E402
 
@@ -155,12 +156,12 @@ def main() -> int:
         from matedit.render.context import headless_context
 
         ctx = headless_context()
-    saved = lights.AREA_WIDEN_DIVISOR
+    saved = brdf.AREA_WIDEN_DIVISOR
     try:
         for c in (3.0, saved):
             if ctx is not None and c != saved:
                 continue  # the GLSL is compiled with its own default
-            lights.AREA_WIDEN_DIVISOR = c
+            brdf.AREA_WIDEN_DIVISOR = c
             t0 = time.perf_counter()
             spec = _gpu(ctx) if ctx is not None else _twin
             spheres, tilted, tubes = table(spec, args.quick)
@@ -181,7 +182,7 @@ def main() -> int:
             print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
     finally:
-        lights.AREA_WIDEN_DIVISOR = saved
+        brdf.AREA_WIDEN_DIVISOR = saved
         if ctx is not None:
             ctx.release()
     return 0

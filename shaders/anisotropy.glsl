@@ -6,8 +6,11 @@
 // along, so the roughness along it, at, is the larger one. Physically that is ACROSS the
 // grooves: brushing along a direction leaves grooves along it, whose normals tilt across it,
 // so a brushed surface's highlight is stretched perpendicular to the brushing.
-// Included by lights.glsl inside its #if, after common.glsl and brdf.glsl: it includes
-// nothing itself (a file spliced first inside an #if would be missing where it is off).
+// Included by lights.glsl inside its #if, after common.glsl and brdf.glsl:
+// its own includes of them are then already spliced (each file is spliced once), and they let
+// the file compile alone. A file spliced FIRST inside an #if would be missing where it is off.
+#include "common.glsl"
+#include "brdf.glsl"
 
 // Smallest alpha across the stretch: anisotropy 1 would make ab = 0, a mirror in one axis.
 const float ANISOTROPY_MIN_ALPHA = 1e-3;

@@ -3,6 +3,14 @@
 // light code never names a formula. `roughness` is perceptual, `a` is alpha.
 #include "common.glsl"
 
+// Widening of the highlight by a sphere or tube light: a' = a + sourceRadius / (DIVISOR d).
+// 2: the form most public implementations of the notes use (a + 0.5 * sourceRadius / d);
+// measured within 0.78 .. 1.20 of the true specular energy for r/d <= 0.25 at roughness >= 0.2
+// (benchmarks/LIGHTS_ENERGY.md), where 3 (docs/shading.md's earlier reading) reaches x2.15.
+#ifndef MATEDIT_AREA_WIDEN_DIVISOR
+#define MATEDIT_AREA_WIDEN_DIVISOR 2.0
+#endif
+
 // Lambert diffuse lobe without the albedo: multiply by diffuseColor.
 float Fd_Lambert() {
     // Karis 2013, "Real Shading in Unreal Engine 4", diffuse BRDF: Lambert, c_diff / pi

@@ -14,13 +14,6 @@
 const float LIGHT_FALLOFF_EPS = 0.01;
 // Smallest perceptual roughness analytic lights see: a mirror has no finite peak.
 const float MIN_ANALYTIC_ROUGHNESS = 0.03;
-// Widening of the highlight by a sphere or tube light: a' = a + sourceRadius / (DIVISOR d).
-// 2: the form most public implementations of the notes use (a + 0.5 * sourceRadius / d);
-// measured within 0.78 .. 1.20 of the true specular energy for r/d <= 0.25 at roughness >= 0.2
-// (benchmarks/LIGHTS_ENERGY.md), where 3 (docs/shading.md's earlier reading) reaches x2.15.
-#ifndef MATEDIT_AREA_WIDEN_DIVISOR
-#define MATEDIT_AREA_WIDEN_DIVISOR 2.0
-#endif
 #if defined(MATERIAL_HAS_ANISOTROPY)
 #include "anisotropy.glsl"
 #endif

@@ -8,6 +8,9 @@
 #include "ibl.glsl"
 #include "sheen.glsl"
 
+// Everything below reads the ShadingContext's sheen fields, which exist only then.
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+
 // The sheen fields of the context: shownColor is the colour drawn (the material's sheenColor
 // times the lobe view's lobeOn(LOBE_SHEEN)), sheenColor the material's own, which scales the
 // base whether the view shows the sheen or not (the base keeps what it has in the full image).
@@ -82,3 +85,4 @@ vec3 sheenImageBasedLighting(ShadingContext s) {
     float dfg = sheenDFG(uBrdfLut, NoV, s.sheenRoughness);
     return sheenSplitSum(prefiltered, s.sheenColor, dfg) * uIbl.params.y;
 }
+#endif

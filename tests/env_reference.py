@@ -2,7 +2,7 @@
 
 Nothing here imports matedit: a generated sun-and-sky environment, the cube-map geometry
 (OpenGL's face table, the convention of matedit/ibl/cubemap.py, restated), the BRDF of the
-reference mode written from SHADING.md / Karis 2013 (Lambert c_diff / pi; GGX D with
+reference mode written from Karis 2013 (docs/shading.md#brdf) (Lambert c_diff / pi; GGX D with
 alpha = roughness^2, at least 1e-3 as the shader takes for a mirror; Schlick-Smith
 visibility with k = alpha / 2; Schlick Fresnel with the exact fifth power), and a brute-force
 quadrature of f(l, v) N.l L(l) over a cube map taken as piecewise constant on its texels

@@ -36,9 +36,22 @@ def exported(tmp_path_factory):
     for path in SAMPLES:
         r = cli("export", str(path), "-o", str(folder / f"{path.stem}.mtlx"), "--size",
                 str(SIZE))
+        if path.stem in REFUSED:  # refused by name, never exported wrong
+            assert r.returncode == 2 and REFUSED[path.stem] in r.stderr, r.stderr
+            continue
         assert r.returncode == 0, r.stderr
         notes[path.stem] = r.stderr
     return folder, notes
+
+
+# Samples standard_surface cannot carry, and the field the export refuses them by: a varying
+# anisotropy direction has no standard_surface input (its rotation takes a constant here).
+REFUSED = {"radial_brushed_aluminium": "anisotropyDirection"}
+
+
+def _exportable(path: Path) -> None:
+    if path.stem in REFUSED:
+        pytest.skip(f"{path.stem}: export refused by name ({REFUSED[path.stem]})")
 
 
 def load_with_stdlib(path: Path):
@@ -52,6 +65,7 @@ def load_with_stdlib(path: Path):
 
 @pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
 def test_exported_mtlx_validates(exported, path):
+    _exportable(path)
     folder, notes = exported
     out = folder / f"{path.stem}.mtlx"
     doc = load_with_stdlib(out)
@@ -80,13 +94,19 @@ SURFACE_INPUTS = {
     "metalness": "metallic", "specular_roughness": "roughness",
     "normal": "normal", "emission_color": "emissive", "opacity": "opacity",
     "coat": "coat", "coat_color": "coatColor", "coat_roughness": "coatRoughness",
-    "coat_IOR": "coatIor",
+    "coat_IOR": "coatIor", "coat_normal": "coatNormal", "specular_color": "specularColor",
+    "specular_IOR": "ior", "sheen_color": "sheenColor", "sheen_roughness": "sheenRoughness",
+    "specular_anisotropy": "anisotropy",
 }
+# The talk's inputs, which every exported material has.
+TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",
+               "emission_color", "opacity"}
 
 
 @pytest.mark.gl
 @pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
 def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
+    _exportable(path)
     from matedit.compiler.api import lower_and_optimise
     from matedit.interop import bake
     from matedit.io.document import FileResolver, load
@@ -105,7 +125,7 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
             out = doc.getNodeGraph(inp.getNodeGraphString()).getOutput(inp.getOutputString())
             got = drawer.draw(doc, out, folder)
             want = cpu[SURFACE_INPUTS[inp.getName()]]
-            if inp.getName() == "normal":  # normalmap on T = +X, B = +Y, N = +Z
+            if inp.getName() in ("normal", "coat_normal"):  # normalmap: T = +X, B = +Y, N = +Z
                 want = want / np.linalg.norm(want, axis=-1, keepdims=True)
             k = want.shape[-1]
             if inp.getName() == "opacity":
@@ -125,6 +145,7 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
 def test_round_trip_import_compile_evaluate_equals_original(exported, path):
     """export -> import -> compile -> CPU evaluation equals the original at the texel centres
     of the bake (baked nodes come back as float EXR textures read there): within 1e-6."""
+    _exportable(path)
     from matedit.compiler.api import lower_and_optimise
     from matedit.interop import bake
     from matedit.io.document import FileResolver, load
@@ -606,7 +627,7 @@ def test_every_mapped_kind_matches_materialx_glsl_and_round_trips(ctx, tmp_path)
             o = doc.getNodeGraph(inp.getNodeGraphString()).getOutput(inp.getOutputString())
             got = drawer.draw(doc, o, tmp_path)
             want = cpu[SURFACE_INPUTS[inp.getName()]]
-            if inp.getName() == "normal":
+            if inp.getName() in ("normal", "coat_normal"):
                 want = want / np.linalg.norm(want, axis=-1, keepdims=True)
             k = 1 if inp.getName() == "opacity" else want.shape[-1]
             np.testing.assert_allclose(got[..., :k], want[..., :k], atol=2e-3,
@@ -614,7 +635,7 @@ def test_every_mapped_kind_matches_materialx_glsl_and_round_trips(ctx, tmp_path)
             checked.append(inp.getName())
     finally:
         drawer.release()
-    assert set(checked) == {k for k in SURFACE_INPUTS if not k.startswith("coat")}, checked
+    assert set(checked) == TALK_INPUTS, checked
     back = tmp_path / "back.json"
     r = cli("import", str(out), "-o", str(back))
     assert r.returncode == 0, r.stderr

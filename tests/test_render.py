@@ -136,7 +136,7 @@ def test_white_furnace_reference_returns_lut_a_plus_b(fresh):
         fresh.set_material(compile_document(flat_material(roughness=roughness)))
         fresh.render_converged()
         got = fresh.read_hdr("reference").mean(-1)
-        want = sample_lut(table, NoV[inner], np.full(inner.sum(), roughness)).sum(-1)
+        want = sample_lut(table, NoV[inner], np.full(inner.sum(), roughness))[..., :2].sum(-1)
         err = np.abs(got[inner] - want)
         # 2048 samples a pixel, rotated per frame: Monte Carlo noise ~1%; LUT bilinear ~0.5%.
         assert np.median(err) < 0.01, (roughness, np.median(err))
@@ -268,7 +268,12 @@ def test_split_sum_and_reference_agree_on_samples(fresh):
     fresh.reference_frames = 32
     try:
         for path in MATERIALS:
-            fresh.set_material(compile_document(fmt.load(path), FileResolver()))
+            cm = compile_document(fmt.load(path), FileResolver())
+            if "anisotropy" in cm.ir.attributes:
+                # The reference's environment estimator has no anisotropic lobe yet (its
+                # area lights do): brushed samples are judged by tests/test_lobe_anisotropy.py.
+                continue
+            fresh.set_material(cm)
             fresh.mode = "splitsum"
             fresh.render()
             split = fresh.read_hdr().copy()

@@ -53,7 +53,7 @@ def test_the_child_draws_the_viewports_variant_in_another_process(client):
 
 
 def test_forward_viewports_get_the_forward_variant(client):
-    cm = _compiled("brushed_gold")
+    cm = _compiled("worn_painted_steel")  # the talk's fields only: deferred by default
     r = client.warm(cm, ViewportState(deferred=False))
     assert r.ok, r.error
     assert r.program == _expected(cm, deferred=False) != _expected(cm)

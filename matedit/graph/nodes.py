@@ -383,7 +383,6 @@ EXPANDED_GROUPS = "expanded_groups"
 EXPANDED_GROUPS_SETTING = SettingDef(EXPANDED_GROUPS, "list", ["Base"],
                                      "pin groups shown expanded on the canvas",
                                      structural=False)
-ATTRIBUTE_GROUPS = ("Base", "Specular", "Coat", "Sheen", "Anisotropy")
 BREAK_ATTRIBUTES = "break_attributes"  # the kind that splits a MaterialAttributes (no role)
 
 

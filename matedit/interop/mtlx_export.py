@@ -827,15 +827,9 @@ class _Exporter:
         outputs.append(("specular_roughness", "float", f["roughness"].ref()))
         written = set(self.ir.attributes)
         if "normal" in written:
-            n = f["normal"].ref()
-            if not (n[0] == "value" and tuple(n[1]) == (0.0, 0.0, 1.0)):
-                enc = self.node("add", "vector3", "normal_encode", [
-                    ("in1", self.node("multiply", "vector3", "normal_half",
-                                      [("in1", n, "vector3"), ("in2", ("value", 0.5), "float")]),
-                     "vector3"), ("in2", ("value", 0.5), "float")])
-                outputs.append(("normal", "vector3", self.node("normalmap", "vector3",
-                                                               "normal_map",
-                                                               [("in", enc, "vector3")])))
+            nm = self.normal_map(f["normal"], "normal")
+            if nm is not None:
+                outputs.append(("normal", "vector3", nm))
         if "emissive" in written:
             e = f["emissive"].ref()
             if not (e[0] == "value" and not any(e[1])):
@@ -863,6 +857,18 @@ class _Exporter:
         mat = self.doc.addMaterialNode(mx.createValidName(f"M_{self.stem}"), shader)
         del mat
 
+    def normal_map(self, v: V, hint: str) -> tuple | None:
+        """A tangent-space normal as standard_surface's world normal: encoded to [0, 1] into
+        a normalmap node; None for the constant +Z (the surface's own normal)."""
+        n = v.ref()
+        if n[0] == "value" and tuple(n[1]) == (0.0, 0.0, 1.0):
+            return None
+        enc = self.node("add", "vector3", f"{hint}_encode", [
+            ("in1", self.node("multiply", "vector3", f"{hint}_half",
+                              [("in1", n, "vector3"), ("in2", ("value", 0.5), "float")]),
+             "vector3"), ("in2", ("value", 0.5), "float")])
+        return self.node("normalmap", "vector3", f"{hint}_map", [("in", enc, "vector3")])
+
     def lobes(self, f: dict, written: set, color) -> list[tuple[str, str, tuple]]:
         """standard_surface inputs for the lobes beyond the talk the material writes: the
         same meanings (coat colour a transmittance tint, sheen a weighted colour, IORs), the
@@ -886,14 +892,9 @@ class _Exporter:
             if "sheenRoughness" not in written:
                 out.append(("sheen_roughness", "float", ("value", 0.3)))
         if "coatNormal" in written:
-            n = f["coatNormal"].ref()
-            if not (n[0] == "value" and tuple(n[1]) == (0.0, 0.0, 1.0)):
-                enc = self.node("add", "vector3", "coat_normal_encode", [
-                    ("in1", self.node("multiply", "vector3", "coat_normal_half",
-                                      [("in1", n, "vector3"), ("in2", ("value", 0.5), "float")]),
-                     "vector3"), ("in2", ("value", 0.5), "float")])
-                out.append(("coat_normal", "vector3", self.node(
-                    "normalmap", "vector3", "coat_normal_map", [("in", enc, "vector3")])))
+            nm = self.normal_map(f["coatNormal"], "coat_normal")
+            if nm is not None:
+                out.append(("coat_normal", "vector3", nm))
         if "anisotropyDirection" in written:
             d = f["anisotropyDirection"].ref()
             if d[0] != "value":

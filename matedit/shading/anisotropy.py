@@ -19,11 +19,10 @@ ANISOTROPY_MIN_ALPHA = 1e-3
 
 
 def _widen_divisor() -> float:
-    """lights.glsl's MATEDIT_AREA_WIDEN_DIVISOR, read from the lights twin when called
-    (lights imports this module, so not at import time)."""
-    from matedit.shading import lights
+    """brdf.glsl's MATEDIT_AREA_WIDEN_DIVISOR, read when called (a benchmark varies it)."""
+    from matedit.shading import brdf
 
-    return lights.AREA_WIDEN_DIVISOR
+    return brdf.AREA_WIDEN_DIVISOR
 
 
 @dataclass

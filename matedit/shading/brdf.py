@@ -6,6 +6,10 @@ import numpy as np
 
 from matedit.shading.common import INV_PI, PI, f64, pow5
 
+# a' = a + sourceRadius / (AREA_WIDEN_DIVISOR d): brdf.glsl's MATEDIT_AREA_WIDEN_DIVISOR (read
+# at call time by the lights and the anisotropic lobe; benchmarks/bench_lights.py varies it).
+AREA_WIDEN_DIVISOR = 2.0
+
 
 def Fd_Lambert() -> float:
     return INV_PI

@@ -8,6 +8,7 @@ from typing import Literal
 import numpy as np
 
 from matedit.shading import anisotropy as _aniso
+from matedit.shading import brdf as _brdf
 from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
@@ -25,8 +26,6 @@ LIGHT_TYPES = {
 }
 LIGHT_FALLOFF_EPS = 0.01
 MIN_ANALYTIC_ROUGHNESS = 0.03
-# a' = a + sourceRadius / (AREA_WIDEN_DIVISOR d): lights.glsl's MATEDIT_AREA_WIDEN_DIVISOR.
-AREA_WIDEN_DIVISOR = 2.0
 
 LightKind = Literal["point", "directional", "sphere", "tube"]
 
@@ -121,13 +120,14 @@ def sphereRepresentativePoint(Lc, R, sourceRadius) -> np.ndarray:
 
 def sphereNormalization(a, sourceRadius, d) -> np.ndarray:
     a = f64(a)
-    a_prime = saturate(a + f64(sourceRadius) / (AREA_WIDEN_DIVISOR * np.maximum(f64(d), 1e-8)))
+    widen = f64(sourceRadius) / (_brdf.AREA_WIDEN_DIVISOR * np.maximum(f64(d), 1e-8))
+    a_prime = saturate(a + widen)
     return sq(a / a_prime)
 
 
 def lineNormalization(a, sourceLength, d) -> np.ndarray:
     a = f64(a)
-    a_prime = saturate(a + 0.5 * f64(sourceLength) / (AREA_WIDEN_DIVISOR
+    a_prime = saturate(a + 0.5 * f64(sourceLength) / (_brdf.AREA_WIDEN_DIVISOR
                                                        * np.maximum(f64(d), 1e-8)))
     return a / a_prime
 

@@ -28,7 +28,6 @@ VIEWS: dict[str, tuple[str, int | None, int | None]] = {
     "coat-weight": ("Coat weight", None, 3),
     "anisotropy": ("Anisotropy direction", None, 4),
 }
-LOBE_VIEWS = tuple(v for v, (_, mask, _) in VIEWS.items() if mask is not None or v == "lit")
 ATTRIBUTE_VIEWS = tuple(v for v, (_, _, a) in VIEWS.items() if a is not None)
 
 
