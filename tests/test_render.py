@@ -269,9 +269,11 @@ def test_split_sum_and_reference_agree_on_samples(fresh):
     try:
         for path in MATERIALS:
             cm = compile_document(fmt.load(path), FileResolver())
-            if "anisotropy" in cm.ir.attributes:
-                # The reference's environment estimator has no anisotropic lobe yet (its
-                # area lights do): brushed samples are judged by tests/test_lobe_anisotropy.py.
+            if {"anisotropy", "sheenColor"} & set(cm.ir.attributes):
+                # The reference's environment estimator has no anisotropic lobe yet, and the
+                # sheen's split sum (one lookup around N) is 7 .. 29 % off its own integral by
+                # design (docs/shading.md, Sheen): those lobes are judged against their own
+                # brute-force integrals in tests/test_lobe_anisotropy.py and test_lobe_sheen.py.
                 continue
             fresh.set_material(cm)
             fresh.mode = "splitsum"
