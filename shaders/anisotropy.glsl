@@ -109,22 +109,33 @@ float k_AnalyticProjected(float alphaO) {
     return k_Analytic(sqrt(alphaO));
 }
 
+// The terms both forms of the lobe share at H = normalize(L + V): D, VoH and the projected
+// alphas of V and L (each direction's k is the caller's: analytic lights remap it).
+float anisotropicLobeTerms(AnisotropicLobe l, vec3 N, vec3 V, vec3 L, out float VoH,
+                           out float alphaV, out float alphaL) {
+    // Burley 2012 appendix B.2 eq 13 (D); Heitz 2014 eq 80 (projected roughness)
+    vec3 h = L + V;
+    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
+    float NoH = saturate(dot(N, H));
+    VoH = saturate(dot(V, H));
+    vec3 NxH = cross(N, H);
+    vec3 NxV = cross(N, V);
+    vec3 NxL = cross(N, L);
+    alphaV = projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV));
+    alphaL = projectedAlpha(l.at, l.ab, dot(l.T, L), dot(NxL, NxL));
+    return D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
+}
+
 // Anisotropic D Vis F NoL towards the unit direction L for analytic lights (Fresnel by the
 // spherical Gaussian, k remapped): the form of lights.glsl's specularTowards, same H.
 vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, vec3 F0, vec3 L) {
     // Burley 2012 appendix B.2 eq 13 (D); Heitz 2014 eq 80 with Karis 2013 eq 4 (Vis); eq 5 (F)
     float NoL = saturate(dot(N, L));
     if (NoL <= 0.0) return vec3(0.0);
-    vec3 h = L + V;
-    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
-    float NoH = saturate(dot(N, H));
-    float VoH = saturate(dot(V, H));
-    vec3 NxH = cross(N, H);
-    vec3 NxV = cross(N, V);
-    vec3 NxL = cross(N, L);
-    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
-    float kV = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)));
-    float kL = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, L), dot(NxL, NxL)));
+    float VoH, alphaV, alphaL;
+    float D = anisotropicLobeTerms(l, N, V, L, VoH, alphaV, alphaL);
+    float kV = k_AnalyticProjected(alphaV);
+    float kL = k_AnalyticProjected(alphaL);
     return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_Schlick(F0, VoH) * NoL;
 }
 
@@ -144,6 +155,38 @@ vec3 anisotropicReflection(AnisotropicLobe l, vec3 N, vec3 V) {
     float bb = dot(bent, bent);
     bent = bb > 1e-12 ? bent * inversesqrt(bb) : N;
     return reflect(-V, bent);
+}
+
+// The anisotropic split sum's environment BRDF: the change (dA, dB) of the isotropic LUT's
+// scale and bias of F0 for the anisotropic lobe, tabulated (matedit/ibl/anisotropy_lut.py)
+// over NoV, roughness (x, y: texel centres, as the isotropic LUT), the anisotropy (nodes
+// i / (ANISOTROPY_LUT_NODES - 1)) and |cos| of V's azimuth from T (nodes j / (slabs - 1));
+// z holds ANISOTROPY_LUT_NODES anisotropy texels for each |cos| node. Three-linear inside
+// a slab (the anisotropy coordinate stays on its texel centres), linear between two slabs.
+const int ANISOTROPY_LUT_NODES = 13;
+
+// cos^2 of V's azimuth from T (the table's fourth axis), as projectedAlpha forms it.
+float anisotropicViewCos2(AnisotropicLobe l, vec3 N, vec3 V) {
+    // matedit anisotropic environment BRDF (docs/shading.md, Anisotropy)
+    vec3 NxV = cross(N, V);
+    float ToV = dot(l.T, V);
+    return min(ToV * ToV / max(dot(NxV, NxV), 1e-12), 1.0);
+}
+
+vec2 anisotropicEnvironmentBRDF(highp sampler3D lut, float NoV, float roughness,
+                                float anisotropy, float cos2) {
+    // Karis 2013's split sum (environment BRDF) of the Burley 2012 / Heitz 2014 lobe,
+    // tabulated by matedit (docs/shading.md, Anisotropy)
+    float depth = float(textureSize(lut, 0).z);
+    float nA = float(ANISOTROPY_LUT_NODES);
+    float nC = depth / nA;
+    float c = sqrt(saturate(cos2)) * (nC - 1.0);
+    float m0 = min(floor(c), nC - 1.0);
+    float m1 = min(m0 + 1.0, nC - 1.0);
+    float za = saturate(anisotropy) * (nA - 1.0) + 0.5;
+    vec2 d0 = texture(lut, vec3(NoV, roughness, (m0 * nA + za) / depth)).rg;
+    vec2 d1 = texture(lut, vec3(NoV, roughness, (m1 * nA + za) / depth)).rg;
+    return mix(d0, d1, c - m0);
 }
 
 // Energy kept by a sphere light's widened anisotropic highlight: each alpha is widened by
@@ -210,16 +253,10 @@ vec3 anisotropicBrdfCosineIBL(AnisotropicLobe l, vec3 N, vec3 V, vec3 F0, vec3 L
     float NoL = saturate(dot(N, L));
     if (NoL <= 0.0) return vec3(0.0);
     float NoV = max(dot(N, V), 1e-4);
-    vec3 h = L + V;
-    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
-    float NoH = saturate(dot(N, H));
-    float VoH = saturate(dot(V, H));
-    vec3 NxH = cross(N, H);
-    vec3 NxV = cross(N, V);
-    vec3 NxL = cross(N, L);
-    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
-    float kV = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)));
-    float kL = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, L), dot(NxL, NxL)));
+    float VoH, alphaV, alphaL;
+    float D = anisotropicLobeTerms(l, N, V, L, VoH, alphaV, alphaL);
+    float kV = k_IBL(alphaV);
+    float kL = k_IBL(alphaL);
     return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_SchlickExact(F0, VoH) * NoL;
 }
 

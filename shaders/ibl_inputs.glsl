@@ -2,7 +2,8 @@
 //
 // Bindings (Vulkan: set 0; in GL the renderer assigns units and block bindings by name):
 //   0 LightsBlock (lights_block.glsl), 1 IblBlock, 2 uPrefilteredEnv, 3 uBrdfLut, 4 uEnvironment,
-//   7 uEnvDistribution (5 and 6 are the compiler's FrameBlock and MaterialParams).
+//   7 uEnvDistribution (5 and 6 are the compiler's FrameBlock and MaterialParams),
+//   31 uAnisotropyLut (only under MATERIAL_HAS_ANISOTROPY; material textures are 8 and up).
 // std140 layout of block `IblBlock` (instance `uIbl`), float32 unless said otherwise:
 //   offset   0: vec4 sh[9]   xyz = order-2 SH coefficient of the environment radiance, w = 0;
 //                            order L00, L1-1, L10, L11, L2-2, L2-1, L20, L21, L22 (real SH basis,
@@ -30,3 +31,8 @@ MATEDIT_BINDING(MATEDIT_PREFILTERED_ENV_BINDING) uniform samplerCube uPrefiltere
 MATEDIT_BINDING(MATEDIT_BRDF_LUT_BINDING) uniform sampler2D uBrdfLut;           // (NoV, roughness) -> (A, B) in (R, G)
 MATEDIT_BINDING(MATEDIT_ENVIRONMENT_BINDING) uniform samplerCube uEnvironment;     // unfiltered, for reference mode
 MATEDIT_BINDING(MATEDIT_ENV_DISTRIBUTION_BINDING) uniform sampler2D uEnvDistribution;  // luminance CDFs and density (env_sampling.glsl), reference mode
+#if defined(MATERIAL_HAS_ANISOTROPY)
+// (dA, dB) of the anisotropic lobe's environment BRDF (anisotropicEnvironmentBRDF in
+// anisotropy.glsl; matedit/ibl/anisotropy_lut.py): x NoV, y roughness, z slabs of anisotropy
+MATEDIT_BINDING(MATEDIT_ANISOTROPY_LUT_BINDING) uniform highp sampler3D uAnisotropyLut;
+#endif

@@ -85,11 +85,19 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
     vec3 R = reflect(-V, N);
 #if defined(MATERIAL_HAS_ANISOTROPY)
     // anisotropic split sum: the bent reflection (anisotropy.glsl); the prefiltered lookup
-    // and the environment BRDF stay at the base roughness (docs/shading.md, Anisotropy)
+    // stays at the base roughness (docs/shading.md, Anisotropy)
     R = anisotropicReflection(aniso, N, V);
 #endif
     vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
     vec2 AB = environmentBRDF(uBrdfLut, NoV, roughness);
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    // the anisotropic lobe's own scale and bias of F0: the isotropic LUT plus the table's
+    // change (anisotropy.glsl, matedit/ibl/anisotropy_lut.py); nothing at anisotropy 0
+    if (aniso.anisotropy > 0.0) {
+        AB += anisotropicEnvironmentBRDF(uAnisotropyLut, NoV, roughness, aniso.anisotropy,
+                                         anisotropicViewCos2(aniso, N, V));
+    }
+#endif
     vec3 color = diffuseIrradianceSH9(sh, N, diffuseColor)
                + splitSumSpecular(prefiltered, AB, F0) * specularScale;
     return color * uIbl.params.y;

@@ -23,6 +23,7 @@ _.paintGL
 # moderngl reads these attributes of its textures and contexts when they are set.
 _.repeat_x
 _.repeat_y
+_.repeat_z
 _.blend_func
 
 # pygltflib writes this material field; MaterialX's XmlReadOptions reads this option.

@@ -17,8 +17,9 @@ from matedit.ibl.importance import distribution_from_cube
 from matedit.render.fullscreen import FullscreenQuad, mat_bytes, render_program
 from matedit.shading.ibl import IBL_MODE_NONE, pack_ibl_block
 
-PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT, DISTRIBUTION_UNIT = (
-    BINDINGS[k] for k in ("PREFILTERED_ENV", "BRDF_LUT", "ENVIRONMENT", "ENV_DISTRIBUTION"))
+PREFILTERED_UNIT, LUT_UNIT, ENVIRONMENT_UNIT, DISTRIBUTION_UNIT, ANISOTROPY_LUT_UNIT = (
+    BINDINGS[k] for k in ("PREFILTERED_ENV", "BRDF_LUT", "ENVIRONMENT", "ENV_DISTRIBUTION",
+                          "ANISOTROPY_LUT"))
 # SH irradiance coefficients -> radiance coefficients: divide by the cosine lobe's A_l
 # (Ramamoorthi and Hanrahan 2001): pi, 2pi/3, pi/4 for bands 0, 1, 2.
 SH_BAND_SCALE = np.array([math.pi] + [2 * math.pi / 3] * 3 + [math.pi / 4] * 5)
@@ -46,6 +47,8 @@ class EnvironmentLighting:
         self._ibl = None  # matedit.ibl.IBLTextures
         self._cube: moderngl.TextureCube | None = None
         self._distribution: moderngl.Texture | None = None  # env_sampling.glsl's table
+        # anisotropy.glsl's environment BRDF table (read only by anisotropic programs)
+        self._anisotropy_lut: moderngl.Texture3D | None = None
         self.levels = 1
         self.sh = np.zeros((9, 3))  # radiance coefficients
         self.warnings: list[str] = []
@@ -81,6 +84,11 @@ class EnvironmentLighting:
         self._ibl.brdf_lut.use(location=LUT_UNIT)
         self._cube.use(location=ENVIRONMENT_UNIT)
         self._distribution.use(location=DISTRIBUTION_UNIT)
+        if self._anisotropy_lut is None:
+            from matedit.ibl.anisotropy_lut import upload_anisotropy_lut
+
+            self._anisotropy_lut = upload_anisotropy_lut(self.ctx)
+        self._anisotropy_lut.use(location=ANISOTROPY_LUT_UNIT)
 
     def draw_background(self, view_projection: np.ndarray, blur: float,
                         intensity: float) -> None:
@@ -117,5 +125,8 @@ class EnvironmentLighting:
 
     def release(self) -> None:
         self._release_textures()
+        if self._anisotropy_lut is not None:
+            self._anisotropy_lut.release()
+            self._anisotropy_lut = None
         self._block.release()
         self._background.release()

@@ -24,7 +24,8 @@ from matedit.shading.views import view_defines
 _BLOCKS = (("LightsBlock", "LIGHTS"), ("IblBlock", "IBL"), ("FrameBlock", "FRAME"),
            ("MaterialParams", "MATERIAL"))
 _SAMPLERS = (("uPrefilteredEnv", "PREFILTERED_ENV"), ("uBrdfLut", "BRDF_LUT"),
-             ("uEnvironment", "ENVIRONMENT"), ("uEnvDistribution", "ENV_DISTRIBUTION"))
+             ("uEnvironment", "ENVIRONMENT"), ("uEnvDistribution", "ENV_DISTRIBUTION"),
+             ("uAnisotropyLut", "ANISOTROPY_LUT"))
 
 
 @dataclass

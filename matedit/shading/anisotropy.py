@@ -107,18 +107,27 @@ def _half(L, V) -> np.ndarray:
     return h / np.sqrt(np.maximum(dot(h, h), 1e-30))[..., None]
 
 
-def anisotropicSpecularTowards(l: AnisotropicLobe, N, V, NoV, F0, L) -> np.ndarray:
-    """D Vis F NoL for analytic lights (spherical-Gaussian Fresnel, remapped k); 0 below
-    the horizon, as the GLSL returns early."""
+def anisotropicLobeTerms(l: AnisotropicLobe, N, V, L):
+    """(D, VoH, alphaV, alphaL) at H = normalize(L + V), the terms both forms of the lobe
+    share (Burley 2012 B.2 eq 13; Heitz 2014 eq 80); each caller applies its own k."""
     N, V, L = f64(N), f64(V), f64(L)
-    NoL = saturate(dot(N, L))
     H = _half(L, V)
     NoH = saturate(dot(N, H))
     VoH = saturate(dot(V, H))
     with np.errstate(divide="ignore", invalid="ignore"):
         D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), _onemx2(N, H), l.at, l.ab)
-        kV = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, V), _onemx2(N, V)))
-        kL = k_AnalyticProjected(projectedAlpha(l.at, l.ab, dot(l.T, L), _onemx2(N, L)))
+        alphaV = projectedAlpha(l.at, l.ab, dot(l.T, V), _onemx2(N, V))
+        alphaL = projectedAlpha(l.at, l.ab, dot(l.T, L), _onemx2(N, L))
+    return D, VoH, alphaV, alphaL
+
+
+def anisotropicSpecularTowards(l: AnisotropicLobe, N, V, NoV, F0, L) -> np.ndarray:
+    """D Vis F NoL for analytic lights (spherical-Gaussian Fresnel, remapped k); 0 below
+    the horizon, as the GLSL returns early."""
+    NoL = saturate(dot(f64(N), f64(L)))
+    D, VoH, alphaV, alphaL = anisotropicLobeTerms(l, N, V, L)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kV, kL = k_AnalyticProjected(alphaV), k_AnalyticProjected(alphaL)
         lobe = np.where(NoL > 0.0, D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
     return lobe[..., None] * F_Schlick(F0, VoH)
 
@@ -186,16 +195,11 @@ def ggxAnisotropicSampleDirection(l: AnisotropicLobe, N, V, Xi) -> np.ndarray:
 
 def anisotropicBrdfCosineIBL(l: AnisotropicLobe, N, V, F0, L) -> np.ndarray:
     """f NoL as the IBL reference integrates it: k = alpha_o / 2 per direction, exact Fresnel."""
-    N, V, L = f64(N), f64(V), f64(L)
-    NoL = saturate(dot(N, L))
-    NoV = np.maximum(dot(N, V), 1e-4)
-    H = _half(L, V)
-    NoH = saturate(dot(N, H))
-    VoH = saturate(dot(V, H))
+    NoL = saturate(dot(f64(N), f64(L)))
+    NoV = np.maximum(dot(f64(N), f64(V)), 1e-4)
+    D, VoH, alphaV, alphaL = anisotropicLobeTerms(l, N, V, L)
     with np.errstate(divide="ignore", invalid="ignore"):
-        D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), _onemx2(N, H), l.at, l.ab)
-        kV = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, V), _onemx2(N, V)))
-        kL = k_IBL(projectedAlpha(l.at, l.ab, dot(l.T, L), _onemx2(N, L)))
+        kV, kL = k_IBL(alphaV), k_IBL(alphaL)
         lobe = np.where(NoL > 0.0, D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
     return lobe[..., None] * F_SchlickExact(F0, VoH)
 
@@ -208,3 +212,42 @@ def anisotropicSampleIBL(l: AnisotropicLobe, N, V, Xi) -> tuple[np.ndarray, np.n
 
 def anisotropicPdfIBL(l: AnisotropicLobe, N, V, L) -> np.ndarray:
     return ggxAnisotropicDirectionPdf(l, N, V, L)
+
+
+def _linear_axis(x, n: int, centred: bool):
+    """Texel indices and weight of GL linear filtering along one axis of n texels, for a
+    value x in [0, 1] at texel centres (i + 0.5) / n (clamped to the edge) or, `centred`
+    False, at nodes i / (n - 1) (the texture coordinate (x (n - 1) + 0.5) / n)."""
+    p = x * n - 0.5 if centred else x * (n - 1)
+    p = np.clip(p, 0.0, n - 1)
+    i0 = np.minimum(np.floor(p).astype(np.int64), n - 1)
+    i1 = np.minimum(i0 + 1, n - 1)
+    return i0, i1, p - i0
+
+
+def anisotropicViewCos2(l: AnisotropicLobe, N, V) -> np.ndarray:
+    """cos^2 of V's azimuth from T, the table's fourth axis (projectedAlpha's cos^2)."""
+    ToV = dot(l.T, f64(V))
+    return np.minimum(ToV * ToV / np.maximum(_onemx2(f64(N), f64(V)), 1e-12), 1.0)
+
+
+def anisotropicEnvironmentBRDF(table, NoV, roughness, anisotropy, cos2) -> np.ndarray:
+    """The change (dA, dB) of the environment BRDF for the anisotropic lobe
+    (matedit.ibl.anisotropy_lut): `table` (NoV, roughness, anisotropy, cos^2, 2) filtered as
+    the GLSL's 3D texture is (linear in NoV, roughness and anisotropy inside the slab of one
+    |cos(phi)| = sqrt(cos2) node), then linear between the two slabs; 0 at anisotropy 0."""
+    t = f64(table)
+    nv, nr, na, nc = t.shape[:4]
+    NoV, r, an, c = np.broadcast_arrays(f64(NoV), f64(roughness), saturate(anisotropy),
+                                        np.sqrt(saturate(cos2)))
+    out = np.zeros(NoV.shape + (2,))
+    iv = _linear_axis(NoV, nv, True)
+    ir = _linear_axis(r, nr, True)
+    ia = _linear_axis(an, na, False)
+    ic = _linear_axis(c, nc, False)
+    for a_, wa in ((iv[0], 1 - iv[2]), (iv[1], iv[2])):
+        for b_, wb in ((ir[0], 1 - ir[2]), (ir[1], ir[2])):
+            for c_, wc in ((ia[0], 1 - ia[2]), (ia[1], ia[2])):
+                for d_, wd in ((ic[0], 1 - ic[2]), (ic[1], ic[2])):
+                    out += (wa * wb * wc * wd)[..., None] * t[a_, b_, c_, d_]
+    return np.where((an > 0.0)[..., None], out, 0.0)

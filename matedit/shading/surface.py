@@ -74,6 +74,9 @@ class IblInputs:
     # (the coat reads them along its own reflection vector, NoV and roughness); None: the same.
     coat_prefiltered: object = None
     coat_brdf_lut: object = None
+    # The anisotropic environment BRDF table the renderer binds at ANISOTROPY_LUT
+    # (matedit.ibl.anisotropy_lut.anisotropy_lut()); None: the isotropic LUT alone.
+    anisotropy_lut: object = None
 
 
 def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
@@ -108,6 +111,10 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
         else:
             pref = f64(ibl.prefiltered)
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV, roughness)
+        if aniso is not None and ibl.anisotropy_lut is not None:
+            AB = AB + _aniso.anisotropicEnvironmentBRDF(
+                ibl.anisotropy_lut, NoV, roughness, aniso.anisotropy,
+                _aniso.anisotropicViewCos2(aniso, N, V))
         color = diffuseIrradianceSH9(ibl.sh, N, diffuseColor) + splitSumSpecular(
             pref, AB, F0) * f64(specularScale)
     return color * ibl.intensity
