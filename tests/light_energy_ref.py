@@ -62,14 +62,23 @@ def sphere_true_energy(radius: float, d: float, roughness: float) -> float:
     return le * 2 * math.pi * integrand.mean() * (1.0 - cmax)
 
 
+def _rho_of(roughness: float, rho):
+    """rho(directions (..., 3)) -> albedo: the given callable, or GGX's, of the direction's z."""
+    if rho is not None:
+        return rho
+    mu_t, rho_t = _albedo_table(roughness)
+    return lambda u: np.interp(np.clip(u[..., 2], 0.0, 1.0), mu_t, rho_t)
+
+
 def capsule_true_energy(radius: float, length: float, d: float, roughness: float,
-                        nx: int = 3000, ny: int = 300) -> float:
+                        nx: int = 3000, ny: int = 300, rho=None) -> float:
     """Ray-cast quadrature over the plane z = d: the direction to (x, y, d) sees the capsule
     (axis along X through (0, 0, d), segment half-length length / 2) when the ray passes
-    within `radius` of the segment; dOmega = d dx dy / |q|^3."""
+    within `radius` of the segment; dOmega = d dx dy / |q|^3. `rho`: the albedo of a
+    direction (an anisotropic lobe's), else GGX's at `roughness`."""
     h = length / 2
     le = 1.0 / (2 * radius * length + math.pi * radius * radius)
-    mu_t, rho_t = _albedo_table(roughness)
+    albedo = _rho_of(roughness, rho)
     ext = h + radius
     # The capsule is seen within |x| <= ext (1 + small) on the plane at height d; rays from
     # the origin hitting it at depth d +- r land within that box widened by r / d.
@@ -90,7 +99,7 @@ def capsule_true_energy(radius: float, length: float, d: float, roughness: float
     hit = dist2 <= radius * radius
     domega = d * (2 * wx / nx) * (2 * wy / ny) / qn ** 3
     mu = uz
-    return float(le * np.sum(np.where(hit, np.interp(mu, mu_t, rho_t) * mu * domega, 0.0)))
+    return float(le * np.sum(np.where(hit, albedo(u) * mu * domega, 0.0)))
 
 
 def exitance_axisymmetric(spec_of_view, n: int = 40000) -> float:
@@ -122,12 +131,13 @@ def tube_view_grid(nb: int = 1600, ng: int = 1600):
 
 
 def sphere_true_energy_tilted(radius: float, d: float, tilt: float, roughness: float,
-                              n: int = 512) -> float:
+                              n: int = 512, rho=None) -> float:
     """As sphere_true_energy for a sphere whose centre lies `tilt` radians from the normal
-    (in the XZ plane): a solid-angle grid over its cone, clipped at the horizon."""
+    (in the XZ plane): a solid-angle grid over its cone, clipped at the horizon. `rho`: the
+    albedo of a direction (an anisotropic lobe's), else GGX's at `roughness`."""
     le = 1.0 / (math.pi * radius * radius)
     cmax = math.sqrt(max(0.0, 1.0 - (radius / d) ** 2))
-    mu_t, rho_t = _albedo_table(roughness)
+    albedo = _rho_of(roughness, rho)
     c = cmax + (np.arange(n) + 0.5) / n * (1.0 - cmax)
     phi = (np.arange(2 * n) + 0.5) / (2 * n) * 2 * math.pi
     C, P = np.meshgrid(c, phi, indexing="ij")
@@ -135,5 +145,7 @@ def sphere_true_energy_tilted(radius: float, d: float, tilt: float, roughness: f
     # cone around the axis (sin t, 0, cos t): z of the direction
     z = C * math.cos(tilt) - s * np.cos(P) * math.sin(tilt)
     w = (1.0 - cmax) * 2 * math.pi / C.size
+    x = C * math.sin(tilt) + s * np.cos(P) * math.cos(tilt)
+    u = np.stack([x, s * np.sin(P), z], -1)
     zc = np.clip(z, 0.0, 1.0)
-    return float(le * np.sum(np.where(z > 0, np.interp(zc, mu_t, rho_t) * zc, 0.0)) * w)
+    return float(le * np.sum(np.where(z > 0, albedo(u) * zc, 0.0)) * w)
