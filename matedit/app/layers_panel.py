@@ -158,8 +158,21 @@ class _LayerRow(QWidget):
             self.blend.setToolTip("How this layer blends over the ones below")
             self.blend.currentIndexChanged.connect(
                 lambda i: panel.set_blend(layer.id, self.blend.itemData(i)))
-        top.addWidget(self.blend)
+        # The mode menu has its own row, under the name, so it keeps the panel's whole width
+        # even in a narrow dock; its list opens as wide as its longest title.
+        self.blend.setSizeAdjustPolicy(
+            QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+        self.blend.setMinimumContentsLength(6)
+        view = self.blend.view()
+        view.setMinimumWidth(view.sizeHintForColumn(0) + 24)
         lay.addLayout(top)
+        row = QHBoxLayout()
+        lab = QLabel("blend")
+        lab.setObjectName("fieldLabel")
+        row.addSpacing(26)
+        row.addWidget(lab)
+        row.addWidget(self.blend, 1)
+        lay.addLayout(row)
         self.parked = None
         if is_base and parked:
             n = len(parked)

@@ -68,7 +68,7 @@ def port_at(scene, scene_pos: QPointF, radius: float, *, want_output: bool | Non
     rect = QRectF(scene_pos.x() - radius, scene_pos.y() - radius, 2 * radius, 2 * radius)
     best, best_d = None, radius * radius
     for it in scene.items(rect):
-        if not isinstance(it, PortItem):
+        if not isinstance(it, PortItem) or _folded(it):
             continue
         if want_output is not None and it.is_output != want_output:
             continue
@@ -85,6 +85,12 @@ def port_at(scene, scene_pos: QPointF, radius: float, *, want_output: bool | Non
         if dd <= best_d:
             best, best_d = it, dd
     return best
+
+
+def _folded(port: PortItem) -> bool:
+    """Whether the port is folded away under its node's pin group header."""
+    parent = port.parentItem()
+    return isinstance(parent, NodeItem) and parent.is_hidden(port.name, port.is_output)
 
 
 @dataclass
@@ -153,7 +159,14 @@ class WireDrag:
         # Over a node's body: its first port of the right side whose type fits.
         for it in self.scene.items(scene_pos):
             if isinstance(it, NodeItem) and it.node_id != self.anchor.node_id:
-                ports = [p for p in it.ports() if p.is_output == want]
+                header = it.header_at(scene_pos)
+                if (header is not None and not header.expanded and header.is_output == want
+                        and hasattr(self.scene, "set_group_expanded")):
+                    # Hovering a folded group with a wire opens it, as a node editor's
+                    # collapsed panel does, so its pins can be aimed at.
+                    self.scene.set_group_expanded(it.node_id, header.group, True)
+                    return None
+                ports = [p for p in it.ports() if p.is_output == want and not _folded(p)]
                 ports.sort(key=lambda p: p.pos().y())
                 for p in ports:
                     src, dst = ((self.anchor_type, GENERIC if p.generic else p.type_name)

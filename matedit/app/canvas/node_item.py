@@ -36,6 +36,22 @@ class PortRow:
     type: str
     doc: str = ""
     generic: bool = False  # declared `T`: takes any float or vector until wired
+    group: str = ""  # the pin group it folds into ("" : always shown)
+
+
+@dataclass(frozen=True)
+class GroupHeader:
+    """A foldable pin group's header row: its name, how many pins, which side, open or not."""
+
+    group: str
+    count: int
+    is_output: bool
+    expanded: bool
+
+    @property
+    def label(self) -> str:
+        arrow = "\u25be" if self.expanded else "\u25b8"  # down: open, right: folded
+        return f"{arrow} {self.group} ({self.count})"
 
 
 @dataclass
@@ -46,21 +62,64 @@ class NodeLayout:
     inputs: dict[str, QPointF] = field(default_factory=dict)
     outputs: dict[str, QPointF] = field(default_factory=dict)
     preview: QRectF | None = None
+    # Foldable groups: the header rows (with the y of their centre) and the pins a folded
+    # group hides; a hidden pin's entry in inputs/outputs is its header's point, so wires
+    # to it end on the header.
+    headers: list[tuple[GroupHeader, float]] = field(default_factory=list)
+    hidden: dict[tuple[str, bool], str] = field(default_factory=dict)
+    # What each side shows, top to bottom: a PortRow or a GroupHeader per row.
+    in_rows: list[PortRow | GroupHeader] = field(default_factory=list)
+    out_rows: list[PortRow | GroupHeader] = field(default_factory=list)
+
+    def header_at(self, local: QPointF) -> GroupHeader | None:
+        """The header row under a point in node coordinates (the whole row is the button)."""
+        for header, y in self.headers:
+            if abs(local.y() - y) <= C.ROW_HEIGHT / 2 and 0.0 <= local.x() <= self.width:
+                return header
+        return None
+
+
+def fold_rows(rows: list[PortRow], is_output: bool, expanded: frozenset[str] | None
+              ) -> tuple[list[PortRow | GroupHeader], dict[str, str]]:
+    """One side's rows with its pin groups folded: ungrouped pins first, then each group (in
+    the order its first pin comes) as a header row followed, if expanded, by its pins.
+    Also the hidden pins, name -> group. `expanded` None: the node has no groups."""
+    if expanded is None or not any(r.group for r in rows):
+        return list(rows), {}
+    out: list[PortRow | GroupHeader] = [r for r in rows if not r.group]
+    order = list(dict.fromkeys(r.group for r in rows if r.group))
+    hidden: dict[str, str] = {}
+    for g in order:
+        members = [r for r in rows if r.group == g]
+        is_open = g in expanded
+        out.append(GroupHeader(g, len(members), is_output, is_open))
+        if is_open:
+            out.extend(members)
+        else:
+            hidden.update((r.name, g) for r in members)
+    return out, hidden
+
+
+def _row_label(row: PortRow | GroupHeader) -> str:
+    return row.label if isinstance(row, GroupHeader) else row.name
 
 
 def measure(title: str, subtitle: str, inputs: list[PortRow], outputs: list[PortRow],
-            preview: bool = False) -> NodeLayout:
+            preview: bool = False, expanded: frozenset[str] | None = None) -> NodeLayout:
     """The size of a node and where its ports sit (pure geometry, usable before an item exists).
 
     Inputs and outputs share rows, left and right, as in Unreal's material editor:
-    a node is as tall as its longer side, not the sum of both.
+    a node is as tall as its longer side, not the sum of both. With `expanded` (the open
+    pin groups), grouped pins fold under header rows (see `fold_rows`).
     """
+    in_rows, in_hidden = fold_rows(inputs, False, expanded)
+    out_rows, out_hidden = fold_rows(outputs, True, expanded)
     fm_t, fm_p = C.metrics("title"), C.metrics("port")
     head = 2 * 8.0 + fm_t.horizontalAdvance(title)
     if subtitle:
         head = max(head, 16.0 + C.metrics("subtitle").horizontalAdvance(subtitle))
-    ins = [fm_p.horizontalAdvance(p.name) for p in inputs]
-    outs = [fm_p.horizontalAdvance(p.name) for p in outputs]
+    ins = [fm_p.horizontalAdvance(_row_label(p)) for p in in_rows]
+    outs = [fm_p.horizontalAdvance(_row_label(p)) for p in out_rows]
     rows_w = 0.0
     for i in range(max(len(ins), len(outs))):
         a = ins[i] if i < len(ins) else 0.0
@@ -69,12 +128,21 @@ def measure(title: str, subtitle: str, inputs: list[PortRow], outputs: list[Port
     width = max(C.NODE_MIN_WIDTH, head, rows_w, (C.PREVIEW_SIZE + 16) if preview else 0.0)
     width = min(C.NODE_MAX_WIDTH, float(round(width / 4.0 + 0.49) * 4))
     top = C.HEADER_HEIGHT + (C.SUBTITLE_HEIGHT if subtitle else 0.0) + 3.0
-    lay = NodeLayout(width, 0.0, top)
-    for i, p in enumerate(inputs):
-        lay.inputs[p.name] = QPointF(0.0, top + (i + 0.5) * C.ROW_HEIGHT)
-    for i, p in enumerate(outputs):
-        lay.outputs[p.name] = QPointF(width, top + (i + 0.5) * C.ROW_HEIGHT)
-    y = top + max(len(inputs), len(outputs)) * C.ROW_HEIGHT
+    lay = NodeLayout(width, 0.0, top, in_rows=in_rows, out_rows=out_rows)
+    for rows, hidden, table, x, out in ((in_rows, in_hidden, lay.inputs, 0.0, False),
+                                        (out_rows, out_hidden, lay.outputs, width, True)):
+        at: dict[str, QPointF] = {}
+        for i, r in enumerate(rows):
+            y = top + (i + 0.5) * C.ROW_HEIGHT
+            if isinstance(r, GroupHeader):
+                lay.headers.append((r, y))
+                at[r.group] = QPointF(x, y)
+            else:
+                table[r.name] = QPointF(x, y)
+        for name, g in hidden.items():
+            table[name] = at[g]
+            lay.hidden[(name, out)] = g
+    y = top + max(len(in_rows), len(out_rows)) * C.ROW_HEIGHT
     if preview:
         y += 4.0
         lay.preview = QRectF((width - C.PREVIEW_SIZE) / 2, y, C.PREVIEW_SIZE, C.PREVIEW_SIZE)
@@ -134,6 +202,7 @@ class NodeItem(QGraphicsRectItem):
         self._ports: dict[tuple[str, bool], PortItem] = {}
         self._badge: BadgeItem | None = None
         self._ports_visible = True
+        self.expanded: frozenset[str] | None = None  # open pin groups (None: no groups)
         self.layout = NodeLayout(C.NODE_MIN_WIDTH, C.HEADER_HEIGHT + C.BODY_PAD, C.HEADER_HEIGHT)
         F = QGraphicsItem.GraphicsItemFlag
         self.setFlags(F.ItemIsMovable | F.ItemIsSelectable | F.ItemSendsGeometryChanges)
@@ -144,12 +213,15 @@ class NodeItem(QGraphicsRectItem):
 
     # --- content, from the scene -------------------------------------------------------------
     def set_content(self, title: str, subtitle: str, category: str, inputs: list[PortRow],
-                    outputs: list[PortRow], tooltip: str = "") -> None:
-        if (title, subtitle, category, inputs, outputs) == (
-                self.title, self.subtitle, self.category, self.inputs, self.outputs):
+                    outputs: list[PortRow], tooltip: str = "",
+                    expanded: frozenset[str] | None = None) -> None:
+        if (title, subtitle, category, inputs, outputs, expanded) == (
+                self.title, self.subtitle, self.category, self.inputs, self.outputs,
+                self.expanded):
             return
         self.title, self.subtitle, self.category = title, subtitle, category
         self.inputs, self.outputs = list(inputs), list(outputs)
+        self.expanded = expanded
         self.setToolTip(tooltip)
         self._relayout()
 
@@ -160,14 +232,22 @@ class NodeItem(QGraphicsRectItem):
             for i, row in enumerate(rows):
                 t = types.get(row.name)
                 if t and t != row.type:
-                    rows[i] = PortRow(row.name, t, row.doc, row.generic)
+                    rows[i] = PortRow(row.name, t, row.doc, row.generic, row.group)
                     port = self._ports.get((row.name, out))
                     if port is not None:
                         port.set_type(t)
                     changed = True
         if changed:
+            self.layout.in_rows = [self._current(r, False) for r in self.layout.in_rows]
+            self.layout.out_rows = [self._current(r, True) for r in self.layout.out_rows]
             self.update()
         return changed
+
+    def _current(self, row: PortRow | GroupHeader, out: bool) -> PortRow | GroupHeader:
+        if isinstance(row, GroupHeader):
+            return row
+        return next((r for r in (self.outputs if out else self.inputs) if r.name == row.name),
+                    row)
 
     def set_connected(self, inputs: set[str], outputs: set[str]) -> None:
         if inputs != self.connected_inputs or outputs != self.connected_outputs:
@@ -228,6 +308,20 @@ class NodeItem(QGraphicsRectItem):
             local = QPointF(self.layout.width if is_output else 0.0, C.HEADER_HEIGHT / 2)
         return self.pos() + local
 
+    def is_hidden(self, name: str, is_output: bool) -> bool:
+        """Whether the port is folded away under its group's header."""
+        return (name, is_output) in self.layout.hidden
+
+    def header_at(self, scene_pos: QPointF) -> GroupHeader | None:
+        """The pin group header row under a scene point, if any."""
+        return self.layout.header_at(scene_pos - self.pos())
+
+    def header_connected(self, header: GroupHeader) -> bool:
+        """Whether a pin of the group is wired (shown on a folded header)."""
+        rows = self.outputs if header.is_output else self.inputs
+        wired = self.connected_outputs if header.is_output else self.connected_inputs
+        return any(r.group == header.group and r.name in wired for r in rows)
+
     def port_type(self, name: str, is_output: bool) -> str:
         rows = self.outputs if is_output else self.inputs
         return next((r.type for r in rows if r.name == name), "T")
@@ -239,12 +333,12 @@ class NodeItem(QGraphicsRectItem):
 
     def set_ports_visible(self, visible: bool) -> None:
         self._ports_visible = visible
-        for port in self._ports.values():
-            port.setVisible(visible)
+        for key, port in self._ports.items():
+            port.setVisible(visible and key not in self.layout.hidden)
 
     def _relayout(self) -> None:
         self.layout = measure(self.title, self.subtitle, self.inputs, self.outputs,
-                              self._preview is not None)
+                              self._preview is not None, self.expanded)
         self._set_bounds()
         wanted: dict[tuple[str, bool], tuple[PortRow, QPointF]] = {}
         for row in self.inputs:
@@ -262,11 +356,11 @@ class NodeItem(QGraphicsRectItem):
             if port is None:
                 port = PortItem(self, self.node_id, row.name, key[1], row.type, row.doc)
                 port.generic = row.generic
-                port.setVisible(self._ports_visible)
                 self._ports[key] = port
             else:
                 port.set_type(row.type)
                 port.doc = row.doc
+            port.setVisible(self._ports_visible and key not in self.layout.hidden)
             port.setPos(pos)
         self._place_badge()
         self.update()
@@ -284,6 +378,18 @@ class NodeItem(QGraphicsRectItem):
         path.addRoundedRect(QRectF(0, 0, self.layout.width, self.layout.height), C.CORNER,
                             C.CORNER)
         return path
+
+    def mousePressEvent(self, event) -> None:
+        """A click on a pin group's header folds or unfolds it (through the scene, as an
+        undoable setting change); anywhere else selects and drags as usual."""
+        header = (self.layout.header_at(event.pos())
+                  if event.button() == Qt.MouseButton.LeftButton else None)
+        scene = self.scene()
+        if header is not None and scene is not None and hasattr(scene, "toggle_group"):
+            scene.toggle_group(self.node_id, header.group)
+            event.accept()
+            return
+        super().mousePressEvent(event)
 
     def itemChange(self, change, value):
         GC = QGraphicsItem.GraphicsItemChange
@@ -403,24 +509,37 @@ class NodeItem(QGraphicsRectItem):
             painter.setFont(C.port_font())
         # Labels sharing a row split the width: each side leaves the other what it needs.
         across = lay.width - 2 * C.LABEL_GAP - 10
-        in_w = [fm.horizontalAdvance(r.name) for r in self.inputs]
-        out_w = [fm.horizontalAdvance(r.name) for r in self.outputs]
-        for rows, table, out, connected in (
-                (self.inputs, lay.inputs, False, self.connected_inputs),
-                (self.outputs, lay.outputs, True, self.connected_outputs)):
+        if labels:  # header rows first, as bands under everything else on their row
+            for _, y in lay.headers:
+                painter.fillRect(QRectF(1.0, y - C.ROW_HEIGHT / 2 + 1, lay.width - 2.0,
+                                        C.ROW_HEIGHT - 2), C.GROUP_HEADER_FILL)
+        in_w = [fm.horizontalAdvance(_row_label(r)) for r in lay.in_rows]
+        out_w = [fm.horizontalAdvance(_row_label(r)) for r in lay.out_rows]
+        for rows, out, connected in ((lay.in_rows, False, self.connected_inputs),
+                                     (lay.out_rows, True, self.connected_outputs)):
             other_w = in_w if out else out_w
+            x = lay.width if out else 0.0
             for i, row in enumerate(rows):
-                pos = table[row.name]
-                port_shape(painter, pos, row.type, C.PORT_RADIUS, row.name in connected)
+                pos = QPointF(x, lay.top + (i + 0.5) * C.ROW_HEIGHT)
+                if isinstance(row, GroupHeader):
+                    wired = self.header_connected(row)
+                    if not row.expanded:  # a folded group keeps a mark where its wires end
+                        self._paint_header_mark(painter, pos, wired)
+                else:
+                    port_shape(painter, pos, row.type, C.PORT_RADIUS, row.name in connected)
                 if not labels:
                     continue
+                text_of = _row_label(row)
                 own = out_w[i] if out else in_w[i]
                 other = other_w[i] if i < len(other_w) else 0.0
                 room = max(across - other, across / 2) if other else across
-                text = row.name if own <= room else fm.elidedText(
-                    row.name, Qt.TextElideMode.ElideRight, room)
-                painter.setPen(C.PORT_LABEL_DIM if (not out and row.name in connected)
-                               else C.PORT_LABEL)
+                text = text_of if own <= room else fm.elidedText(
+                    text_of, Qt.TextElideMode.ElideRight, room)
+                if isinstance(row, GroupHeader):
+                    painter.setPen(C.GROUP_HEADER_TEXT)
+                else:
+                    painter.setPen(C.PORT_LABEL_DIM if (not out and row.name in connected)
+                                   else C.PORT_LABEL)
                 r = QRectF(0, pos.y() - C.ROW_HEIGHT / 2, 0, C.ROW_HEIGHT)
                 if out:
                     r.setLeft(lay.width - C.LABEL_GAP - room)
@@ -431,6 +550,14 @@ class NodeItem(QGraphicsRectItem):
                     r.setRight(C.LABEL_GAP + room)
                     align = Qt.AlignmentFlag.AlignLeft
                 painter.drawText(r, align | Qt.AlignmentFlag.AlignVCenter, text)
+
+    @staticmethod
+    def _paint_header_mark(painter: QPainter, pos: QPointF, wired: bool) -> None:
+        """A folded group's mark on the edge: filled when one of its pins is wired."""
+        painter.setPen(QPen(C.GROUP_HEADER_TEXT, 1.4))
+        painter.setBrush(QBrush(C.GROUP_HEADER_TEXT) if wired else QBrush(C.NODE_BODY))
+        r = C.PORT_RADIUS - 1.0
+        painter.drawEllipse(pos, r, r)
 
 
 def _wrap(text: str, fm, width: float) -> list[str]:

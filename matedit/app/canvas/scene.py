@@ -26,7 +26,7 @@ from matedit.app.canvas.reroute_item import RerouteItem
 from matedit.app.canvas.wire_item import WireItem
 from matedit.app.controller import DocumentController
 from matedit.graph import nodes
-from matedit.graph.commands import MoveNodes, PutComment
+from matedit.graph.commands import MoveNodes, PutComment, SetSetting
 from matedit.graph.model import ChangeEvent, Link, Node
 from matedit.graph.nodes import Role, is_value_parameter, role_of
 from matedit.graph.ports import node_ports
@@ -75,6 +75,19 @@ def describe(node: Node, function_name: str = "") -> tuple[str, str, str, str]:
     if d is not None:
         tip += f"<br>{escape(d.description)}"
     return title, sub, d.category if d else "", tip
+
+
+def expanded_groups(node: Node) -> frozenset[str] | None:
+    """The pin groups a node shows open (None where its kind folds none): its
+    EXPANDED_GROUPS setting, else the setting's default (a new node, an old document)."""
+    d = nodes.REGISTRY.get(node.kind)
+    s = d.setting(nodes.EXPANDED_GROUPS) if d is not None else None
+    if s is None:
+        return None
+    value = node.settings.get(nodes.EXPANDED_GROUPS, s.default)
+    if not isinstance(value, (list, tuple)):
+        value = s.default
+    return frozenset(str(g) for g in value)
 
 
 class NodeScene(QGraphicsScene):
@@ -168,20 +181,22 @@ class NodeScene(QGraphicsScene):
             return
         try:
             ports = node_ports(node, self.controller.resolver, self.controller.document)
-            ins = [PortRow(p.name, p.type, p.doc, p.type == "T") for p in ports.inputs]
-            outs = [PortRow(p.name, p.type, p.doc, p.type == "T") for p in ports.outputs]
+            ins = [PortRow(p.name, p.type, p.doc, p.type == "T",
+                           nodes.port_group(node.kind, p.name)) for p in ports.inputs]
+            outs = [PortRow(p.name, p.type, p.doc, p.type == "T",
+                            nodes.port_group(node.kind, p.name)) for p in ports.outputs]
         except (LookupError, ValueError):
             ins, outs = [], []  # the analysis reports why, as a badge
         # Keep types the last analysis resolved for generic ports that are still there.
         a = self.controller.analysis
         if a is not None:
             it, ot = a.in_types.get(node_id, {}), a.out_types.get(node_id, {})
-            ins = [PortRow(r.name, str(it[r.name]), r.doc, r.generic) if r.name in it else r
+            ins = [dataclasses.replace(r, type=str(it[r.name])) if r.name in it else r
                    for r in ins]
-            outs = [PortRow(r.name, str(ot[r.name]), r.doc, r.generic) if r.name in ot else r
+            outs = [dataclasses.replace(r, type=str(ot[r.name])) if r.name in ot else r
                     for r in outs]
         title, sub, category, tip = describe(node, self.function_name(node))
-        item.set_content(title, sub, category, ins, outs, tip)
+        item.set_content(title, sub, category, ins, outs, tip, expanded_groups(node))
         self._update_connected(node_id)
 
     def function_name(self, node: Node) -> str:
@@ -371,6 +386,28 @@ class NodeScene(QGraphicsScene):
             self.wire_items[link].update_path()
 
     node_geometry_changed = node_item_moved
+
+    def toggle_group(self, node_id: str, group: str) -> bool:
+        """Fold or unfold one pin group of a node: an undoable, non-structural setting change
+        (no recompile). False if the node has no such groups or the edit is refused."""
+        node = self.graph.nodes.get(node_id)
+        open_now = expanded_groups(node) if node is not None else None
+        if open_now is None:
+            return False
+        return self.set_group_expanded(node_id, group, group not in open_now)
+
+    def set_group_expanded(self, node_id: str, group: str, expanded: bool) -> bool:
+        node = self.graph.nodes.get(node_id)
+        open_now = expanded_groups(node) if node is not None else None
+        if open_now is None or (group in open_now) == expanded:
+            return False
+        # Keep the groups in the order the node shows them, so the saved list is stable.
+        order = [f.group for f in nodes.ATTRIBUTE_FIELDS]
+        new = open_now | {group} if expanded else open_now - {group}
+        value = sorted(new, key=lambda g: (order.index(g) if g in order else len(order), g))
+        verb = "expand" if expanded else "collapse"
+        return self.controller.push(SetSetting(node_id, nodes.EXPANDED_GROUPS, value,
+                                               text=f"{verb} {group} pins"))
 
     def request_comment_edit(self, comment_id: str, rect, positions: dict) -> None:
         old = self.graph.comments.get(comment_id)
