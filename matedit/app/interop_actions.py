@@ -52,7 +52,8 @@ def _in_worker(fn):
 
 
 class InteropActions:
-    """The actions, installed into a File menu; `window` is the MainWindow."""
+    """The File menu's import and export actions (`entries()`); `window` is the MainWindow
+    (dialogs' parent; its controller, document actions and status line)."""
 
     def __init__(self, window) -> None:
         self.window = window
@@ -70,14 +71,9 @@ class InteropActions:
         self.act_import.triggered.connect(lambda: self.import_mtlx())
         self.actions = [self.act_gltf, self.act_mtlx, self.act_bake, self.act_cross]
 
-    def install(self, file_menu, after: QAction) -> None:
-        acts = file_menu.actions()
-        i = acts.index(after) + 1 if after in acts else len(acts)
-        before = acts[i] if i < len(acts) else None
-        for a in self.actions:
-            file_menu.insertAction(before, a)
-        file_menu.insertSeparator(before)
-        file_menu.insertAction(before, self.act_import)
+    def entries(self) -> list[QAction | None]:
+        """The File menu's entries, in order (None: a separator)."""
+        return [*self.actions, None, self.act_import]
 
     # --- helpers ---------------------------------------------------------------------------
     @property
@@ -326,10 +322,3 @@ def open_document_paths() -> set[Path]:
         if shiboken6.isValid(acts) and acts.document.path is not None:
             out.add(_real(Path(acts.document.path)))
     return out
-
-
-def install(window, file_menu, after: QAction) -> InteropActions:
-    """Add the interop entries to `file_menu` after `after` (File › Export Shaders…)."""
-    acts = InteropActions(window)
-    acts.install(file_menu, after)
-    return acts
