@@ -12,12 +12,17 @@ from __future__ import annotations
 import os
 import threading
 from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
 
 from PySide6.QtCore import QSettings, Qt
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QApplication, QInputDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QInputDialog, QMessageBox, QWidget
 
 from matedit.app import file_dialogs
+
+if TYPE_CHECKING:
+    from matedit.app.controller import DocumentController
+    from matedit.app.document_actions import DocumentActions
 
 FOLDER_KEY = "interop/folder"
 
@@ -51,12 +56,22 @@ def _in_worker(fn):
     return box.get("value")
 
 
-class InteropActions:
-    """The File menu's import and export actions (`entries()`); `window` is the MainWindow
-    (dialogs' parent; its controller, document actions and status line)."""
+class InteropHost(Protocol):
+    """What the interop actions need of the main window."""
 
-    def __init__(self, window) -> None:
-        self.window = window
+    controller: DocumentController
+    actions: DocumentActions
+
+    def status(self, text: str) -> None: ...
+
+
+class InteropActions:
+    """The File menu's import and export actions (`entries()`), on `window` (the dialogs'
+    parent), working on `host`'s document."""
+
+    def __init__(self, window: QWidget, host: InteropHost) -> None:
+        self.window = window  # the dialogs' parent
+        self.host = host
         self.last_message = ""
         w = window
         self.act_gltf = QAction("Export &glTF…", w)
@@ -78,11 +93,11 @@ class InteropActions:
     # --- helpers ---------------------------------------------------------------------------
     @property
     def doc(self):
-        return self.window.controller.document
+        return self.host.controller.document
 
     @property
     def resolver(self):
-        return self.window.controller.resolver
+        return self.host.controller.resolver
 
     def _stem(self) -> str:
         from matedit.interop.export import stem_of
@@ -125,7 +140,7 @@ class InteropActions:
 
     def _done(self, text: str) -> bool:
         self.last_message = text
-        self.window.status(text)
+        self.host.status(text)
         return True
 
     def _inputs(self):
@@ -280,7 +295,7 @@ class InteropActions:
         if _real(out) in open_document_paths():
             text = (f"{out.name} is open in the editor. An import is saved as a new file and "
                     "never replaces an open document: choose another name.")
-            self.window.actions.show_error(title, text)
+            self.host.actions.show_error(title, text)
             self.last_message = text
             return False
 
@@ -292,7 +307,7 @@ class InteropActions:
         try:
             refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
             doc = import_mtlx(src, out, material)
-            if not self.window.actions.maybe_save():
+            if not self.host.actions.maybe_save():
                 return False
             atomic_write_text(out, dumps(doc))
         except MtlxImportError as exc:
@@ -302,7 +317,7 @@ class InteropActions:
             return False
         except Exception as exc:
             return self._fail(title, exc)
-        return self.window.actions.open(out, ask=False) and self._done(f"imported {src.name}")
+        return self.host.actions.open(out, ask=False) and self._done(f"imported {src.name}")
 
 
 def _real(path: Path) -> Path:

@@ -61,7 +61,7 @@ class MainWindow(QMainWindow):
         self.library, self.lights, self.environment = p.library, p.lights, p.environment
         self.code, self.diagnostics = p.code, p.diagnostics
         self.problems = ProblemsModel(self.compiler, self.viewport, self)
-        self.menus: Menus = install_menus(self, p.docks())  # canvas commands from the table
+        self.menus: Menus = install_menus(self, self, p.docks())  # canvas commands from the table
         self._build_status()
         self._connect()
         # File › New Instance, the Parameters dock, the Library's instances

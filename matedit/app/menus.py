@@ -2,10 +2,10 @@
 node and Frame all, Help › Node Reference) are the action table's QActions
 (`matedit.app.canvas.actions`); the window's own actions are made here.
 
-`install_menus(host, docks)` builds them on `host` (a `MenuHost`: what the menus call) and
-returns a `Menus`: the menus by name and the actions. Every action made here carries an id
-(its objectName, `ACTION_IDS`), and features add their entries relative to one
-(`insert_after`), never at a position.
+`install_menus(window, host, docks)` builds them on `window`, calling `host` (a `MenuHost`:
+the slots the menus need), and returns a `Menus`: the menus by name and the actions. Every
+action made here carries an id (its objectName: "file.new", "file.export", …), and features
+add their entries relative to one (`insert_after`), never at a position.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup
-from PySide6.QtWidgets import QDockWidget, QMenu, QMenuBar, QToolBar
+from PySide6.QtWidgets import QDockWidget, QMainWindow, QMenu, QToolBar
 
 from matedit.app.canvas.actions import EDIT_MENU, VIEW_MENU
 from matedit.app.theme import icon
@@ -49,8 +49,6 @@ class MenuHost(Protocol):
     def show_about(self) -> None: ...
     def open_material(self, path: str | Path) -> bool: ...
     def status(self, text: str) -> None: ...
-    def menuBar(self) -> QMenuBar: ...  # noqa: N802 - Qt's name
-    def addToolBar(self, title: str) -> QToolBar: ...  # noqa: N802 - Qt's name
 
 
 
@@ -147,48 +145,49 @@ class Menus:
     about: QAction
 
 
-def install_menus(w: MenuHost, docks: Iterable[QDockWidget]) -> Menus:
-    """File, Edit, View and Help menus and the toolbar of the main window `w`; the View menu
-    lists `docks`."""
+def install_menus(window: QMainWindow, w: MenuHost, docks: Iterable[QDockWidget]) -> Menus:
+    """File, Edit, View and Help menus and the toolbar of `window`, calling `w`'s slots; the
+    View menu lists `docks`."""
     from matedit.app.interop_actions import InteropActions
 
     canvas = w.tabs.canvas_actions
-    new = make_action(w, "&New", w.actions.new, K.New, "new", "New material", "file.new")
-    open_ = make_action(w, "&Open…", w.actions.open_dialog, K.Open, "open",
+    new = make_action(window, "&New", w.actions.new, K.New, "new", "New material", "file.new")
+    open_ = make_action(window, "&Open…", w.actions.open_dialog, K.Open, "open",
                         "Open a material or a material function", "file.open")
-    save = make_action(w, "&Save", w.save_active, K.Save, "save",
+    save = make_action(window, "&Save", w.save_active, K.Save, "save",
                        "Save the document in the active tab", "file.save")
-    save_as = make_action(w, "Save &As…", w.save_active_as, K.SaveAs, "save-as",
+    save_as = make_action(window, "Save &As…", w.save_active_as, K.SaveAs, "save-as",
                           action_id="file.save_as")
-    export = make_action(w, "&Export Shaders…", w.export_shaders, "Ctrl+E", "export",
+    export = make_action(window, "&Export Shaders…", w.export_shaders, "Ctrl+E", "export",
                          "Write GLSL for chosen targets to a folder", "file.export")
-    save_image = make_action(w, "Save &Viewport Image…", w.save_viewport_image, None, "save",
+    save_image = make_action(window, "Save &Viewport Image…", w.save_viewport_image, None, "save",
                              "The viewport's frame as PNG or linear EXR", "file.save_image")
-    quit_ = make_action(w, "&Quit", w.close, K.Quit, action_id="file.quit")
-    undo = w.undo_group.createUndoAction(w, "&Undo")
+    quit_ = make_action(window, "&Quit", w.close, K.Quit, action_id="file.quit")
+    undo = w.undo_group.createUndoAction(window, "&Undo")
     undo.setObjectName("edit.undo")
     undo.setShortcut(K.Undo)
     undo.setIcon(icon("undo"))
-    redo = w.undo_group.createRedoAction(w, "&Redo")
+    redo = w.undo_group.createRedoAction(window, "&Redo")
     redo.setObjectName("edit.redo")
     redo.setShortcut(K.Redo)
     redo.setIcon(icon("redo"))
-    reset_layout = make_action(w, "Reset &Layout", w.reset_layout, action_id="view.reset_layout")
-    snap = make_action(w, "&Snap to Grid", w.tabs.set_snap_to_grid, None,
+    reset_layout = make_action(window, "Reset &Layout", w.reset_layout,
+                               action_id="view.reset_layout")
+    snap = make_action(window, "&Snap to Grid", w.tabs.set_snap_to_grid, None,
                        tip="Moved nodes land on the canvas grid", action_id="view.snap")
     snap.setCheckable(True)
-    shortcuts = make_action(w, "&Keyboard Reference…", w.show_shortcuts, "Ctrl+/",
+    shortcuts = make_action(window, "&Keyboard Reference…", w.show_shortcuts, "Ctrl+/",
                             tip="Every shortcut, searchable", action_id="help.shortcuts")
-    about = make_action(w, "&About matedit", w.show_about, action_id="help.about")
+    about = make_action(window, "&About matedit", w.show_about, action_id="help.about")
 
-    mb = w.menuBar()
+    mb = window.menuBar()
     f = mb.addMenu("&File")
     _add(f, (new, open_))
-    recent = RecentMenu(w.actions, w.open_material, w)
+    recent = RecentMenu(w.actions, w.open_material, window)
     recent.menuAction().setObjectName("file.recent")
     f.addMenu(recent)
     _add(f, (None, save, save_as, None, export, save_image))
-    interop = InteropActions(w)
+    interop = InteropActions(window, w)
     insert_after(f, "file.export", interop.entries())
     _add(f, (None, quit_))
 
@@ -207,7 +206,7 @@ def install_menus(w: MenuHost, docks: Iterable[QDockWidget]) -> Menus:
     canvas.fill(h, ("node_docs",))
     _add(h, (None, about))
 
-    tb = w.addToolBar("Main")
+    tb = window.addToolBar("Main")
     tb.setObjectName("mainToolBar")
     tb.setMovable(False)
     tb.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
