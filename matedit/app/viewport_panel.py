@@ -213,7 +213,7 @@ class ViewportPanel(QWidget):
         if self.compiler.latest is not None and self.view.has_material:
             return
         self.view.clear_material()
-        errors = [d.format() for d in diagnostics if getattr(d.severity, "value", "") == "error"]
+        errors = [d.format() for d in diagnostics if d.severity.value == "error"]
         self._show_failure("This material does not compile",
                            errors or [d.format() for d in diagnostics])
 
