@@ -202,7 +202,7 @@ def test_diagnostics_title_counts_the_rows_it_lists(qtbot):
     settle(qtbot, w)
     rows = [p for p in w.diagnostics.problems if p.severity == "error"]
     assert rows
-    assert w.diagnostics_dock.windowTitle() == f"Diagnostics ({len(rows)})"
+    assert w.panels.diagnostics_dock.windowTitle() == f"Diagnostics ({len(rows)})"
     assert w.diagnostics.topLevelItemCount() == len(w.diagnostics.problems)
 
 
@@ -212,12 +212,12 @@ def test_ampersand_in_names_is_shown_not_eaten(qtbot):
     w = make_window(qtbot, SAMPLE, show=True)
     # Tabified with the inspector, its tab reads '&' as a mnemonic: escaped there; floating,
     # the title bar draws the title as it is. The View menu always reads a mnemonic.
-    assert w.tabifiedDockWidgets(w.lights_dock)
-    assert w.lights_dock.windowTitle() == "Lights && Environment"
-    assert w.lights_dock.toggleViewAction().text() == "Lights && Environment"
-    w.lights_dock.setFloating(True)
-    qtbot.waitUntil(lambda: w.lights_dock.windowTitle() == "Lights & Environment")
-    assert w.lights_dock.toggleViewAction().text() == "Lights && Environment"
+    assert w.tabifiedDockWidgets(w.panels.lights_dock)
+    assert w.panels.lights_dock.windowTitle() == "Lights && Environment"
+    assert w.panels.lights_dock.toggleViewAction().text() == "Lights && Environment"
+    w.panels.lights_dock.setFloating(True)
+    qtbot.waitUntil(lambda: w.panels.lights_dock.windowTitle() == "Lights & Environment")
+    assert w.panels.lights_dock.toggleViewAction().text() == "Lights && Environment"
     tab = w.tabs.open_function(graphs_dir() / "functions" / "uv_tile_rotate.json",
                                w.tabs.material)
     assert tab is not None

@@ -106,8 +106,8 @@ def test_recent_files_and_new_document(qtbot, sample_copy):
 
     w = make_window(qtbot, sample_copy)
     assert DocumentActions.recent_files()[0] == str(sample_copy.resolve())
-    w.recent_menu.fill()
-    assert any(a.text() == sample_copy.name for a in w.recent_menu.actions())
+    w.menus.recent.fill()
+    assert any(a.text() == sample_copy.name for a in w.menus.recent.actions())
     assert w.actions.new()
     nodes = w.controller.document.graph.nodes  # a new material starts with its output
     assert [n.kind for n in nodes.values()] == ["material_output"]
@@ -179,16 +179,16 @@ def test_dock_layout_is_restored(qtbot):
     from matedit.app.main_window import MainWindow
 
     w = make_window(qtbot, SAMPLE, show=True)
-    w.code_dock.show()
-    w.history_dock.hide()
+    w.panels.code_dock.show()
+    w.panels.history_dock.hide()
     assert w.close()
     w2 = MainWindow(start=False)
     qtbot.addWidget(w2)
     w2.show()
     qtbot.waitExposed(w2)
-    assert w2.history_dock.isHidden() and not w2.code_dock.isHidden()
+    assert w2.panels.history_dock.isHidden() and not w2.panels.code_dock.isHidden()
     w2.reset_layout()
-    assert not w2.history_dock.isHidden()
+    assert not w2.panels.history_dock.isHidden()
 
 
 def test_matedit_with_a_file_opens_the_editor_and_subcommands_still_work(monkeypatch,

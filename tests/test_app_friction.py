@@ -17,7 +17,8 @@ SAMPLE = EDITOR_SAMPLE
 def short_inspector(qtbot, w) -> None:
     """A window whose inspector is short enough to scroll (the default layout gives it the
     height to show a layer stack whole)."""
-    w.resizeDocks([w.viewport_dock, w.inspector_dock], [620, 160], Qt.Orientation.Vertical)
+    w.resizeDocks([w.panels.viewport_dock, w.panels.inspector_dock], [620, 160],
+                  Qt.Orientation.Vertical)
     qtbot.wait(10)
 
 
@@ -57,7 +58,7 @@ def test_view_menu_shows_dock_check_states(qtbot):
     for a in docks.values():
         assert a.icon().isNull()  # an icon would be drawn instead of the check mark
     assert docks["Inspector"].isChecked()
-    w.inspector_dock.close()
+    w.panels.inspector_dock.close()
     assert not docks["Inspector"].isChecked()
 
 
@@ -186,7 +187,7 @@ def test_help_keyboard_reference_is_searchable(qtbot):
     assert rows and all("reroute" in " ".join(r).lower() for r in rows)
     assert any(r[0] == "Double-click a wire" for r in rows)
     help_menu = next(a.menu() for a in w.menuBar().actions() if a.text() == "&Help")
-    assert w.act_shortcuts in help_menu.actions() and w.act_about in help_menu.actions()
+    assert w.menus.shortcuts in help_menu.actions() and w.menus.about in help_menu.actions()
 
 
 def test_node_docs_open_from_f1_the_palette_and_the_inspector(qtbot):
@@ -233,8 +234,8 @@ def test_snap_to_grid_lands_moved_nodes_on_the_grid(qtbot):
     from matedit.app.canvas import constants as C
 
     w = make_window(qtbot, SAMPLE, show=True)
-    assert not w.act_snap.isChecked()
-    w.act_snap.trigger()
+    assert not w.menus.snap.isChecked()
+    w.menus.snap.trigger()
     canvas = w.tabs.material.canvas
     canvas.select_nodes(["mask_noise"])
     item = canvas.scene().node_items["mask_noise"]
@@ -257,7 +258,7 @@ def test_viewport_view_light_rig_snap_and_export_targets_are_remembered(qtbot):
 
     rig = [Light(kind="point", position=(1.0, 2.0, 3.0), intensity=7.0)]
     w.lights.set_lights(rig, emit=True)
-    w.act_snap.setChecked(True)
+    w.menus.snap.setChecked(True)
     w.save_layout()
     dlg = ExportDialog(w.controller.document, w.controller.resolver, w)
     dlg.boxes["glsl450"].setChecked(True)
@@ -270,7 +271,7 @@ def test_viewport_view_light_rig_snap_and_export_targets_are_remembered(qtbot):
     assert w2.viewport.mode_combo.currentText() == "Reference"
     assert w2.viewport.view._exposure == pytest.approx(-1.3)
     assert w2.lights.lights == rig
-    assert w2.act_snap.isChecked()
+    assert w2.menus.snap.isChecked()
     dlg2 = ExportDialog(w2.controller.document, w2.controller.resolver, w2)
     assert set(dlg2.targets()) == {"glsl330", "glsl450"}
     dlg2.close()
@@ -334,7 +335,8 @@ def test_a_document_saves_its_preview_with_a_user_hdr_relative_to_it(qtbot, tmp_
     write_image(hdr, np_ones())
     w = make_window(qtbot, SAMPLE)
     w.viewport.mesh_combo.setCurrentText("cylinder")
-    w.viewport.view._environment = str(hdr)  # what choosing it did (the bake is skipped)
+    monkeypatch.setattr(w.viewport.view, "set_environment", lambda *_a: None)  # no bake
+    assert w.viewport.choose_environment(str(hdr))
     w.actions.ask_save_path = lambda _s: str(tmp_path / "mat" / "m.json")
     assert w.actions.save_as()
     saved = json.loads((tmp_path / "mat" / "m.json").read_text())

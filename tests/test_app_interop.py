@@ -28,7 +28,7 @@ def test_editor_exports_and_imports(qtbot, tmp_path):
     from matedit.interop.mtlx_export import validate
 
     w = make_window(qtbot, SAMPLE)
-    ia = w.interop
+    ia = w.menus.interop
     assert ia.export_gltf(tmp_path / "m.glb", size=16), ia.last_message
     issues = validate_gltf(tmp_path / "m.glb", tmp_path)
     assert issues["numErrors"] == 0, issues["messages"][:5]
@@ -65,7 +65,7 @@ def test_editor_import_error_names_the_node(qtbot, tmp_path, monkeypatch):
     shown = []
     monkeypatch.setattr(QMessageBox, "critical", lambda *a: shown.append(a[2]))
     w = make_window(qtbot, SAMPLE)
-    assert not w.interop.import_mtlx(src, tmp_path / "x.json")
+    assert not w.menus.interop.import_mtlx(src, tmp_path / "x.json")
     assert shown and "NG/lumpy" in shown[0] and "noise3d" in shown[0]
     assert not (tmp_path / "x.json").exists()
     assert w.controller.document.path == SAMPLE
@@ -149,7 +149,7 @@ def test_editor_import_of_several_materials_asks_which(qtbot, tmp_path, monkeypa
 
     monkeypatch.setattr(QInputDialog, "getItem", pick)
     w = make_window(qtbot, SAMPLE)
-    ia = w.interop
+    ia = w.menus.interop
     pick.answer = ("", False)  # cancelled: nothing imported
     assert not ia.import_mtlx(src, tmp_path / "none.json")
     assert not (tmp_path / "none.json").exists()
@@ -195,7 +195,7 @@ def test_editor_import_proposes_a_new_name_and_never_replaces_the_open_document(
                         lambda parent, caption, directory, filter: (asked.append(directory)
                                                                     or answer[0], ""))
     answer = [str(mine)]  # the artist picks the open document's own file anyway
-    assert not w.interop.import_mtlx(src)
+    assert not w.menus.interop.import_mtlx(src)
     assert asked == [str(tmp_path / "tile_3.json")]  # a new name, in the document's folder
     assert w.shown_errors and "open in the editor" in w.shown_errors[-1][1]
     assert "tile.json" in w.shown_errors[-1][1]
@@ -203,7 +203,7 @@ def test_editor_import_proposes_a_new_name_and_never_replaces_the_open_document(
     assert w.controller.document.path == mine and w.controller.dirty
     assert w.controller.document.graph.nodes["out"].label == "unsaved edit"
     # Asked without a dialog, the same refusal.
-    assert not w.interop.import_mtlx(src, mine)
+    assert not w.menus.interop.import_mtlx(src, mine)
     assert mine.read_bytes() == before and w.controller.dirty
 
     # An existing file other than the open document: the save dialog asks before replacing.
@@ -211,6 +211,6 @@ def test_editor_import_proposes_a_new_name_and_never_replaces_the_open_document(
     assert not dlg.testOption(QFileDialog.Option.DontConfirmOverwrite)
     dlg.deleteLater()
     answer[0] = asked[0]  # the proposal, taken
-    assert w.interop.import_mtlx(src), w.interop.last_message
+    assert w.menus.interop.import_mtlx(src), w.menus.interop.last_message
     assert w.controller.document.path == tmp_path / "tile_3.json"
     assert mine.read_bytes() == before

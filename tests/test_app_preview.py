@@ -179,7 +179,7 @@ def test_save_viewport_image_as_png_and_linear_exr(window, qtbot, tmp_path):
     png = read_image(tmp_path / "shot.png").pixels[..., :3]
     assert png.shape == shown.shape
     assert np.abs(png - shown).max() < 1.5 / 255  # the frame as shown, 8-bit
-    assert w.act_save_image in w.menuBar().actions()[0].menu().actions()
+    assert w.menus.save_image in w.menus.file.actions()
 
     assert w.viewport.save_image(tmp_path / "shot.exr")
     exr = read_image(tmp_path / "shot.exr")

@@ -232,3 +232,35 @@ def test_a_new_document_whose_glsl_fails_to_link_draws_nothing_of_the_last(windo
     assert not view.renderer.has_material and not window.viewport.shows_material()
     assert window.viewport.failure_message.startswith("This material's GLSL does not build")
     assert any(p.source == "GL" for p in window.diagnostics.problems)
+
+
+def test_a_value_edit_sets_the_uniforms_of_that_port_and_no_other(window, qtbot, monkeypatch):
+    """valuesChanged names the node and port: the viewport sets the uniforms that read it
+    (from the compiled material's table) and redraws; a macro of edits sets them all."""
+    from matedit.app.controller import MANY_VALUES, ValueChange
+    from matedit.graph.commands import Macro
+
+    cm = window.compiler.latest
+    reading = sorted(u.name for u in cm.ir.uniforms if (u.node, u.port) == ("stack",
+                                                                             "paint_color"))
+    assert reading and len(cm.ir.uniforms) > len(reading)  # others are left alone
+    changes, sets = [], []
+    window.controller.valuesChanged.connect(changes.append)
+    real = window.viewport.view.set_values
+    monkeypatch.setattr(window.viewport.view, "set_values",
+                        lambda u, t: (sets.append((sorted(u), dict(t))), real(u, t)))
+    assert window.controller.push(SetValue("stack", "paint_color", [0.9, 0.02, 0.02]))
+    assert changes == [ValueChange("stack", "paint_color")]
+    assert sets == [(reading, {})]
+    values = window.viewport.view.renderer.material.values  # what the buffer was packed from
+    assert all(np.allclose(values[n], [0.9, 0.02, 0.02], atol=1e-6) for n in reading)
+
+    changes.clear()
+    sets.clear()
+    macro = Macro([SetValue("stack", "paint_color", [0.1, 0.2, 0.3]),
+                   SetValue("stack", "paint_color", [0.2, 0.3, 0.4])], text="two")
+    assert window.controller.push(macro)
+    assert changes == [MANY_VALUES]  # one announcement for the whole macro
+    assert len(sets) == 1 and sets[0][0] == sorted(u.name for u in cm.ir.uniforms)
+    window.controller.undo_stack.undo()
+    assert changes == [MANY_VALUES, MANY_VALUES]

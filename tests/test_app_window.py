@@ -150,10 +150,10 @@ def test_at_the_default_size_the_inspector_and_the_light_properties_show_unscrol
         assert _inside(f, ins), f
 
     qtbot.waitUntil(lambda: bool(w.lights.lights), timeout=30000)  # the renderer's lights
-    w.lights_dock.raise_()
+    w.panels.lights_dock.raise_()
     w.lights.list.setCurrentRow(0)
     settle(qtbot, w, 50)
-    scroll = w.lights_dock.widget()
+    scroll = w.panels.lights_dock.widget()
     assert isinstance(scroll, QScrollArea)
     rows = [w.lights.form.itemAt(i).widget() for i in range(w.lights.form.count())]
     rows = [r for r in rows if r is not None and r.isVisible()]
@@ -242,3 +242,41 @@ def test_canvas_keys_stay_out_of_other_widgets_of_an_active_window(qtbot):
     qtbot.waitUntil(lambda: QApplication.focusWidget() is canvas, timeout=2000)
     qtbot.keyClick(canvas, Qt.Key.Key_D, Qt.KeyboardModifier.ControlModifier)
     assert len(g.nodes) == n + 1  # and on the canvas they act
+
+
+def test_the_file_menu_is_composed_by_action_ids(qtbot):
+    """Features insert their entries relative to an action id, not a position: New Instance
+    after New, the interop entries after Export Shaders, in this order."""
+    w = make_window(qtbot)
+    ids = [a.objectName() if not a.isSeparator() else "|" for a in w.menus.file.actions()]
+    texts = [a.text() for a in w.menus.file.actions() if not a.isSeparator()]
+    assert ids[:4] == ["file.new", "file.new_instance", "file.open", "file.recent"]
+    i = ids.index("file.export")
+    assert texts[texts.index("&Export Shaders…") + 1:][:5] == [
+        "Export &glTF…", "Export &MaterialX…", "Export &Baked Textures…",
+        "Export &HLSL and MSL…", "&Import MaterialX…"]
+    assert ids[i + 5] == "|" and ids[-2:] == ["|", "file.quit"]
+    assert ids.index("file.save_image") > ids.index("file.export")
+    assert w.menus.help.title() == "&Help" and w.menus.help.menuAction() in \
+        w.menuBar().actions()
+    from matedit.app.menus import find_action
+
+    with pytest.raises(KeyError):
+        find_action(w.menus.file, "file.nothing")
+
+
+def test_one_environment_choice_drives_both_choosers(qtbot, monkeypatch):
+    """The viewport bar and the Lights dock choose through one EnvironmentChoice: either
+    chooser moves the other, and the choice says what lights the view."""
+    w = make_window(qtbot)
+    choice = w.viewport.environment
+    assert w.environment.choice is choice
+    assert w.environment.combo.model() is w.viewport.env_combo.model()
+    baked = []
+    monkeypatch.setattr(w.viewport.view, "set_environment", lambda spec, _p=None:
+                        baked.append(spec))
+    w.environment.combo.activated.emit(w.environment.combo.findText("Sky"))
+    assert baked == ["sky"] and choice.current == "sky"
+    assert w.viewport.env_combo.currentText() == "Sky"
+    w.viewport.env_combo.activated.emit(w.viewport.env_combo.findText("Studio"))
+    assert baked == ["sky", "studio"] and w.environment.combo.currentText() == "Studio"

@@ -130,7 +130,7 @@ def test_library_lists_instances_under_their_parent(window, qtbot):
 def test_file_open_of_an_instance_opens_the_editor(window, qtbot):
     path = graphs_dir() / "instances" / "worn_paint_green.json"
     assert window.actions.open(path, ask=False)
-    (editor,) = window.instance_editors
+    (editor,) = window.instances.editors
     qtbot.addWidget(editor)
     assert editor.doc.parameters == load_instance(path).parameters
     assert editor.panel.is_marked("scratch_amount")
@@ -140,7 +140,7 @@ def test_file_open_of_an_instance_opens_the_editor(window, qtbot):
 
 def test_material_parameters_dock_is_grouped_and_edits_by_command(qtbot):
     w = make_window(qtbot, MASTER)
-    panel = w.parameters_panel
+    panel = w.instances.parameters_panel
     assert [g for g, _ in panel.group_order()] == ["Paint", "Rust"]
     panel.rows["wear_amount"].field.edited.emit(0.75, None)
     node = w.controller.document.graph.nodes["wear_amt"]

@@ -8,7 +8,7 @@ import pytest
 from graphs_util import material, node
 from PySide6.QtCore import QPoint, Qt
 
-from matedit.app.controller import DocumentController
+from matedit.app.controller import MANY_VALUES, DocumentController
 from matedit.app.ramp_widget import RampEditor, RampStops
 
 pytestmark = pytest.mark.gui
@@ -106,5 +106,5 @@ def test_a_closed_editor_ignores_later_edits(qtbot):
     from PySide6.QtCore import QCoreApplication, QEvent
 
     QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
-    controller.valuesChanged.emit()  # must not reach the deleted widget
+    controller.valuesChanged.emit(MANY_VALUES)  # must not reach the deleted widget
     del e

@@ -58,6 +58,7 @@ def quit_after_first_frame(setting: str) -> None:
     of an installed build; it changes nothing else."""
     from PySide6.QtCore import QTimer
 
+    from matedit.app.main_window import MainWindow
     from matedit.app.viewport import ViewportWidget
 
     try:
@@ -69,16 +70,16 @@ def quit_after_first_frame(setting: str) -> None:
     app = make_application()  # run() reuses this instance
 
     def arm() -> None:
-        views = [v for w in app.topLevelWidgets() for v in w.findChildren(ViewportWidget)]
-        if not views:
+        windows = [w for w in app.topLevelWidgets() if isinstance(w, MainWindow)]
+        if not windows:
             QTimer.singleShot(20, arm)
             return
-        view = views[0]
-        compiler = getattr(view.window(), "compiler", None)
+        window = windows[0]
+        view = window.viewport.view
 
         def on_frame() -> None:
             # A compiled material reaches the renderer before the frame after it is drawn.
-            if view.renderer is not None and getattr(compiler, "current", None) is not None:
+            if view.renderer is not None and window.compiler.current is not None:
                 print(f"matedit: viewport frame drawn, {view.width()}x{view.height()}",
                       file=sys.stderr)
                 app.exit(0)

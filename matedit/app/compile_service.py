@@ -10,6 +10,7 @@ the compiler's names (`p_<parameter>`, `u_<node>_<port>`).
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable
 from typing import Any
 
 from PySide6.QtCore import QObject, Signal
@@ -24,16 +25,27 @@ from matedit.graph.validate import Diagnostic, Severity
 VIEWPORT_TARGET = "glsl330"
 
 
-def uniform_values(compiled: CompiledMaterial, doc: MaterialDocument) -> dict[str, Any]:
-    """Current values of the compiled material's uniforms, from the document."""
+def uniform_values(compiled: CompiledMaterial, doc: MaterialDocument,
+                   uniforms: Iterable[Any] | None = None) -> dict[str, Any]:
+    """Current values of the compiled material's uniforms (or of `uniforms`, some of them),
+    from the document."""
     out: dict[str, Any] = {}
-    for u in compiled.ir.uniforms:
+    for u in compiled.ir.uniforms if uniforms is None else uniforms:
         node = doc.graph.nodes.get(u.node)
         value = node.values.get(u.port, u.default) if node is not None else u.default
         try:
             out[u.name] = coerce_value(PortType(u.type.value), value)
         except (ValueError, TypeError):
             out[u.name] = u.default
+    return out
+
+
+def uniforms_by_port(compiled: CompiledMaterial) -> dict[tuple[str, str], list[Any]]:
+    """The compiled material's uniforms by the (node, port) whose value each reads: a value
+    edit sets those and no other."""
+    out: dict[tuple[str, str], list[Any]] = {}
+    for u in compiled.ir.uniforms:
+        out.setdefault((u.node, u.port), []).append(u)
     return out
 
 

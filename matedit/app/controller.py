@@ -9,6 +9,9 @@ as Qt signals; views subscribe and never hold graph state of their own.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 from PySide6.QtCore import QObject, QTimer, Signal
@@ -18,6 +21,28 @@ from matedit.graph.commands import Command, CommandError, Macro, SetSetting, Set
 from matedit.graph.model import ChangeEvent, ChangeKind, MaterialDocument
 from matedit.graph.validate import Analysis, analyse
 from matedit.io.document import FileResolver
+
+
+@dataclass(frozen=True)
+class ValueChange:
+    """What a `valuesChanged` signal carries: the node and the port (or, with `setting`, the
+    non-structural setting, such as a texture's path) whose value changed. `node` None says
+    many values changed at once (a macro applied or undone): receivers refresh everything."""
+
+    node: str | None = None
+    port: str | None = None
+    setting: bool = False
+
+    @property
+    def many(self) -> bool:
+        return self.node is None
+
+    def touches(self, node_id: str) -> bool:
+        """Whether a receiver showing node `node_id` is concerned."""
+        return self.node is None or self.node == node_id
+
+
+MANY_VALUES = ValueChange()
 
 
 class ModelUndoCommand(QUndoCommand):
@@ -38,10 +63,12 @@ class ModelUndoCommand(QUndoCommand):
         if self._skip_redo:
             self._skip_redo = False
             return
-        self.command.apply(self.controller.document.graph)
+        with self.controller.batch(isinstance(self.command, Macro)):
+            self.command.apply(self.controller.document.graph)
 
     def undo(self) -> None:
-        self.command.revert(self.controller.document.graph)
+        with self.controller.batch(isinstance(self.command, Macro)):
+            self.command.revert(self.controller.document.graph)
 
 
 _merge_ids = itertools.count(1000)
@@ -84,14 +111,15 @@ class DocumentController(QObject):
 
     - `changed(ChangeEvent)`: every model change event, as it happens.
     - `structureChanged()`: after a structural edit settles (debounced, 150 ms): recompile.
-    - `valuesChanged()`: after a value edit: set uniforms and redraw.
+    - `valuesChanged(ValueChange)`: after a value edit, naming the node and port (set that
+      uniform and redraw), or `MANY_VALUES` after a macro of value edits (set them all).
     - `documentReplaced()`: a new document was opened or created.
     - `analysed(Analysis)`: validation results after each structural change.
     """
 
     changed = Signal(object)
     structureChanged = Signal()
-    valuesChanged = Signal()
+    valuesChanged = Signal(object)  # ValueChange
     documentReplaced = Signal()
     analysed = Signal(object)
 
@@ -105,6 +133,8 @@ class DocumentController(QObject):
         self._debounce.setSingleShot(True)
         self._debounce.setInterval(150)
         self._debounce.timeout.connect(self._settle)
+        self._batching = False
+        self._batched_values = False
         self.document.graph.subscribe(self._on_event)
         self._settle()
 
@@ -134,7 +164,8 @@ class DocumentController(QObject):
         the same id merge into one undo step.
         """
         try:
-            command.apply(self.document.graph)  # refused edits never reach the stack
+            with self.batch(isinstance(command, Macro)):
+                command.apply(self.document.graph)  # refused edits never reach the stack
         except CommandError:
             return False
         if merge_id is None:
@@ -147,12 +178,31 @@ class DocumentController(QObject):
         return self.push(Macro(list(commands), text=text)) if commands else False
 
     # --- events ----------------------------------------------------------------------------
+    @contextmanager
+    def batch(self, on: bool = True) -> Iterator[None]:
+        """Value events inside are announced once, as `MANY_VALUES`, at the end."""
+        if not on or self._batching:
+            yield
+            return
+        self._batching, self._batched_values = True, False
+        try:
+            yield
+        finally:
+            self._batching = False
+            if self._batched_values:
+                self.valuesChanged.emit(MANY_VALUES)
+
     def _on_event(self, event: ChangeEvent) -> None:
         self.changed.emit(event)
         if event.kind == ChangeKind.STRUCTURAL:
             self._debounce.start()
         elif event.kind == ChangeKind.VALUE:
-            self.valuesChanged.emit()
+            if self._batching:
+                self._batched_values = True
+            else:
+                self.valuesChanged.emit(ValueChange(event.node_ids[0] if event.node_ids
+                                                    else None, event.port,
+                                                    event.what == "setting"))
 
     def flush(self) -> None:
         """Run a pending debounced structural update now (tests, save)."""

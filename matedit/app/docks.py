@@ -1,23 +1,29 @@
 """The main window's dockable panels: which panel goes where, their default sizes, and the
 Lights dock's title (an '&' drawn as itself).
 
-`build_docks(window)` makes the panels and docks and sets them on the window as
-attributes (``viewport``, ``inspector``, …, ``viewport_dock``, ``inspector_dock``, …).
+`build_docks(window, compiler, controller, undo_group)` makes the panels and their docks on
+`window` and returns them as one typed `Panels`; the window keeps it and sets nothing else.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import shiboken6
 from PySide6.QtCore import Qt, QTimer
+from PySide6.QtGui import QUndoGroup
 from PySide6.QtWidgets import QDockWidget, QMainWindow, QScrollArea, QUndoView, QVBoxLayout, QWidget
 
 from matedit.app.code_view import CodeView
+from matedit.app.compile_service import MaterialCompiler
+from matedit.app.controller import DocumentController
 from matedit.app.diagnostics import DiagnosticsPanel
+from matedit.app.environment import EnvironmentPanel
 from matedit.app.inspector import InspectorPanel
 from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
-from matedit.app.viewport import EnvironmentPanel, ViewportPanel
+from matedit.app.viewport_panel import ViewportPanel
 
 LIGHTS_TITLE = "Lights & Environment"
 # Default sizes at the default window size (1480x900): the viewport keeps a useful square,
@@ -43,13 +49,41 @@ def add_dock(window: QMainWindow, title: str, name: str, widget: QWidget,
     return dock
 
 
-def _lights_host(w) -> QScrollArea:
+@dataclass(frozen=True)
+class Panels:
+    """The main window's panels and the docks that hold them."""
+
+    viewport: ViewportPanel
+    inspector: InspectorPanel
+    layers: LayersPanel
+    library: LibraryPanel
+    lights: LightsPanel
+    environment: EnvironmentPanel  # on the viewport's EnvironmentChoice
+    code: CodeView
+    diagnostics: DiagnosticsPanel
+    history: QUndoView
+    viewport_dock: QDockWidget
+    inspector_dock: QDockWidget
+    layers_dock: QDockWidget
+    library_dock: QDockWidget
+    lights_dock: QDockWidget
+    code_dock: QDockWidget
+    diagnostics_dock: QDockWidget
+    history_dock: QDockWidget
+
+    def docks(self) -> list[QDockWidget]:
+        """The docks in the order the View menu lists them."""
+        return [self.viewport_dock, self.inspector_dock, self.layers_dock, self.library_dock,
+                self.lights_dock, self.code_dock, self.diagnostics_dock, self.history_dock]
+
+
+def _lights_host(environment: EnvironmentPanel, lights: LightsPanel) -> QScrollArea:
     host = QWidget()
     lay = QVBoxLayout(host)
     lay.setContentsMargins(0, 0, 0, 0)
     lay.setSpacing(0)
-    lay.addWidget(w.environment)
-    lay.addWidget(w.lights, 1)
+    lay.addWidget(environment)
+    lay.addWidget(lights, 1)
     scroll = QScrollArea()  # its height must not squeeze the viewport above
     scroll.setObjectName("lightsScroll")
     scroll.setWidgetResizable(True)
@@ -58,66 +92,60 @@ def _lights_host(w) -> QScrollArea:
     return scroll
 
 
-def build_docks(w) -> None:
-    """The panels and their docks on the main window `w` (needs ``w.compiler``,
-    ``w.controller`` and ``w.undo_group``)."""
+def build_docks(w: QMainWindow, compiler: MaterialCompiler, controller: DocumentController,
+                undo_group: QUndoGroup) -> Panels:
+    """The panels and their docks on the main window `w`, laid out at their default sizes."""
     L, R, B = (Qt.DockWidgetArea.LeftDockWidgetArea, Qt.DockWidgetArea.RightDockWidgetArea,
                Qt.DockWidgetArea.BottomDockWidgetArea)
     # The side columns run the window's full height; the bottom docks sit under the canvas
     # alone, so the inspector and the lights get that height.
     w.setCorner(Qt.Corner.BottomLeftCorner, L)
     w.setCorner(Qt.Corner.BottomRightCorner, R)
-    w.viewport = ViewportPanel(w.compiler)
-    w.inspector = InspectorPanel(w.controller)
-    w.layers = LayersPanel(w.controller)
-    w.library = LibraryPanel()
-    w.lights = LightsPanel()
-    w.code = CodeView(w.compiler)
-    w.diagnostics = DiagnosticsPanel()
-    w.history = QUndoView(w.undo_group)
-    w.history.setEmptyLabel("<opened>")
-    w.environment = EnvironmentPanel(w.viewport)
+    viewport = ViewportPanel(compiler)
+    inspector = InspectorPanel(controller)
+    layers = LayersPanel(controller)
+    library = LibraryPanel()
+    lights = LightsPanel()
+    code = CodeView(compiler)
+    diagnostics = DiagnosticsPanel()
+    history = QUndoView(undo_group)
+    history.setEmptyLabel("<opened>")
+    environment = EnvironmentPanel(viewport.environment)
 
-    w.library_dock = add_dock(w, "Library", "libraryDock", w.library, L, "folder-add")
-    w.layers_dock = add_dock(w, "Layers", "layersDock", w.layers, L, "layer")
-    w.viewport_dock = add_dock(w, "Viewport", "viewportDock", w.viewport, R, "material")
-    w.inspector_dock = add_dock(w, "Inspector", "inspectorDock", w.inspector, R)
-    w.lights_dock = add_dock(w, LIGHTS_TITLE, "lightsDock", _lights_host(w), R, "light")
-    for sig in (w.lights_dock.topLevelChanged, w.lights_dock.dockLocationChanged,
-                w.lights_dock.visibilityChanged):
+    library_dock = add_dock(w, "Library", "libraryDock", library, L, "folder-add")
+    layers_dock = add_dock(w, "Layers", "layersDock", layers, L, "layer")
+    viewport_dock = add_dock(w, "Viewport", "viewportDock", viewport, R, "material")
+    inspector_dock = add_dock(w, "Inspector", "inspectorDock", inspector, R)
+    lights_dock = add_dock(w, LIGHTS_TITLE, "lightsDock", _lights_host(environment, lights), R,
+                           "light")
+    for sig in (lights_dock.topLevelChanged, lights_dock.dockLocationChanged,
+                lights_dock.visibilityChanged):
         sig.connect(lambda *_: shiboken6.isValid(w)  # also fires while closing down
-                    and QTimer.singleShot(0, w, lambda: retitle_lights(w)))
-    w.diagnostics_dock = add_dock(w, "Diagnostics", "diagnosticsDock", w.diagnostics, B,
-                                  "warning")
-    w.code_dock = add_dock(w, "GLSL", "codeDock", w.code, B)
-    w.history_dock = add_dock(w, "History", "historyDock", w.history, B, "undo")
-    w.splitDockWidget(w.library_dock, w.layers_dock, Qt.Orientation.Vertical)
-    w.splitDockWidget(w.viewport_dock, w.inspector_dock, Qt.Orientation.Vertical)
-    w.tabifyDockWidget(w.inspector_dock, w.lights_dock)
-    w.inspector_dock.raise_()
-    w.tabifyDockWidget(w.diagnostics_dock, w.code_dock)
-    w.tabifyDockWidget(w.code_dock, w.history_dock)
-    w.diagnostics_dock.raise_()
-    retitle_lights(w)
-    w.resizeDocks([w.library_dock, w.viewport_dock], list(SIDE_WIDTHS),
-                  Qt.Orientation.Horizontal)
-    w.resizeDocks([w.viewport_dock, w.inspector_dock], list(RIGHT_HEIGHTS),
-                  Qt.Orientation.Vertical)
-    w.resizeDocks([w.library_dock, w.layers_dock], list(LEFT_HEIGHTS),
-                  Qt.Orientation.Vertical)
-    w.resizeDocks([w.diagnostics_dock], [BOTTOM_HEIGHT], Qt.Orientation.Vertical)
+                    and QTimer.singleShot(0, w, lambda: retitle_lights(w, lights_dock)))
+    diagnostics_dock = add_dock(w, "Diagnostics", "diagnosticsDock", diagnostics, B,
+                                "warning")
+    code_dock = add_dock(w, "GLSL", "codeDock", code, B)
+    history_dock = add_dock(w, "History", "historyDock", history, B, "undo")
+    w.splitDockWidget(library_dock, layers_dock, Qt.Orientation.Vertical)
+    w.splitDockWidget(viewport_dock, inspector_dock, Qt.Orientation.Vertical)
+    w.tabifyDockWidget(inspector_dock, lights_dock)
+    inspector_dock.raise_()
+    w.tabifyDockWidget(diagnostics_dock, code_dock)
+    w.tabifyDockWidget(code_dock, history_dock)
+    diagnostics_dock.raise_()
+    retitle_lights(w, lights_dock)
+    w.resizeDocks([library_dock, viewport_dock], list(SIDE_WIDTHS), Qt.Orientation.Horizontal)
+    w.resizeDocks([viewport_dock, inspector_dock], list(RIGHT_HEIGHTS), Qt.Orientation.Vertical)
+    w.resizeDocks([library_dock, layers_dock], list(LEFT_HEIGHTS), Qt.Orientation.Vertical)
+    w.resizeDocks([diagnostics_dock], [BOTTOM_HEIGHT], Qt.Orientation.Vertical)
+    return Panels(viewport, inspector, layers, library, lights, environment, code, diagnostics,
+                  history, viewport_dock, inspector_dock, layers_dock, library_dock,
+                  lights_dock, code_dock, diagnostics_dock, history_dock)
 
 
-def panel_docks(w) -> list[QDockWidget]:
-    """The docks in the order the View menu lists them."""
-    return [w.viewport_dock, w.inspector_dock, w.layers_dock, w.library_dock, w.lights_dock,
-            w.code_dock, w.diagnostics_dock, w.history_dock]
-
-
-def retitle_lights(w) -> None:
+def retitle_lights(w: QMainWindow, d: QDockWidget) -> None:
     """'&' shown as itself everywhere: a dock's title bar draws its title as it is, but
     the tab of tabified docks and the View menu read '&' as a mnemonic marker."""
-    d = w.lights_dock
     tabbed = not d.isFloating() and bool(w.tabifiedDockWidgets(d))
     d.setWindowTitle(LIGHTS_TITLE.replace("&", "&&") if tabbed else LIGHTS_TITLE)
     d.toggleViewAction().setText(LIGHTS_TITLE.replace("&", "&&"))

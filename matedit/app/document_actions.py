@@ -121,6 +121,8 @@ class DocumentActions(QObject):
         self.open_recovered_material: Callable[[RecoveryEntry, MaterialDocument], None] | \
             None = None
         self.open_function: Callable[[Path], None] | None = None  # File > Open on a function
+        # An instance file opens in the instance editor (None: it cannot be opened here).
+        self.open_instance: Callable[[str], object] | None = None
         # The preview settings saved with a material, for the file it is saved as.
         self.preview_settings: Callable[[Path], dict] | None = None
         self.ask_open_path: Callable[[], str] = self._ask_open_path
@@ -223,8 +225,8 @@ class DocumentActions(QObject):
         the file's recovery file, if there is one. An instance opens in its own editor."""
         from matedit.io.instance import is_instance_file  # instances open in their editor
 
-        if is_instance_file(path) and hasattr(self.parent(), "open_instance"):
-            return self.parent().open_instance(str(path)) is not None
+        if is_instance_file(path) and self.open_instance is not None:
+            return self.open_instance(str(path)) is not None
         doc = self.read(path)
         if doc is None:
             return False

@@ -7,8 +7,9 @@ switch compiles the instance's permutation; the renderer keeps programs by struc
 so switching back links nothing. Saving writes the instance file (atomically) with the
 parent's parameter list, so orphaned overrides stay recognisable.
 
-`install(window)` adds the editor's entry points to the main window: File › New Instance of
-Material…, and opening instances from the Library (listed under their parent material).
+`Instances(window, host, file_menu, library, beside)` adds the editor's entry points to the
+main window: File › New Instance of Material…, the Parameters dock, and opening instances from
+the Library (listed under their parent material).
 """
 
 from __future__ import annotations
@@ -16,12 +17,16 @@ from __future__ import annotations
 import copy
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtGui import QAction
 from PySide6.QtWidgets import (
+    QDockWidget,
     QHBoxLayout,
     QLabel,
+    QMainWindow,
+    QMenu,
     QMessageBox,
     QPushButton,
     QSplitter,
@@ -31,7 +36,9 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app import file_dialogs
-from matedit.app.library import KIND_ROLE, PATH_ROLE
+from matedit.app.docks import add_dock
+from matedit.app.library import KIND_ROLE, PATH_ROLE, LibraryPanel
+from matedit.app.menus import insert_after
 from matedit.app.parameter_panel import ParameterPanel
 from matedit.app.viewport import ViewportWidget
 from matedit.compiler import CompileError, compile_document
@@ -46,6 +53,10 @@ from matedit.io.instance import (
     resolve,
     save_instance,
 )
+
+if TYPE_CHECKING:
+    from matedit.app.controller import DocumentController
+    from matedit.app.document_actions import DocumentActions
 
 INSTANCE_FILTER = "Material instances (*.json)"
 
@@ -257,68 +268,83 @@ def create_instance(parent_file: str | Path, path: str | Path, parent=None) -> I
 
 # --- main window hooks ------------------------------------------------------------------
 
-def install(window) -> None:
-    """File › New Instance of Material…, and the Library's instance entries."""
-    from PySide6.QtGui import QAction
+class InstanceHost(Protocol):
+    """What the instance editor's entry points need of the main window."""
 
-    window.instance_editors = []
-    act = QAction("New &Instance of Material…", window)
-    act.setToolTip("Create a material instance of the open material (or a chosen file)")
-    act.triggered.connect(lambda: _new_instance_dialog(window))
-    menu = window.menuBar().actions()[0].menu()
-    menu.insertAction(menu.actions()[1], act)
+    controller: DocumentController
+    actions: DocumentActions
 
-    def show(editor: InstanceEditor) -> InstanceEditor:
-        window.instance_editors.append(editor)
-        editor.message.connect(window.status)
+    def status(self, text: str) -> None: ...
+
+
+class Instances:
+    """The instance editor's part of the main window: File › New Instance of Material…, the
+    Parameters dock, the Library's instance entries, and the editors opened."""
+
+    def __init__(self, window: QMainWindow, host: InstanceHost, file_menu: QMenu,
+                 library: LibraryPanel, beside: QDockWidget) -> None:
+        self.window = window
+        self.host = host
+        self.library = library
+        self.editors: list[InstanceEditor] = []
+        self.new_action = QAction("New &Instance of Material…", window)
+        self.new_action.setObjectName("file.new_instance")
+        self.new_action.setToolTip("Create a material instance of the open material (or a "
+                                   "chosen file)")
+        self.new_action.triggered.connect(lambda: self.new_instance_dialog())
+        insert_after(file_menu, "file.new", [self.new_action])
+        self.parameters_panel = MaterialParameters(host.controller)
+        self.parameters_dock = add_dock(window, "Parameters", "parametersDock",
+                                        self.parameters_panel,
+                                        Qt.DockWidgetArea.RightDockWidgetArea)
+        window.tabifyDockWidget(beside, self.parameters_dock)
+        beside.raise_()
+        library.instanceOpenRequested.connect(self.open)
+        library.refreshed.connect(self._attach)
+        self._attach(library.files)  # the Library listed its files before this was connected
+        library.instanceCreateRequested.connect(lambda p: self.new_instance_dialog(p))
+
+    def _attach(self, files: list[Path]) -> None:  # the Library's instances, under parents
+        attach_instances(self.library.items("material"), files, PATH_ROLE, KIND_ROLE)
+
+    def _show(self, editor: InstanceEditor) -> InstanceEditor:
+        self.editors.append(editor)
+        editor.message.connect(self.host.status)
         editor.show()
         return editor
 
-    def open_path(path: str) -> InstanceEditor | None:
+    def open(self, path: str) -> InstanceEditor | None:
+        """An editor on the instance file `path` (a warning if it cannot be read)."""
         try:
-            return show(open_instance(path))
+            return self._show(open_instance(path))
         except (FormatError, InstanceError) as exc:
-            QMessageBox.warning(window, "Cannot open instance", str(exc))
+            QMessageBox.warning(self.window, "Cannot open instance", str(exc))
             return None
 
-    window.parameters_panel = MaterialParameters(window.controller)
-    from matedit.app.docks import add_dock
+    def create(self, parent_file: str | Path, path: str | Path) -> InstanceEditor:
+        """Writes a new instance of `parent_file` at `path` and opens it."""
+        return self._show(create_instance(parent_file, path))
 
-    window.parameters_dock = add_dock(window, "Parameters", "parametersDock",
-                                      window.parameters_panel,
-                                      Qt.DockWidgetArea.RightDockWidgetArea)
-    window.tabifyDockWidget(window.inspector_dock, window.parameters_dock)
-    window.inspector_dock.raise_()
-    window.open_instance = open_path
-    window.create_instance = lambda parent_file, path: show(create_instance(parent_file, path))
-    window.library.instanceOpenRequested.connect(open_path)
-
-    def attach(files: list[Path]) -> None:  # the Library's instances, under their parents
-        attach_instances(window.library.items("material"), files, PATH_ROLE, KIND_ROLE)
-
-    window.library.refreshed.connect(attach)
-    attach(window.library.files)  # the Library listed its files before this was connected
-    window.library.instanceCreateRequested.connect(lambda p: _new_instance_dialog(window, p))
-
-
-def _new_instance_dialog(window, parent_file: str | None = None) -> None:
-    if parent_file is None:
-        doc = window.actions.document if hasattr(window, "actions") else None
-        parent_file = str(doc.path) if doc is not None and doc.path else None
-    if parent_file is None:
-        parent_file, _ = file_dialogs.open_file(window, "Instance of which material?",
-                                                "", INSTANCE_FILTER)
-        if not parent_file:
-            return
-    stem = Path(parent_file).stem
-    path, _ = file_dialogs.save_file(window, "Save the new instance as",
-                                     str(Path(parent_file).with_name(f"{stem}_inst.json")),
-                                     INSTANCE_FILTER)
-    if path:
-        try:
-            window.create_instance(parent_file, path)
-        except (FormatError, InstanceError, OSError) as exc:
-            QMessageBox.warning(window, "Cannot create instance", str(exc))
+    def new_instance_dialog(self, parent_file: str | None = None) -> None:
+        """Of the open material (or, unsaved, of a chosen file), saved where the user says."""
+        window = self.window
+        if parent_file is None:
+            doc = self.host.actions.document
+            parent_file = str(doc.path) if doc is not None and doc.path else None
+        if parent_file is None:
+            parent_file, _ = file_dialogs.open_file(window, "Instance of which material?",
+                                                    "", INSTANCE_FILTER)
+            if not parent_file:
+                return
+        stem = Path(parent_file).stem
+        path, _ = file_dialogs.save_file(window, "Save the new instance as",
+                                         str(Path(parent_file).with_name(f"{stem}_inst.json")),
+                                         INSTANCE_FILTER)
+        if path:
+            try:
+                self.create(parent_file, path)
+            except (FormatError, InstanceError, OSError) as exc:
+                QMessageBox.warning(window, "Cannot create instance", str(exc))
 
 
 # --- a material's own parameters, grouped (the Parameters dock) ---------------------------

@@ -12,12 +12,17 @@ from __future__ import annotations
 import os
 import threading
 from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
 
 from PySide6.QtCore import QSettings, Qt
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QApplication, QInputDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QInputDialog, QMessageBox, QWidget
 
 from matedit.app import file_dialogs
+
+if TYPE_CHECKING:
+    from matedit.app.controller import DocumentController
+    from matedit.app.document_actions import DocumentActions
 
 FOLDER_KEY = "interop/folder"
 
@@ -51,11 +56,22 @@ def _in_worker(fn):
     return box.get("value")
 
 
-class InteropActions:
-    """The actions, installed into a File menu; `window` is the MainWindow."""
+class InteropHost(Protocol):
+    """What the interop actions need of the main window."""
 
-    def __init__(self, window) -> None:
-        self.window = window
+    controller: DocumentController
+    actions: DocumentActions
+
+    def status(self, text: str) -> None: ...
+
+
+class InteropActions:
+    """The File menu's import and export actions (`entries()`), on `window` (the dialogs'
+    parent), working on `host`'s document."""
+
+    def __init__(self, window: QWidget, host: InteropHost) -> None:
+        self.window = window  # the dialogs' parent
+        self.host = host
         self.last_message = ""
         w = window
         self.act_gltf = QAction("Export &glTF…", w)
@@ -70,23 +86,18 @@ class InteropActions:
         self.act_import.triggered.connect(lambda: self.import_mtlx())
         self.actions = [self.act_gltf, self.act_mtlx, self.act_bake, self.act_cross]
 
-    def install(self, file_menu, after: QAction) -> None:
-        acts = file_menu.actions()
-        i = acts.index(after) + 1 if after in acts else len(acts)
-        before = acts[i] if i < len(acts) else None
-        for a in self.actions:
-            file_menu.insertAction(before, a)
-        file_menu.insertSeparator(before)
-        file_menu.insertAction(before, self.act_import)
+    def entries(self) -> list[QAction | None]:
+        """The File menu's entries, in order (None: a separator)."""
+        return [*self.actions, None, self.act_import]
 
     # --- helpers ---------------------------------------------------------------------------
     @property
     def doc(self):
-        return self.window.controller.document
+        return self.host.controller.document
 
     @property
     def resolver(self):
-        return self.window.controller.resolver
+        return self.host.controller.resolver
 
     def _stem(self) -> str:
         from matedit.interop.export import stem_of
@@ -129,7 +140,7 @@ class InteropActions:
 
     def _done(self, text: str) -> bool:
         self.last_message = text
-        self.window.status(text)
+        self.host.status(text)
         return True
 
     def _inputs(self):
@@ -284,7 +295,7 @@ class InteropActions:
         if _real(out) in open_document_paths():
             text = (f"{out.name} is open in the editor. An import is saved as a new file and "
                     "never replaces an open document: choose another name.")
-            self.window.actions.show_error(title, text)
+            self.host.actions.show_error(title, text)
             self.last_message = text
             return False
 
@@ -296,7 +307,7 @@ class InteropActions:
         try:
             refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
             doc = import_mtlx(src, out, material)
-            if not self.window.actions.maybe_save():
+            if not self.host.actions.maybe_save():
                 return False
             atomic_write_text(out, dumps(doc))
         except MtlxImportError as exc:
@@ -306,7 +317,7 @@ class InteropActions:
             return False
         except Exception as exc:
             return self._fail(title, exc)
-        return self.window.actions.open(out, ask=False) and self._done(f"imported {src.name}")
+        return self.host.actions.open(out, ask=False) and self._done(f"imported {src.name}")
 
 
 def _real(path: Path) -> Path:
@@ -326,10 +337,3 @@ def open_document_paths() -> set[Path]:
         if shiboken6.isValid(acts) and acts.document.path is not None:
             out.add(_real(Path(acts.document.path)))
     return out
-
-
-def install(window, file_menu, after: QAction) -> InteropActions:
-    """Add the interop entries to `file_menu` after `after` (File › Export Shaders…)."""
-    acts = InteropActions(window)
-    acts.install(file_menu, after)
-    return acts

@@ -3,6 +3,10 @@
 Panels are wired to the active tab's controller (inspector, history, diagnostics)
 or to the material's (viewport, layers, code). Dock layout and window geometry
 are kept in QSettings and restored at the next start.
+
+The window is composed here and only here: `build_docks` returns the `Panels`,
+`install_menus` the `Menus`, `Instances` the instance editor's part; each takes what it
+needs of the window as a typed Protocol, and no other module sets an attribute on it.
 """
 
 from __future__ import annotations
@@ -18,13 +22,13 @@ from matedit.app.canvas.actions import PaletteOnTab
 from matedit.app.canvas_tabs import CanvasTab, CanvasTabs
 from matedit.app.compile_service import MaterialCompiler
 from matedit.app.controller import DocumentController
-from matedit.app.docks import build_docks
+from matedit.app.docks import Panels, build_docks
 from matedit.app.document_actions import DocumentActions, document_title, new_material
 from matedit.app.export_dialog import ExportDialog
 from matedit.app.help import NodeDocs, ShortcutReference, show_about
-from matedit.app.instance_editor import install as install_instances
+from matedit.app.instance_editor import InstanceEditor, Instances
 from matedit.app.layout import WindowLayout
-from matedit.app.menus import install_menus
+from matedit.app.menus import Menus, install_menus
 from matedit.app.node_preview import PreviewTarget
 from matedit.app.problems import ProblemsModel
 from matedit.resources import graphs_dir
@@ -50,13 +54,20 @@ class MainWindow(QMainWindow):
 
         self.tabs = CanvasTabs(self.controller, self.actions, self.undo_group, self)
         self.setCentralWidget(self.tabs)
-        build_docks(self)  # the panels: self.viewport, self.inspector, … and their docks
+        self.panels: Panels = build_docks(self, self.compiler, self.controller,
+                                          self.undo_group)
+        p = self.panels  # the panels the window's own code reaches most, by name
+        self.viewport, self.inspector, self.layers = p.viewport, p.inspector, p.layers
+        self.library, self.lights, self.environment = p.library, p.lights, p.environment
+        self.code, self.diagnostics = p.code, p.diagnostics
         self.problems = ProblemsModel(self.compiler, self.viewport, self)
-        install_menus(self)  # self.act_* and the menus; canvas commands from the table
+        self.menus: Menus = install_menus(self, self, p.docks())  # canvas commands from the table
         self._build_status()
         self._connect()
-        install_instances(self)  # File › New Instance, Library instances (instance_editor)
-        self.layout_state = WindowLayout(self, self.viewport, self.lights, self.act_snap)
+        # File › New Instance, the Parameters dock, the Library's instances
+        self.instances = Instances(self, self, self.menus.file, p.library, p.inspector_dock)
+        self.actions.open_instance = self.open_instance
+        self.layout_state = WindowLayout(self, self.viewport, self.lights, self.menus.snap)
         if restore_layout:
             self.restore_layout()
         self.undo_group.setActiveStack(self.controller.undo_stack)
@@ -150,6 +161,16 @@ class MainWindow(QMainWindow):
     def show_about(self) -> None:
         show_about(self, self.viewport.gl_renderer())
 
+    def save_viewport_image(self) -> bool:
+        return self.viewport.save_image_dialog()
+
+    # --- instances -------------------------------------------------------------------------
+    def open_instance(self, path: str) -> InstanceEditor | None:
+        return self.instances.open(path)
+
+    def create_instance(self, parent_file: str | Path, path: str | Path) -> InstanceEditor:
+        return self.instances.create(parent_file, path)
+
     def _open_recovered_material(self, entry, doc) -> None:
         """A second recovered material gets a window of its own."""
         w = MainWindow(restore_layout=False, start=False)
@@ -201,8 +222,8 @@ class MainWindow(QMainWindow):
         canvas.select_nodes([node_id])
         canvas.frame_selection()
         self.inspector.show_node(node_id)
-        self.inspector_dock.show()
-        self.inspector_dock.raise_()
+        self.panels.inspector_dock.show()
+        self.panels.inspector_dock.raise_()
 
     def _layer_selected(self, stack_id: str) -> None:
         if self.tabs.active is not self.tabs.material:
@@ -229,7 +250,7 @@ class MainWindow(QMainWindow):
         if tab is not m:
             m.canvas.set_node_errors(self.problems.material_errors())
         n = sum(1 for p in self.diagnostics.problems if p.severity == "error")  # the rows
-        self.diagnostics_dock.setWindowTitle("Diagnostics" + (f" ({n})" if n else ""))
+        self.panels.diagnostics_dock.setWindowTitle("Diagnostics" + (f" ({n})" if n else ""))
         self._retitle()
 
     def status(self, text: str) -> None:

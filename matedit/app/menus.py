@@ -2,29 +2,60 @@
 node and Frame all, Help › Node Reference) are the action table's QActions
 (`matedit.app.canvas.actions`); the window's own actions are made here.
 
-`install_menus(window)` sets the window's actions on it as ``act_*`` attributes and its
-recent-files menu as ``recent_menu``.
+`install_menus(window, host, docks)` builds them on `window`, calling `host` (a `MenuHost`:
+the slots the menus need), and returns a `Menus`: the menus by name and the actions. Every
+action made here carries an id (its objectName: "file.new", "file.export", …), and features
+add their entries relative to one (`insert_after`), never at a position.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
 
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import QMenu
+from PySide6.QtGui import QAction, QKeySequence, QUndoGroup
+from PySide6.QtWidgets import QDockWidget, QMainWindow, QMenu, QToolBar
 
 from matedit.app.canvas.actions import EDIT_MENU, VIEW_MENU
-from matedit.app.docks import panel_docks
 from matedit.app.theme import icon
+
+if TYPE_CHECKING:
+    from matedit.app.canvas_tabs import CanvasTabs
+    from matedit.app.controller import DocumentController
+    from matedit.app.document_actions import DocumentActions
+    from matedit.app.interop_actions import InteropActions
 
 K = QKeySequence.StandardKey
 
 
+class MenuHost(Protocol):
+    """What the menus need of the main window: the slots they call and where they go."""
+
+    actions: DocumentActions
+    controller: DocumentController
+    tabs: CanvasTabs
+    undo_group: QUndoGroup
+
+    def save_active(self) -> bool: ...
+    def save_active_as(self) -> bool: ...
+    def export_shaders(self) -> None: ...
+    def save_viewport_image(self) -> bool: ...
+    def close(self) -> bool: ...
+    def reset_layout(self) -> None: ...
+    def show_shortcuts(self) -> object: ...
+    def show_about(self) -> None: ...
+    def open_material(self, path: str | Path) -> bool: ...
+    def status(self, text: str) -> None: ...
+
+
+
 def make_action(parent, text: str, slot, shortcut=None, icon_name: str = "",
-                tip: str = "") -> QAction:
+                tip: str = "", action_id: str = "") -> QAction:
     a = QAction(icon(icon_name or "none"), text, parent)
+    a.setObjectName(action_id)
     if shortcut is not None:
         a.setShortcut(shortcut)
     if tip:
@@ -66,63 +97,120 @@ def _add(menu, actions) -> None:
             menu.addAction(a)
 
 
-def install_menus(w) -> None:
-    """File, Edit, View and Help menus and the toolbar of the main window `w`."""
-    canvas = w.tabs.canvas_actions
-    w.act_new = make_action(w, "&New", w.actions.new, K.New, "new", "New material")
-    w.act_open = make_action(w, "&Open…", w.actions.open_dialog, K.Open, "open",
-                             "Open a material or a material function")
-    w.act_save = make_action(w, "&Save", w.save_active, K.Save, "save",
-                             "Save the document in the active tab")
-    w.act_save_as = make_action(w, "Save &As…", w.save_active_as, K.SaveAs, "save-as")
-    w.act_export = make_action(w, "&Export Shaders…", w.export_shaders, "Ctrl+E", "export",
-                               "Write GLSL for chosen targets to a folder")
-    w.act_save_image = make_action(w, "Save &Viewport Image…",
-                                   lambda: w.viewport.save_image_dialog(), None, "save",
-                                   "The viewport's frame as PNG or linear EXR")
-    w.act_quit = make_action(w, "&Quit", w.close, K.Quit)
-    w.act_undo = w.undo_group.createUndoAction(w, "&Undo")
-    w.act_undo.setShortcut(K.Undo)
-    w.act_undo.setIcon(icon("undo"))
-    w.act_redo = w.undo_group.createRedoAction(w, "&Redo")
-    w.act_redo.setShortcut(K.Redo)
-    w.act_redo.setIcon(icon("redo"))
-    w.act_reset_layout = make_action(w, "Reset &Layout", w.reset_layout)
-    w.act_snap = make_action(w, "&Snap to Grid", w.tabs.set_snap_to_grid, None,
-                             tip="Moved nodes land on the canvas grid")
-    w.act_snap.setCheckable(True)
-    w.act_shortcuts = make_action(w, "&Keyboard Reference…", w.show_shortcuts, "Ctrl+/",
-                                  tip="Every shortcut, searchable")
-    w.act_about = make_action(w, "&About matedit", w.show_about)
+def find_action(menu: QMenu, action_id: str) -> QAction:
+    """The entry of `menu` whose id (objectName) is `action_id`; KeyError if none."""
+    for a in menu.actions():
+        if a.objectName() == action_id:
+            return a
+    raise KeyError(f"no action {action_id!r} in the {menu.title()} menu")
 
-    mb = w.menuBar()
+
+def insert_after(menu: QMenu, action_id: str, actions: Iterable[QAction | None]) -> None:
+    """Adds `actions` (None: a separator) to `menu` right after the entry `action_id`."""
+    entries = menu.actions()
+    i = entries.index(find_action(menu, action_id)) + 1
+    before = entries[i] if i < len(entries) else None
+    for a in actions:
+        if before is None:  # the last entry: append
+            menu.addSeparator() if a is None else menu.addAction(a)
+        elif a is None:
+            menu.insertSeparator(before)
+        else:
+            menu.insertAction(before, a)
+
+
+@dataclass(frozen=True)
+class Menus:
+    """The menus by name, the toolbar, and the window's own actions."""
+
+    file: QMenu
+    edit: QMenu
+    view: QMenu
+    help: QMenu
+    toolbar: QToolBar
+    recent: RecentMenu
+    interop: InteropActions
+    new: QAction
+    open: QAction
+    save: QAction
+    save_as: QAction
+    export: QAction
+    save_image: QAction
+    quit: QAction
+    undo: QAction
+    redo: QAction
+    reset_layout: QAction
+    snap: QAction
+    shortcuts: QAction
+    about: QAction
+
+
+def install_menus(window: QMainWindow, w: MenuHost, docks: Iterable[QDockWidget]) -> Menus:
+    """File, Edit, View and Help menus and the toolbar of `window`, calling `w`'s slots; the
+    View menu lists `docks`."""
+    from matedit.app.interop_actions import InteropActions
+
+    canvas = w.tabs.canvas_actions
+    new = make_action(window, "&New", w.actions.new, K.New, "new", "New material", "file.new")
+    open_ = make_action(window, "&Open…", w.actions.open_dialog, K.Open, "open",
+                        "Open a material or a material function", "file.open")
+    save = make_action(window, "&Save", w.save_active, K.Save, "save",
+                       "Save the document in the active tab", "file.save")
+    save_as = make_action(window, "Save &As…", w.save_active_as, K.SaveAs, "save-as",
+                          action_id="file.save_as")
+    export = make_action(window, "&Export Shaders…", w.export_shaders, "Ctrl+E", "export",
+                         "Write GLSL for chosen targets to a folder", "file.export")
+    save_image = make_action(window, "Save &Viewport Image…", w.save_viewport_image, None, "save",
+                             "The viewport's frame as PNG or linear EXR", "file.save_image")
+    quit_ = make_action(window, "&Quit", w.close, K.Quit, action_id="file.quit")
+    undo = w.undo_group.createUndoAction(window, "&Undo")
+    undo.setObjectName("edit.undo")
+    undo.setShortcut(K.Undo)
+    undo.setIcon(icon("undo"))
+    redo = w.undo_group.createRedoAction(window, "&Redo")
+    redo.setObjectName("edit.redo")
+    redo.setShortcut(K.Redo)
+    redo.setIcon(icon("redo"))
+    reset_layout = make_action(window, "Reset &Layout", w.reset_layout,
+                               action_id="view.reset_layout")
+    snap = make_action(window, "&Snap to Grid", w.tabs.set_snap_to_grid, None,
+                       tip="Moved nodes land on the canvas grid", action_id="view.snap")
+    snap.setCheckable(True)
+    shortcuts = make_action(window, "&Keyboard Reference…", w.show_shortcuts, "Ctrl+/",
+                            tip="Every shortcut, searchable", action_id="help.shortcuts")
+    about = make_action(window, "&About matedit", w.show_about, action_id="help.about")
+
+    mb = window.menuBar()
     f = mb.addMenu("&File")
-    _add(f, (w.act_new, w.act_open))
-    w.recent_menu = RecentMenu(w.actions, w.open_material, w)
-    f.addMenu(w.recent_menu)
-    _add(f, (None, w.act_save, w.act_save_as, None, w.act_export, w.act_save_image))
-    from matedit.app.interop_actions import install as install_interop
-    w.interop = install_interop(w, f, w.act_export)
-    _add(f, (None, w.act_quit))
+    _add(f, (new, open_))
+    recent = RecentMenu(w.actions, w.open_material, window)
+    recent.menuAction().setObjectName("file.recent")
+    f.addMenu(recent)
+    _add(f, (None, save, save_as, None, export, save_image))
+    interop = InteropActions(window, w)
+    insert_after(f, "file.export", interop.entries())
+    _add(f, (None, quit_))
 
     e = mb.addMenu("&Edit")
-    _add(e, (w.act_undo, w.act_redo, None))
+    _add(e, (undo, redo, None))
     canvas.fill(e, EDIT_MENU)
 
     v = mb.addMenu("&View")
     canvas.fill(v, VIEW_MENU)
     v.addSeparator()
-    _add(v, [d.toggleViewAction() for d in panel_docks(w)])
-    _add(v, (w.act_snap, None, w.act_reset_layout))
+    _add(v, [d.toggleViewAction() for d in docks])
+    _add(v, (snap, None, reset_layout))
 
     h = mb.addMenu("&Help")
-    h.addAction(w.act_shortcuts)
+    h.addAction(shortcuts)
     canvas.fill(h, ("node_docs",))
-    _add(h, (None, w.act_about))
+    _add(h, (None, about))
 
-    tb = w.addToolBar("Main")
+    tb = window.addToolBar("Main")
     tb.setObjectName("mainToolBar")
     tb.setMovable(False)
     tb.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
-    _add(tb, (w.act_new, w.act_open, w.act_save, None, w.act_undo, w.act_redo, None,
-              canvas["add_node"], canvas["frame_all"], None, w.act_export))
+    _add(tb, (new, open_, save, None, undo, redo, None,
+              canvas["add_node"], canvas["frame_all"], None, export))
+    return Menus(f, e, v, h, tb, recent, interop, new, open_, save, save_as, export,
+                 save_image, quit_, undo, redo, reset_layout, snap, shortcuts, about)

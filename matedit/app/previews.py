@@ -139,12 +139,16 @@ class NodePreviews(QObject):
         self._timer.setInterval(120)
         self._timer.timeout.connect(self.refresh)
         controller.structureChanged.connect(self._timer.start)
-        controller.valuesChanged.connect(self._timer.start)
+        controller.valuesChanged.connect(self._values_changed)
         controller.documentReplaced.connect(self._timer.start)
         canvas.selectionChangedIds.connect(self._selected)
         self._selection: set[str] = set()
         self._shown: set[str] = set()
         self.textures = TextureCache()
+        self._timer.start()
+
+    def _values_changed(self, _change) -> None:
+        """Any value can reach every thumbnail downstream of it: all are evaluated again."""
         self._timer.start()
 
     def images(self) -> dict[str, QImage]:

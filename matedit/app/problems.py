@@ -8,9 +8,15 @@ compiler often say the same thing), and says what the status bar should show.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from PySide6.QtCore import QObject, Signal
 
 from matedit.app.diagnostics import Problem
+
+if TYPE_CHECKING:
+    from matedit.app.compile_service import MaterialCompiler
+    from matedit.app.viewport_panel import ViewportPanel
 
 
 def unique(problems: list[Problem]) -> list[Problem]:
@@ -29,7 +35,7 @@ class ProblemsModel(QObject):
 
     changed = Signal()
 
-    def __init__(self, compiler, view, parent=None) -> None:
+    def __init__(self, compiler: MaterialCompiler, view: ViewportPanel, parent=None) -> None:
         super().__init__(parent)
         self.compiler = compiler
         self.compile: list[Problem] = []
@@ -53,8 +59,7 @@ class ProblemsModel(QObject):
         self.changed.emit()
 
     def _shows_material(self) -> bool:
-        shows = getattr(self.view, "shows_material", None)
-        return bool(shows()) if callable(shows) else True
+        return self.view.shows_material()
 
     def _failed(self, diagnostics) -> None:
         self.compile = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "",

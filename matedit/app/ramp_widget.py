@@ -205,11 +205,16 @@ class RampEditor(QWidget):
         self.color.edited.connect(self._recolour)
         self.add_button.clicked.connect(self._add_in_widest_gap)
         self.remove_button.clicked.connect(self.remove_stop)
-        controller.valuesChanged.connect(self.refresh)
+        controller.valuesChanged.connect(self._values_changed)
         self.refresh()
 
     def _node(self):
         return self.controller.document.graph.nodes.get(self.node_id)
+
+    def _values_changed(self, change) -> None:
+        """Another node's edit leaves the ramp as it is (`change`: a ValueChange)."""
+        if change.touches(self.node_id):
+            self.refresh()
 
     def refresh(self) -> None:
         node = self._node()

@@ -1,0 +1,491 @@
+"""The viewport panel: the GL view (`matedit.app.viewport`) under its tool bar (mesh, IBL
+mode, shading view, environment, exposure, save, camera reset), with the notices laid over
+it (previewing a socket, a material that does not compile) and the view state kept across
+restarts and stored with documents."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDoubleSpinBox,
+    QHBoxLayout,
+    QLabel,
+    QSlider,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from matedit.app import file_dialogs
+from matedit.app.compile_service import MaterialCompiler, uniform_values, uniforms_by_port
+from matedit.app.controller import ValueChange
+from matedit.app.environment import ENVIRONMENTS, EnvironmentChoice, environment_combo
+from matedit.app.paths import texture_paths
+from matedit.app.theme import icon
+from matedit.app.viewport import ViewportWidget
+from matedit.shading.views import VIEWS
+
+MESHES = ("sphere", "cube", "plane", "cylinder")
+VIEW_TIPS = {
+    "lit": "Every lobe",
+    "base": "The base's diffuse and specular only",
+    "coat": "The clear coat's reflection only",
+    "sheen": "The sheen only",
+    "specular": "Every specular reflection: the base's and the coat's",
+    "roughness": "Roughness as a grey level (linear)",
+    "normal": "The world shading normal, N / 2 + 1/2",
+    "coat-weight": "The clear coat's weight as a grey level (linear)",
+    "anisotropy": "Stripes along the anisotropy direction over the dimmed surface; grey to "
+                  "amber with the anisotropy",
+}
+MODES = {"Split-sum": "splitsum", "Reference": "reference", "Difference": "difference"}
+SAVE_FILTER = "PNG image, as shown (*.png);;OpenEXR, linear radiance (*.exr)"
+
+
+class ViewportPanel(QWidget):
+    """The viewport with its bar: mesh, IBL mode (difference mean), exposure, environment."""
+
+    environmentChanged = Signal(str)  # the EnvironmentChoice's `changed`
+    statusMessage = Signal(str)
+    glErrors = Signal(list)  # the view's: [(node id, message)] when a program fails to build
+    materialApplied = Signal(bool)
+
+    def __init__(self, compiler: MaterialCompiler, parent=None) -> None:
+        super().__init__(parent)
+        self.compiler = compiler
+        self.controller = compiler.controller
+        lay = QVBoxLayout(self)
+        lay.setContentsMargins(0, 0, 0, 0)
+        lay.setSpacing(0)
+        bar = QWidget()
+        bar.setObjectName("viewportBar")
+        bl = QHBoxLayout(bar)
+        bl.setContentsMargins(4, 3, 4, 3)
+        bl.setSpacing(4)
+        self.mesh_combo = QComboBox()
+        self.mesh_combo.addItems(list(MESHES))
+        self.mesh_combo.setToolTip("Preview mesh")
+        self.mode_combo = QComboBox()
+        self.mode_combo.addItems(list(MODES))
+        self.mode_combo.setToolTip("Image-based lighting: split-sum approximation, brute-force "
+                                   "reference, or their difference")
+        self.view_combo = QComboBox()
+        self.view_combo.setObjectName("viewChooser")
+        for i, (name, (title, _, attribute)) in enumerate(VIEWS.items()):
+            if attribute is not None and VIEWS[list(VIEWS)[i - 1]][2] is None:
+                self.view_combo.insertSeparator(self.view_combo.count())
+            self.view_combo.addItem(title, name)
+            self.view_combo.setItemData(self.view_combo.count() - 1, VIEW_TIPS[name],
+                                        Qt.ItemDataRole.ToolTipRole)
+        self.view_combo.setToolTip("What the viewport shows: the lit material, some of its "
+                                   "lobes only, or one of its fields")
+        self.view = ViewportWidget()
+        self.environment = EnvironmentChoice(self.view, self, self)
+        self.env_combo = environment_combo(self.environment)
+        self.env_combo.setToolTip("Environment lighting")
+        self.exposure = QSlider(Qt.Orientation.Horizontal)
+        self.exposure.setRange(-60, 60)  # tenths of EV: the arrow keys step 0.1 EV
+        self.exposure.setSingleStep(1)
+        self.exposure.setPageStep(10)
+        self.exposure.setMinimumWidth(140)
+        self.exposure.setToolTip("Exposure (EV); arrow keys step 0.1 EV, Page Up/Down 1 EV")
+        self.exposure_spin = QDoubleSpinBox()
+        self.exposure_spin.setRange(-6.0, 6.0)
+        self.exposure_spin.setDecimals(1)
+        self.exposure_spin.setSingleStep(0.1)
+        self.exposure_spin.setSuffix(" EV")
+        self.exposure_spin.setKeyboardTracking(False)
+        self.exposure_spin.setToolTip("Exposure in EV (type a value; arrow keys step 0.1)")
+        # Laid over the view's bottom edge (placed with the banner): its text never moves
+        # anything, and it takes no room from the bar.
+        self.diff_label = QLabel("", self)
+        self.diff_label.setObjectName("diffMean")
+        self.diff_label.setStyleSheet("background: rgba(20, 22, 27, 170); color: #d5d9e0;"
+                                      " padding: 1px 6px;")
+        self.diff_label.hide()
+        self.diff_label.setToolTip("Reference and difference modes: samples a pixel so far, "
+                                   "and the mean difference from the split-sum image")
+        self.save_button = QToolButton()
+        self.save_button.setIcon(icon("save"))
+        self.save_button.setToolTip("Save the viewport image (PNG as shown, or linear EXR)")
+        self.save_button.clicked.connect(self.save_image_dialog)
+        reset = QToolButton()
+        reset.setIcon(icon("reset"))
+        reset.setToolTip("Reset the camera (or double-click the view)")
+        for w in (self.mesh_combo, self.mode_combo, self.view_combo, self.env_combo):
+            bl.addWidget(w)
+        bl.addWidget(self.exposure, 1)
+        bl.addWidget(self.exposure_spin)
+        bl.addStretch(1)
+        bl.addWidget(self.save_button)
+        bl.addWidget(reset)
+        lay.addWidget(bar)
+        self.banner = QWidget(self)  # laid over the view's top edge: the view keeps its size
+        self.banner.setObjectName("previewBanner")
+        self.banner.setStyleSheet("#previewBanner { background: #6b4f12; }")
+        bn = QHBoxLayout(self.banner)
+        bn.setContentsMargins(8, 2, 4, 2)
+        self.banner_label = QLabel("")
+        self.banner_label.setStyleSheet("color: #ffe7a8; font-weight: bold;")
+        self.banner_clear = QToolButton()
+        self.banner_clear.setText("Show material")
+        self.banner_clear.setToolTip("Stop previewing the node: show the whole material again")
+        self.banner_clear.clicked.connect(lambda: compiler.set_preview(None))
+        bn.addWidget(self.banner_label, 1)
+        bn.addWidget(self.banner_clear)
+        self.banner.hide()
+        lay.addWidget(self.view, 1)
+        self.failure = self._failure_notice()  # laid over the view: "does not compile"
+        self.save_dialog = file_dialogs.save_file  # tests replace it
+        self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment
+        self.mesh_combo.currentTextChanged.connect(self.view.set_mesh)
+        self.mode_combo.currentTextChanged.connect(self._mode_changed)
+        self.view_combo.currentIndexChanged.connect(self._view_changed)
+        self.exposure.valueChanged.connect(self._exposure_changed)
+        self.exposure_spin.valueChanged.connect(
+            lambda ev: self.exposure.setValue(int(round(ev * 10))))
+        self.environment.changed.connect(self.environmentChanged)
+        reset.clicked.connect(lambda: self.view.renderer and (self.view.renderer.camera.reset(),
+                                                              self.view.update()))
+        self.view.frameDrawn.connect(self._frame_drawn)
+        self.view.statusMessage.connect(self.statusMessage)
+        self.view.glErrors.connect(self.glErrors)
+        self.view.materialApplied.connect(self.materialApplied)
+        compiler.compiled.connect(self.on_compiled)
+        compiler.failed.connect(self._compile_failed)
+        compiler.documentChanged.connect(self._document_changed)
+        self.view.glErrors.connect(self._gl_failed)
+        self.view.materialApplied.connect(lambda ok: ok and self._hide_failure())
+        compiler.viewport_state = self.view.viewport_state
+        compiler.previewChanged.connect(self._preview_changed)
+        self.controller.valuesChanged.connect(self._values_changed)
+        self._by_port: tuple[object, dict] = (None, {})  # (compiled, uniforms_by_port)
+
+    # --- material --------------------------------------------------------------------------
+    def on_compiled(self, compiled) -> None:
+        self.view.set_material(compiled)
+        self.push_values()
+
+    # --- a document with nothing to draw -------------------------------------------------
+    def _failure_notice(self) -> QWidget:
+        box = QWidget(self)
+        box.setObjectName("noMaterial")
+        box.setStyleSheet("#noMaterial { background: rgba(28, 20, 22, 225);"
+                          " border: 1px solid #b04a4a; border-radius: 4px; }")
+        bl = QVBoxLayout(box)
+        bl.setContentsMargins(14, 10, 14, 12)
+        bl.setSpacing(6)
+        self.failure_title = QLabel("")
+        self.failure_title.setStyleSheet("color: #ff9c9c; font-weight: bold; font-size: 13pt;"
+                                         " background: transparent; border: none;")
+        self.failure_title.setAlignment(Qt.AlignmentFlag.AlignHCenter)
+        self.failure_text = QLabel("")
+        self.failure_text.setWordWrap(True)
+        self.failure_text.setStyleSheet("color: #e4d6d6; background: transparent;"
+                                        " border: none;")
+        bl.addWidget(self.failure_title)
+        bl.addWidget(self.failure_text)
+        box.hide()
+        return box
+
+    def shows_material(self) -> bool:
+        """Whether the view draws a material of the open document (False: the notice)."""
+        return self.view.has_material and self.failure.isHidden()
+
+    @property
+    def failure_message(self) -> str:
+        """The notice's title and text while it is shown, else ""."""
+        if self.failure.isHidden():
+            return ""
+        return f"{self.failure_title.text()}\n{self.failure_text.text()}"
+
+    def _document_changed(self) -> None:
+        self.view.clear_material()
+        self._hide_failure()
+
+    def _compile_failed(self, diagnostics) -> None:
+        """A compile failed: with an earlier good version of this document the view keeps
+        drawing it; without one it draws no material and says why."""
+        if self.compiler.latest is not None and self.view.has_material:
+            return
+        self.view.clear_material()
+        errors = [d.format() for d in diagnostics if d.severity.value == "error"]
+        self._show_failure("This material does not compile",
+                           errors or [d.format() for d in diagnostics])
+
+    def _gl_failed(self, errors) -> None:
+        if self.view.has_material:
+            return  # this document's last good program is still drawn
+        self._show_failure("This material's GLSL does not build",
+                           [f"node {nid}: {msg}" if nid else str(msg) for nid, msg in errors])
+
+    def _show_failure(self, title: str, lines: list[str]) -> None:
+        shown = [line if len(line) <= 300 else line[:297] + "…" for line in lines[:4]]
+        more = len(lines) - len(shown)
+        text = "\n".join(f"• {line}" for line in shown)
+        if more > 0:
+            text += f"\n… and {more} more"
+        text += "\n\nThe viewport shows no material until it compiles. " \
+                "The errors are listed in Diagnostics."
+        self.failure_title.setText(title)
+        self.failure_text.setText(text.strip())
+        self.failure.show()
+        self.failure.raise_()
+        self._place_banner()
+
+    def _hide_failure(self) -> None:
+        self.failure.hide()
+
+    def push_values(self) -> None:
+        """Every uniform and texture of the material, from the document."""
+        cm = self.compiler.latest  # never waits for a compile in flight
+        if cm is None:
+            return
+        doc = self.controller.document
+        self.view.set_values(uniform_values(cm, doc), texture_paths(cm, doc))
+
+    def _values_changed(self, change: ValueChange) -> None:
+        """One port's edit sets the uniforms that read it; a setting (a texture's path), many
+        values at once, or a view whose GL is not up yet gets everything."""
+        cm = self.compiler.latest
+        if cm is None:
+            return
+        if change.many or change.setting or self.view.renderer is None:
+            self.push_values()
+            return
+        if self._by_port[0] is not cm:
+            self._by_port = (cm, uniforms_by_port(cm))
+        uniforms = self._by_port[1].get((change.node, change.port))
+        if uniforms:
+            self.view.set_values(uniform_values(cm, self.controller.document, uniforms), {})
+
+    # --- the typed interface the window uses ------------------------------------------------
+    def set_lights(self, lights: list) -> None:
+        self.view.set_lights(lights)
+
+    def renderer_lights(self) -> list | None:
+        """The renderer's light rig once it runs; None while it starts; [] if it cannot."""
+        if self.view.renderer is not None:
+            return self.view.lights
+        return [] if self.view.problem else None
+
+    def gl_renderer(self) -> str:
+        return self.view.gl_renderer()
+
+    # --- saving the picture; dropped environments -------------------------------------------
+    def save_image_dialog(self) -> bool:
+        path, _ = self.save_dialog(self, "Save the viewport image", "viewport.png",
+                                   SAVE_FILTER)
+        return bool(path) and self.save_image(path)
+
+    def _inputs(self) -> dict[Path, str]:
+        """Files the document reads (matedit.io.inputs: the document, its functions and
+        layers, every texture, live or not), and the viewport's environment file."""
+        from matedit.io.inputs import document_inputs
+
+        out = document_inputs(self.controller.document, self.controller.resolver)
+        if self.environment.is_file():
+            out.setdefault(Path(os.path.realpath(self.environment.current)), "the environment")
+        return out
+
+    def save_image(self, path: str | Path) -> bool:
+        """The current frame as PNG (display-referred, as shown) or as EXR (scene-linear
+        radiance, before exposure and display transform)."""
+        path = Path(path)
+        if path.suffix.lower() not in (".png", ".exr"):
+            path = path.with_suffix(path.suffix + ".png") if path.suffix else \
+                path.with_suffix(".png")
+        from matedit.io.inputs import OverwriteError, refuse_overwrite
+
+        try:
+            refuse_overwrite([path], self._inputs())
+        except OverwriteError:
+            self.statusMessage.emit(f"{path.name} is a file the material reads: not "
+                                    "overwritten")
+            return False
+        if self.view.renderer is None:
+            self.statusMessage.emit("no image to save: the renderer is not running")
+            return False
+        try:
+            if path.suffix.lower() == ".exr":
+                from matedit.io.images import write_image
+
+                write_image(path, self.view.read_hdr())
+            else:
+                from PySide6.QtCore import QBuffer, QByteArray, QIODevice
+
+                from matedit.io.atomic import atomic_write_bytes
+
+                data = QByteArray()
+                buf = QBuffer(data)
+                buf.open(QIODevice.OpenModeFlag.WriteOnly)
+                if not self.view.grabFramebuffer().save(buf, "PNG"):
+                    raise OSError("PNG encoding failed")
+                buf.close()
+                atomic_write_bytes(path, bytes(data.data()))
+        except (OSError, ValueError) as exc:
+            self.statusMessage.emit(f"cannot save {path.name}: {exc}")
+            return False
+        self.statusMessage.emit(f"saved the viewport image to {path}")
+        return True
+
+    @staticmethod
+    def _dropped_environment(mime) -> str:
+        for url in mime.urls() if mime.hasUrls() else []:
+            p = url.toLocalFile()
+            if p and Path(p).suffix.lower() in (".hdr", ".exr"):
+                return p
+        return ""
+
+    def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._dropped_environment(event.mimeData()):
+            event.acceptProposedAction()
+        else:
+            event.ignore()
+
+    def dragMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        self.dragEnterEvent(event)
+
+    def dropEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        path = self._dropped_environment(event.mimeData())
+        if not path:
+            event.ignore()
+            return
+        event.acceptProposedAction()
+        self.choose_environment(path)
+
+    def _preview_changed(self, target) -> None:
+        if target is None:
+            self.banner.hide()
+            return
+        self.banner_label.setText(f"Previewing {target.label()}, not the material")
+        self._place_banner()
+        self.banner.show()
+        self.banner.raise_()
+
+    def _place_banner(self) -> None:
+        g = self.view.geometry()
+        self.banner.setGeometry(g.x(), g.y(), g.width(), self.banner.sizeHint().height())
+        if not self.failure.isHidden():
+            width = max(120, min(g.width() - 24, 560))
+            height = min(g.height() - 16, self.failure.heightForWidth(width)
+                         if self.failure.hasHeightForWidth() else
+                         self.failure.sizeHint().height())
+            self.failure.setGeometry(g.x() + (g.width() - width) // 2,
+                                     g.y() + max(8, (g.height() - height) // 2),
+                                     width, max(40, height))
+        self.diff_label.adjustSize()
+        self.diff_label.move(g.x() + 4, g.y() + g.height() - self.diff_label.height() - 4)
+
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        self._place_banner()
+
+    # --- bar -------------------------------------------------------------------------------
+    def _mode_changed(self, text: str) -> None:
+        self.view.set_mode(MODES[text])
+        self.diff_label.setText("")
+        self.diff_label.setVisible(MODES[text] != "splitsum")
+
+    def _view_changed(self, index: int) -> None:
+        view = self.view_combo.itemData(index)
+        if isinstance(view, str):  # not a separator
+            self.view.set_view(view)
+            if self.view.shading_view != view:  # refused (a failed link): show what is drawn
+                self.set_view(self.view.shading_view)
+
+    def set_view(self, view: str) -> None:
+        """Chooses a view (matedit.shading.views name) as the chooser does."""
+        self.view_combo.setCurrentIndex(self.view_combo.findData(view))
+
+    def _exposure_changed(self, tenths: int) -> None:
+        ev = tenths / 10.0
+        self.exposure_spin.blockSignals(True)
+        self.exposure_spin.setValue(ev)
+        self.exposure_spin.blockSignals(False)
+        self.view.set_exposure(ev)
+
+    def _frame_drawn(self) -> None:
+        r = self.view.renderer
+        if r is None or r.mode == "splitsum":
+            return
+        total = r.reference_frames * r.reference_samples
+        done = min(r.accumulated_frames, r.reference_frames) * r.reference_samples
+        text = f"{done}/{total} samples" if not r.converged else f"{total} samples"
+        if r.mode == "difference" and r.converged:
+            mean = r.difference_mean
+            if mean is not None:
+                text += f" · mean |Δ| {float(mean):.4f}"
+        self.diff_label.setText(text)
+        self._place_banner()
+        self.diff_label.raise_()
+
+    def view_state(self) -> dict:
+        """Mesh, mode, exposure, environment and energy compensation, as remembered across
+        restarts."""
+        return {"mesh": self.mesh_combo.currentText(), "mode": self.mode_combo.currentText(),
+                "exposure": self.exposure.value() / 10.0,
+                "environment": self.environment.current,
+                "energy_compensation": self.view.settings.energy_compensation}
+
+    def restore_view_state(self, state: dict) -> None:
+        mesh, mode = state.get("mesh"), state.get("mode")
+        if isinstance(mesh, str) and mesh in MESHES:
+            self.mesh_combo.setCurrentText(mesh)
+        if isinstance(mode, str) and mode in MODES:
+            self.mode_combo.setCurrentText(mode)
+        ev = state.get("exposure")
+        if isinstance(ev, (int, float)):
+            self.exposure.setValue(int(round(float(ev) * 10)))
+        energy = state.get("energy_compensation")
+        if isinstance(energy, bool):
+            self.view.change_settings(energy_compensation=energy)
+        env = state.get("environment")
+        if isinstance(env, str) and env and env != self.environment.current and (
+                env in ENVIRONMENTS.values() or Path(env).is_file()):
+            self.choose_environment(env)
+
+    def document_preview(self, saved_as: Path) -> dict:
+        """The mesh and environment to store in a document saved as `saved_as`: a user HDR
+        as a path relative to the document, like every reference it holds."""
+        from matedit.io.inputs import as_reference
+
+        env = self.environment.current
+        if env not in ENVIRONMENTS.values():
+            try:  # a file named like a built-in is written as ./studio
+                env = as_reference(Path(os.path.relpath(Path(env).resolve(), Path(
+                    saved_as).resolve().parent)).as_posix(), "environment")
+            except ValueError:  # another drive
+                env = Path(env).resolve().as_posix()
+        return {"mesh": self.mesh_combo.currentText(), "environment": env}
+
+    def set_preview(self, preview: dict, doc_path: Path | None = None) -> None:
+        """Mesh and environment stored with a document (a file relative to `doc_path`)."""
+        from matedit.io.inputs import BUILTIN_PREFIX
+
+        mesh = preview.get("mesh")  # `cube` or `builtin:cube`
+        if isinstance(mesh, str) and mesh.removeprefix(BUILTIN_PREFIX) in MESHES:
+            self.mesh_combo.setCurrentText(mesh.removeprefix(BUILTIN_PREFIX))
+        env = preview.get("environment")
+        if not isinstance(env, str) or not env:
+            return
+        if env.removeprefix(BUILTIN_PREFIX) in ENVIRONMENTS.values():
+            env = env.removeprefix(BUILTIN_PREFIX)
+        else:
+            p = Path(env)
+            if not p.is_absolute() and doc_path is not None:
+                p = Path(doc_path).resolve().parent / p
+            if not p.is_file():
+                self.statusMessage.emit(f"the document's environment {env} is missing")
+                return
+            env = str(p.resolve())
+        if env != self.environment.current:
+            self.choose_environment(env)
+
+    def choose_environment(self, spec: str) -> bool:
+        """Bakes `spec` (studio, sky or a file) with a progress dialog; False on a bad file."""
+        return self.environment.choose(spec)
