@@ -12,6 +12,7 @@ the representative-point lights, evaluated by matedit.shading (the numpy twin th
 to the GLSL at 1e-4; `--gpu` evaluates the GLSL itself), for the widening divisor of
 a' = a + r / (c d): c = 3 (docs/shading.md's reading, before) and c = 2 (the default now).
 The tests (tests/test_shading_light_energy.py) check a subset on the GPU.
+The sheen lobe's sphere lights are measured against its own brute force (sheen_table).
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ import matedit.shading.anisotropy as anisotropy  # noqa: E402
 import matedit.shading.brdf as brdf  # noqa: E402
 import matedit.shading.coat as coat  # noqa: E402
 import matedit.shading.lights as lights  # noqa: E402
+import matedit.shading.sheen as sheen  # noqa: E402
 
 D = 2.0
 TILT = math.radians(45.0)  # the second sphere table: the light 45 degrees off the normal
@@ -231,6 +233,81 @@ def goal(spheres, tilted, tubes) -> str:
             f"{'met' if ok else 'missed'}; range {min(inside):.2f} .. {max(inside):.2f}")
 
 
+# -- the sheen lobe (issue 23): its lights against its own brute force -----------------------
+
+SHEEN_ROUGHNESS = (0.3, 0.5, 0.7, 1.0)
+
+
+def _no_lut(NoV, r):
+    """E = 0: the base is black here, so its albedo scaling does not matter."""
+    return np.zeros(np.broadcast_shapes(np.shape(NoV), np.shape(r)) + (3,))
+
+
+def _twin_sheen(V, kind, radius, length, rough, tilt=0.0):
+    """The sheen lobe alone: base black (no diffuse, its specular scaled to 0), a white sheen
+    of roughness `rough` on N = +Z, lit by the light as the renderer lights it (sphere and
+    tube towards the light's centre, sheen_shading.glsl)."""
+    n = len(V)
+    N = np.tile([0.0, 0.0, 1.0], (n, 1))
+    s = lights.makeShadingContext(np.zeros((n, 3)), N, V, np.zeros((n, 3)), np.zeros((n, 3)),
+                                  np.full(n, 0.9))
+    s.specularScale = 0.0
+    white = np.ones((n, 3))
+    sheen.setupSheen(s, white, np.full(n, rough), white, _no_lut)
+    pos = (D * math.sin(tilt), 0.0, D * math.cos(tilt))
+    light = lights.Light(kind, position=pos, direction=(1.0, 0.0, 0.0),
+                         intensity=1.0, influence_radius=1e4, source_radius=radius,
+                         source_length=length)
+    return lights.evaluateLight(s, light)[:, 0]
+
+
+def _sheen_true_of_view(V, radius, rough, n_cos=48, n_phi=96):
+    """Brute force: the radiance the white sheen reflects towards each V from a uniform sphere
+    light of radius `radius` straight above at D (Le = I / (pi r^2)), by a midpoint grid over
+    the light's cone in (cos, phi), uniform in solid angle."""
+    cos_max = math.sqrt(max(1.0 - (radius / D) ** 2, 0.0))
+    c = 1.0 - (np.arange(n_cos) + 0.5) / n_cos * (1.0 - cos_max)
+    phi = (np.arange(n_phi) + 0.5) / n_phi * 2.0 * math.pi
+    C, P = np.meshgrid(c, phi, indexing="ij")
+    S = np.sqrt(1.0 - C * C)
+    L = np.stack([S * np.cos(P), S * np.sin(P), C], -1).reshape(-1, 3)
+    d_omega = 2.0 * math.pi * (1.0 - cos_max) / len(L)
+    Le = 1.0 / (math.pi * radius * radius)
+    N = np.array([0.0, 0.0, 1.0])
+    alpha = sheen.sheenAlpha(rough)
+    out = np.empty(len(V))
+    for i, v in enumerate(V):
+        f = sheen.sheenBRDF(N, v, L, alpha) * L[:, 2]
+        out[i] = Le * float(f.sum()) * d_omega
+    return out
+
+
+def sheen_table(quick: bool) -> list:
+    """Sphere lights straight above: rendered / brute-force sheen exitance."""
+    n_view = 400 if quick else 1500
+    rows = []
+    for rd in SPHERE_RD:
+        row = []
+        for rough in SHEEN_ROUGHNESS:
+            true = exitance_axisymmetric(
+                lambda V, rd=rd, rough=rough: _sheen_true_of_view(V, rd * D, rough), n=n_view)
+            e = exitance_axisymmetric(
+                lambda V, rd=rd, rough=rough: _twin_sheen(V, "sphere", rd * D, 0.0, rough),
+                n=n_view)
+            row.append(e / true)
+        rows.append((rd, row))
+    return rows
+
+
+def sheen_markdown(rows) -> str:
+    head = "| light | " + " | ".join(f"sheen rough {r}" for r in SHEEN_ROUGHNESS) + " |"
+    lines = ["**sheen lobe: rendered / brute-force sheen energy, sphere light straight above, "
+             "numpy twin**", "", head, "|---|" + "---|" * len(SHEEN_ROUGHNESS)]
+    for rd, row in rows:
+        lines.append(f"| sphere r/d {rd} | " + " | ".join(f"{x:.3f}" for x in row) + " |")
+    return "\n".join(lines)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
@@ -265,6 +342,10 @@ def main() -> int:
                            spheres, tilted, tubes))
             print()
             print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
+            print()
+            t0 = time.perf_counter()
+            print(sheen_markdown(sheen_table(args.quick)))
+            print(f"[{time.perf_counter() - t0:.1f} s]")
             print()
         if ctx is None:
             # the anisotropic lobe: representative point along the bent reflection, widening

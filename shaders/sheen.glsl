@@ -7,9 +7,12 @@
 #include "common.glsl"
 #include "sampling.glsl"
 
-// Smallest perceptual sheen roughness: the Charlie exponent 1 / alpha grows without bound as
-// alpha -> 0 (the LUT bake clamps the same way, so its low rows equal this one).
-const float MIN_SHEEN_ROUGHNESS = 0.07;
+// Smallest perceptual sheen roughness. Below ~0.26 Estevez and Kulla's fitted Lambda lets the
+// lobe's directional albedo exceed 1 at grazing views (up to 2.9 at 0.07, 1.15 at 0.2, measured
+// by brute force), which the albedo scaling of the base cannot conserve; at 0.3 the albedo stays
+// below 0.93 for every NoV (tests/test_lobe_sheen.py). The LUT bake clamps the same way, so
+// its low rows equal this one.
+const float MIN_SHEEN_ROUGHNESS = 0.3;
 
 // alpha of the sheen from its perceptual roughness, clamped away from 0.
 float sheenAlpha(float sheenRoughness) {
@@ -57,7 +60,7 @@ float sheenLambda(float NoX, float alpha) {
 // Lambda. Chosen over Neubelt and Pettineo's 1 / (4 (NoL + NoV - NoL NoV)) (Filament's
 // cloth) because that one is not a shadowing term: its albedo reaches 1.35 at roughness 0.3 at
 // grazing views (tests/test_lobe_sheen.py), which no albedo scaling can conserve; with the
-// fitted Lambda it stays below 0.93 for roughness >= 0.3. The paper's terminator softening
+// fitted Lambda it stays below 0.95 for roughness >= 0.3 (MIN_SHEEN_ROUGHNESS). The paper's terminator softening
 // (Lambda(NoL)^(1 + 2 (1 - NoL)^8)) is left out: it breaks reciprocity and energy bounds.
 float V_Charlie(float NoV, float NoL, float alpha) {
     // Estevez and Kulla 2017, "Production Friendly Microfacet Sheen BRDF":

@@ -20,7 +20,9 @@ from matedit.shading.ibl import (
 )
 from matedit.shading.sampling import tangentFrame
 
-MIN_SHEEN_ROUGHNESS = 0.07
+# Smallest sheen roughness: below ~0.26 the fitted Lambda lets the lobe's directional albedo
+# exceed 1 at grazing views (sheen.glsl); at 0.3 it stays below 0.93 for every NoV.
+MIN_SHEEN_ROUGHNESS = 0.3
 
 
 def sheenAlpha(sheenRoughness) -> np.ndarray:
