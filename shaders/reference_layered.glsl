@@ -66,11 +66,16 @@ vec3 layeredBrdfCosine(LayeredReference r, vec3 L) {
     // Filament Materials documentation, "Clear coat"; glTF KHR_materials_sheen albedo scaling
     ShadingContext s = r.s;
     vec3 f;
+    // A half vector below a lobe's normal (V under that normal's horizon: normal maps) gets
+    // none of the lobe, as referenceBrdfCosine: its sampling cannot reach it, and D's
+    // cross-product form would be unbounded there (H = -N) with a density of 0.
+    vec3 H = normalize(L + s.V);
 #if defined(MATERIAL_HAS_ANISOTROPY)
     float NoL = dot(s.N, L);
-    f = NoL > 0.0 ? s.diffuseColor * (INV_PI * NoL)
-                    + anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L) * s.specularScale
-                  : vec3(0.0);
+    f = NoL > 0.0 ? s.diffuseColor * (INV_PI * NoL) : vec3(0.0);
+    if (NoL > 0.0 && dot(s.N, H) > 0.0) {
+        f += anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L) * s.specularScale;
+    }
 #else
     f = referenceBrdfCosine(r.base, L);
 #endif
@@ -79,7 +84,8 @@ vec3 layeredBrdfCosine(LayeredReference r, vec3 L) {
       + sheenBrdfCosine(s.N, s.V, L, s.sheenColor, s.sheenAlpha);
 #endif
 #if defined(MATERIAL_HAS_COAT)
-    f = f * coatTransmittance(s.coat, dot(s.coat.N, L)) + vec3(coatBrdfCosine(s.coat, s.V, L));
+    f *= coatTransmittance(s.coat, dot(s.coat.N, L));
+    if (dot(s.coat.N, H) > 0.0) f += vec3(coatBrdfCosine(s.coat, s.V, L));
 #endif
     return f;
 }

@@ -68,11 +68,15 @@ def makeLayeredReference(s: ShadingContext, roughness) -> LayeredReference:
 def layeredBrdfCosine(r: LayeredReference, L) -> np.ndarray:
     """f(l, v) N.l of the layered BRDF towards L, in lights.glsl's order of layers."""
     s, L = r.s, f64(L)
+    # no lobe where the half vector is below its normal (the GLSL's comment)
+    h = L + s.V
+    H = h / np.sqrt(np.maximum(dot(h, h), 1e-30))[..., None]
     if s.aniso is not None:
         NoL = dot(s.N, L)
+        spec = _aniso.anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L) * f64(
+            s.specularScale)
         f = (f64(s.diffuseColor) * (INV_PI * NoL)[..., None]
-             + _aniso.anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L)
-             * f64(s.specularScale))
+             + np.where((dot(s.N, H) > 0.0)[..., None], np.nan_to_num(spec), 0.0))
         f = np.where((NoL > 0.0)[..., None], f, 0.0)
     else:
         f = referenceBrdfCosine(r.base, L)
@@ -80,8 +84,9 @@ def layeredBrdfCosine(r: LayeredReference, L) -> np.ndarray:
         f = (f * _sheen.sheenBaseScale(s, saturate(dot(s.N, L)))[..., None]
              + _sheen.sheenBrdfCosine(s.N, s.V, L, s.sheenColor, s.sheenAlpha))
     if s.coat is not None:
-        f = (f * _coat.coatTransmittance(s.coat, dot(s.coat.N, L))
-             + _coat.coatBrdfCosine(s.coat, s.V, L)[..., None])
+        coat = np.where(dot(s.coat.N, H) > 0.0, np.nan_to_num(
+            _coat.coatBrdfCosine(s.coat, s.V, L)), 0.0)
+        f = f * _coat.coatTransmittance(s.coat, dot(s.coat.N, L)) + coat[..., None]
     return f
 
 
