@@ -171,30 +171,4 @@ vec3 coatSampleDirection(CoatContext c, vec3 V, vec2 Xi, out float pdf) {
     return L;
 }
 
-// The coat's image-based light by importance sampling its lobe (reference mode), and the
-// base's reference seen through the coat as in the split sum. With L from the coat's GGX
-// sampling, f NoL / pdf = F G VoH / (NoH NoV), evaluated in that form (no D / D).
-vec3 coatReferenceIBL(CoatContext c, vec3 V, vec3 baseIbl, samplerCube env, uint sampleCount,
-                      vec2 offset, float intensity) {
-    // Karis 2013, "Real Shading in Unreal Engine 4", SpecularIBL, on the coat's normal
-    float a = coatReferenceAlpha(c);
-    float k = k_IBL(a);
-    vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < sampleCount; i++) {
-        vec2 Xi = rotatedHammersley(i, sampleCount, offset);
-        vec3 H = importanceSampleGGX(Xi, a, c.N);
-        vec3 L = 2.0 * dot(V, H) * H - V;
-        float NoL = saturate(dot(c.N, L));
-        float NoH = saturate(dot(c.N, H));
-        float VoH = saturate(dot(V, H));
-        if (NoL > 0.0) {
-            float G = G1_Schlick(NoL, k) * G1_Schlick(c.NoV, k);
-            float F = c.F0 + (1.0 - c.F0) * Fc_Exact(VoH);
-            sum += textureLod(env, L, 0.0).rgb * (F * G * VoH / max(NoH * c.NoV, 1e-8));
-        }
-    }
-    float coat = c.weight * c.scale * intensity / float(sampleCount);
-    return baseIbl * coatTransmittance(c, c.NoV) + sum * coat;
-}
-
 #endif

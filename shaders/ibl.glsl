@@ -182,25 +182,35 @@ vec3 referenceBrdfCosine(ReferenceSurface s, vec3 L) {
     return diffuse + (D * Vis * NoL) * F_SchlickExact(s.F0, VoH) * s.specularScale;
 }
 
+// Solid-angle density of L under the reference's GGX half-vector sampling, D NoH / (4 VoH)
+// (Walter et al. 2007); 0 where L + V vanishes or V.H <= 0.
+float referenceGgxPdf(ReferenceSurface s, vec3 L) {
+    // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38
+    vec3 h = L + s.V;
+    float hh = dot(h, h);
+    if (hh < 1e-12) return 0.0;
+    vec3 H = h * inversesqrt(hh);
+    float VoH = dot(s.V, H);
+    if (VoH <= 0.0) return 0.0;
+    float NoH = saturate(dot(s.N, H));
+    vec3 NxH = cross(s.N, H);
+    return D_GGX(NoH, referenceAlpha(s), dot(NxH, NxH)) * NoH / (4.0 * VoH);
+}
+
+// A direction from the reference's GGX lobe for the point Xi (may lie below the horizon).
+vec3 referenceGgxSample(ReferenceSurface s, vec2 Xi) {
+    // Karis 2013, ImportanceSampleGGX, then L = 2 (V.H) H - V
+    vec3 H = importanceSampleGGX(Xi, referenceAlpha(s), s.N);
+    return 2.0 * dot(s.V, H) * H - s.V;
+}
+
 // Solid-angle density of L under referenceBrdfSample: the mixture of NoL / pi and the GGX
-// half-vector density D NoH / (4 VoH) (Walter et al. 2007).
+// half-vector density.
 float referenceBrdfPdf(ReferenceSurface s, vec3 L) {
     // the one-sample mixture's density: (1 - c) p_cos + c p_ggx
     float c = referenceSpecularChance(s);
     float cosine = max(dot(s.N, L), 0.0) * INV_PI;
-    float ggx = 0.0;
-    vec3 h = L + s.V;
-    float hh = dot(h, h);
-    if (hh >= 1e-12) {
-        vec3 H = h * inversesqrt(hh);
-        float VoH = dot(s.V, H);
-        if (VoH > 0.0) {
-            float NoH = saturate(dot(s.N, H));
-            vec3 NxH = cross(s.N, H);
-            ggx = D_GGX(NoH, referenceAlpha(s), dot(NxH, NxH)) * NoH / (4.0 * VoH);
-        }
-    }
-    return (1.0 - c) * cosine + c * ggx;
+    return (1.0 - c) * cosine + c * referenceGgxPdf(s, L);
 }
 
 // A direction drawn from the BRDF for the uniform point Xi (may lie below the horizon);
@@ -211,8 +221,7 @@ vec3 referenceBrdfSample(ReferenceSurface s, vec2 Xi, out float pdf) {
     vec3 L;
     if (Xi.x < c) {
         vec2 X = vec2(min(Xi.x / c, 0.99999994), Xi.y);
-        vec3 H = importanceSampleGGX(X, referenceAlpha(s), s.N);
-        L = 2.0 * dot(s.V, H) * H - s.V;
+        L = referenceGgxSample(s, X);
     } else {
         vec2 X = vec2(min((Xi.x - c) / (1.0 - c), 0.99999994), Xi.y);
         L = importanceSampleCosine(X, s.N);

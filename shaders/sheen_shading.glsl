@@ -48,34 +48,13 @@ vec3 sheenLayerCosine(ShadingContext s, vec3 base, vec3 L) {
     return sheenLayer(s, base, L, saturate(dot(s.N, L)));
 }
 
-#ifndef MATEDIT_SPLIT_SUM_ONLY
-// Monte Carlo estimate of the sheen under the unfiltered environment (reference mode), by
-// sheenSampleDirection; the reference IBL's estimator can take the same three functions.
-vec3 referenceSheenIBL(samplerCube env, ShadingContext s, uint sampleCount, vec2 offset) {
-    // Uniform hemisphere sampling: the estimator is L(l) f NoL / pdf
-    vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < sampleCount; i++) {
-        float pdf;
-        vec3 L = sheenSampleDirection(rotatedHammersley(i, sampleCount, offset), s.N, pdf);
-        sum += textureLod(env, L, 0.0).rgb
-             * sheenBrdfCosine(s.N, s.V, L, s.sheenColor, s.sheenAlpha) / pdf;
-    }
-    return sum / float(sampleCount);
-}
-#endif
-
-// The sheen's image-based light: split sum (the environment prefiltered at the sheen
-// roughness around N, times sheenColor and the DFG term) or the reference estimate.
+// The sheen's split-sum image-based light: the environment prefiltered at the sheen
+// roughness around N, times sheenColor and the DFG term (reference mode integrates the sheen
+// with the rest of the layered BRDF, reference_layered.glsl).
 vec3 sheenImageBasedLighting(ShadingContext s) {
     // Filament's cloth IBL, after Karis 2013 eq 6-8: prefiltered(r) sheenColor DFG_charlie
     int mode = int(uIbl.params.w + 0.5);
     if (mode == IBL_MODE_NONE) return vec3(0.0);
-#ifndef MATEDIT_SPLIT_SUM_ONLY
-    if (mode == IBL_MODE_REFERENCE) {
-        uint count = uint(max(uIbl.params.z, 1.0));
-        return referenceSheenIBL(uEnvironment, s, count, uIbl.sampleOffset.xy) * uIbl.params.y;
-    }
-#endif
     // Around N, not R: the Charlie lobe is wide and spreads over the hemisphere at grazing
     // views, where R lies on the horizon (tests/test_lobe_sheen.py: worst 0.29 / 0.13 / 0.07
     // relative at roughness 0.3 / 0.7 / 1.0 around N under a gradient sky, 0.45 / 0.44 /

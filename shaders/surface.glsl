@@ -12,6 +12,11 @@
 #endif
 #ifndef MATEDIT_SPLIT_SUM_ONLY
 #include "lights_reference.glsl"
+#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY)
+// The reference of a material with lobes integrates the whole layered BRDF at once.
+#define MATEDIT_LAYERED_REFERENCE
+#include "reference_layered.glsl"
+#endif
 #endif
 
 // The lobes a view shows: MATEDIT_LOBES is a mask of LOBE_* bits (unset: every lobe). The
@@ -158,30 +163,41 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     else
 #endif
     direct = directLighting(s);
-    vec3 ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale
-#if defined(MATERIAL_HAS_ANISOTROPY)
-                                  , s.aniso
+#if defined(MATEDIT_LAYERED_REFERENCE)
+    // Reference mode with lobes: the whole layered BRDF by one MIS estimator
+    // (reference_layered.glsl); the split sum layers its lobes' lookups below.
+    bool layeredReference = int(uIbl.params.w + 0.5) == IBL_MODE_REFERENCE;
+#else
+    const bool layeredReference = false;
 #endif
-                                  );
+    vec3 ibl;
+#if defined(MATEDIT_LAYERED_REFERENCE)
+    if (layeredReference) {
+        uint count = uint(max(uIbl.params.z, 1.0));
+        ibl = layeredEnvironmentIBL(uEnvironment, uEnvDistribution,
+                                    makeLayeredReference(s, roughness), count,
+                                    uIbl.sampleOffset.xy) * uIbl.params.y;
+    }
+#endif
+    if (!layeredReference) {
+        ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale
+#if defined(MATERIAL_HAS_ANISOTROPY)
+                                 , s.aniso
+#endif
+                                 );
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
-    // The base's IBL is linear in its diffuse colour and specular scale: scaling the sum is
-    // scaling both by the view's albedo scaling.
-    ibl = ibl * s.sheenScaleV + sheenImageBasedLighting(s);
+        // The base's IBL is linear in its diffuse colour and specular scale: scaling the sum
+        // is scaling both by the view's albedo scaling.
+        ibl = ibl * s.sheenScaleV + sheenImageBasedLighting(s);
 #endif
 #if defined(MATERIAL_HAS_COAT)
-    // The coat's image-based light, and the base's seen through the coat (coat.glsl).
-    int coatMode = int(uIbl.params.w + 0.5);
-    if (coatMode == IBL_MODE_SPLIT_SUM) {
-        ibl = coatImageBasedLighting(s.coat, V, ibl, uPrefilteredEnv, uBrdfLut, uIbl.params.x,
-                                     uIbl.params.y);
-    }
-#ifndef MATEDIT_SPLIT_SUM_ONLY
-    if (coatMode == IBL_MODE_REFERENCE) {
-        ibl = coatReferenceIBL(s.coat, V, ibl, uEnvironment, uint(max(uIbl.params.z, 1.0)),
-                               uIbl.sampleOffset.xy, uIbl.params.y);
-    }
+        // The coat's image-based light, and the base's seen through it (coat.glsl).
+        if (int(uIbl.params.w + 0.5) == IBL_MODE_SPLIT_SUM) {
+            ibl = coatImageBasedLighting(s.coat, V, ibl, uPrefilteredEnv, uBrdfLut,
+                                         uIbl.params.x, uIbl.params.y);
+        }
 #endif
-#endif
+    }
     return (direct + ibl) * m.cavity + m.emissive * lobeOn(LOBE_EMISSIVE);
 }
 

@@ -15,13 +15,12 @@ from matedit.shading.brdf import (
     D_GGX,
     Fc_Exact,
     Fc_SphericalGaussian,
-    G1_Schlick,
     V_SchlickSmith,
     k_Analytic,
     k_IBL,
 )
 from matedit.shading.common import dot, f64, mix, reflect, saturate
-from matedit.shading.ibl import environmentBRDF, prefilteredRadiance, rotatedHammersley
+from matedit.shading.ibl import environmentBRDF, prefilteredRadiance
 from matedit.shading.sampling import importanceSampleGGX
 
 
@@ -154,25 +153,3 @@ def coatSampleDirection(c: CoatContext, V, Xi) -> tuple[np.ndarray, np.ndarray]:
     H = importanceSampleGGX(f64(Xi), coatReferenceAlpha(c), c.N)
     L = 2.0 * dot(V, H)[..., None] * H - V
     return L, coatPdf(c, V, L)
-
-
-def coatReferenceIBL(c: CoatContext, V, baseIbl, env, sampleCount: int, offset,
-                     intensity) -> np.ndarray:
-    # Karis 2013, SpecularIBL on the coat's normal: estimator F G VoH / (NoH NoV)
-    V = f64(V)
-    a = coatReferenceAlpha(c)
-    k = k_IBL(a)
-    total = np.zeros(np.broadcast_shapes(c.N.shape, V.shape))
-    for i in range(sampleCount):
-        Xi = rotatedHammersley(i, sampleCount, f64(offset))
-        H = importanceSampleGGX(np.broadcast_to(Xi, total.shape[:-1] + (2,)), a, c.N)
-        L = 2.0 * dot(V, H)[..., None] * H - V
-        NoL = saturate(dot(c.N, L))
-        NoH = saturate(dot(c.N, H))
-        VoH = saturate(dot(V, H))
-        G = G1_Schlick(NoL, k) * G1_Schlick(c.NoV, k)
-        F = c.F0 + (1.0 - c.F0) * Fc_Exact(VoH)
-        w = np.where(NoL > 0.0, F * G * VoH / np.maximum(NoH * c.NoV, 1e-8), 0.0)
-        total = total + f64(env(L)) * w[..., None]
-    coat = c.weight * c.scale * intensity / sampleCount
-    return f64(baseIbl) * coatTransmittance(c, c.NoV) + total * coat[..., None]

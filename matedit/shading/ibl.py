@@ -235,18 +235,28 @@ def referenceBrdfCosine(s: ReferenceSurface, L) -> np.ndarray:
     return np.where((NoL > 0.0)[..., None], out, 0.0)
 
 
-def referenceBrdfPdf(s: ReferenceSurface, L) -> np.ndarray:
-    L = f64(L)
-    c = referenceSpecularChance(s)
-    cosine = np.maximum(dot(s.N, L), 0.0) * INV_PI
-    H, valid = _half(s, L)
+def referenceGgxPdf(s: ReferenceSurface, L) -> np.ndarray:
+    """D NoH / (4 VoH) of the reference's GGX, 0 where L + V vanishes or V.H <= 0."""
+    H, valid = _half(s, f64(L))
     VoH = dot(s.V, H)
     NoH = saturate(dot(s.N, H))
     NxH = cross(s.N, H)
     with np.errstate(invalid="ignore", divide="ignore"):
         ggx = D_GGX(NoH, referenceAlpha(s), dot(NxH, NxH)) * NoH / (4.0 * VoH)
-    ggx = np.where(valid & (VoH > 0.0), ggx, 0.0)
-    return (1.0 - c) * cosine + c * ggx
+    return np.where(valid & (VoH > 0.0), ggx, 0.0)
+
+
+def referenceGgxSample(s: ReferenceSurface, Xi) -> np.ndarray:
+    """A direction of the reference's GGX lobe for the points Xi (may lie below the horizon)."""
+    H = importanceSampleGGX(f64(Xi), referenceAlpha(s), s.N)
+    return 2.0 * dot(s.V, H)[..., None] * H - s.V
+
+
+def referenceBrdfPdf(s: ReferenceSurface, L) -> np.ndarray:
+    L = f64(L)
+    c = referenceSpecularChance(s)
+    cosine = np.maximum(dot(s.N, L), 0.0) * INV_PI
+    return (1.0 - c) * cosine + c * referenceGgxPdf(s, L)
 
 
 def referenceBrdfSample(s: ReferenceSurface, Xi) -> tuple[np.ndarray, np.ndarray]:
@@ -259,9 +269,7 @@ def referenceBrdfSample(s: ReferenceSurface, Xi) -> tuple[np.ndarray, np.ndarray
         xs = np.minimum(np.where(spec, x / np.where(c > 0, c, 1.0), 0.0), _ONE_BELOW)
         xd = np.minimum(np.where(spec, 0.0, (x - c) / np.where(c < 1, 1.0 - c, 1.0)),
                         _ONE_BELOW)
-    H = importanceSampleGGX(np.stack(np.broadcast_arrays(xs, Xi[..., 1]), -1),
-                            referenceAlpha(s), s.N)
-    Ls = 2.0 * dot(s.V, H)[..., None] * H - s.V
+    Ls = referenceGgxSample(s, np.stack(np.broadcast_arrays(xs, Xi[..., 1]), -1))
     Ld = importanceSampleCosine(np.stack(np.broadcast_arrays(xd, Xi[..., 1]), -1), s.N)
     L = np.where(spec[..., None], Ls, Ld)
     return L, referenceBrdfPdf(s, L)

@@ -13,8 +13,6 @@ import numpy as np
 from matedit.shading.common import INV_PI, PI, dot, f64, mix, saturate, sq
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
-    IBL_MODE_REFERENCE,
-    _sample_points,
     prefilteredRadiance,
     sample_lut,
 )
@@ -160,26 +158,12 @@ def sheenLayerCosine(s, base, L) -> np.ndarray:
     return sheenLayer(s, base, L, saturate(dot(s.N, L)))
 
 
-def referenceSheenIBL(env, s, sampleCount: int, offset) -> np.ndarray:
-    """Uniform hemisphere estimate of the sheen under `env`: mean of L(l) f NoL / pdf."""
-    Xi = _sample_points(sampleCount, offset)
-    shape = np.broadcast_shapes(s.N[..., None, :].shape[:-1], Xi.shape[:-1])
-    N = np.broadcast_to(s.N[..., None, :], shape + (3,))
-    V = np.broadcast_to(s.V[..., None, :], shape + (3,))
-    L, pdf = sheenSampleDirection(np.broadcast_to(Xi, shape + (2,)), N)
-    alpha = f64(s.sheenAlpha)[..., None] if np.ndim(s.sheenAlpha) else s.sheenAlpha
-    f = sheenBrdfCosine(N, V, L, s.sheenColor[..., None, :], alpha)
-    return (f64(env(L)) * f / pdf[..., None]).sum(axis=-2) / sampleCount
-
-
 def sheenImageBasedLighting(s, ibl) -> np.ndarray:
-    """Split sum (prefiltered at the sheen roughness around N) or the reference estimate;
+    """Split sum (prefiltered at the sheen roughness around N; reference mode integrates the
+    sheen in reference_layered);
     `ibl` is matedit.shading.surface.IblInputs."""
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(s.N.shape, s.V.shape))
-    if ibl.mode == IBL_MODE_REFERENCE:
-        count = max(int(ibl.samples), 1)
-        return referenceSheenIBL(ibl.environment, s, count, ibl.sample_offset) * ibl.intensity
     NoV = saturate(dot(s.N, s.V))
     if callable(ibl.prefiltered):  # around N (sheen_shading.glsl)
         pref = prefilteredRadiance(ibl.prefiltered, s.N, s.sheenRoughness, ibl.mip_count)
@@ -190,7 +174,7 @@ def sheenImageBasedLighting(s, ibl) -> np.ndarray:
 
 
 __all__ = [
-    "MIN_SHEEN_ROUGHNESS", "D_Charlie", "V_Charlie", "referenceSheenIBL", "setupSheen",
+    "MIN_SHEEN_ROUGHNESS", "D_Charlie", "V_Charlie", "setupSheen",
     "sheenAlbedoScaling", "sheenAlpha", "sheenBRDF", "sheenBaseScale", "sheenBrdfCosine",
     "sheenDFG", "sheenImageBasedLighting", "sheenLambda", "sheenLambdaFit", "sheenLayer",
     "sheenLayerCosine", "sheenSampleDirection", "sheenSamplePdf", "sheenSplitSum",

@@ -9,6 +9,7 @@ import numpy as np
 
 from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat as _coat
+from matedit.shading import reference_layered as _layered
 from matedit.shading.common import dot, f64, mix, reflect, saturate
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
@@ -175,18 +176,23 @@ def shadeSurface(
         setupSheen(s, m.sheenColor, m.sheenRoughness,
                    f64(m.sheenColor) * lobeOn(lobes, LOBE_SHEEN), lut_of(ibl))
     direct = directLighting(s, lights)
-    indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
-                                  s.aniso)
-    if sheen:  # the base's IBL is linear in diffuseColor and specularScale
-        indirect = indirect * f64(s.sheenScaleV)[..., None] + sheenImageBasedLighting(s, ibl)
-    if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
-        indirect = _coat.coatImageBasedLighting(
-            s.coat, V, indirect, ibl.coat_prefiltered if ibl.coat_prefiltered is not None
-            else ibl.prefiltered, ibl.coat_brdf_lut if ibl.coat_brdf_lut is not None
-            else ibl.brdf_lut, ibl.mip_count, ibl.intensity, ibl.lut_values)
-    elif coat and s.coat is not None and ibl.mode == IBL_MODE_REFERENCE:
-        indirect = _coat.coatReferenceIBL(s.coat, V, indirect, ibl.environment,
-                                          max(int(ibl.samples), 1), ibl.sample_offset,
-                                          ibl.intensity)
+    if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic):
+        # the whole layered BRDF by one MIS estimator (reference_layered.glsl)
+        if ibl.environment is None or ibl.environment_distribution is None:
+            raise ValueError("reference mode needs IblInputs.environment and its distribution")
+        indirect = _layered.layeredEnvironmentIBL(
+            ibl.environment, ibl.environment_distribution,
+            _layered.makeLayeredReference(s, roughness), max(int(ibl.samples), 1),
+            ibl.sample_offset) * ibl.intensity
+    else:
+        indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
+                                      s.aniso)
+        if sheen:  # the base's IBL is linear in diffuseColor and specularScale
+            indirect = indirect * f64(s.sheenScaleV)[..., None] + sheenImageBasedLighting(s, ibl)
+        if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
+            indirect = _coat.coatImageBasedLighting(
+                s.coat, V, indirect, ibl.coat_prefiltered if ibl.coat_prefiltered is not None
+                else ibl.prefiltered, ibl.coat_brdf_lut if ibl.coat_brdf_lut is not None
+                else ibl.brdf_lut, ibl.mip_count, ibl.intensity, ibl.lut_values)
     return (direct + indirect) * f64(m.cavity)[..., None] + f64(m.emissive) * lobeOn(
         lobes, LOBE_EMISSIVE)

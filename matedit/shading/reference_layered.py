@@ -1,0 +1,149 @@
+"""Twin of shaders/reference_layered.glsl: reference mode's MIS estimator of the whole
+layered BRDF (coat over sheen over base, anisotropic GGX where the material has it), with
+a one-sample lobe mixture as the BRDF strategy. Loops over samples, vectorised over pixels."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from matedit.shading import anisotropy as _aniso
+from matedit.shading import coat as _coat
+from matedit.shading import sheen as _sheen
+from matedit.shading.brdf import F_SchlickExact
+from matedit.shading.common import INV_PI, dot, f64, saturate
+from matedit.shading.env_sampling import environmentPdf, sampleEnvironmentDirection
+from matedit.shading.ibl import (
+    ReferenceSurface,
+    environmentSamplePoint,
+    makeReferenceSurface,
+    referenceBrdfCosine,
+    referenceGgxPdf,
+    referenceGgxSample,
+    rotatedHammersley,
+)
+from matedit.shading.lights import ShadingContext
+from matedit.shading.sampling import importanceSampleCosine
+
+LAYER_SPECULAR, LAYER_DIFFUSE, LAYER_SHEEN, LAYER_COAT = range(4)  # the GLSL's order
+_LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+_ONE_BELOW = float(np.float32(0.99999994))
+
+
+@dataclass
+class LayeredReference:
+    s: ShadingContext
+    base: ReferenceSurface
+    chance: np.ndarray  # (..., 4): base specular, diffuse, sheen, coat
+
+
+def makeLayeredReference(s: ShadingContext, roughness) -> LayeredReference:
+    """Lobe chances from the lobes' estimated reflectances towards the eye (luminance)."""
+    base = makeReferenceSurface(s.N, s.V, s.diffuseColor, s.F0, roughness, s.specularScale)
+    NoV = saturate(dot(s.N, s.V))
+    shape = NoV.shape
+    under = np.ones(shape)
+    w_sheen = np.zeros(shape)
+    w_coat = np.zeros(shape)
+    if s.coat is not None:
+        under = under * (_coat.coatTransmittance(s.coat, s.coat.NoV) @ _LUMINANCE)
+        w_coat = np.broadcast_to(_coat.coatFresnel(s.coat, s.coat.NoV) * s.coat.scale, shape)
+    if s.sheenMax is not None:
+        smax = f64(s.sheenMax)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            E = np.where(smax > 0.0, (1.0 - f64(s.sheenScaleV)) / np.where(smax > 0, smax, 1.0),
+                         0.0)
+        w_sheen = under * (f64(s.sheenColor) @ _LUMINANCE) * E
+        under = under * f64(s.sheenScaleV)
+    w_diff = under * (f64(s.diffuseColor) @ _LUMINANCE)
+    w_spec = under * ((F_SchlickExact(f64(s.F0), NoV) * f64(s.specularScale)) @ _LUMINANCE)
+    w = np.stack(np.broadcast_arrays(w_spec, w_diff, w_sheen, w_coat), -1)
+    total = w.sum(-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        chance = np.where(total > 0.0, w / np.where(total > 0, total, 1.0), 0.25)
+    return LayeredReference(s, base, chance)
+
+
+def layeredBrdfCosine(r: LayeredReference, L) -> np.ndarray:
+    """f(l, v) N.l of the layered BRDF towards L, in lights.glsl's order of layers."""
+    s, L = r.s, f64(L)
+    # no lobe where the half vector is below its normal (the GLSL's comment)
+    h = L + s.V
+    H = h / np.sqrt(np.maximum(dot(h, h), 1e-30))[..., None]
+    if s.aniso is not None:
+        NoL = dot(s.N, L)
+        spec = _aniso.anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L) * f64(
+            s.specularScale)
+        f = (f64(s.diffuseColor) * (INV_PI * NoL)[..., None]
+             + np.where((dot(s.N, H) > 0.0)[..., None], np.nan_to_num(spec), 0.0))
+        f = np.where((NoL > 0.0)[..., None], f, 0.0)
+    else:
+        f = referenceBrdfCosine(r.base, L)
+    if s.sheenMax is not None:
+        f = (f * _sheen.sheenBaseScale(s, saturate(dot(s.N, L)))[..., None]
+             + _sheen.sheenBrdfCosine(s.N, s.V, L, s.sheenColor, s.sheenAlpha))
+    if s.coat is not None:
+        coat = np.where(dot(s.coat.N, H) > 0.0, np.nan_to_num(
+            _coat.coatBrdfCosine(s.coat, s.V, L)), 0.0)
+        f = f * _coat.coatTransmittance(s.coat, dot(s.coat.N, L)) + coat[..., None]
+    return f
+
+
+def layeredBrdfPdf(r: LayeredReference, L) -> np.ndarray:
+    s, L, c = r.s, f64(L), r.chance
+    p = c[..., LAYER_DIFFUSE] * np.maximum(dot(s.N, L), 0.0) * INV_PI
+    if s.aniso is not None:
+        p = p + c[..., LAYER_SPECULAR] * _aniso.anisotropicPdfIBL(s.aniso, s.N, s.V, L)
+    else:
+        p = p + c[..., LAYER_SPECULAR] * referenceGgxPdf(r.base, L)
+    if s.sheenMax is not None:
+        p = p + c[..., LAYER_SHEEN] * _sheen.sheenSamplePdf(s.N, L)
+    if s.coat is not None:
+        p = p + c[..., LAYER_COAT] * _coat.coatPdf(s.coat, s.V, L)
+    return p
+
+
+def layeredBrdfSample(r: LayeredReference, Xi) -> tuple[np.ndarray, np.ndarray]:
+    """(L, pdf): one lobe picked by Xi.x, which is stretched back to [0, 1) for it."""
+    s, Xi, c = r.s, f64(Xi), r.chance
+    x = Xi[..., 0]
+    before = np.concatenate([np.zeros(c.shape[:-1] + (1,)), np.cumsum(c, -1)[..., :3]], -1)
+    # the GLSL's loop: the first lobe i < 3 with x < start_i + c_i, else the coat
+    ends = before[..., :3] + c[..., :3]
+    lobe = np.where((x[..., None] < ends).any(-1), np.argmax(x[..., None] < ends, -1), 3)
+    start = np.take_along_axis(before, lobe[..., None], -1)[..., 0]
+    width = np.maximum(np.take_along_axis(c, lobe[..., None], -1)[..., 0], 1e-20)
+    X = np.stack(np.broadcast_arrays(np.clip((x - start) / width, 0.0, _ONE_BELOW),
+                                     Xi[..., 1]), -1)
+    L = importanceSampleCosine(X, s.N)  # the diffuse lobe, and a chance-0 coat's stand-in
+    if s.aniso is not None:
+        Ls = _aniso.anisotropicSampleIBL(s.aniso, s.N, s.V, X)[0]
+    else:
+        Ls = referenceGgxSample(r.base, X)
+    L = np.where((lobe == LAYER_SPECULAR)[..., None], Ls, L)
+    if s.sheenMax is not None:
+        L = np.where((lobe == LAYER_SHEEN)[..., None], _sheen.sheenSampleDirection(X, s.N)[0], L)
+    if s.coat is not None:
+        L = np.where((lobe == LAYER_COAT)[..., None],
+                     _coat.coatSampleDirection(s.coat, s.V, X)[0], L)
+    return L, layeredBrdfPdf(r, L)
+
+
+def layeredEnvironmentIBL(env, dist, r: LayeredReference, sampleCount: int,
+                          offset) -> np.ndarray:
+    """Balance heuristic over one BRDF and one environment sample per step."""
+    total = np.zeros(np.broadcast_shapes(r.s.N.shape, r.s.V.shape))
+    for i in range(sampleCount):
+        Xi = np.broadcast_to(rotatedHammersley(i, sampleCount, f64(offset)),
+                             total.shape[:-1] + (2,))
+        Lb, pb = layeredBrdfSample(r, Xi)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            wb = np.where(pb > 0.0, 1.0 / (pb + environmentPdf(dist, Lb)), 0.0)
+        Le, pe = sampleEnvironmentDirection(dist, environmentSamplePoint(Xi))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            we = np.where(pe > 0.0, 1.0 / (pe + layeredBrdfPdf(r, Le)), 0.0)
+        fb = np.nan_to_num(layeredBrdfCosine(r, Lb))
+        fe = np.nan_to_num(layeredBrdfCosine(r, Le))
+        total = total + fb * f64(env(Lb)) * wb[..., None] + fe * f64(env(Le)) * we[..., None]
+    return total / sampleCount

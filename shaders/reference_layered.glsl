@@ -1,0 +1,176 @@
+// The reference mode's estimator for a material with lobes beyond the talk (clear coat,
+// sheen, anisotropic GGX): the whole layered BRDF, coat over sheen over base, exactly as the
+// analytic lights layer it (lights.glsl: sheenLayer, then coatLayer), integrated against the
+// unfiltered environment by the MIS estimator of ibl.glsl (one BRDF and one environment
+// sample a step, balance heuristic). The BRDF sample picks one lobe (diffuse, base specular,
+// sheen, coat) by chances from estimated lobe weights; its density is the whole mixture's.
+// surface.glsl includes this file only where a lobe is compiled in and the reference is
+// (MATEDIT_LAYERED_REFERENCE); a material without lobes keeps referenceEnvironmentIBL.
+#include "common.glsl"
+#include "ibl.glsl"
+#include "lights.glsl"
+
+#if defined(MATEDIT_LAYERED_REFERENCE)
+
+// The layered surface: the shading context (its lobes), the base as ibl.glsl's reference
+// surface (the material's unclamped roughness: the alpha floor is referenceAlpha's), and
+// the chances of the four lobes.
+struct LayeredReference {
+    ShadingContext s;
+    ReferenceSurface base;
+    float chance[4];  // base specular, diffuse, sheen, coat: one-sample model chances
+};
+
+// The base's two lobes in ibl.glsl's order (its specular first), so that a lobe at weight 0
+// draws the base's own samples.
+const int LAYER_SPECULAR = 0;
+const int LAYER_DIFFUSE = 1;
+const int LAYER_SHEEN = 2;
+const int LAYER_COAT = 3;
+
+// The lobes' chances: each lobe's estimated reflectance towards the eye (luminance), the
+// lobes under the coat and the sheen scaled by what those let through towards the eye.
+LayeredReference makeLayeredReference(ShadingContext s, float roughness) {
+    // Veach 1997, "Robust Monte Carlo Methods for Light Transport Simulation", 9.2.4:
+    // one-sample model, a strategy chosen with probability c_i
+    LayeredReference r;
+    r.s = s;
+    r.base = makeReferenceSurface(s.N, s.V, s.diffuseColor, s.F0, roughness, s.specularScale);
+    const vec3 Y = vec3(0.2126, 0.7152, 0.0722);
+    float NoV = saturate(dot(s.N, s.V));
+    float under = 1.0;
+    float w[4];
+    w[LAYER_SHEEN] = 0.0;
+    w[LAYER_COAT] = 0.0;
+#if defined(MATERIAL_HAS_COAT)
+    under *= dot(coatTransmittance(s.coat, s.coat.NoV), Y);
+    w[LAYER_COAT] = coatFresnel(s.coat, s.coat.NoV) * s.coat.scale;
+#endif
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    // the sheen's albedo E(NoV) from its albedo scaling 1 - max3(c) E
+    float E = s.sheenMax > 0.0 ? (1.0 - s.sheenScaleV) / s.sheenMax : 0.0;
+    w[LAYER_SHEEN] = under * dot(s.sheenColor, Y) * E;
+    under *= s.sheenScaleV;
+#endif
+    w[LAYER_DIFFUSE] = under * dot(s.diffuseColor, Y);
+    w[LAYER_SPECULAR] = under * dot(F_SchlickExact(s.F0, NoV) * s.specularScale, Y);
+    float total = w[0] + w[1] + w[2] + w[3];
+    for (int i = 0; i < 4; i++) r.chance[i] = total > 0.0 ? w[i] / total : 0.25;
+    return r;
+}
+
+// f(l, v) N.l of the layered BRDF towards L: the base (Lambert plus GGX, anisotropic where
+// the material is) scaled by the sheen's albedo scaling plus the sheen, all seen through the
+// coat plus the coat's own lobe (lights.glsl's order for one light).
+vec3 layeredBrdfCosine(LayeredReference r, vec3 L) {
+    // Filament Materials documentation, "Clear coat"; glTF KHR_materials_sheen albedo scaling
+    ShadingContext s = r.s;
+    vec3 f;
+    // A half vector below a lobe's normal (V under that normal's horizon: normal maps) gets
+    // none of the lobe, as referenceBrdfCosine: its sampling cannot reach it, and D's
+    // cross-product form would be unbounded there (H = -N) with a density of 0.
+    vec3 H = normalize(L + s.V);
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    float NoL = dot(s.N, L);
+    f = NoL > 0.0 ? s.diffuseColor * (INV_PI * NoL) : vec3(0.0);
+    if (NoL > 0.0 && dot(s.N, H) > 0.0) {
+        f += anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L) * s.specularScale;
+    }
+#else
+    f = referenceBrdfCosine(r.base, L);
+#endif
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    f = f * sheenBaseScale(s, saturate(dot(s.N, L)))
+      + sheenBrdfCosine(s.N, s.V, L, s.sheenColor, s.sheenAlpha);
+#endif
+#if defined(MATERIAL_HAS_COAT)
+    f *= coatTransmittance(s.coat, dot(s.coat.N, L));
+    if (dot(s.coat.N, H) > 0.0) f += vec3(coatBrdfCosine(s.coat, s.V, L));
+#endif
+    return f;
+}
+
+// Solid-angle density of L under layeredBrdfSample: sum of chance_i p_i(L).
+float layeredBrdfPdf(LayeredReference r, vec3 L) {
+    // the one-sample mixture's density (Veach 1997, 9.2.4)
+    ShadingContext s = r.s;
+    float p = r.chance[LAYER_DIFFUSE] * max(dot(s.N, L), 0.0) * INV_PI;
+#if defined(MATERIAL_HAS_ANISOTROPY)
+    p += r.chance[LAYER_SPECULAR] * anisotropicPdfIBL(s.aniso, s.N, s.V, L);
+#else
+    p += r.chance[LAYER_SPECULAR] * referenceGgxPdf(r.base, L);
+#endif
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    p += r.chance[LAYER_SHEEN] * sheenSamplePdf(s.N, L);
+#endif
+#if defined(MATERIAL_HAS_COAT)
+    p += r.chance[LAYER_COAT] * coatPdf(s.coat, s.V, L);
+#endif
+    return p;
+}
+
+// A direction from one lobe chosen by Xi.x (then stretched back to [0, 1) for that lobe);
+// `pdf` receives layeredBrdfPdf of it.
+vec3 layeredBrdfSample(LayeredReference r, vec2 Xi, out float pdf) {
+    // Veach 1997, 9.2.4: choose strategy i with chance c_i, sample it, density sum c_j p_j
+    ShadingContext s = r.s;
+    int lobe = LAYER_COAT;
+    float start = 0.0;
+    for (int i = 0; i < 3; i++) {
+        if (Xi.x < start + r.chance[i]) { lobe = i; break; }
+        start += r.chance[i];
+    }
+    vec2 X = vec2(min((Xi.x - start) / max(r.chance[lobe], 1e-20), 0.99999994), Xi.y);
+    X.x = max(X.x, 0.0);
+    vec3 L;
+    float unused;
+    if (lobe == LAYER_SPECULAR) {
+#if defined(MATERIAL_HAS_ANISOTROPY)
+        L = anisotropicSampleIBL(s.aniso, s.N, s.V, X, unused);
+#else
+        L = referenceGgxSample(r.base, X);
+#endif
+    } else if (lobe == LAYER_DIFFUSE) {
+        L = importanceSampleCosine(X, s.N);
+    } else if (lobe == LAYER_SHEEN) {
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+        L = sheenSampleDirection(X, s.N, unused);
+#else
+        L = importanceSampleCosine(X, s.N);  // chance 0 without a sheen
+#endif
+    } else {
+#if defined(MATERIAL_HAS_COAT)
+        L = coatSampleDirection(s.coat, s.V, X, unused);
+#else
+        L = importanceSampleCosine(X, s.N);  // chance 0 without a coat
+#endif
+    }
+    pdf = layeredBrdfPdf(r, L);
+    return L;
+}
+
+// The layered BRDF's reflected radiance under `env` (distribution `dist`): per sample one
+// direction from layeredBrdfSample and one from the environment, balance heuristic.
+vec3 layeredEnvironmentIBL(samplerCube env, sampler2D dist, LayeredReference r,
+                           uint sampleCount, vec2 offset) {
+    // Veach 1997, ch. 9: sum over strategies of f L / (p_brdf + p_env), one sample of each
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < sampleCount; i++) {
+        vec2 Xi = rotatedHammersley(i, sampleCount, offset);
+        float pb;
+        vec3 Lb = layeredBrdfSample(r, Xi, pb);
+        if (pb > 0.0) {
+            vec3 f = layeredBrdfCosine(r, Lb);
+            sum += f * textureLod(env, Lb, 0.0).rgb / (pb + environmentPdf(dist, Lb));
+        }
+        float pe;
+        vec3 Le = sampleEnvironmentDirection(dist, environmentSamplePoint(Xi), pe);
+        if (pe > 0.0) {
+            vec3 f = layeredBrdfCosine(r, Le);
+            sum += f * textureLod(env, Le, 0.0).rgb / (pe + layeredBrdfPdf(r, Le));
+        }
+    }
+    return sum / float(sampleCount);
+}
+
+#endif
