@@ -138,6 +138,11 @@ def test_every_lobe_in_reference_mode_equals_the_twin(ctx):
     inputs["dir"] = (d / np.linalg.norm(d, axis=-1, keepdims=True)).astype(np.float32)
     defines = COAT + ("MATERIAL_HAS_COAT_NORMAL", "MATERIAL_HAS_SHEEN_COLOR",
                       "MATERIAL_HAS_ANISOTROPY")
+    # every sampler the program declares is bound (the anisotropic split-sum table too,
+    # unused in reference mode): a sampler3D left at unit 0 beside a cube is a GL error
+    from matedit.ibl.anisotropy_lut import upload_anisotropy_lut
+
+    textures = {**textures, "uAnisotropyLut": upload_anisotropy_lut(ctx)}
     try:
         got = gpu_eval_many(ctx, _ALL_LOBES, inputs, {"result": "vec3"},
                             includes=["surface.glsl"], uniform_blocks=blocks,
