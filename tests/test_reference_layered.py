@@ -166,7 +166,7 @@ def test_a_coat_draw_with_the_view_below_the_coat_normal_fails_instead_of_a_fire
     there is 0 and the mixture's (the other lobes' ~1e-4 chances) near 0, so f / pdf was
     ~5e3 times the radiance. Such a draw must come back with pdf 0 (a failed sample);
     every kept draw's f / pdf is then bounded by the coat's Schlick-Smith and Fresnel terms
-    (here below 100 (measured 38), where the bug gave ~5e3), and the twin's chosen-lobe check is what
+    (here below 100, measured 38, where the bug gave ~5e3); the twin's chosen-lobe check
     makes the difference (the mixture density alone would keep the draw)."""
     from matedit.shading import coat as coat_twin
     from matedit.shading import reference_layered as rl
