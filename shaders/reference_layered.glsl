@@ -90,27 +90,43 @@ vec3 layeredBrdfCosine(LayeredReference r, vec3 L) {
     return f;
 }
 
+// Solid-angle density of L under lobe `lobe`'s own sampling (0 for a lobe not compiled in).
+float layeredLobePdf(LayeredReference r, int lobe, vec3 L) {
+    // Walter et al. 2007 for the GGX lobes, cos / pi for the diffuse
+    ShadingContext s = r.s;
+    if (lobe == LAYER_DIFFUSE) return max(dot(s.N, L), 0.0) * INV_PI;
+    if (lobe == LAYER_SPECULAR) {
+#if defined(MATERIAL_HAS_ANISOTROPY)
+        return anisotropicPdfIBL(s.aniso, s.N, s.V, L);
+#else
+        return referenceGgxPdf(r.base, L);
+#endif
+    }
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    if (lobe == LAYER_SHEEN) return sheenSamplePdf(s.N, L);
+#endif
+#if defined(MATERIAL_HAS_COAT)
+    if (lobe == LAYER_COAT) return coatPdf(s.coat, s.V, L);
+#endif
+    return 0.0;
+}
+
 // Solid-angle density of L under layeredBrdfSample: sum of chance_i p_i(L).
 float layeredBrdfPdf(LayeredReference r, vec3 L) {
     // the one-sample mixture's density (Veach 1997, 9.2.4)
-    ShadingContext s = r.s;
-    float p = r.chance[LAYER_DIFFUSE] * max(dot(s.N, L), 0.0) * INV_PI;
-#if defined(MATERIAL_HAS_ANISOTROPY)
-    p += r.chance[LAYER_SPECULAR] * anisotropicPdfIBL(s.aniso, s.N, s.V, L);
-#else
-    p += r.chance[LAYER_SPECULAR] * referenceGgxPdf(r.base, L);
-#endif
-#if defined(MATERIAL_HAS_SHEEN_COLOR)
-    p += r.chance[LAYER_SHEEN] * sheenSamplePdf(s.N, L);
-#endif
-#if defined(MATERIAL_HAS_COAT)
-    p += r.chance[LAYER_COAT] * coatPdf(s.coat, s.V, L);
-#endif
+    float p = 0.0;
+    for (int i = 0; i < 4; i++) p += r.chance[i] * layeredLobePdf(r, i, L);
     return p;
 }
 
 // A direction from one lobe chosen by Xi.x (then stretched back to [0, 1) for that lobe);
-// `pdf` receives layeredBrdfPdf of it.
+// `pdf` receives layeredBrdfPdf of it, or 0 where the chosen lobe's own density there is 0.
+// That happens where V is below a GGX lobe's normal (interpolated or mapped normals): a half
+// vector H with V.H < 0 reflects V to an L whose half vector is -H, which the lobe's
+// density (and that of the mixture's other lobes) does not count as drawn from H. Such a
+// draw is a failed sample: counted, it would be weighted by the other lobes' densities
+// alone (near 0 there), a firefly and a bias; dropped, the drawn directions' density is
+// exactly chance_i p_i summed, so the estimator stays unbiased.
 vec3 layeredBrdfSample(LayeredReference r, vec2 Xi, out float pdf) {
     // Veach 1997, 9.2.4: choose strategy i with chance c_i, sample it, density sum c_j p_j
     ShadingContext s = r.s;
@@ -145,7 +161,7 @@ vec3 layeredBrdfSample(LayeredReference r, vec2 Xi, out float pdf) {
         L = importanceSampleCosine(X, s.N);  // chance 0 without a coat
 #endif
     }
-    pdf = layeredBrdfPdf(r, L);
+    pdf = layeredLobePdf(r, lobe, L) > 0.0 ? layeredBrdfPdf(r, L) : 0.0;
     return L;
 }
 

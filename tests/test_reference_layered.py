@@ -162,3 +162,37 @@ def test_every_lobe_in_reference_mode_equals_the_twin(ctx):
     ref = twin(**inputs)
     check_monte_carlo("shadeSurface[coat+sheen+anisotropy, reference]", got, ref,
                       perturbation_spread(twin, inputs, rng), inputs["N"], inputs["V"])
+
+
+def test_a_coat_draw_with_the_view_below_the_coat_normal_fails_instead_of_a_firefly():
+    """Regression (varnished_oak's reference firefly of 114 against a split-sum maximum of
+    1.29): V 0.0102 below an interpolated normal, a smooth full coat (chance ~1). A coat half
+    vector H with V.H < 0 reflects V to an L whose half vector is -H: the coat's density
+    there is 0 and the mixture's (the other lobes' ~1e-4 chances) near 0, so f / pdf was
+    ~5e3 times the radiance. Such a draw must come back with pdf 0 (a failed sample);
+    every kept draw's f / pdf is then bounded by the coat's Schlick-Smith and Fresnel terms
+    (here below 100, measured 38, where the bug gave ~5e3); the twin's chosen-lobe check
+    makes the difference (the mixture density alone would keep the draw)."""
+    from matedit.shading import coat as coat_twin
+    from matedit.shading import reference_layered as rl
+    from matedit.shading.lights import makeShadingContext
+    from matedit.shading.sampling import hammersley
+
+    n = 4096
+    N = np.tile(_unit([0.0, 0.0, 1.0]), (n, 1))
+    V = np.tile(_unit([math.sqrt(1 - 0.0102 ** 2), 0.0, -0.0102]), (n, 1))
+    s = makeShadingContext(np.zeros((n, 3)), N, V, np.tile([0.25, 0.15, 0.08], (n, 1)),
+                           np.full((n, 3), 0.02), np.full(n, 0.5))
+    s.coat = coat_twin.makeCoatContext(N, V, 1.0, 0.06, 0.045, np.ones(3), 1.5)
+    r = rl.makeLayeredReference(s, np.full(n, 0.5))
+    assert np.all(r.chance[..., rl.LAYER_COAT] > 0.99)
+    Xi = np.stack([hammersley(i, n) for i in range(n)])
+    L, pdf = rl.layeredBrdfSample(r, Xi)
+    coat_own = coat_twin.coatPdf(s.coat, s.V, L)
+    failed = coat_own <= 0.0
+    assert failed.sum() > n // 10  # the case does exercise V.H < 0 draws
+    assert np.all(pdf[failed] == 0.0)
+    kept = pdf > 0.0
+    f = np.nan_to_num(rl.layeredBrdfCosine(r, L))[kept]
+    ratio = f.max(-1) / pdf[kept]
+    assert ratio.max() < 100.0, ratio.max()

@@ -90,18 +90,25 @@ def layeredBrdfCosine(r: LayeredReference, L) -> np.ndarray:
     return f
 
 
+def layeredLobePdf(r: LayeredReference, lobe: int, L) -> np.ndarray:
+    """Density of L under one lobe's own sampling (0 for a lobe the material lacks)."""
+    s, L = r.s, f64(L)
+    if lobe == LAYER_DIFFUSE:
+        return np.maximum(dot(s.N, L), 0.0) * INV_PI
+    if lobe == LAYER_SPECULAR:
+        if s.aniso is not None:
+            return _aniso.anisotropicPdfIBL(s.aniso, s.N, s.V, L)
+        return referenceGgxPdf(r.base, L)
+    if lobe == LAYER_SHEEN and s.sheenMax is not None:
+        return _sheen.sheenSamplePdf(s.N, L)
+    if lobe == LAYER_COAT and s.coat is not None:
+        return _coat.coatPdf(s.coat, s.V, L)
+    return np.zeros(np.broadcast_shapes(s.N.shape, L.shape)[:-1])
+
+
 def layeredBrdfPdf(r: LayeredReference, L) -> np.ndarray:
-    s, L, c = r.s, f64(L), r.chance
-    p = c[..., LAYER_DIFFUSE] * np.maximum(dot(s.N, L), 0.0) * INV_PI
-    if s.aniso is not None:
-        p = p + c[..., LAYER_SPECULAR] * _aniso.anisotropicPdfIBL(s.aniso, s.N, s.V, L)
-    else:
-        p = p + c[..., LAYER_SPECULAR] * referenceGgxPdf(r.base, L)
-    if s.sheenMax is not None:
-        p = p + c[..., LAYER_SHEEN] * _sheen.sheenSamplePdf(s.N, L)
-    if s.coat is not None:
-        p = p + c[..., LAYER_COAT] * _coat.coatPdf(s.coat, s.V, L)
-    return p
+    """The mixture's density: sum of chance_i p_i(L)."""
+    return sum(r.chance[..., i] * layeredLobePdf(r, i, L) for i in range(4))
 
 
 def layeredBrdfSample(r: LayeredReference, Xi) -> tuple[np.ndarray, np.ndarray]:
@@ -127,7 +134,11 @@ def layeredBrdfSample(r: LayeredReference, Xi) -> tuple[np.ndarray, np.ndarray]:
     if s.coat is not None:
         L = np.where((lobe == LAYER_COAT)[..., None],
                      _coat.coatSampleDirection(s.coat, s.V, X)[0], L)
-    return L, layeredBrdfPdf(r, L)
+    # a draw the chosen lobe's own density does not count (V below its normal, V.H < 0) fails
+    own = np.zeros(L.shape[:-1])
+    for i in range(4):
+        own = np.where(lobe == i, layeredLobePdf(r, i, L), own)
+    return L, np.where(own > 0.0, layeredBrdfPdf(r, L), 0.0)
 
 
 def layeredEnvironmentIBL(env, dist, r: LayeredReference, sampleCount: int,
