@@ -93,9 +93,32 @@ def case(env, u, rough, an, N, theta_v, phi_v):
     half = anisotropy.makeAnisotropicLobe(a, an / 2, np.array([1.0, 0, 0]), T, B, N)
     p_half = pref(a, anisotropy.anisotropicReflection(half, N, V))
     p_mirror = pref(a, 2 * (V @ N) * N - V)
+    # (a) Filament's bend factor: anisotropy * saturate(5 roughness) in the mix
+    fil = anisotropy.makeAnisotropicLobe(a, an * min(5 * rough, 1.0), np.array([1.0, 0, 0]),
+                                         T, B, N)
+    p_fil = pref(a, anisotropy.anisotropicReflection(fil, N, V))
+
+    # (b) taps along the lobe's long axis: H_i = normalize(N + s_i at T), each prefiltered at
+    # the narrow alpha ab along reflect(-V, H_i); weights normalised to 1 (furnace unchanged)
+    def taps(s_i):
+        w_i = (1 + s_i * s_i) ** -2
+        acc = 0.0
+        for s, w in zip(s_i, w_i):
+            Hi = N + s * at * T
+            Hi /= np.linalg.norm(Hi)
+            Ri = 2 * (V @ Hi) * Hi - V
+            if Ri @ N <= 0:
+                Ri = Ri - 1.01 * (Ri @ N) * N
+                Ri /= np.linalg.norm(Ri)
+            acc += w * pref(ab, Ri)
+        return acc / w_i.sum()
+    p_t3 = taps(np.array([-0.8, 0.0, 0.8]))
+    p_t5 = taps(np.array([-1.2, -0.6, 0.0, 0.6, 1.2]))
     return brute, {"before": p_base * e_iso, "table": p_base * e_tab,
                    "table + geometric alpha": p_geo * e_tab,
-                   "table + half bend": p_half * e_tab, "table + no bend": p_mirror * e_tab}
+                   "table + half bend": p_half * e_tab, "table + no bend": p_mirror * e_tab,
+                   "table + Filament bend": p_fil * e_tab, "table + 3 taps": p_t3 * e_tab,
+                   "table + 5 taps": p_t5 * e_tab}
 
 
 def main() -> int:
