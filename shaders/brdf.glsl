@@ -35,6 +35,21 @@ float D_GGX(float NoH, float a, float oneMinusNoH2) {
     return a2 / (PI * d * d);
 }
 
+// Solid-angle density of L under GGX half-vector sampling around N with alpha a,
+// D NoH / (4 VoH); 0 where L + V vanishes or V.H <= 0 (the reference mode's estimators).
+float ggxReflectionPdf(vec3 N, vec3 V, vec3 L, float a) {
+    // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38
+    vec3 h = L + V;
+    float hh = dot(h, h);
+    if (hh < 1e-12) return 0.0;
+    vec3 H = h * inversesqrt(hh);
+    float VoH = dot(V, H);
+    if (VoH <= 0.0) return 0.0;
+    float NoH = saturate(dot(N, H));
+    vec3 NxH = cross(N, H);
+    return D_GGX(NoH, a, dot(NxH, NxH)) * NoH / (4.0 * VoH);
+}
+
 // Schlick's k for analytic lights: Disney's remapping of roughness.
 float k_Analytic(float roughness) {
     // Karis 2013, "Real Shading in Unreal Engine 4", eq 4: k = (roughness + 1)^2 / 8

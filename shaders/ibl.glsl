@@ -185,16 +185,8 @@ vec3 referenceBrdfCosine(ReferenceSurface s, vec3 L) {
 // Solid-angle density of L under the reference's GGX half-vector sampling, D NoH / (4 VoH)
 // (Walter et al. 2007); 0 where L + V vanishes or V.H <= 0.
 float referenceGgxPdf(ReferenceSurface s, vec3 L) {
-    // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38
-    vec3 h = L + s.V;
-    float hh = dot(h, h);
-    if (hh < 1e-12) return 0.0;
-    vec3 H = h * inversesqrt(hh);
-    float VoH = dot(s.V, H);
-    if (VoH <= 0.0) return 0.0;
-    float NoH = saturate(dot(s.N, H));
-    vec3 NxH = cross(s.N, H);
-    return D_GGX(NoH, referenceAlpha(s), dot(NxH, NxH)) * NoH / (4.0 * VoH);
+    // Walter et al. 2007 (brdf.glsl)
+    return ggxReflectionPdf(s.N, s.V, L, referenceAlpha(s));
 }
 
 // A direction from the reference's GGX lobe for the point Xi (may lie below the horizon).

@@ -39,15 +39,7 @@ float ggxDirectionPdf(ShadingContext s, vec3 L) {
 #if defined(MATERIAL_HAS_ANISOTROPY)
     return ggxAnisotropicDirectionPdf(s.aniso, s.N, s.V, L);
 #endif
-    vec3 h = L + s.V;
-    float hh = dot(h, h);
-    if (hh < 1e-12) return 0.0;
-    vec3 H = h * inversesqrt(hh);
-    float VoH = dot(s.V, H);
-    if (VoH <= 0.0) return 0.0;
-    float NoH = saturate(dot(s.N, H));
-    vec3 NxH = cross(s.N, H);
-    return D_GGX(NoH, s.a, dot(NxH, NxH)) * NoH / (4.0 * VoH);
+    return ggxReflectionPdf(s.N, s.V, L, s.a);
 }
 
 // A GGX-sampled direction for the point Xi (may lie below the horizon).
