@@ -206,19 +206,23 @@ float referenceBrdfPdf(ReferenceSurface s, vec3 L) {
 }
 
 // A direction drawn from the BRDF for the uniform point Xi (may lie below the horizon);
-// `pdf` receives referenceBrdfPdf of it.
+// `pdf` receives referenceBrdfPdf of it, or 0 for a failed GGX draw: one whose half vector
+// has V.H < 0 (V below a mapped normal's horizon), whose L the GGX density does not count
+// as drawn (its own half vector is the opposite one). Weighted by the cosine lobe's
+// density alone it would be a firefly and a bias; dropped, the estimator stays unbiased.
 vec3 referenceBrdfSample(ReferenceSurface s, vec2 Xi, out float pdf) {
-    // Xi.x picks the lobe and is stretched back to [0, 1) for it
+    // Xi.x picks the lobe and is stretched back to [0, 1) for it (Veach 1997, 9.2.4)
     float c = referenceSpecularChance(s);
     vec3 L;
-    if (Xi.x < c) {
+    bool specular = Xi.x < c;
+    if (specular) {
         vec2 X = vec2(min(Xi.x / c, 0.99999994), Xi.y);
         L = referenceGgxSample(s, X);
     } else {
         vec2 X = vec2(min((Xi.x - c) / (1.0 - c), 0.99999994), Xi.y);
         L = importanceSampleCosine(X, s.N);
     }
-    pdf = referenceBrdfPdf(s, L);
+    pdf = (!specular || referenceGgxPdf(s, L) > 0.0) ? referenceBrdfPdf(s, L) : 0.0;
     return L;
 }
 

@@ -272,7 +272,9 @@ def referenceBrdfSample(s: ReferenceSurface, Xi) -> tuple[np.ndarray, np.ndarray
     Ls = referenceGgxSample(s, np.stack(np.broadcast_arrays(xs, Xi[..., 1]), -1))
     Ld = importanceSampleCosine(np.stack(np.broadcast_arrays(xd, Xi[..., 1]), -1), s.N)
     L = np.where(spec[..., None], Ls, Ld)
-    return L, referenceBrdfPdf(s, L)
+    # a GGX draw its own density does not count (V.H < 0) is a failed sample: pdf 0
+    failed = spec & ~(referenceGgxPdf(s, L) > 0.0)
+    return L, np.where(failed, 0.0, referenceBrdfPdf(s, L))
 
 
 def environmentSamplePoint(Xi) -> np.ndarray:
