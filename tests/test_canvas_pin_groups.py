@@ -208,6 +208,61 @@ def test_a_wire_dragged_over_a_folded_header_opens_it_and_connects(view):
     QTest.mouseRelease(vp, LEFT, Qt.KeyboardModifier.NoModifier, target)
     assert Link("r", "value", "make", "sheenRoughness") in c.document.graph.links
     assert Link("r", "value", "make", "sheenRoughness") in scene.wire_items
+    # The group the wire went into stays open, saved with the connection as one undo step.
+    assert "Sheen" in c.document.graph.nodes["make"].settings[nodes.EXPANDED_GROUPS]
+    c.undo_stack.undo()
+    QApplication.processEvents()
+    assert Link("r", "value", "make", "sheenRoughness") not in c.document.graph.links
+    assert "Sheen" not in item(view, "make").expanded
+
+
+def _hover_then(view, group: str, release_at) -> None:
+    """Drag a wire from a new parameter over `group`'s folded header, then release it at
+    `release_at(view)` (a viewport point) or, for None, press Escape mid-drag."""
+    view.controller.push(AddNode(Node("r", "scalar_parameter", (0, 400), {"name": "r"},
+                                      {"value": 0.2})))
+    QApplication.processEvents()
+    src = view.mapFromScene(item(view, "r").port_scene_pos("value", True))
+    it = item(view, "make")
+    _, y = header(it, group)
+    over = view.mapFromScene(it.pos() + QPointF(it.layout.width / 2, y))
+    vp = view.viewport()
+    QTest.mousePress(vp, LEFT, Qt.KeyboardModifier.NoModifier, src)
+    for i in range(1, 7):
+        p = QPointF(src) + (QPointF(over) - QPointF(src)) * (i / 6)
+        QApplication.sendEvent(vp, QMouseEvent(QEvent.Type.MouseMove, p,
+                                                QPointF(vp.mapToGlobal(p.toPoint())),
+                                                Qt.MouseButton.NoButton, LEFT,
+                                                Qt.KeyboardModifier.NoModifier))
+    assert group in it.expanded
+    if release_at is None:
+        QTest.keyClick(vp, Qt.Key.Key_Escape)
+        QTest.mouseRelease(vp, LEFT, Qt.KeyboardModifier.NoModifier, over)
+    else:
+        QTest.mouseRelease(vp, LEFT, Qt.KeyboardModifier.NoModifier, release_at(view))
+    QApplication.processEvents()
+
+
+@pytest.mark.parametrize("how", ["base pin", "escape"])
+def test_a_group_a_passing_wire_opened_folds_back_without_an_undo_step(view, how):
+    c = view.controller
+    before = c.undo_stack.count()
+
+    def base_pin(v):
+        return v.mapFromScene(item(v, "make").port_scene_pos("roughness", False))
+    _hover_then(view, "Sheen", base_pin if how == "base pin" else None)
+    it = item(view, "make")
+    assert "Sheen" not in it.expanded
+    assert "Sheen" not in c.document.graph.nodes["make"].settings.get(
+        nodes.EXPANDED_GROUPS, ["Base"])
+    assert {"sheenColor", "sheenRoughness"}.isdisjoint(visible_inputs(it))
+    if how == "base pin":  # the connection alone is the undo step after the new node
+        assert Link("r", "value", "make", "roughness") in c.document.graph.links
+        assert c.undo_stack.count() == before + 2
+        c.undo_stack.undo()
+        assert Link("r", "value", "make", "roughness") not in c.document.graph.links
+    else:
+        assert c.undo_stack.count() == before + 1
 
 
 def test_folded_pins_take_no_clicks(view):

@@ -160,11 +160,10 @@ class WireDrag:
         for it in self.scene.items(scene_pos):
             if isinstance(it, NodeItem) and it.node_id != self.anchor.node_id:
                 header = it.header_at(scene_pos)
-                if (header is not None and not header.expanded and header.is_output == want
-                        and hasattr(self.scene, "set_group_expanded")):
-                    # Hovering a folded group with a wire opens it, as a node editor's
-                    # collapsed panel does, so its pins can be aimed at.
-                    self.scene.set_group_expanded(it.node_id, header.group, True)
+                if header is not None and not header.expanded and header.is_output == want:
+                    # Hovering a folded group with a wire opens it for the drag, as a node
+                    # editor's collapsed panel does, so its pins can be aimed at.
+                    self.scene.peek_group(it.node_id, header.group)
                     return None
                 ports = [p for p in it.ports() if p.is_output == want and not _folded(p)]
                 ports.sort(key=lambda p: p.pos().y())

@@ -102,6 +102,9 @@ class NodeScene(QGraphicsScene):
         self.node_items: dict[str, NodeItem] = {}
         self.wire_items: dict[Link, WireItem] = {}
         self.comment_items: dict[str, CommentItem] = {}
+        # Pin groups a dragged wire opened by hovering their header: view state for the
+        # length of the drag (peek_group / end_peeks), not the document's setting.
+        self._peeked: dict[str, set[str]] = {}
         self._wires_of: dict[str, set[Link]] = {}
         self._node_errors: dict[str, str] = {}  # GLSL errors mapped to nodes, from the window
         self.snap_to_grid = False  # moves end on the minor grid
@@ -196,7 +199,10 @@ class NodeScene(QGraphicsScene):
             outs = [dataclasses.replace(r, type=str(ot[r.name])) if r.name in ot else r
                     for r in outs]
         title, sub, category, tip = describe(node, self.function_name(node))
-        item.set_content(title, sub, category, ins, outs, tip, expanded_groups(node))
+        expanded = expanded_groups(node)
+        if expanded is not None and node_id in self._peeked:
+            expanded = expanded | self._peeked[node_id]
+        item.set_content(title, sub, category, ins, outs, tip, expanded)
         self._update_connected(node_id)
 
     def function_name(self, node: Node) -> str:
@@ -397,17 +403,53 @@ class NodeScene(QGraphicsScene):
         return self.set_group_expanded(node_id, group, group not in open_now)
 
     def set_group_expanded(self, node_id: str, group: str, expanded: bool) -> bool:
+        command = self._group_command(node_id, group, expanded)
+        return command is not None and self.controller.push(command)
+
+    def _group_command(self, node_id: str, group: str, expanded: bool) -> SetSetting | None:
+        """The undoable setting change that opens or folds one group (None: nothing to do)."""
         node = self.graph.nodes.get(node_id)
         open_now = expanded_groups(node) if node is not None else None
         if open_now is None or (group in open_now) == expanded:
-            return False
+            return None
         # Keep the groups in the order the node shows them, so the saved list is stable.
         order = [f.group for f in nodes.ATTRIBUTE_FIELDS]
         new = open_now | {group} if expanded else open_now - {group}
         value = sorted(new, key=lambda g: (order.index(g) if g in order else len(order), g))
         verb = "expand" if expanded else "collapse"
-        return self.controller.push(SetSetting(node_id, nodes.EXPANDED_GROUPS, value,
-                                               text=f"{verb} {group} pins"))
+        return SetSetting(node_id, nodes.EXPANDED_GROUPS, value, text=f"{verb} {group} pins")
+
+    def peek_group(self, node_id: str, group: str) -> None:
+        """Open a folded group while a wire hovers its header, so its pins can be aimed at:
+        view state only, no undo step; end_peeks folds it back when the drag ends."""
+        node = self.graph.nodes.get(node_id)
+        if node is None or expanded_groups(node) is None:
+            return
+        self._peeked.setdefault(node_id, set()).add(group)
+        self._refresh_node(node_id)
+        for link in self._wires_of.get(node_id, ()):
+            self.wire_items[link].update_path()
+
+    def end_peeks(self, dropped: Link | None) -> list[SetSetting]:
+        """Fold back the groups peek_group opened. The group the dropped wire connects into
+        stays open: returned as the setting change to push with the connection (one undo
+        step undoes both)."""
+        peeked, self._peeked = self._peeked, {}
+        keep: list[SetSetting] = []
+        for node_id, groups in peeked.items():
+            node = self.graph.nodes.get(node_id)
+            if node is None:
+                continue
+            if dropped is not None and node_id in (dropped.src, dropped.dst):
+                port = dropped.dst_port if dropped.dst == node_id else dropped.src_port
+                group = nodes.port_group(node.kind, port)
+                command = self._group_command(node_id, group, True) if group in groups else None
+                if command is not None:
+                    keep.append(command)
+            self._refresh_node(node_id)
+            for link in self._wires_of.get(node_id, ()):
+                self.wire_items[link].update_path()
+        return keep
 
     def request_comment_edit(self, comment_id: str, rect, positions: dict) -> None:
         old = self.graph.comments.get(comment_id)

@@ -513,14 +513,15 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         result = wire.finish(self.mapToScene(pos), self._hit_radius())
         anchor = wire.anchor
         wire.cleanup()
+        keep_open = self._scene.end_peeks(result.link if moved else None)
         if not moved:
             return
         if result.link is not None:
             if result.lifted is None:
-                self.controller.push(Connect(result.link))
+                self.controller.push_all([Connect(result.link), *keep_open], "connect")
             elif result.lifted != result.link:
-                self.controller.push_all([Disconnect(result.lifted), Connect(result.link)],
-                                         "reconnect")
+                self.controller.push_all([Disconnect(result.lifted), Connect(result.link),
+                                          *keep_open], "reconnect")
         elif result.reason is not None:
             self.refuse(result.reason, pos)
         elif result.lifted is not None:
@@ -687,6 +688,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             if self._wire is not None:
                 self._wire.cleanup()
                 self._wire = None
+                self._scene.end_peeks(None)
             else:
                 self._scene.clearSelection()
         else:
