@@ -170,14 +170,66 @@ def _ggx_term(L, N, V, a):
     return D, H
 
 
+# Estevez and Kulla 2017, "Production Friendly Microfacet Sheen BRDF", table 1: the fitted
+# exponent L(x) = a / (1 + b x^c) + d x + e of the Charlie lobe's Lambda, at r = 0 and r = 1,
+# interpolated by (1 - r)^2 with r = alpha.
+_SHEEN_FIT_R0 = (25.3245, 3.32435, 0.16801, -1.27393, -4.85967)
+_SHEEN_FIT_R1 = (21.5473, 3.82987, 0.19823, -1.97760, -4.32054)
+
+
+def _sheen_lambda(x, alpha):
+    t = (1 - alpha) ** 2
+    a, b, c, d, e = (r1 * (1 - t) + r0 * t for r0, r1 in zip(_SHEEN_FIT_R0, _SHEEN_FIT_R1))
+
+    def fit(u):
+        return a / (1 + b * np.power(u, c)) + d * u + e
+    x = np.clip(x, 0.0, 1.0)
+    return np.where(x < 0.5, np.exp(fit(x)), np.exp(2 * fit(0.5) - fit(1 - x)))
+
+
+def sheen_white(L, N, V, alpha):
+    """D_Charlie G2 / (4 NoL NoV) NoL of a white sheen (height-correlated Smith G2 of the
+    fitted Lambda, no Fresnel): what the sheen contributes towards L, per unit colour."""
+    nol = L @ N
+    nov = max(float(N @ V), 1e-4)
+    H = L + V
+    H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+    sin2 = np.clip(1 - (H @ N) ** 2, 0, 1)
+    D = (2 + 1 / alpha) * sin2 ** (0.5 / alpha) / (2 * math.pi)
+    nl = np.maximum(nol, 1e-12)
+    G = 1 / (1 + _sheen_lambda(nov, alpha) + _sheen_lambda(nl, alpha))
+    return np.where(nol > 0, D * G / (4 * nov), 0.0)  # D G / (4 NoL NoV) times NoL
+
+
+def sheen_albedo(alpha, n_mu: int = 129, n_theta: int = 192, n_phi: int = 384):
+    """E(mu) of the white sheen lobe, its directional albedo, on a grid of mu = NoV in
+    [0, 1], by the midpoint rule over the hemisphere of L (the sheen's own integral, not
+    the LUT the shader reads). Returns (mu, E)."""
+    mu = np.linspace(0.0, 1.0, n_mu)
+    th = (np.arange(n_theta) + 0.5) * (math.pi / 2) / n_theta
+    ph = (np.arange(n_phi) + 0.5) * 2 * math.pi / n_phi
+    st, ct = np.sin(th)[:, None], np.cos(th)[:, None]
+    L = np.stack(np.broadcast_arrays(st * np.cos(ph), st * np.sin(ph), ct), -1)
+    dw = (math.pi / 2 / n_theta) * (2 * math.pi / n_phi) * st
+    N = np.array([0.0, 0.0, 1.0])
+    E = np.empty(n_mu)
+    for i, m in enumerate(mu):
+        m = max(m, 1e-4)
+        V = np.array([math.sqrt(1 - m * m), 0.0, m])
+        E[i] = float((sheen_white(L, N, V, alpha) * dw).sum())
+    return mu, E
+
+
 def layered_brdf_cosine(L, p):
     """f(l, v) N.l of a colourless clear coat (on the base's normal) over a base whose
     specular is anisotropic GGX (Burley 2012 B.2: at = a (1 + an), ab = a (1 - an);
     Schlick-Smith k = alpha_o / 2 of each direction's projected roughness, Heitz 2014
     eq 80) or, at an = 0, the isotropic one of brdf_cosine. The coat: Fc(x) = w (F0c +
     (1 - F0c)(1 - x)^5); the base seen through it times (1 - Fc(NoV)) (1 - Fc(NoL)); the
-    coat's GGX at alpha max(rc^2, 1e-3), k = alpha / 2, Schlick F, times w.
-    p: N, V, dc, F0, r, an, T, cw, cr, cf0."""
+    coat's GGX at alpha max(rc^2, 1e-3), k = alpha / 2, Schlick F, times w. Between them,
+    where p has a sheen colour sc > 0: the Charlie sheen of roughness sr (clamped at 0.3)
+    over the base, which it scales by its albedo (p["sheen_albedo"]: sheen_albedo's table).
+    p: N, V, dc, F0, r, an, T, cw, cr, cf0 [, sc, sr, sheen_albedo]."""
     N, V, T = p["N"], p["V"], p["T"]
     nol = L @ N
     nov = max(float(N @ V), 1e-4)
@@ -203,6 +255,16 @@ def layered_brdf_cosine(L, p):
         F = p["F0"] + (1 - p["F0"]) * ((1 - voh) ** 5)[..., None]
         base = p["dc"] / math.pi * nol[..., None] + (D * vis * nol)[..., None] * F
         base = np.where((nol > 0)[..., None], base, 0.0)
+    sc = np.asarray(p.get("sc", (0.0, 0.0, 0.0)), float)
+    if sc.max() > 0:
+        # the sheen over the base (glTF KHR_materials_sheen albedo scaling): the base times
+        # min(1 - max(c) E(NoV), 1 - max(c) E(NoL)), plus c D G / (4 NoL NoV) NoL
+        alpha = max(p["sr"], 0.3) ** 2
+        mu, E = p["sheen_albedo"]
+        m = sc.max()
+        scale = np.minimum(1 - m * np.interp(nov, mu, E),
+                           1 - m * np.interp(np.clip(nol, 0, 1), mu, E))
+        base = base * scale[..., None] + sheen_white(L, N, V, alpha)[..., None] * sc
     w, f0c = p["cw"], p["cf0"]
 
     def fc(x):

@@ -1,5 +1,5 @@
 """Reference mode's estimator of the whole layered BRDF (shaders/reference_layered.glsl:
-coat over base, anisotropic GGX) against an independent brute-force quadrature
+coat over sheen over base, anisotropic GGX) against an independent brute-force quadrature
 (tests/env_reference.py, layered_brdf_cosine: no matedit.shading), under the built-in
 studio and a generated sun and sky, as tests/test_env_importance.py judges the base's
 estimator (frames of 32 samples, each rotated by the R2 offset of its frame, averaged).
@@ -101,6 +101,76 @@ def test_layered_reference_converges_to_the_brute_force(ctx, environments, env_n
                 off = abs(mis[i] - other) @ LUM / (other @ LUM)
                 print(f"  {c['name']}: without {lobe} {off:.4f}")
                 assert off > max(0.035, 2.5 * rel[i]), (c["name"], lobe, off)
+
+
+# --- the sheen in the whole layered BRDF ----------------------------------------------------
+
+SHEEN_BODY = """
+    ShadingContext s = makeShadingContext(vec3(0.0), N, V, dc, F0, r);
+    s.coat = makeCoatContext(N, V, cw, cr, MIN_ANALYTIC_ROUGHNESS, vec3(1.0), 1.5, 1.0);
+    s.aniso = makeAnisotropicLobe(s.a, an, vec3(1.0, 0.0, 0.0), T, cross(N, T), N);
+    setupSheen(s, sc, sr, sc);
+    mis = layeredEnvironmentIBL(uEnvironment, uEnvDistribution, makeLayeredReference(s, r),
+                                32u, off);
+"""
+SHEEN_CASES = [
+    dict(_case("velvet: sheen over a dark dielectric", [0.3, 0.8, 0.5], 0.35,
+               [0.08, 0.02, 0.03], [0.04] * 3, 0.8), sc=np.array([0.9, 0.5, 0.6]), sr=0.5),
+    dict(_case("coated sheen over anisotropic metal", [0.1, 0.3, 0.9], 0.7, [0, 0, 0],
+               [0.8, 0.8, 0.85], 0.5, an=0.5, cw=0.6, cr=0.2),
+         sc=np.array([0.4, 0.4, 0.4]), sr=0.9),
+]
+
+
+@pytest.fixture(scope="module")
+def brdf_lut_texture(gl_ctx):
+    """The preview's environment BRDF LUT (its B channel is the sheen albedo the shader
+    reads; the reference side integrates its own)."""
+    from matedit.ibl import brdf_lut
+
+    lut = brdf_lut(64, 1024, ctx=gl_ctx)
+    tex = gl_ctx.texture((lut.shape[1], lut.shape[0]), lut.shape[2],
+                         lut.astype(np.float32).tobytes(), dtype="f4")
+    tex.repeat_x = tex.repeat_y = False
+    tex.filter = (gl_ctx.LINEAR, gl_ctx.LINEAR)
+    yield tex
+    tex.release()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("env_name", ["studio", "sun"])
+def test_layered_reference_with_a_sheen_converges_to_the_brute_force(
+        ctx, environments, env_name, brdf_lut_texture):  # noqa: F811
+    """The sheen (Charlie D, the fitted Lambda's G2, albedo scaling of what is under it)
+    inside coat over sheen over base: the estimator against env_reference's quadrature, whose
+    sheen albedo is its own midpoint-rule integral (not the LUT)."""
+    from env_reference import sheen_albedo
+
+    env = environments[env_name]
+    cases = [dict(c, sheen_albedo=sheen_albedo(max(c["sr"], 0.3) ** 2)) for c in SHEEN_CASES]
+    truth = np.array([_truth(env, c) for c in cases])
+    frames, n = 128, len(cases)
+    keys = ("N", "V", "T", "dc", "F0", "r", "an", "cw", "cr", "sc", "sr")
+    rep = {k: np.repeat(np.array([c[k] for c in cases], np.float64), frames, axis=0)
+           for k in keys}
+    rep["off"] = np.tile(np.array([_r2(f) for f in range(frames)]), (n, 1))
+    out = gpu_eval_many(ctx, SHEEN_BODY, rep, {"mis": "vec3"},
+                        includes=["surface.glsl"],
+                        textures={"uEnvironment": env.cube, "uEnvDistribution": env.dist,
+                                  "uBrdfLut": brdf_lut_texture},
+                        defines=("MATERIAL_HAS_COAT", "MATERIAL_HAS_ANISOTROPY",
+                                 "MATERIAL_HAS_SHEEN_COLOR"))
+    mis = out["mis"].reshape(n, frames, 3).mean(axis=1)
+    rel = np.abs(mis - truth) @ LUM / (truth @ LUM)
+    print(f"\n{env_name}: sheen cases, relative error at 4096 samples", np.round(rel, 5))
+    # the same bound as without the sheen (the LUT's E against the quadrature's own: below
+    # 1e-3 of the total)
+    assert rel.max() < 0.02, rel
+    for i, c in enumerate(cases):
+        other = _truth(env, dict(c, sc=np.zeros(3)))
+        off = abs(mis[i] - other) @ LUM / (other @ LUM)
+        print(f"  {c['name']}: without the sheen {off:.4f}")
+        assert off > max(0.035, 2.5 * rel[i]), (c["name"], off)
 
 
 # --- the GPU's layered estimator against its numpy twin (matedit.shading.reference_layered) -
