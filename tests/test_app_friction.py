@@ -354,3 +354,28 @@ def np_ones():
     import numpy as np
 
     return np.ones((8, 16, 3), np.float32)
+
+
+def test_save_as_names_an_untitled_document_after_its_file_and_retitles_the_window(
+        qtbot, tmp_path):
+    """A new material saved as rusty_panel.json is called "rusty_panel" in the file and the
+    window title, even when nothing was edited (Save As of a clean document); saved again
+    under another name it follows; a name the artist gave is kept."""
+    import json
+
+    w = make_window(qtbot)
+    assert w.controller.document.name in ("", "Untitled")
+    w.actions.ask_save_path = lambda _s: str(tmp_path / "rusty_panel.json")
+    assert w.actions.save_as()
+    assert json.loads((tmp_path / "rusty_panel.json").read_text())["name"] == "rusty_panel"
+    assert w.windowTitle().startswith("rusty_panel.json")
+    w.actions.ask_save_path = lambda _s: str(tmp_path / "rusty_panel_v2.json")
+    assert w.actions.save_as()
+    assert json.loads((tmp_path / "rusty_panel_v2.json").read_text())["name"] == \
+        "rusty_panel_v2"
+    assert w.windowTitle().startswith("rusty_panel_v2.json")
+    w.controller.document.name = "Weathered Copper"
+    w.actions.ask_save_path = lambda _s: str(tmp_path / "copper.json")
+    assert w.actions.save_as()
+    assert json.loads((tmp_path / "copper.json").read_text())["name"] == "Weathered Copper"
+    assert w.windowTitle().startswith("copper.json")

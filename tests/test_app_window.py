@@ -55,6 +55,16 @@ def test_one_action_table_serves_the_menus_the_toolbar_the_context_menu_and_the_
         assert table[cid] in edit.actions()  # the very QAction, not a copy
     for cid in ("frame_all", "frame_selection", "minimap"):
         assert table[cid] in view.actions()
+    # View > Minimap is a toggle whose check mark is the canvas's minimap, both ways.
+    minimap = table["minimap"]
+    assert minimap.isCheckable()
+    table.refresh(canvas)
+    assert minimap.isChecked() == (not canvas.minimap.isHidden())
+    was = canvas.minimap.isHidden()
+    minimap.trigger()
+    assert canvas.minimap.isHidden() != was and minimap.isChecked() == was
+    minimap.trigger()
+    assert canvas.minimap.isHidden() == was and minimap.isChecked() != was
     assert table["node_docs"] in help_menu.actions()
     toolbar = w.findChild(QToolBar, "mainToolBar")
     assert table["add_node"] in toolbar.actions() and table["frame_all"] in toolbar.actions()

@@ -190,6 +190,26 @@ def test_duplicate_offsets_the_copy(view):
     assert view.selected_ids() == ids
 
 
+def test_duplicating_a_parameter_gives_the_copy_a_free_name_so_the_material_compiles(view):
+    """Ctrl+D on a parameter: the copy is the next free name (p -> p_2 -> p_3), the message
+    counts in the singular, and the document has no duplicate-name error."""
+    from matedit.graph.validate import validate
+
+    messages: list[str] = []
+    view.message.connect(messages.append)
+    c = view.controller
+    view.select_nodes(["p"])
+    first = view.duplicate_selection()
+    view.select_nodes(["p"])
+    second = view.duplicate_selection()
+    g = c.document.graph
+    assert g.nodes[first[0]].settings["name"] == "p_2"
+    assert g.nodes[second[0]].settings["name"] == "p_3"
+    assert g.nodes["p"].settings["name"] == "p"
+    assert messages[-1] == "Duplicated 1 node"
+    assert not [d for d in validate(c.document, c.resolver) if d.severity == "error"]
+
+
 def test_frame_all_makes_every_node_visible(view):
     c = view.controller
     c.push(AddNode(Node("far1", "one_minus", (-3000, -2000))))

@@ -323,6 +323,13 @@ class DocumentActions(QObject):
     def _write(self, path: Path) -> bool:
         old_path = self.document.path
         old_recovery = self.recovery_file()
+        old_name = self.document.name
+        # Saved under a new file, a document still called by its placeholder ("Untitled") or
+        # by its old file's stem takes the new file's stem as its name.
+        if old_path is None or Path(old_path) != path:
+            stems = {"", "Untitled"} | ({Path(old_path).stem} if old_path else set())
+            if (old_name or "") in stems:
+                self.document.name = path.stem
         try:
             if old_path is None:
                 relativise_references(self.document, path)
@@ -330,6 +337,7 @@ class DocumentActions(QObject):
                 self.document.preview.update(self.preview_settings(path))
             save(self.document, path)
         except (OSError, ValueError) as exc:
+            self.document.name = old_name
             self.show_error("Cannot save", f"{path} could not be saved:\n{exc}")
             return False
         self.controller.undo_stack.setClean()

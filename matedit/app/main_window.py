@@ -101,6 +101,7 @@ class MainWindow(QMainWindow):
         c.analysed.connect(lambda _a: self._refresh_problems())
         self.actions.opened.connect(lambda _p: self._retitle())
         self.actions.saved.connect(lambda p: self.status(f"saved {p}"))
+        self.actions.saved.connect(lambda _p: self._retitle())  # Save As of a clean document
         self.actions.message.connect(self.status)
         self.problems.changed.connect(self._refresh_problems)
         self.viewport.statusMessage.connect(self.status)

@@ -54,6 +54,8 @@ class CanvasCommand:
     icon: str = ""
     tip: str = ""
     enabled: Callable[[NodeCanvasView], bool] = _always
+    # a toggle's state on the canvas (its menu entry shows a check mark); None: not a toggle
+    checked: Callable[[NodeCanvasView], bool] | None = None
 
 
 TABLE: tuple[CanvasCommand, ...] = (
@@ -78,7 +80,8 @@ TABLE: tuple[CanvasCommand, ...] = (
     CanvasCommand("frame_selection", "Frame &Selection", lambda v: v.frame_selection(),
                   ("F",), tip="Frame the selection (everything when nothing is selected)"),
     CanvasCommand("minimap", "&Minimap", lambda v: v.toggle_minimap(), ("M",),
-                  tip="Show or hide the canvas minimap"),
+                  tip="Show or hide the canvas minimap",
+                  checked=lambda v: not v.minimap.isHidden()),
     CanvasCommand("node_docs", "&Node Reference", lambda v: v.request_docs(), ("F1",),
                   tip="Documentation of the selected node kind", enabled=_one_node_selected),
 )
@@ -109,6 +112,7 @@ class CanvasActions(QObject):
             a.setObjectName(f"canvas_{c.id}")
             a.setShortcuts([QKeySequence(k) for k in c.keys])
             a.setShortcutContext(Qt.ShortcutContext.WidgetShortcut)
+            a.setCheckable(c.checked is not None)
             if c.tip:
                 a.setToolTip(c.tip)
                 a.setStatusTip(c.tip)
@@ -133,13 +137,18 @@ class CanvasActions(QObject):
         if not c.enabled(canvas):
             return False
         c.run(canvas)
+        if c.checked is not None:
+            self._actions[command_id].setChecked(c.checked(canvas))
         return True
 
     def refresh(self, canvas: NodeCanvasView | None = None) -> None:
         """Enabled states for `canvas` (default: the target), before a menu shows."""
         canvas = canvas if canvas is not None else self._target()
         for cid, a in self._actions.items():
-            a.setEnabled(self._commands[cid].enabled(canvas))
+            c = self._commands[cid]
+            a.setEnabled(c.enabled(canvas))
+            if c.checked is not None:
+                a.setChecked(c.checked(canvas))
 
     def action_for_key(self, event) -> str:
         """The id of the command a key press stands for ('' if none)."""

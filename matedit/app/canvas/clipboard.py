@@ -24,6 +24,7 @@ from matedit.graph.model import (
     MaterialGraph,
     Node,
 )
+from matedit.graph.nodes import is_value_parameter
 from matedit.io.document import FormatError, from_dict, to_dict
 
 MIME = "application/x-matedit-nodes"
@@ -96,13 +97,21 @@ def paste_commands(graph: MaterialGraph, clip: MaterialDocument,
     ids: dict[str, str] = {}
     commands: list[Command] = []
     dx, dy = offset
+    # A parameter's name is its uniform: a pasted or duplicated one whose name the graph
+    # already has gets the next free "name_2", "name_3"... (two would stop the material).
+    names = {str(n.settings.get("name")) for n in graph.nodes.values()
+             if is_value_parameter(n.kind)}
     for old in sorted(clip.graph.nodes):
         n = clip.graph.nodes[old]
         new = fresh_id(graph, old, reserved)
         reserved.add(new)
         ids[old] = new
+        settings = dict(n.settings)
+        if is_value_parameter(n.kind) and isinstance(settings.get("name"), str):
+            settings["name"] = _free_name(settings["name"], names)
+            names.add(settings["name"])
         commands.append(AddNode(Node(new, n.kind, (n.position[0] + dx, n.position[1] + dy),
-                                     dict(n.settings), dict(n.values), n.label),
+                                     settings, dict(n.values), n.label),
                                 text="paste"))
     for l in sorted(clip.graph.links):
         if l.src in ids and l.dst in ids:
@@ -114,6 +123,18 @@ def paste_commands(graph: MaterialGraph, clip: MaterialDocument,
         x, y, w, h = c.rect
         commands.append(PutComment(new, Comment(new, c.text, (x + dx, y + dy, w, h), c.color)))
     return commands, [ids[k] for k in sorted(ids)]
+
+
+def _free_name(name: str, taken: set[str]) -> str:
+    """`name`, or with its numeric suffix moved on (roughness -> roughness_2, tint_2 -> tint_3)
+    until no other parameter has it."""
+    if name not in taken:
+        return name
+    stem, _, tail = name.rpartition("_")
+    stem, i = (stem, int(tail)) if stem and tail.isdigit() else (name, 1)
+    while f"{stem}_{i}" in taken or i == 1:
+        i += 1
+    return f"{stem}_{i}"
 
 
 def payload_bounds(clip: MaterialDocument) -> tuple[float, float] | None:

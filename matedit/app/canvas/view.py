@@ -292,8 +292,8 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         if not commands or not self.controller.push_all(commands, text):
             return []
         self.select_nodes(ids)
-        self.message.emit(f"{text.capitalize()}d {len(ids)} node{'s' if len(ids) != 1 else ''}"
-                          if text == "paste" else f"Duplicated {len(ids)} nodes")
+        verb = "Pasted" if text == "paste" else "Duplicated"
+        self.message.emit(f"{verb} {len(ids)} node{'s' if len(ids) != 1 else ''}")
         return ids
 
     def _new_node(self, kind: str, scene_pos: QPointF, settings: dict | None) -> Node | None:
