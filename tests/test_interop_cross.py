@@ -81,9 +81,13 @@ def test_cli_all_writes_hlsl_and_msl_with_bindings(tmp_path):
     r = run(str(SAMPLES[0]), "-o", str(tmp_path), "--target", "all")
     assert r.returncode == 0, r.stderr
     stem = SAMPLES[0].stem
-    for t in ("glsl330", "glsl450", "essl300", "hlsl", "msl"):
+    for t in ("glsl330", "glsl450", "essl300"):
         assert (tmp_path / f"{stem}.{t}.vert").is_file()
         assert (tmp_path / f"{stem}.{t}.frag").is_file()
+    for suffix in ("hlsl", "metal"):  # HLSL and MSL end in their languages' extensions
+        assert (tmp_path / f"{stem}.vert.{suffix}").is_file()
+        assert (tmp_path / f"{stem}.frag.{suffix}").is_file()
+        assert not list(tmp_path.glob(f"*.{'msl' if suffix == 'metal' else suffix}.*"))
     refl = json.loads((tmp_path / f"{stem}.reflection.json").read_text())
     assert refl["targets"]["hlsl"]["bindings"]["vertex"] == [
         {"name": "FrameBlock", "register": f"b{FRAME_BINDING}"}]

@@ -1,6 +1,6 @@
 """Export compiled shaders: targets and a folder; the same files as `matedit compile`
-(STEM.TARGET.vert, STEM.TARGET.frag and STEM.reflection.json), never over the material or a
-file it uses.
+(STEM.TARGET.vert and .frag, STEM.vert.hlsl, STEM.frag.metal and the rest, and
+STEM.reflection.json), never over the material or a file it uses.
 
 Every target `matedit compile --target` knows is offered: the GLSL dialects, and HLSL and MSL
 (translated from glsl450 through SPIR-V by spirv-cross). Where a tool HLSL/MSL need is not

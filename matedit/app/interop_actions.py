@@ -80,11 +80,9 @@ class InteropActions:
         self.act_mtlx.triggered.connect(lambda: self.export_mtlx())
         self.act_bake = QAction("Export &Baked Textures…", w)
         self.act_bake.triggered.connect(lambda: self.export_baked())
-        self.act_cross = QAction("Export &HLSL and MSL…", w)
-        self.act_cross.triggered.connect(lambda: self.export_cross())
         self.act_import = QAction("&Import MaterialX…", w)
         self.act_import.triggered.connect(lambda: self.import_mtlx())
-        self.actions = [self.act_gltf, self.act_mtlx, self.act_bake, self.act_cross]
+        self.actions = [self.act_gltf, self.act_mtlx, self.act_bake]
 
     def entries(self) -> list[QAction | None]:
         """The File menu's entries, in order (None: a separator)."""
@@ -213,19 +211,6 @@ class InteropActions:
         except Exception as exc:
             return self._fail(title, exc)
         return self._done(f"baked {len(paths)} maps into {folder}")
-
-    def export_cross(self, folder: Path | None = None) -> bool:
-        title = "Export HLSL and MSL"
-        folder = folder or self._ask_folder(title)
-        if folder is None:
-            return False
-        from matedit.interop.export import export_shaders
-
-        try:
-            written = export_shaders(self.doc, self.resolver, ["hlsl", "msl"], folder)
-        except Exception as exc:
-            return self._fail(title, exc)
-        return self._done(f"exported {len(written)} files to {folder}")
 
     def _choose_material(self, src: Path, title: str) -> tuple[bool, str | None]:
         """(go on, the material to import): with several in the document, the one picked

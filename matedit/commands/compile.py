@@ -1,6 +1,7 @@
 """`matedit compile FILE -o DIR [--target glsl330|glsl450|essl300|hlsl|msl|all]`.
 
-Writes DIR/STEM.TARGET.vert, DIR/STEM.TARGET.frag and DIR/STEM.reflection.json; refuses an
+Writes DIR/STEM.TARGET.vert and DIR/STEM.TARGET.frag (HLSL and MSL: DIR/STEM.vert.hlsl,
+DIR/STEM.frag.metal and so on, matedit.interop.export) and DIR/STEM.reflection.json; refuses an
 output that is, or resolves to, the document or a file it references."""
 
 from __future__ import annotations

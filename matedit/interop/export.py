@@ -1,7 +1,9 @@
 """The compiled-shader files of one material: what `matedit compile` and the editor's
 Export write, the same bytes from both.
 
-DIR/STEM.TARGET.vert, DIR/STEM.TARGET.frag per target, and DIR/STEM.reflection.json. No file
+DIR/STEM.TARGET.vert and DIR/STEM.TARGET.frag per GLSL target (glslang picks the stage by that
+extension), DIR/STEM.vert.hlsl / .frag.hlsl and DIR/STEM.vert.metal / .frag.metal for HLSL and
+MSL (the extensions their compilers and IDEs know), and DIR/STEM.reflection.json. No file
 may replace the document or anything it reads (`matedit.io.inputs`); nothing written names a
 folder of this machine (the reflection's `source` is the document's file name).
 """
@@ -22,6 +24,16 @@ def stem_of(doc: MaterialDocument) -> str:
     return name[:-5] if name.endswith(".json") else name
 
 
+# Targets whose files end in their language's extension rather than the stage's.
+LANGUAGE_SUFFIX = {"hlsl": "hlsl", "msl": "metal"}
+
+
+def stage_file_name(stem: str, target: str, stage: str) -> str:
+    """The file name of one stage ("vert" or "frag") of `target`."""
+    suffix = LANGUAGE_SUFFIX.get(target)
+    return f"{stem}.{stage}.{suffix}" if suffix else f"{stem}.{target}.{stage}"
+
+
 def shader_files(doc: MaterialDocument, compiled: dict[str, CompiledMaterial],
                  folder: Path) -> dict[Path, str]:
     """Output path -> text for every file of the export."""
@@ -30,8 +42,8 @@ def shader_files(doc: MaterialDocument, compiled: dict[str, CompiledMaterial],
     files: dict[Path, str] = {}
     reflection: dict = {"source": Path(doc.path).name if doc.path else stem, "targets": {}}
     for name, cm in compiled.items():
-        files[folder / f"{stem}.{name}.vert"] = cm.vertex_text
-        files[folder / f"{stem}.{name}.frag"] = cm.fragment_text
+        files[folder / stage_file_name(stem, name, "vert")] = cm.vertex_text
+        files[folder / stage_file_name(stem, name, "frag")] = cm.fragment_text
         reflection["targets"][name] = cm.reflection()
     first = next(iter(compiled.values())).reflection()
     for key in ("attributes", "uniforms", "textures", "uniform_block"):
