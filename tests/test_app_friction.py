@@ -379,3 +379,55 @@ def test_save_as_names_an_untitled_document_after_its_file_and_retitles_the_wind
     assert w.actions.save_as()
     assert json.loads((tmp_path / "copper.json").read_text())["name"] == "Weathered Copper"
     assert w.windowTitle().startswith("copper.json")
+
+
+@pytest.mark.parametrize("typed, value, shown", [
+    ("1e9", 1e9, "1000000000"), ("2,5", 2.5, "2.500"), ("2.5", 2.5, "2.500"),
+    ("-3.5E-1", -0.35, "-0.350"), ("123456", 123456.0, "123456"),
+])
+def test_a_number_field_reads_what_an_artist_types(qtbot, typed, value, shown):
+    """Typed into a float field's box and confirmed with Enter: an exponent is an exponent
+    (1e9 was read as 19), the locale's decimal comma is a decimal point (2,5 was 25), and a
+    large value shows all its digits."""
+    from PySide6.QtTest import QTest
+
+    from matedit.app.fields import FloatField
+
+    f = FloatField(0.5)
+    qtbot.addWidget(f)
+    f.show()
+    got = []
+    f.edited.connect(lambda v, _m: got.append(v))
+    f.spin.lineEdit().selectAll()
+    QTest.keyClicks(f.spin, typed)
+    QTest.keyClick(f.spin, Qt.Key.Key_Return)
+    assert got and got[-1] == pytest.approx(value)
+    assert f.value() == pytest.approx(value)
+    assert f.spin.text() == shown
+
+
+def test_a_black_colour_shows_black_and_a_pick_on_it_takes(qtbot):
+    """A colour ramp's black stop, shown by the field that showed a grey one: the swatch is
+    black at x 1 (it was the old grey at x 0, and a picked colour stayed black). An artist's
+    own x 0 keeps its hue, and a pick then brings the intensity back to 1."""
+    from PySide6.QtGui import QColor
+
+    from matedit.app.fields import ColorField
+
+    f = ColorField([0.5, 0.5, 0.5])
+    qtbot.addWidget(f)
+    got = []
+    f.edited.connect(lambda v, _m: got.append(v))
+    f.set_value([0.0, 0.0, 0.0])
+    assert f.intensity.value() == 1.0
+    assert "rgb(0,0,0)" in f.swatch.styleSheet()
+    f.dialog_factory = lambda *_a: QColor(255, 0, 0)
+    f.pick()
+    assert got[-1] == [1.0, 0.0, 0.0] and "rgb(255,0,0)" in f.swatch.styleSheet()
+    f.intensity.setValue(0.0)  # typed by the artist: the value is black, the hue stays
+    assert got[-1] == [0.0, 0.0, 0.0]
+    f.set_value(got[-1])  # the model's value coming back
+    assert f.intensity.value() == 0.0 and "rgb(0,0,0)" in f.swatch.styleSheet()
+    f.dialog_factory = lambda *_a: QColor(0, 255, 0)
+    f.pick()
+    assert got[-1] == [0.0, 1.0, 0.0] and f.intensity.value() == 1.0

@@ -9,11 +9,12 @@ inspector turns their signals into commands.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, Signal
-from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap
+from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap, QValidator
 from PySide6.QtWidgets import (
     QAbstractScrollArea,
     QApplication,
@@ -35,7 +36,7 @@ from matedit.app.controller import new_merge_id
 from matedit.app.theme import icon
 
 SLIDER_STEPS = 1000
-SPIN_LIMIT = 1e6
+SPIN_LIMIT = 1e12  # a typed 1e9 stays 1e9 (float32 uniforms hold it)
 IMAGE_FILTER = "Images (*.png *.jpg *.jpeg *.tga *.tif *.tiff *.exr *.hdr *.bmp);;All files (*)"
 
 
@@ -61,8 +62,42 @@ def guard_wheel(widget: QWidget) -> QWidget:
     return widget
 
 
+# What a number field reads as a number while it is typed: a sign, digits with one decimal
+# separator ('.' or the locale's ','), and an exponent (1e9, 2.5E-3).
+_NUMBER = re.compile(r"[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?")
+_PARTIAL = re.compile(r"[+-]?(\d*([.,]\d*)?)([eE][+-]?\d*)?")
+
+
+class NumberSpin(QDoubleSpinBox):
+    """A spin box that reads what artists type: `1e9`, `2,5` as well as `2.5`, and shows a
+    large value in full (digits, not a cut-off "100000.000")."""
+
+    def validate(self, text: str, pos: int):  # noqa: D102 - Qt's
+        t = text.strip()
+        if _NUMBER.fullmatch(t):
+            return QValidator.State.Acceptable, text, pos
+        if _PARTIAL.fullmatch(t):
+            return QValidator.State.Intermediate, text, pos
+        return QValidator.State.Invalid, text, pos
+
+    def valueFromText(self, text: str) -> float:  # noqa: N802 - Qt's name
+        try:
+            v = float(text.strip().replace(",", "."))
+        except ValueError:
+            return self.value()
+        return min(max(v, self.minimum()), self.maximum()) if math.isfinite(v) else self.value()
+
+    def textFromValue(self, value: float) -> str:  # noqa: N802 - Qt's name
+        if abs(value) >= 1e4:  # no decimals past ten thousand: the digits fit the field
+            return f"{value:.0f}"
+        return f"{value:.{self.decimals()}f}"
+
+    def fixup(self, text: str) -> str:
+        return text.strip().replace(",", ".")
+
+
 def _spin(decimals: int = 3) -> QDoubleSpinBox:
-    s = QDoubleSpinBox()
+    s = NumberSpin()
     guard_wheel(s)
     s.setRange(-SPIN_LIMIT, SPIN_LIMIT)
     s.setDecimals(decimals)
@@ -258,13 +293,25 @@ class ColorField(QWidget):
         if peak <= 0.0 or len(rgb) != len(self._base):
             return None
         k = max(rgb) / peak
+        if k == 0.0 and self.intensity.value() != 0.0:
+            return None  # black from elsewhere (a ramp's other stop): a black swatch at x 1
         if k < 0 or any(abs(b * k - c) > 1e-5 * max(1.0, abs(c)) for b, c in zip(self._base,
                                                                                 rgb)):
             return None
         return k
 
+    def _unmute(self) -> None:
+        """A colour picked at intensity 0 would change nothing the artist can see: back to 1."""
+        if self.intensity.value() == 0.0:
+            self.intensity.blockSignals(True)
+            self.intensity.setValue(1.0)
+            self.intensity.blockSignals(False)
+
     def _paint(self) -> None:
-        r, g, b = (int(round(linear_to_srgb(c) * 255)) for c in self._base)
+        # the swatch is the colour itself where it is not HDR (an intensity below 1 darkens
+        # it), else its hue at full brightness beside the multiplier
+        k = min(float(self.intensity.value()), 1.0)
+        r, g, b = (int(round(linear_to_srgb(c * k) * 255)) for c in self._base)
         self.swatch.setStyleSheet(f"background: rgb({r},{g},{b});")
         v = self.value()
         self.swatch.setToolTip("linear RGB " + ", ".join(f"{c:.3f}" for c in v))
@@ -281,6 +328,7 @@ class ColorField(QWidget):
             return
         self._base = [round(srgb_to_linear(x), 6) for x in
                       (chosen.redF(), chosen.greenF(), chosen.blueF())]
+        self._unmute()
         self._paint()
         self.edited.emit(self.value(), None)
 
@@ -299,6 +347,7 @@ class ColorField(QWidget):
                 return
             self._base = [round(srgb_to_linear(x), 6) for x in (c.redF(), c.greenF(),
                                                                  c.blueF())]
+            self._unmute()
             self._paint()
             self.edited.emit(self.value(), merge)
 
