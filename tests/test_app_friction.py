@@ -431,3 +431,36 @@ def test_a_black_colour_shows_black_and_a_pick_on_it_takes(qtbot):
     f.dialog_factory = lambda *_a: QColor(0, 255, 0)
     f.pick()
     assert got[-1] == [0.0, 1.0, 0.0] and f.intensity.value() == 1.0
+
+
+def test_the_lights_list_grows_with_the_rig_and_selecting_keeps_the_panel_scrolled(qtbot):
+    """Eight lights: the list shows them all (it was three rows tall); in a short dock,
+    scrolled down to the form, picking another light leaves the panel where it was (it
+    jumped back to the top)."""
+    from PySide6.QtWidgets import QApplication, QScrollArea
+
+    from matedit.app.lights_panel import MAX_LIST_ROWS
+    from matedit.shading.lights import Light
+
+    w = make_window(qtbot, SAMPLE, show=True)
+    panel = w.panels.lights
+    rig = [Light("sphere", position=(float(i), 2.0, 3.0)) for i in range(MAX_LIST_ROWS)]
+    panel.set_lights(rig)
+    lst = panel.list
+    assert lst.height() >= lst.sizeHintForRow(0) * MAX_LIST_ROWS
+    assert lst.verticalScrollBar().maximum() == 0  # every light in view
+    scroll = w.findChild(QScrollArea, "lightsScroll")
+    w.panels.lights_dock.setFloating(True)
+    w.panels.lights_dock.resize(320, 260)
+    qtbot.wait(20)
+    qtbot.wait(50)
+    QApplication.processEvents()
+    bar = scroll.verticalScrollBar()
+    assert bar.maximum() > 0
+    bar.setValue(bar.maximum())
+    at = bar.value()
+    assert at > 0
+    lst.setCurrentRow(5)
+    qtbot.wait(20)
+    QApplication.processEvents()
+    assert bar.value() == at

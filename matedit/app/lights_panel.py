@@ -15,6 +15,7 @@ from PySide6.QtWidgets import (
     QListWidget,
     QListWidgetItem,
     QMenu,
+    QScrollArea,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -25,6 +26,7 @@ from matedit.app.theme import icon
 from matedit.shading.lights import LIGHT_TYPES, Light
 
 KINDS = ("sphere", "tube", "point", "directional")
+MAX_LIST_ROWS = 8  # the lights list grows to this many rows, then scrolls
 
 
 def default_light(kind: str) -> Light:
@@ -83,9 +85,7 @@ class LightsPanel(QWidget):
         install_rig_actions(self, bar)  # load / save the rig as a file (matedit.io.rig)
         lay.addLayout(bar)
         self.list = QListWidget()
-        self.list.setMinimumHeight(84)
-        self.list.setMaximumHeight(110)
-        self.list.currentRowChanged.connect(self._show)
+        self.list.currentRowChanged.connect(self._show_keeping_scroll)
         lay.addWidget(self.list)
         self.form_host = QWidget()
         self.form = QFormLayout(self.form_host)
@@ -126,11 +126,36 @@ class LightsPanel(QWidget):
             QListWidgetItem(icon("light"), describe(light), self.list)
         self.list.blockSignals(False)
         self.remove_button.setEnabled(bool(self._lights))
+        self._fit_list()
         if self._lights:
             self.list.setCurrentRow(max(0, select))
             self._show(max(0, select))
         else:
             self._show(-1)
+
+    def _fit_list(self) -> None:
+        """The list as tall as its lights (3 rows at least, 8 at most, then it scrolls)."""
+        row = self.list.sizeHintForRow(0) if self.list.count() else 0
+        row = max(row, self.list.fontMetrics().height() + 6)
+        rows = min(max(self.list.count(), 3), MAX_LIST_ROWS)
+        self.list.setFixedHeight(row * rows + 2 * self.list.frameWidth() + 2)
+
+    def _show_keeping_scroll(self, row: int) -> None:
+        """Another light's form, with the panel's scroll position where it was: rebuilding
+        the form would otherwise scroll the dock back to its top."""
+        area = self._scroll_area()
+        bar = area.verticalScrollBar() if area is not None else None
+        at = bar.value() if bar is not None else 0
+        self._show(row)
+        if bar is not None:
+            bar.setValue(at)
+            QTimer.singleShot(0, self, lambda: bar.setValue(at))  # after the relayout
+
+    def _scroll_area(self) -> QScrollArea | None:
+        w = self.parentWidget()
+        while w is not None and not isinstance(w, QScrollArea):
+            w = w.parentWidget()
+        return w
 
     def _clear_form(self) -> None:
         while self.form.rowCount():
