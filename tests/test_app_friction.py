@@ -464,3 +464,25 @@ def test_the_lights_list_grows_with_the_rig_and_selecting_keeps_the_panel_scroll
     qtbot.wait(20)
     QApplication.processEvents()
     assert bar.value() == at
+
+
+def test_a_function_tabs_diagnostics_do_not_say_the_material_compiles_when_it_does_not(
+        qtbot):
+    """The status bar says the material does not compile; a function tab with no problems of
+    its own said "No problems: the material compiles." It speaks of itself, and of the
+    material's failure."""
+    from matedit.app.diagnostics import Problem
+
+    w = make_window(qtbot, SAMPLE)
+    w.tabs.open_function(graphs_dir() / "functions" / "rotate_uv.json")
+    assert w.tabs.active is not w.tabs.material
+
+    def row() -> str:
+        w._refresh_problems()
+        return w.diagnostics.topLevelItem(0).text(3)
+    w.problems.compile = []
+    assert row() == "No problems in this function."
+    w.problems.compile = [Problem("error", "parameter name 'p' is used by q too", "p", "name",
+                                  "compiler")]
+    assert row() == ("No problems in this function; the material does not compile "
+                     "(see its tab).")

@@ -42,7 +42,9 @@ class DiagnosticsPanel(QTreeWidget):
         self.itemActivated.connect(self._clicked)
         self.set_problems([])
 
-    def set_problems(self, problems: list[Problem]) -> None:
+    def set_problems(self, problems: list[Problem],
+                     empty_text: str = "No problems: the material compiles.") -> None:
+        """The rows; `empty_text` is the one row shown when there are none."""
         seen = set()
         unique = []
         for p in problems:  # validation and the compiler often report the same thing
@@ -53,7 +55,7 @@ class DiagnosticsPanel(QTreeWidget):
         self.problems = unique
         self.clear()
         if not unique:
-            it = QTreeWidgetItem(self, ["", "", "", "No problems: the material compiles."])
+            it = QTreeWidgetItem(self, ["", "", "", empty_text])
             it.setIcon(0, icon("ok"))
             return
         order = {"error": 0, "warning": 1}

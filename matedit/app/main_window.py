@@ -245,8 +245,8 @@ class MainWindow(QMainWindow):
         tab = self.tabs.active
         m = self.tabs.material
         self.compile_label.setText(self.problems.status)
-        self.diagnostics.set_problems(self.problems.for_tab(tab.controller.analysis,
-                                                            tab is m))
+        self.diagnostics.set_problems(self.problems.for_tab(tab.controller.analysis, tab is m),
+                                      self.problems.empty_text(tab is m))
         tab.canvas.set_node_errors(self.diagnostics.errors_by_node())
         if tab is not m:
             m.canvas.set_node_errors(self.problems.material_errors())

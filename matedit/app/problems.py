@@ -92,6 +92,21 @@ class ProblemsModel(QObject):
             out += self.compile + self.gl
         return unique(out)
 
+    @property
+    def material_fails(self) -> bool:
+        """Whether the material's last compile or GL build failed (what the status says)."""
+        return any(p.severity == "error" for p in self.compile + self.gl)
+
+    def empty_text(self, is_material: bool) -> str:
+        """The Diagnostics panel's line when a tab has no problems of its own: a function
+        tab says so of itself, and that the material still does not compile where it
+        does not (its tab lists why)."""
+        if is_material:
+            return "No problems: the material compiles."
+        if self.material_fails:
+            return "No problems in this function; the material does not compile (see its tab)."
+        return "No problems in this function."
+
     def material_errors(self) -> dict[str, str]:
         """The compiler's and GL's errors by node (badges on the material's canvas)."""
         out: dict[str, str] = {}
