@@ -10,7 +10,7 @@ the framework that uses it. Dead code is deleted, not listed.
 _ = object()
 
 # Qt calls these overrides of QGraphicsScene, QGraphicsView, QOpenGLWidget, QTreeWidget,
-# QUndoCommand and QWidget by name.
+# QUndoCommand, QWidget and QDoubleSpinBox by name.
 _.drawBackground
 _.wheelEvent
 _.contextMenuEvent
@@ -19,6 +19,10 @@ _.mimeTypes
 _.initializeGL
 _.resizeGL
 _.paintGL
+# QAbstractSpinBox/QDoubleSpinBox (matedit.app.fields.NumberSpin)
+_.textFromValue
+_.valueFromText
+_.fixup
 
 # moderngl reads these attributes of its textures and contexts when they are set.
 _.repeat_x
