@@ -5,6 +5,7 @@ Real widgets under Xvfb (pytest-xvfb starts the server; pytest-qt drives the wid
 
 from __future__ import annotations
 
+import math
 import os
 
 os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
@@ -181,13 +182,47 @@ def test_copy_paste_between_two_documents_keeps_inner_links_with_fresh_ids(view,
     assert_mirrors(v2)
 
 
-def test_duplicate_offsets_the_copy(view):
+def _overlaps(view, node_id):
+    from PySide6.QtWidgets import QApplication
+
+    QApplication.processEvents()
+    items = view.scene().node_items
+    mine = items[node_id].sceneBoundingRect()
+    return [nid for nid, it in items.items()
+            if nid != node_id and it.sceneBoundingRect().intersects(mine)]
+
+
+def test_duplicate_offsets_the_copy_into_free_space(view):
+    """The copy goes 40 right and down of the original, then on to the nearest place where
+    it covers no node (it used to land half over the original)."""
     view.select_nodes(["mul"])
     ids = view.duplicate_selection()
     assert len(ids) == 1 and ids[0] != "mul"
     g = view.controller.document.graph
-    assert g.nodes[ids[0]].position == (290.0, 40.0)
+    x, y = g.nodes[ids[0]].position
+    assert math.hypot(x - 290.0, y - 40.0) < 300
+    assert not _overlaps(view, ids[0])
     assert view.selected_ids() == ids
+
+
+def test_a_node_added_on_another_lands_beside_it_selected(view):
+    """Added from the palette right on top of the Make Attributes: it lands in free space
+    nearby, selected (so the Inspector shows it, not what was selected before)."""
+    view.select_nodes(["make"])
+    make = view.controller.document.graph.nodes["make"].position
+    nid = view.add_node_at("gradient_noise", QPointF(*make))
+    assert nid and not _overlaps(view, nid)
+    x, y = view.controller.document.graph.nodes[nid].position
+    assert math.hypot(x - make[0], y - make[1]) < 400
+    assert view.selected_ids() == [nid]
+
+
+def test_a_wire_dropped_on_empty_canvas_joins_the_new_nodes_subject_input():
+    """Smooth Step's value, not edge0 (its first input); Remap's value."""
+    from matedit.app.canvas.interaction import compatible_port
+
+    assert compatible_port("smoothstep", "float", True) == "value"
+    assert compatible_port("remap", "float", True) == "value"
 
 
 def test_duplicating_a_parameter_gives_the_copy_a_free_name_so_the_material_compiles(view):

@@ -49,8 +49,17 @@ def kind_ports(kind: str) -> NodePorts | None:
         return None
 
 
+# Input names that say "what this node works on", as opposed to its controls (Smooth Step's
+# value rather than edge0, Remap's value rather than in_min): a wire dropped on empty canvas
+# joins one of these first.
+SUBJECT_INPUTS = ("value", "in", "input", "color", "base", "a", "uv", "normal", "attributes",
+                  "vector", "x", "height", "mask")
+
+
 def compatible_port(kind: str, anchor_type: str, anchor_is_output: bool) -> str | None:
-    """The port of a new `kind` node that a wire from the anchor would join: exact type first."""
+    """The port of a new `kind` node that a wire from the anchor would join: among the ports
+    whose type fits (the exact type before a conversion), the node's subject input before a
+    control (SUBJECT_INPUTS), else the first."""
     ports = kind_ports(kind)
     if ports is None:
         return None
@@ -58,8 +67,15 @@ def compatible_port(kind: str, anchor_type: str, anchor_is_output: bool) -> str 
         pairs = [(p.name, anchor_type, p.type) for p in ports.inputs]
     else:
         pairs = [(p.name, p.type, anchor_type) for p in ports.outputs]
-    exact = next((n for n, s, d in pairs if s == d and s != GENERIC), None)
-    return exact or next((n for n, s, d in pairs if type_accepts(s, d)), None)
+    fits = [(n, s == d and s != GENERIC) for n, s, d in pairs if type_accepts(s, d)]
+    if not fits:
+        return None
+
+    def rank(item: tuple[str, bool]) -> tuple[int, int]:
+        name, exact = item
+        subject = anchor_is_output and name in SUBJECT_INPUTS
+        return (0 if exact else 1, 0 if subject else 1)
+    return min(fits, key=rank)[0]
 
 
 def port_at(scene, scene_pos: QPointF, radius: float, *, want_output: bool | None = None,

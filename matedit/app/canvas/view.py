@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from matedit.app.canvas import clipboard
+from matedit.app.canvas import clipboard, placement
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.actions import CONTEXT_MENU, CanvasActions
 from matedit.app.canvas.comment_item import CommentItem
@@ -171,7 +171,11 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         node = self._new_node(kind, scene_pos, settings)
         if node is None:
             return ""
-        return node.id if self.controller.push(AddNode(node)) else ""
+        placement.place(node, self._scene)  # never on another node
+        if not self.controller.push(AddNode(node)):
+            return ""
+        self.select_nodes([node.id])  # the Inspector shows the new node
+        return node.id
 
     def set_node_errors(self, errors: dict[str, str]) -> None:
         """Errors mapped to nodes (GLSL compile errors), shown as red badges; replaces the last."""
@@ -288,7 +292,15 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         return cid if self.controller.push(PutComment(cid, comment, text="add comment")) else ""
 
     def _paste_doc(self, clip: MaterialDocument, offset, text: str) -> list[str]:
-        commands, ids = clipboard.paste_commands(self.controller.document.graph, clip, offset)
+        graph = self.controller.document.graph
+        # the pasted group moves together to the nearest place where it covers no node
+        dx, dy = offset
+        rects = [placement.node_rect(dataclasses.replace(
+            n, position=(n.position[0] + dx, n.position[1] + dy)))
+            for n in clip.graph.nodes.values()]
+        shift = placement.free_offset(rects, placement.taken_rects(self._scene))
+        offset = (dx + shift.x(), dy + shift.y())
+        commands, ids = clipboard.paste_commands(graph, clip, offset)
         if not commands or not self.controller.push_all(commands, text):
             return []
         self.select_nodes(ids)
@@ -366,6 +378,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
                       [PortRow(p.name, p.type) for p in ports.outputs])
         local = lay.inputs[port] if a_out else lay.outputs[port]
         node.position = (round(at.x() - local.x(), 1), round(at.y() - local.y(), 1))
+        placement.place(node, self._scene)
         link = (Link(a_node, a_port, node.id, port) if a_out else
                 Link(node.id, port, a_node, a_port))
         doc = self.controller.document
@@ -377,6 +390,8 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
             self.refuse(reason)
             return node.id
         ok = self.controller.push_all([AddNode(node), Connect(link)], "add connected node")
+        if ok:
+            self.select_nodes([node.id])
         return node.id if ok else ""
 
     # --- selection ---------------------------------------------------------------------------
