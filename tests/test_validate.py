@@ -212,3 +212,27 @@ def test_missing_texture_is_a_warning_not_an_error(tmp_path):
     assert not [x for x in diags if x.severity == Severity.ERROR]
     (w,) = [x for x in diags if x.severity == Severity.WARNING]
     assert (w.node_id, w.port) == ("tex", "path") and "checker" in w.message
+
+
+def test_a_call_without_a_function_yet_is_a_warning_and_the_material_compiles():
+    """A Function Call just placed, its function not chosen: a warning on that node (it used
+    to be an error that stopped the material and cleared every thumbnail), no ports, and
+    the material compiles as if it were not there."""
+    from matedit.compiler.api import compile_document
+    from matedit.graph.model import Node
+    from matedit.io.document import FileResolver, load
+    from matedit.resources import graphs_dir
+
+    doc = load(graphs_dir() / "materials" / "mossy_stone.json")
+    before = compile_document(doc, FileResolver()).fragment_text
+    doc.graph.nodes["call"] = Node("call", "function_call", (0, 0), {})
+    diags = validate(doc, FileResolver())
+    mine = [d for d in diags if d.node_id == "call"]
+    assert [d.severity.value for d in mine] == ["warning"]
+    assert mine[0].port == "function" and "no function chosen" in mine[0].message
+    assert not [d for d in diags if d.severity.value == "error"]
+    assert compile_document(doc, FileResolver()).fragment_text == before
+    # a function setting that is not a file name is still an error naming the field
+    doc.graph.nodes["call"] = Node("call", "function_call", (0, 0), {"function": 7})
+    bad = [d for d in validate(doc, FileResolver()) if d.node_id == "call"]
+    assert [(d.severity.value, d.port) for d in bad] == [("error", "function")]

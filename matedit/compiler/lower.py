@@ -367,6 +367,8 @@ class _Lowerer:
         return op, callee
 
     def _k_function_call(self, nid, node) -> None:
+        if not node.settings.get("function"):
+            return  # no function chosen yet: no ports, nothing to call (validate warns)
         ins = self.a.in_types[nid]
         args = {p.name: self.arg(nid, p.name, ins[p.name], p.default)
                 for p in self.a.ports[nid].inputs}

@@ -187,8 +187,12 @@ def node_ports(
         return NodePorts(ins + tuple(extra), outs)
     if rule == PortsRule.FUNCTION_SIGNATURE:
         ref = s.get("function")
-        if not ref or not isinstance(ref, str):
-            raise PortError(node.id, "function", "no function file chosen")
+        if ref is None or ref == "":
+            # A call just placed, before its function is chosen: no ports yet, so nothing
+            # can be wired to it and the material compiles without it (validate warns).
+            return NodePorts((), ())
+        if not isinstance(ref, str):
+            raise PortError(node.id, "function", "the function must be a file name")
         if resolver is None:
             raise LookupError(f"cannot resolve function {ref!r} without a resolver")
         fn = resolver.resolve(ref, owner)

@@ -125,6 +125,10 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
                 why = gpu_number_problem(node.settings[s.name])
                 if why:
                     diags.append(error(why, nid, s.name, f))
+        if nodes.role_of(node.kind) == nodes.Role.FUNCTION_CALL \
+                and node.settings.get("function") in (None, ""):
+            diags.append(warning("no function chosen yet: the call does nothing until one is",
+                                 nid, "function", f))
         try:
             ports[nid] = node_ports(node, resolver, doc)
         except PortError as exc:
