@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import QSize, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QComboBox,
     QFormLayout,
@@ -85,6 +85,8 @@ class LightsPanel(QWidget):
         install_rig_actions(self, bar)  # load / save the rig as a file (matedit.io.rig)
         lay.addLayout(bar)
         self.list = QListWidget()
+        self.list.setIconSize(QSize(16, 16))  # compact rows: the form below must fit too
+        self.list.setUniformItemSizes(True)
         self.list.currentRowChanged.connect(self._show_keeping_scroll)
         lay.addWidget(self.list)
         self.form_host = QWidget()
@@ -138,7 +140,7 @@ class LightsPanel(QWidget):
         row = self.list.sizeHintForRow(0) if self.list.count() else 0
         row = max(row, self.list.fontMetrics().height() + 6)
         rows = min(max(self.list.count(), 3), MAX_LIST_ROWS)
-        self.list.setFixedHeight(row * rows + 2 * self.list.frameWidth() + 2)
+        self.list.setFixedHeight(row * rows + 2 * self.list.frameWidth())
 
     def _show_keeping_scroll(self, row: int) -> None:
         """Another light's form, with the panel's scroll position where it was: rebuilding
