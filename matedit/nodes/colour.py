@@ -1,5 +1,4 @@
-"""Colour kinds: luminance, HSV, grading, the blend modes and the colour ramp.
-"""
+"""Colour kinds: luminance, HSV, grading, the blend modes and the colour ramp."""
 
 from __future__ import annotations
 
@@ -192,7 +191,7 @@ def _mix_towards_inverse(b: MxBuilder) -> Makers:  # mix(color, 1 − color, amo
 
 _fn("invert", "Invert", "Colour", "1 − color, by amount.",
     [_i(*_C), _i("amount", "float", 1.0, "", UNIT)], [_o("result", "vec3")],
-    mtlx=MxRecipe("mix_towards_inverse", _mix_towards_inverse),  # mix(color, 1 − color, amount)
+    mtlx=MxRecipe("mix_towards_inverse", _mix_towards_inverse),
     numpy=lambda ctx, color, amount: (_mix(color, 1.0 - color, _col(amount)),))
 
 
@@ -223,7 +222,7 @@ def _mix_from_grey(b: MxBuilder) -> Makers:  # mix(rec709 luminance, color, amou
 
 _fn("saturation", "Saturation", "Colour", "Mixes between grey (0) and the colour (1) and past.",
     [_i(*_C), _i("amount", "float", 1.0, "", (0.0, 2.0))], [_o("result", "vec3")],
-    mtlx=MxRecipe("mix_from_grey", _mix_from_grey),  # mix(rec709 luminance, color, amount)
+    mtlx=MxRecipe("mix_from_grey", _mix_from_grey),
     numpy=lambda ctx, color, amount: (_mix(_col(_luminance(color)), color, _col(amount)),))
 
 

@@ -1,5 +1,4 @@
-"""Masks from the surface's geometry and view.
-"""
+"""Masks from the surface's geometry and view."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""Material attributes, the layer blends, material functions and the output.
-"""
+"""Material attributes, the layer blends, material functions and the output."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""Maths, vector and logic kinds: GLSL built-ins as inline templates, a few functions.
-"""
+"""Maths, vector and logic kinds: GLSL built-ins as inline templates, a few functions."""
 
 from __future__ import annotations
 
@@ -63,7 +62,7 @@ def _subtract_from_one(b: MxBuilder) -> Makers:  # subtract(1, value)
 
 
 _op("one_minus", "One Minus", "(1.0 - {value})", [_i("value", T)], "1 − value.",
-    mtlx=MxRecipe("subtract_from_one", _subtract_from_one),  # subtract(1, value)
+    mtlx=MxRecipe("subtract_from_one", _subtract_from_one),
     numpy=lambda ctx, value: (1.0 - value,))
 
 
@@ -182,7 +181,7 @@ def _floor_step(b: MxBuilder) -> Makers:  # clamp(floor(value - edge) + 1, 0, 1)
 # GLSL step(edge, x): 0 where x < edge, else 1.
 _op("step", "Step", "step({edge}, {value})", [_i("edge", T, 0.5), _i("value", T)],
     "0 below edge, 1 at or above it.",
-    mtlx=MxRecipe("floor_step", _floor_step),  # clamp(floor(value - edge) + 1, 0, 1)
+    mtlx=MxRecipe("floor_step", _floor_step),
     numpy=lambda ctx, edge, value: (np.where(value < edge, 0.0, 1.0).astype(value.dtype),))
 _op("smoothstep", "Smooth Step", "smoothstep({edge0}, {edge1}, {value})",
     [_i("edge0", T, 0.0), _i("edge1", T, 1.0), _i("value", T)],
@@ -328,7 +327,7 @@ def _floor_in_steps(b: MxBuilder) -> Makers:  # floor(value s) / s, s = max(step
 _op("posterize", "Posterize", "(floor({value} * max({steps}, 1.0)) / max({steps}, 1.0))",
     [_i("value", T), _i("steps", T, 4.0, "levels per unit (at least 1)", (1.0, 64.0))],
     "Quantises value into steps levels per unit.",
-    mtlx=MxRecipe("floor_in_steps", _floor_in_steps),  # floor(value s) / s, s = max(steps, 1)
+    mtlx=MxRecipe("floor_in_steps", _floor_in_steps),
     numpy=_posterize)
 
 

@@ -1,5 +1,4 @@
-"""Tangent-space normal kinds.
-"""
+"""Tangent-space normal kinds."""
 
 from __future__ import annotations
 

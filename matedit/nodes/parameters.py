@@ -1,5 +1,4 @@
-"""Constants and the parameters artists tune (uniforms, textures, static switches).
-"""
+"""Constants and the parameters artists tune (uniforms, textures, static switches)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""Texture sampling.
-"""
+"""Texture sampling."""
 
 from __future__ import annotations
 

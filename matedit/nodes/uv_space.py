@@ -1,5 +1,4 @@
-"""Coordinates: UVs, the surface's geometry and time, space transforms, triplanar mapping.
-"""
+"""Coordinates: UVs, the surface's geometry and time, space transforms, triplanar mapping."""
 
 from __future__ import annotations
 

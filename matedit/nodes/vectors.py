@@ -1,5 +1,4 @@
-"""Kinds that split, mask, join and pass vectors through.
-"""
+"""Kinds that split, mask, join and pass vectors through."""
 
 from __future__ import annotations
 
@@ -24,6 +23,7 @@ from matedit.nodes.kind import (
     register,
 )
 
+# Components of a MaterialX value type.
 _WIDTH = {"float": 1, "vector2": 2, "vector3": 3, "vector4": 4}
 
 
