@@ -95,9 +95,10 @@ def function_interface(doc: MaterialDocument) -> NodePorts:
             raise PortError(node.id, "name", f"function {side} name "
                             f"{s['name']!r}{where} {why}")
         if role == Role.FUNCTION_INPUT:
-            ins.append((key, Port(str(s["name"]), t, s.get("default"), None,
-                                      f"function input {s['name']}", t in (MA, "texture2d")
-                                      and s.get("default") is None)))
+            ins.append((key, Port(str(s["name"]), t, s.get("default"),
+                                  doc=f"function input {s['name']}",
+                                  required=t in (MA, "texture2d")
+                                  and s.get("default") is None)))
         else:
             outs.append((key, Port(str(s["name"]), t)))
     return NodePorts(tuple(p for _, p in sorted(ins, key=lambda kp: kp[0])),
@@ -203,27 +204,28 @@ def _layer_stack_inputs(node, resolver, owner) -> list[Port]:
             raise PortError(node.id, f"layers[{index}].function",
                             f"{ref} is not a material layer: it has no MaterialAttributes output")
         for p in iface.inputs:
-            ports.append(Port(f"{lid}_{p.name}", p.type, p.default, p.range,
-                                  f"{layer.get('name', lid)}: {p.doc or p.name}", p.required))
+            ports.append(Port(f"{lid}_{p.name}", p.type, p.default, range=p.range,
+                              doc=f"{layer.get('name', lid)}: {p.doc or p.name}",
+                              required=p.required))
         if index == 0:
             continue
         blend = layer.get("blend", "alpha")
         label = layer.get("name", lid)
-        ports.append(Port(f"{lid}_opacity", "float", 1.0, (0.0, 1.0),
-                              f"{label}: overall strength"))
+        ports.append(Port(f"{lid}_opacity", "float", 1.0, range=(0.0, 1.0),
+                          doc=f"{label}: overall strength"))
         if blend == "alpha" or blend in COLOR_LAYER_BLENDS:
-            ports.append(Port(f"{lid}_mask", "float", 1.0, (0.0, 1.0),
-                                  f"{label}: where the layer covers the ones below"))
+            ports.append(Port(f"{lid}_mask", "float", 1.0, range=(0.0, 1.0),
+                              doc=f"{label}: where the layer covers the ones below"))
         elif blend == "coat":
-            ports.append(Port(f"{lid}_mask", "float", 1.0, (0.0, 1.0),
-                                  f"{label}: where the coat lies (its weight)"))
+            ports.append(Port(f"{lid}_mask", "float", 1.0, range=(0.0, 1.0),
+                              doc=f"{label}: where the coat lies (its weight)"))
         elif blend == "height":
-            ports.append(Port(f"{lid}_mask", "float", 0.5, (0.0, 1.0),
-                                  f"{label}: layer height"))
-            ports.append(Port(f"{lid}_base_height", "float", 0.5, (0.0, 1.0),
-                                  f"{label}: height of the layers below"))
-            ports.append(Port(f"{lid}_contrast", "float", 0.1, (0.001, 1.0),
-                                  f"{label}: transition width"))
+            ports.append(Port(f"{lid}_mask", "float", 0.5, range=(0.0, 1.0),
+                              doc=f"{label}: layer height"))
+            ports.append(Port(f"{lid}_base_height", "float", 0.5, range=(0.0, 1.0),
+                              doc=f"{label}: height of the layers below"))
+            ports.append(Port(f"{lid}_contrast", "float", 0.1, range=(0.001, 1.0),
+                              doc=f"{label}: transition width"))
         elif isinstance(blend, str) and blend.endswith(".json"):
             if resolver is None:
                 raise LookupError(f"cannot resolve blend {blend!r} without a resolver")
@@ -235,8 +237,8 @@ def _layer_stack_inputs(node, resolver, owner) -> list[Port]:
                                 "inputs and a MaterialAttributes output")
             for p in biface.inputs:
                 if p.type != MA:
-                    ports.append(Port(f"{lid}_{p.name}", p.type, p.default, p.range,
-                                          f"{label}: {p.name}"))
+                    ports.append(Port(f"{lid}_{p.name}", p.type, p.default, range=p.range,
+                                      doc=f"{label}: {p.name}"))
         else:
             raise PortError(node.id, f"layers[{index}].blend",
                             f"unknown blend {blend!r} ({', '.join(LAYER_BLENDS)}, "

@@ -25,8 +25,8 @@ class Port:
     name: str
     type: str  # a PortType value or "T"
     default: Any = None
-    range: tuple[float, float] | None = None
     doc: str = ""
+    range: tuple[float, float] | None = None
     required: bool = False
     # Where an editor shows the port: ports sharing a group fold together (the material
     # attributes: Base, Specular, Coat, Sheen, Anisotropy). Empty: ungrouped.
@@ -354,7 +354,7 @@ _SEED = ("seed", "float", 0.0, "integer seed: another seed, another pattern", (0
 
 def _i(name: str, type_: str, default: Any = 0.0, doc: str = "",
        rng: tuple[float, float] | None = None, required: bool = False) -> Port:
-    return Port(name, type_, default, rng, doc, required)
+    return Port(name, type_, default, doc, rng, required)
 
 
 def _o(name: str, type_: str, doc: str = "", group: str = "") -> Port:

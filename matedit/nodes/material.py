@@ -29,7 +29,7 @@ from matedit.nodes.twin import _X, _Z, Attributes, _col, _mix, _safe_normalize, 
 
 
 def _lobe(name, type_, default, doc, rng, group) -> InputDef:
-    return InputDef(name, type_, default, rng, doc, group=group, lobe=True)
+    return InputDef(name, type_, default, doc, rng, group=group, lobe=True)
 
 
 # --- material attributes ---------------------------------------------------------------------
