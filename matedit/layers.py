@@ -33,6 +33,9 @@ LAYERS: tuple[Layer, ...] = (
           ("platformdirs",)),
     # port types and the one implicit conversion; the float32 rule; identifiers
     Layer("types", ("matedit.graph.types", "matedit.graph.numbers", "matedit.graph.names")),
+    # the node kinds, one category module each: definitions, numpy twins, MaterialX recipes
+    # (written through a builder the exporter passes in, so no MaterialX here)
+    Layer("nodes", ("matedit.nodes",), ("numpy",)),
     # the node catalogue, documents, edit commands, layer stacks, validation
     Layer("model", ("matedit.graph",), ("networkx",)),
     # JSON load and save, migrations, the JSON Schema check, atomic writes, images

@@ -17,6 +17,7 @@ from matedit.compiler.emit import fragment_source
 from matedit.compiler.ir import Lit, MaterialIR, Op, Scope, SurfaceUV
 from matedit.compiler.schedule import schedule
 from matedit.compiler.targets import TARGETS
+from matedit.graph import nodes
 from matedit.graph.types import PortType
 
 PKG = Path(matedit.__file__).resolve().parent
@@ -117,8 +118,10 @@ def test_every_op_of_the_samples_has_a_row_with_both_columns():
             for op in scope.ops:
                 impl = ops.implementation(op.kind)
                 assert callable(impl.numpy)
-                # GLSL: the row's template, or the op's data names a template or a function
-                assert impl.glsl or op.data.get("inline") or op.data.get("glsl") \
+                # GLSL: the row's template, the kind's definition (a template or a
+                # function), or the op's data names the material function it calls
+                d = nodes.get(op.kind)
+                assert impl.glsl or (d is not None and (d.inline or d.glsl)) \
                     or op.data.get("function"), op.kind
                 seen.add(op.kind)
     assert {ops.BLEND, ops.WEIGHT, ops.CALL, ops.MASK} <= seen  # the samples use the builtins
@@ -139,10 +142,8 @@ def test_builtin_numpy_column_matches_its_definition():
 
 
 def test_schedule_holds_no_text_and_names_locals_in_first_use_order():
-    a = Op("a_b", "x", "add", [Lit(1.0, PortType.FLOAT), SurfaceUV()], [("c", PortType.VEC2)],
-           {"inline": "({a} + {b})"})
-    b = Op("a", "y", "add", [a.out("c"), a.out("c")], [("b_c", PortType.VEC2)],
-           {"inline": "({a} + {b})"})
+    a = Op("a_b", "x", "add", [Lit(1.0, PortType.FLOAT), SurfaceUV()], [("c", PortType.VEC2)])
+    b = Op("a", "y", "add", [a.out("c"), a.out("c")], [("b_c", PortType.VEC2)])
     scope = Scope("evaluateMaterial", [a, b], outputs=[])
     plan = schedule(MaterialIR(scope, [], [], [], {"add"}, []), "attributes")
     (main,) = plan.scopes

@@ -1,12 +1,10 @@
 """One contract per node kind, in data (issue 15): code outside the catalogue never names a
 kind; it asks the definition (roles, flags, MaterialX mapping).
 
-The grep test parses every module of matedit/ (not the catalogue, graph/nodes.py and
-graph/library.py) and fails on any string constant equal to a registered kind. What it
-allows, and why:
-  - the argument of `_impl("kind")` in compiler/cpu_nodes.py: that decorator is the place a
-    kind's numpy twin says which kind it implements (as shaders/nodes/<kind>.glsl does for
-    GLSL); the test checks each one names a registered kind;
+The grep test parses every module of matedit/ (not the catalogue, the category modules of
+matedit/nodes/) and fails on any string constant equal to a registered kind. A kind's numpy
+twin and MaterialX recipe are referenced from its definition, so nothing outside the
+catalogue binds a kind by name. What it allows, and why:
   - in the MaterialX modules (interop/mtlx_*.py), strings that are MaterialX stdlib node
     categories ("add", "normalize", "time"...): MaterialX's names, not ours, read from
     MaterialX's own libraries;
@@ -25,13 +23,21 @@ import pytest
 
 import matedit
 from matedit.graph import nodes
-from matedit.graph.nodes import BAKE, LOWERED, MxNode, MxRecipe, Role, Thumbnail
+from matedit.graph.nodes import (
+    BAKE,
+    LOWERED,
+    MxNode,
+    MxRecipe,
+    NodeDef,
+    OutputDef,
+    Role,
+    Thumbnail,
+)
 
 PACKAGE = Path(matedit.__file__).parent
-CATALOGUE = {"graph/nodes.py", "graph/library.py"}
+CATALOGUE = "nodes/"  # matedit/nodes/*.py
 MATERIALX_MODULES = {"interop/mtlx_export.py", "interop/mtlx_import.py",
                      "interop/mtlx_map.py"}
-BINDING = ("compiler/cpu_nodes.py", "_impl")
 ALLOWED = {
     ("app/layers_panel.py", "add"): "icon name",
     ("app/lights_panel.py", "add"): "icon name",
@@ -39,9 +45,6 @@ ALLOWED = {
     ("app/lights_panel.py", "length"): "a tube light's length field",
     ("io/rig.py", "length"): "a tube light's length field in the rig file",
     ("app/recovery.py", "time"): "the recovery file's timestamp key",
-    ("compiler/cpu_nodes.py", "multiply"): "blend mode names (the kinds are blend_<mode>)",
-    ("compiler/cpu_nodes.py", "add"): "blend mode names (the kinds are blend_<mode>)",
-    ("compiler/cpu_nodes.py", "subtract"): "blend mode names (the kinds are blend_<mode>)",
 }
 
 
@@ -66,21 +69,14 @@ def _strings(tree: ast.AST):
 
 def _hits(rel: str, text: str, allowed_extra: frozenset[str] = frozenset()):
     kinds = set(nodes.REGISTRY)
-    bound, hits = [], []
-    for n, call in _strings(ast.parse(text)):
-        if n.value not in kinds:
-            continue
-        if (rel, call) == BINDING:
-            bound.append(n.value)
-        elif n.value not in allowed_extra:
-            hits.append((rel, n.lineno, n.value))
-    return hits, bound
+    return [(rel, n.lineno, n.value) for n, _ in _strings(ast.parse(text))
+            if n.value in kinds and n.value not in allowed_extra]
 
 
 def _modules():
     for path in sorted(PACKAGE.rglob("*.py")):
         rel = path.relative_to(PACKAGE).as_posix()
-        if rel not in CATALOGUE:
+        if not rel.startswith(CATALOGUE):
             yield rel, path.read_text(encoding="utf-8")
 
 
@@ -89,8 +85,7 @@ def test_no_kind_names_outside_the_catalogue():
     for rel, text in _modules():
         if rel in MATERIALX_MODULES:
             continue  # test_materialx_modules_name_only_materialx_nodes
-        hits, _ = _hits(rel, text)
-        for h in hits:
+        for h in _hits(rel, text):
             if (rel, h[2]) in ALLOWED:
                 used.add((rel, h[2]))
             else:
@@ -100,15 +95,20 @@ def test_no_kind_names_outside_the_catalogue():
     assert used == set(ALLOWED), f"allow-list entries no longer needed: {set(ALLOWED) - used}"
 
 
-def test_numpy_twins_bind_registered_kinds():
-    text = (PACKAGE / BINDING[0]).read_text(encoding="utf-8")
-    _, bound = _hits(BINDING[0], text)
-    from matedit.compiler.cpu_nodes import BLEND_MODES, COMPILER_HANDLED, IMPLS
+def test_every_kind_the_compiler_does_not_lower_has_its_numpy_twin():
+    from matedit.compiler.cpu_nodes import COMPILER_HANDLED, IMPLS
 
-    assert len(bound) == len(set(bound)), "a kind bound twice"
-    assert set(bound) | {f"blend_{m}" for m in BLEND_MODES} == set(IMPLS)
-    # every kind the compiler does not lower has its numpy twin, and only those
+    # the twin is the definition's; IMPLS is the registry's view of them
     assert set(IMPLS) == set(nodes.REGISTRY) - COMPILER_HANDLED
+    for kind, d in nodes.REGISTRY.items():
+        assert (d.numpy is None) == d.lowered, kind
+        if d.numpy is not None:
+            assert IMPLS[kind] is d.numpy
+    twinless = NodeDef("test_twinless", "Twinless", "Math", "No numpy twin.",
+                       outputs=(OutputDef("value", "float"),), glsl="node_test_twinless")
+    with pytest.raises(ValueError, match="test_twinless.*numpy"):
+        nodes.register(twinless)
+    assert "test_twinless" not in nodes.REGISTRY
 
 
 def test_materialx_modules_name_only_materialx_nodes():
@@ -120,7 +120,7 @@ def test_materialx_modules_name_only_materialx_nodes():
     found = []
     for rel, text in _modules():
         if rel in MATERIALX_MODULES:
-            found += _hits(rel, text, categories)[0]
+            found += _hits(rel, text, categories)
     assert not found, f"kind names in the MaterialX modules: {found}"
     del mx
 
@@ -128,8 +128,7 @@ def test_materialx_modules_name_only_materialx_nodes():
 def test_the_grep_finds_a_kind_name():
     """The scanner itself: a comparison with a kind name, in any module, is found."""
     src = 'def f(node):\n    return node.kind == "layer_stack" or f"{node}texcoord"\n'
-    hits, _ = _hits("app/example.py", src)
-    assert hits == [("app/example.py", 2, "layer_stack")]
+    assert _hits("app/example.py", src) == [("app/example.py", 2, "layer_stack")]
 
 
 # --- the contract's data ---------------------------------------------------------------------
@@ -145,9 +144,8 @@ def test_every_role_names_one_kind_and_back():
 
 def test_lowered_kinds_have_no_glsl_and_others_exactly_one():
     for kind, d in nodes.REGISTRY.items():
-        if d.lowered:
-            assert d.glsl is None, kind
-            assert d.inline != "", kind  # no placeholders
+        if d.lowered:  # the compiler lowers it: no template that is never emitted
+            assert d.glsl is None and d.inline is None, kind
         else:
             assert (d.glsl is None) != (d.inline is None), kind
 
@@ -202,14 +200,13 @@ def test_the_materialx_doc_matches_the_catalogue():
 
 
 def test_a_new_geometry_kind_is_its_definition_and_its_numpy_twin(monkeypatch):
-    """A kind added to the catalogue (and its numpy twin) compiles, evaluates, keeps its
-    op (impure: never folded), shows thumbnails when selected and bakes for MaterialX,
-    with no other code touched."""
-    from matedit.compiler import cpu_nodes
+    """A kind added to the catalogue (its definition, carrying its numpy twin) compiles,
+    evaluates, keeps its op (impure: never folded), shows thumbnails when selected and bakes
+    for MaterialX, with no other code touched."""
     from matedit.compiler.api import lower_and_optimise
     from matedit.compiler.cpu_eval import evaluate
     from matedit.compiler.cpu_nodes import SurfaceArrays
-    from matedit.graph.nodes import InputDef, NodeDef, OutputDef
+    from matedit.graph.nodes import InputDef
     from matedit.interop import mtlx_map
     from tests.graphs_util import link, material, node
 
@@ -217,10 +214,9 @@ def test_a_new_geometry_kind_is_its_definition_and_its_numpy_twin(monkeypatch):
     d = NodeDef(kind, "Height Above", "Coordinates", "World height plus an offset.",
                 inputs=(InputDef("offset", "float", 0.0),),
                 outputs=(OutputDef("value", "float"),), glsl=f"node_{kind}",
-                impure=True, geometry=True)
+                impure=True, geometry=True,
+                numpy=lambda ctx, offset: (ctx.position[:, 1] + offset,))
     monkeypatch.setitem(nodes.REGISTRY, kind, d)
-    monkeypatch.setitem(cpu_nodes.IMPLS, kind,
-                        lambda ctx, offset: (ctx.position[:, 1] + offset,))
     doc = material()
     node(doc, "h", kind, values={"offset": 0.25})
     node(doc, "make", nodes.kind_for(Role.MAKE_ATTRIBUTES))
@@ -237,3 +233,56 @@ def test_a_new_geometry_kind_is_its_definition_and_its_numpy_twin(monkeypatch):
     np.testing.assert_allclose(got, y + 0.25, atol=1e-12)  # exact: one addition
     assert nodes.definition(kind).thumbnail == Thumbnail.SELECTED
     assert mtlx_map.mapping(kind) == BAKE
+
+
+def _one_node_material(kind: str):
+    from tests.graphs_util import link, material, node
+
+    doc = material()
+    node(doc, "n", kind, values={"value": 0.25})
+    node(doc, "make", nodes.kind_for(Role.MAKE_ATTRIBUTES))
+    node(doc, "out", nodes.kind_for(Role.MATERIAL_OUTPUT))
+    link(doc, "n", "result", "make", "roughness")
+    link(doc, "make", "attributes", "out", "attributes")
+    return doc
+
+
+def _kind_with(kind: str, mtlx) -> NodeDef:
+    from matedit.graph.nodes import InputDef
+
+    return NodeDef(kind, "Test", "Math", "A kind the catalogue does not hold.",
+                   inputs=(InputDef("value", "float", 0.0),),
+                   outputs=(OutputDef("result", "float"),), inline="(2.0 * {value})",
+                   mtlx=mtlx, numpy=lambda ctx, value: (2.0 * value,))
+
+
+def test_a_new_kind_exports_by_the_recipe_its_definition_carries(monkeypatch, tmp_path):
+    """A kind's MaterialX recipe is written beside it, through the builder the exporter
+    passes in: the exporter needs no code for it."""
+    pytest.importorskip("MaterialX")
+    from matedit.interop import mtlx_export
+
+    def doubled(b):
+        return [lambda: b.node("multiply", None, "", ("in1", b.arg("value")),
+                               ("in2", b.value(2.0)))]
+
+    kind = "test_doubled"
+    monkeypatch.setitem(nodes.REGISTRY, kind, _kind_with(kind, MxRecipe("doubled", doubled)))
+    result = mtlx_export.export(_one_node_material(kind), None, tmp_path / "d.mtlx", size=8)
+    assert '<multiply name="n" type="float">' in result.text
+    assert not result.baked
+    ok, why = mtlx_export.validate(result.text)
+    assert ok, why
+
+
+def test_a_kind_with_no_mapping_the_exporter_can_write_is_refused_by_name(monkeypatch, tmp_path):
+    """No default recipe: a recipe with no build (and none of the exporter's own) is an
+    error that names the kind, not an export as something else."""
+    pytest.importorskip("MaterialX")
+    from matedit.interop import mtlx_export
+
+    kind = "test_unmapped"
+    monkeypatch.setitem(nodes.REGISTRY, kind, _kind_with(kind, MxRecipe("no_such_recipe")))
+    with pytest.raises(mtlx_export.MtlxExportError,
+                       match=r"node n: node kind 'test_unmapped' has no MaterialX mapping"):
+        mtlx_export.export(_one_node_material(kind), None, tmp_path / "u.mtlx", size=8)

@@ -20,12 +20,12 @@ from material_gpu import render_attributes, surface
 
 from matedit.compiler import compile_document
 from matedit.compiler.cpu_eval import evaluate
-from matedit.compiler.cpu_nodes import coat_material_attributes
 from matedit.compiler.lower import lower_document
 from matedit.graph import nodes
 from matedit.graph.layers import Layer, LayerStack
 from matedit.graph.ports import COLOR_LAYER_BLENDS, LAYER_BLENDS
 from matedit.io.document import FileResolver, load
+from matedit.nodes.material import coat_material_attributes
 from matedit.resources import graphs_dir
 
 GLSLANG = shutil.which("glslangValidator")

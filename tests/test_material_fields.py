@@ -14,11 +14,11 @@ import pytest
 from graphs_util import link, node, simple_material
 
 from matedit.compiler import compile_document
-from matedit.compiler.cpu_nodes import blend_material_attributes
 from matedit.graph import nodes
 from matedit.graph.commands import SetValue
 from matedit.graph.model import ChangeKind
 from matedit.io.document import FileResolver
+from matedit.nodes.material import blend_material_attributes
 from tests.gpu_eval import gpu_eval_many
 
 LOBE_FIELDS = [f for f in nodes.ATTRIBUTE_FIELDS if f.lobe]

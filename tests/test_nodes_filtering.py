@@ -128,7 +128,7 @@ def test_no_footprint_means_hard_edges():
 
 
 def test_derivatives_are_quad_differences_even_on_odd_grids():
-    from matedit.compiler.cpu_nodes import derivatives, fwidth
+    from matedit.nodes.twin import derivatives, fwidth
 
     h, w = 5, 7
     y, x = np.mgrid[0:h, 0:w].astype(float)

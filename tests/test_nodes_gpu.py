@@ -1,5 +1,5 @@
 """The node library: every kind has a GLSL implementation that compiles on its own, a numpy
-twin (matedit.compiler.cpu_nodes), and the two agree on the GPU.
+twin (NodeDef.numpy, in its matedit/nodes category module), and the two agree on the GPU.
 
 Inputs are float32 and both sides compute in float32, so the twins differ only where the
 GPU is allowed to: fused multiply-adds, inversesqrt and the transcendental functions.
@@ -16,6 +16,7 @@ import pytest
 from matedit.compiler import cpu_nodes
 from matedit.compiler.cpu_nodes import IMPLS, SurfaceArrays
 from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, GENERIC, REGISTRY, PortsRule
+from matedit.nodes import material, noise
 from matedit.resources import shaders_dir
 from tests.gpu_eval import gpu_eval, gpu_eval_many
 
@@ -363,7 +364,7 @@ def test_value_noise_lattice_hash_is_bit_exact(ctx, rng):
                    {"cx": (cells[:, 0], "int"), "cy": (cells[:, 1], "int"),
                     "seed": (seeds, "uint")}, includes=["nodes/value_noise.glsl"])  # fmt: skip
     c = cells.astype(np.uint32)
-    ref = cpu_nodes.noise_lattice(c[:, 0], c[:, 1], seeds)
+    ref = noise.noise_lattice(c[:, 0], c[:, 1], seeds)
     check("value_noise.lattice", gpu, ref, rtol=0.0, atol=0.0)
 
 
@@ -562,6 +563,6 @@ def test_blend_at_zero_and_one_returns_base_and_layer():
     a, b = _attributes(rng, ""), _attributes(rng, "")
     zero, one = np.zeros(N, np.float32), np.ones(N, np.float32)
     for t, expected in ((zero, a), (one, b)):
-        out = cpu_nodes.blend_material_attributes(a, b, t)
+        out = material.blend_material_attributes(a, b, t)
         for name in ATTRIBUTE_NAMES:
             np.testing.assert_allclose(out[name], expected[name], atol=1e-6, err_msg=name)

@@ -1,4 +1,4 @@
-"""The node library (matedit.graph.library) on the GPU against its numpy twins, kind by kind.
+"""The node library (tests/library_kinds.py) on the GPU against its numpy twins, kind by kind.
 
 Every fixed-type kind runs once on smooth input fields (so screen derivatives mean
 something), once at large coordinates (UV and positions near 1,000) and once on a grazing
@@ -16,18 +16,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from matedit.compiler import cpu_nodes
 from matedit.compiler.cpu_nodes import IMPLS, SurfaceArrays
-from matedit.graph import library
 from matedit.graph.nodes import GENERIC, MESH_UV, REGISTRY
+from matedit.nodes import noise
 from tests.gpu_eval import gpu_eval, gpu_eval_many
+from tests.library_kinds import LIBRARY_KINDS
 
 W, H = 256, 16
 N = W * H
 COMPS = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4}
 # The library's kinds with fixed port types (the generic ones are checked by
 # test_nodes_gpu.py's generic machinery), and the band-limited checker.
-KINDS = sorted({k for k in library.KINDS
+KINDS = sorted({k for k in LIBRARY_KINDS
                 if not any(i.type == GENERIC for i in REGISTRY[k].inputs)} | {"checker"})
 # Outputs with jumps: the share of points allowed past the bound (measured: none reach it).
 JUMPY = {"saw": 0.01, "cell_id": 0.005, "tile_id": 0.005, "tile_uv": 0.005, "f2": 0.005,
@@ -345,17 +345,17 @@ def test_hashes_are_bit_exact(ctx):
                     "cz": (cells[:, 2], "int"), "seed": (seeds, "uint")},
                    includes=["nodes/noise_lib.glsl"])
     c = cells.astype(np.uint32)
-    ref = cpu_nodes.hash_unit(cpu_nodes.hash_cell3(c[:, 0], c[:, 1], c[:, 2], seeds))
+    ref = noise.hash_unit(noise.hash_cell3(c[:, 0], c[:, 1], c[:, 2], seeds))
     np.testing.assert_array_equal(gpu, ref)
 
 
 def test_gradient_noise_is_continuous_and_in_range():
     p = np.linspace(-20, 20, 200_001)
     uv = np.stack([p, 0.37 * p + 0.11], -1)
-    v = cpu_nodes.gradient_noise2(uv, np.uint32(0))
+    v = noise.gradient_noise2(uv, np.uint32(0))
     assert np.max(np.abs(np.diff(v))) < 1e-3  # no jumps at cell borders
     assert -1.0 <= v.min() and v.max() <= 1.0 and v.std() > 0.15
-    v3 = cpu_nodes.gradient_noise3(np.stack([p, 0.3 * p, -0.7 * p + 1.3], -1), np.uint32(5))
+    v3 = noise.gradient_noise3(np.stack([p, 0.3 * p, -0.7 * p + 1.3], -1), np.uint32(5))
     assert np.max(np.abs(np.diff(v3))) < 1e-3 and -1.1 <= v3.min() and v3.max() <= 1.1
 
 
@@ -363,15 +363,15 @@ def test_cellular_f1_is_the_nearest_feature_point():
     """F1 equals a brute-force nearest distance over a 5 x 5 neighbourhood (jitter 1)."""
     rng = np.random.default_rng(6)
     p = rng.uniform(-10, 10, (500, 2))
-    f1, f2, _ = cpu_nodes.cellular2(p, np.ones(500), np.uint32(0))
+    f1, f2, _ = noise.cellular2(p, np.ones(500), np.uint32(0))
     best = np.full(500, np.inf)
     i = np.floor(p)
     for y in range(-2, 3):
         for x in range(-2, 3):
-            c = cpu_nodes._as_uint(i + [x, y])
-            h = cpu_nodes.hash_cell2(c[:, 0], c[:, 1], np.uint32(0))
-            o = np.stack([cpu_nodes.hash_unit(h, np.float64),
-                          cpu_nodes.hash_unit(cpu_nodes.pcg_hash(h), np.float64)], -1)
+            c = noise._as_uint(i + [x, y])
+            h = noise.hash_cell2(c[:, 0], c[:, 1], np.uint32(0))
+            o = np.stack([noise.hash_unit(h, np.float64),
+                          noise.hash_unit(noise.pcg_hash(h), np.float64)], -1)
             best = np.minimum(best, np.linalg.norm(i + [x, y] + o - p, axis=1))
     np.testing.assert_allclose(f1, best, atol=1e-12)
     assert np.all(f2 >= f1)

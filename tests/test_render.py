@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import copy
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from graphs_util import link, material, node
 
 from matedit.compiler import compile_document
+from matedit.graph import nodes
 from matedit.ibl import BakeSettings, Environment
 from matedit.io import document as fmt
 from matedit.io.document import FileResolver
@@ -227,20 +229,21 @@ def test_same_structure_reuses_program(fresh):
     assert fresh.link_count == links
 
 
-def test_broken_program_keeps_the_last_good_one_and_names_the_node(fresh):
+def test_broken_program_keeps_the_last_good_one_and_names_the_node(fresh, monkeypatch):
     d = flat_material(roughness=0.3)
     good = compile_document(d)
     fresh.set_material(good)
     fresh.render()
     image = fresh.read_hdr().copy()
     # a generator fault: the node's call names a function that does not exist (the renderer
-    # links entry variants emitted from the IR, so the fault goes into the IR)
-    ir = copy.deepcopy(good.ir)
-    op = next(op for op in ir.main.ops if op.kind == "make_attributes")
-    op.data["glsl"] = "node_make_attributez"
-    broken = compile_document(d, ir=ir)
-    assert "node_make_attributez(" in broken.fragment_text
-    status = fresh.set_material(broken)
+    # links entry variants emitted from the IR by the definitions, so the fault goes into
+    # the kind's definition while the broken material links)
+    make = nodes.definition("make_attributes")
+    with monkeypatch.context() as m:
+        m.setitem(nodes.REGISTRY, make.kind, replace(make, glsl="node_make_attributez"))
+        broken = compile_document(d, ir=copy.deepcopy(good.ir))
+        assert "node_make_attributez(" in broken.fragment_text
+        status = fresh.set_material(broken)
     assert not status.ok
     assert status.errors[0][0] == "make"
     fresh.render()

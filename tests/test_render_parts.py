@@ -7,6 +7,7 @@ from __future__ import annotations
 import copy
 import math
 import os
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -17,6 +18,7 @@ from test_shading_colorspace import write_png
 from matedit.compiler import compile_document
 from matedit.compiler.emit import Entry
 from matedit.glsl.layout import FRAME_BLOCK, IBL_BLOCK
+from matedit.graph import nodes
 from matedit.ibl import bake
 from matedit.render import Renderer
 from matedit.render import textures as T
@@ -59,13 +61,14 @@ def test_program_cache_links_each_variant_once(gl_ctx):
     assert cache.table == {}
 
 
-def test_program_cache_locates_a_failed_link_in_the_variant_it_tried(gl_ctx):
+def test_program_cache_locates_a_failed_link_in_the_variant_it_tried(gl_ctx, monkeypatch):
     d = flat_material(roughness=0.3)
     good = compile_document(d)
-    ir = copy.deepcopy(good.ir)
-    op = next(op for op in ir.main.ops if op.kind == "make_attributes")
-    op.data["glsl"] = "node_make_attributez"  # a function no shader defines
-    broken = compile_document(d, ir=ir)
+    # a generator fault: the kind's GLSL names a function no shader defines (the back-end
+    # reads the definition, at compile and at each variant's link)
+    make = nodes.definition("make_attributes")
+    monkeypatch.setitem(nodes.REGISTRY, make.kind, replace(make, glsl="node_make_attributez"))
+    broken = compile_document(d, ir=copy.deepcopy(good.ir))
     cache = ProgramCache(gl_ctx)
     try:
         for forward in (False, True):

@@ -39,8 +39,8 @@ from matedit.app.paths import absolute_of, reference_for
 from matedit.graph import nodes
 from matedit.graph.commands import SetLabel, SetSetting, SetValue
 from matedit.graph.model import ChangeEvent, ChangeKind, Node
-from matedit.graph.nodes import MESH_UV, Role, SettingDef, role_of
-from matedit.graph.ports import PortSpec, normalize_channels
+from matedit.graph.nodes import MESH_UV, Port, Role, SettingDef, role_of
+from matedit.graph.ports import normalize_channels
 from matedit.graph.types import PortType, coerce_value
 
 _COLOUR_WORDS = ("color", "colour", "tint", "albedo", "emissive", "basecolor")
@@ -391,7 +391,7 @@ class InspectorPanel(QScrollArea):
             return
         connected = self.controller.document.graph.inputs_of(node.id)
         in_types = (a.in_types.get(node.id) or {}) if a else {}
-        groups: list[tuple[str, list[PortSpec]]] = []
+        groups: list[tuple[str, list[Port]]] = []
         layer_names = {}
         if role_of(node.kind) == Role.LAYER_STACK:
             for e in node.settings.get("layers", []) or []:

@@ -19,7 +19,7 @@ from matedit.app.controller import DocumentController, new_merge_id
 from matedit.app.fields import ColorField
 from matedit.graph import nodes
 from matedit.graph.commands import SetValue
-from matedit.graph.library import RAMP_STOPS
+from matedit.graph.nodes import RAMP_STOPS
 
 _BAR_H = 22
 _HANDLE = 7
@@ -44,12 +44,11 @@ class RampStops:
 
     def evaluate(self, t: np.ndarray) -> np.ndarray:
         """The ramp at values t, by the node's numpy twin."""
-        from matedit.compiler.cpu_nodes import IMPLS
-
         n = len(t)
         col = [np.full(n, p) for p in self.positions]
         colors = [np.tile(c, (n, 1)) for c in self.colors]
-        ramp = IMPLS[nodes.kind_for(nodes.Role.COLOR_RAMP)]
+        ramp = nodes.definition(nodes.kind_for(nodes.Role.COLOR_RAMP)).numpy
+        assert ramp is not None
         (out,) = ramp(None, t, np.full(n, float(self.count)), *col, *colors)
         return out
 

@@ -84,9 +84,9 @@ SCHEMA: dict[str, Any] = {
 }
 
 
-def _port(p) -> dict[str, Any]:
+def _port(p, is_input: bool) -> dict[str, Any]:
     out: dict[str, Any] = {"name": p.name, "type": p.type, "doc": p.doc}
-    if hasattr(p, "default"):
+    if is_input:
         out["default"] = p.default
         out["range"] = list(p.range) if p.range else None
         out["required"] = bool(p.required)
@@ -107,7 +107,6 @@ def _mtlx(m) -> dict[str, Any] | None:
 
 def catalogue(category: str | None = None) -> dict[str, Any]:
     """Every node kind as plain data (see SCHEMA), sorted by category then title."""
-    from matedit.compiler.cpu_nodes import COMPILER_HANDLED, IMPLS
     from matedit.graph import nodes
 
     records = []
@@ -122,17 +121,16 @@ def catalogue(category: str | None = None) -> dict[str, Any]:
                 impl = {"glsl": "inline", "template": d.inline}
             else:
                 impl = {"glsl": "compiler"}
-            impl["numpy"] = "function" if d.kind in IMPLS else "compiler"
+            impl["numpy"] = "function" if d.numpy is not None else "compiler"
             targets = list(GLSL_TARGETS)
-            if d.kind in IMPLS or d.kind in COMPILER_HANDLED:
-                targets.append("numpy")
+            targets.append("numpy")  # a twin, or the compiler's own evaluation (lowered)
             if _mtlx(d.mtlx) is not None:
                 targets.append("materialx")
             rec: dict[str, Any] = {
                 "kind": d.kind, "title": d.title, "category": d.category,
                 "description": d.description,
-                "inputs": [_port(i) for i in d.inputs],
-                "outputs": [_port(o) for o in d.outputs],
+                "inputs": [_port(i, True) for i in d.inputs],
+                "outputs": [_port(o, False) for o in d.outputs],
                 "settings": [{"name": s.name, "kind": s.kind, "default": s.default,
                               "doc": s.doc, "structural": s.structural,
                               "choices": list(s.choices)} for s in d.settings],

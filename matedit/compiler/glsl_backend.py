@@ -98,8 +98,9 @@ def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
     """One op as one line: a declaration of its value, or declarations and a call that fills
     them through `out` parameters."""
     impl = ops.implementation(op.kind)
+    d = nodes.get(op.kind)  # a catalogue kind's GLSL is its definition's
     args = [expr(a, names) for a in op.args]
-    template = impl.glsl if impl.glsl is not None else op.data.get("inline")
+    template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
     if template is not None:
         (name, t), = outs
         line = f"{TYPE_NAMES[t]} {name} = {_fill(template, op, args, t)};"
@@ -107,7 +108,7 @@ def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
             sets = " ".join(f"{name}.{f} = {a};" for f, a in zip(op.data[impl.assigns], args[1:]))
             line += " " + sets
         return line
-    fn = op.data.get("glsl") or op.data.get("function")
+    fn = d.glsl if d is not None else op.data.get("function")
     decls = " ".join(f"{TYPE_NAMES[t]} {n};" for n, t in outs)
     return f"{decls} {fn}({', '.join(args + [n for n, _ in outs])});"
 

@@ -203,9 +203,8 @@ class _Lowerer:
         else:
             args = self._inputs(nid)
         outs = [(p.name, self.a.out_types[nid][p.name]) for p in self.a.ports[nid].outputs]
-        data = {"glsl": d.glsl} if d.glsl else {"inline": d.inline}
         self.ctx.kinds.add(node.kind)
-        op = self.emit(Op(nid, nid, node.kind, args, outs, data))
+        op = self.emit(Op(nid, nid, node.kind, args, outs))
         if role == Role.MAKE_ATTRIBUTES:
             self.written[op.out("attributes").key()] = ALL_FIELDS - unwritten
         elif role in (Role.MASK_BLEND, Role.HEIGHT_BLEND):
@@ -255,8 +254,7 @@ class _Lowerer:
         self._uniform(UniformInfo(name, PortType.VEC4, value, nid, "value", pname))
         self.ctx.kinds.add(node.kind)
         self.emit(Op(nid, nid, node.kind, [Uni(name, PortType.VEC4)],
-                     [("value", PortType.VEC4), ("xyz", PortType.VEC3)],
-                     {"glsl": nodes.definition(node.kind).glsl}))
+                     [("value", PortType.VEC4), ("xyz", PortType.VEC3)]))
 
     def _k_texture_parameter(self, nid, node) -> None:
         pname = str(node.settings.get("name", nid))
@@ -382,15 +380,13 @@ class _Lowerer:
         brk = nodes.definition(nodes.BREAK_ATTRIBUTES)
         fields = [(f.name, PortType(f.type)) for f in ATTRIBUTE_FIELDS]
         self.ctx.kinds.add(brk.kind)
-        below = self.emit(Op(f"{nid}.{lid}.below", nid, brk.kind, [acc], fields,
-                             {"glsl": brk.glsl}))
-        above = self.emit(Op(f"{nid}.{lid}.above", nid, brk.kind, [value], fields,
-                             {"glsl": brk.glsl}))
+        below = self.emit(Op(f"{nid}.{lid}.below", nid, brk.kind, [acc], fields))
+        above = self.emit(Op(f"{nid}.{lid}.above", nid, brk.kind, [value], fields))
         d = nodes.definition(f"blend_{mode}")
         self.ctx.kinds.add(d.kind)
         color = self.emit(Op(f"{nid}.{lid}.color", nid, d.kind,
                              [below.out("baseColor"), above.out("baseColor"), w],
-                             [("result", PortType.VEC3)], {"glsl": d.glsl}))
+                             [("result", PortType.VEC3)]))
         set_kind = kind_for(Role.SET_ATTRIBUTES)
         self.ctx.kinds.add(set_kind)
         return self.emit(Op(f"{nid}.{lid}.mode", nid, set_kind,
@@ -444,7 +440,7 @@ class _Lowerer:
                         f"{nid}.{lid}.h", nid, hb.kind,
                         [acc, value, port(f"{lid}_base_height"), port(f"{lid}_mask"),
                          port(f"{lid}_contrast")],
-                        [("result", PortType.MATERIAL)], {"glsl": hb.glsl}))
+                        [("result", PortType.MATERIAL)]))
                 else:
                     biface = function_interface(self._resolve(blend, nid))
                     mas = [p.name for p in biface.inputs if p.type == MA][:2]

@@ -1,7 +1,7 @@
 """The one table of op implementations, read by every back-end and by the CPU evaluator.
 
-An `Op` of the IR is either a catalogue node kind (its GLSL function or inline template comes
-with the op's data from the catalogue, its numpy function is `cpu_nodes.IMPLS[kind]`) or one of
+An `Op` of the IR is either a catalogue node kind (its GLSL function or inline template and
+its numpy twin are its definition's, `NodeDef.glsl` / `inline` / `numpy`) or one of
 the compiler's own ops below (swizzle, construction, field assignment, layer weight, blend and
 coat, material-function call). `implementation(kind)` answers both the same way, so the emitter and
 the evaluator each dispatch once, from here, and cannot disagree on what an op means.
@@ -9,8 +9,9 @@ the evaluator each dispatch once, from here, and cannot disagree on what an op m
 A row's `glsl` is a value template read only by the GLSL back-end
 (`matedit.compiler.glsl_backend`): `{0}`, `{1}` are the operands, `{args}` all of them
 comma-separated, `{T}` the result's type name in the back-end's language, any other `{name}`
-an input of the catalogue kind or a key of the op's data. `glsl=None` means the op's data says
-(a catalogue kind's `inline` template, or the `glsl` / `function` it calls with out parameters).
+an input of the catalogue kind or a key of the op's data. `glsl=None` means the kind's
+definition says (its `inline` template, or the `glsl` function it calls with out parameters),
+or for a material-function call the op's data (`function`).
 A new back-end adds its own column; the numpy column is the reference all of them are tested
 against.
 """
@@ -24,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from matedit.compiler.ir import Op
-from matedit.graph.nodes import Role, kind_for, role_of
+from matedit.graph.nodes import Role, get, kind_for, role_of
 
 # The compiler's own op kinds (`Op.kind`); interop.mtlx_export and render.deferred read them.
 MASK = "mask"  # a component swizzle, op.data["channels"]
@@ -76,13 +77,13 @@ def _weight(op: Op, args: list, env) -> tuple:
 
 
 def _blend(op: Op, args: list, env) -> tuple:
-    from matedit.compiler.cpu_nodes import blend_material_attributes
+    from matedit.nodes.material import blend_material_attributes
 
     return (blend_material_attributes(args[0], args[1], np.asarray(args[2])),)
 
 
 def _coat(op: Op, args: list, env) -> tuple:
-    from matedit.compiler.cpu_nodes import coat_material_attributes
+    from matedit.nodes.material import coat_material_attributes
 
     return (coat_material_attributes(args[0], args[1], np.asarray(args[2])),)
 
@@ -105,10 +106,9 @@ BUILTINS: dict[str | Role, OpImpl] = {o.kind: o for o in (
 
 
 def _catalogue(kind: str) -> OpImpl:
-    from matedit.compiler.cpu_nodes import IMPLS
-
     def numpy(op: Op, args: list, env) -> tuple:
-        fn = IMPLS.get(kind)
+        d = get(kind)
+        fn = d.numpy if d is not None else None
         if fn is None:
             raise KeyError(f"no numpy implementation for node kind {kind!r}")
         out = fn(env.surface if env else None, *args)
@@ -126,8 +126,8 @@ def op_kind(kind: str | Role) -> str:
 
 
 def implementation(kind: str) -> OpImpl:
-    """The row of an op kind: a compiler op's own, or a catalogue kind's (from its definition
-    and `cpu_nodes.IMPLS`)."""
+    """The row of an op kind: a compiler op's own, or a catalogue kind's (from its
+    definition)."""
     impl = _CACHE.get(kind)
     if impl is None:
         role = role_of(kind)

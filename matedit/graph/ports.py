@@ -14,36 +14,26 @@ from typing import Any, Protocol
 from matedit.graph import nodes
 from matedit.graph.model import MaterialDocument, Node
 from matedit.graph.names import identifier_problem
-from matedit.graph.nodes import GENERIC, MA, PortsRule, Role, role_of
+from matedit.graph.nodes import GENERIC, MA, Port, PortsRule, Role, role_of
 from matedit.graph.types import PortType, parse_type
 
 
 @dataclass(frozen=True)
-class PortSpec:
-    name: str
-    type: str  # a PortType value or "T"
-    default: Any = None
-    range: tuple[float, float] | None = None
-    doc: str = ""
-    required: bool = False
-
-
-@dataclass(frozen=True)
 class NodePorts:
-    inputs: tuple[PortSpec, ...]
-    outputs: tuple[PortSpec, ...]
-    _by_input: dict[str, PortSpec] = field(init=False, repr=False, compare=False)
-    _by_output: dict[str, PortSpec] = field(init=False, repr=False, compare=False)
+    inputs: tuple[Port, ...]
+    outputs: tuple[Port, ...]
+    _by_input: dict[str, Port] = field(init=False, repr=False, compare=False)
+    _by_output: dict[str, Port] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # first match wins, as a linear scan would (duplicates are reported elsewhere)
         object.__setattr__(self, "_by_input", {p.name: p for p in reversed(self.inputs)})
         object.__setattr__(self, "_by_output", {p.name: p for p in reversed(self.outputs)})
 
-    def input(self, name: str) -> PortSpec | None:
+    def input(self, name: str) -> Port | None:
         return self._by_input.get(name)
 
-    def output(self, name: str) -> PortSpec | None:
+    def output(self, name: str) -> Port | None:
         return self._by_output.get(name)
 
 
@@ -60,12 +50,6 @@ class FunctionResolver(Protocol):
     def resolve(self, ref: str, owner: MaterialDocument | None) -> MaterialDocument:
         """The function document `ref` names, relative to `owner`; raise LookupError if missing."""
         ...
-
-
-def _spec(d: nodes.InputDef | nodes.OutputDef) -> PortSpec:
-    if isinstance(d, nodes.InputDef):
-        return PortSpec(d.name, d.type, d.default, d.range, d.doc, d.required)
-    return PortSpec(d.name, d.type, None, None, d.doc)
 
 
 # The catalogue's colour Blend nodes (blend_<mode>: base, blend, opacity) as layer blend
@@ -111,11 +95,12 @@ def function_interface(doc: MaterialDocument) -> NodePorts:
             raise PortError(node.id, "name", f"function {side} name "
                             f"{s['name']!r}{where} {why}")
         if role == Role.FUNCTION_INPUT:
-            ins.append((key, PortSpec(str(s["name"]), t, s.get("default"), None,
-                                      f"function input {s['name']}", t in (MA, "texture2d")
-                                      and s.get("default") is None)))
+            ins.append((key, Port(str(s["name"]), t, s.get("default"),
+                                  doc=f"function input {s['name']}",
+                                  required=t in (MA, "texture2d")
+                                  and s.get("default") is None)))
         else:
-            outs.append((key, PortSpec(str(s["name"]), t)))
+            outs.append((key, Port(str(s["name"]), t)))
     return NodePorts(tuple(p for _, p in sorted(ins, key=lambda kp: kp[0])),
                      tuple(p for _, p in sorted(outs, key=lambda kp: kp[0])))
 
@@ -135,8 +120,7 @@ def _static_ports(kind: str) -> NodePorts:
     hit = _STATIC.get(kind)
     if hit is None:
         d = nodes.REGISTRY[kind]
-        hit = _STATIC[kind] = NodePorts(tuple(_spec(i) for i in d.inputs),
-                                        tuple(_spec(o) for o in d.outputs))
+        hit = _STATIC[kind] = NodePorts(d.inputs, d.outputs)
     return hit
 
 
@@ -150,8 +134,8 @@ def node_ports(
     rule = d.ports_rule
     if rule is None or rule in _STATIC_RULES:
         return _static_ports(node.kind)
-    ins = tuple(_spec(i) for i in d.inputs)
-    outs = tuple(_spec(o) for o in d.outputs)
+    ins = d.inputs
+    outs = d.outputs
     s = {**d.setting_defaults(), **node.settings}
     if rule == PortsRule.TYPE_SETTING:
         try:
@@ -160,19 +144,19 @@ def node_ports(
             raise PortError(node.id, "type", str(exc)) from None
         if not t.is_numeric:
             raise PortError(node.id, "type", "a constant must be float, vec2, vec3 or vec4")
-        return NodePorts((), (PortSpec("value", t.value),))
+        return NodePorts((), (Port("value", t.value),))
     if rule == PortsRule.FUNCTION_INPUT:
         try:
             type_name = parse_type(str(s["type"])).value
         except ValueError as exc:
             raise PortError(node.id, "type", str(exc)) from None
-        return NodePorts((), (PortSpec("value", type_name),))
+        return NodePorts((), (Port("value", type_name),))
     if rule == PortsRule.FUNCTION_OUTPUT:
         try:
             type_name = parse_type(str(s["type"])).value
         except ValueError as exc:
             raise PortError(node.id, "type", str(exc)) from None
-        return NodePorts((PortSpec("value", type_name, None, required=True),), ())
+        return NodePorts((Port("value", type_name, None, required=True),), ())
     if rule == PortsRule.ATTRIBUTE_FIELDS:
         fields = s.get("fields")
         if not isinstance(fields, list) or not all(isinstance(f, str) for f in fields):
@@ -183,7 +167,7 @@ def node_ports(
             if fd is None:
                 raise PortError(node.id, "fields", f"unknown attribute {f!r} (expected one of "
                                 f"{', '.join(nodes.ATTRIBUTE_NAMES)})")
-            extra.append(_spec(fd))
+            extra.append(fd)
         return NodePorts(ins + tuple(extra), outs)
     if rule == PortsRule.FUNCTION_SIGNATURE:
         ref = s.get("function")
@@ -202,8 +186,8 @@ def node_ports(
     raise PortError(node.id, "kind", f"node kind {node.kind!r} has an unknown ports rule")
 
 
-def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
-    ports: list[PortSpec] = []
+def _layer_stack_inputs(node, resolver, owner) -> list[Port]:
+    ports: list[Port] = []
     seen: set[str] = set()
     for index, layer in enumerate(layer_entries(node)):
         if not isinstance(layer, dict):
@@ -224,27 +208,28 @@ def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
             raise PortError(node.id, f"layers[{index}].function",
                             f"{ref} is not a material layer: it has no MaterialAttributes output")
         for p in iface.inputs:
-            ports.append(PortSpec(f"{lid}_{p.name}", p.type, p.default, p.range,
-                                  f"{layer.get('name', lid)}: {p.doc or p.name}", p.required))
+            ports.append(Port(f"{lid}_{p.name}", p.type, p.default, range=p.range,
+                              doc=f"{layer.get('name', lid)}: {p.doc or p.name}",
+                              required=p.required))
         if index == 0:
             continue
         blend = layer.get("blend", "alpha")
         label = layer.get("name", lid)
-        ports.append(PortSpec(f"{lid}_opacity", "float", 1.0, (0.0, 1.0),
-                              f"{label}: overall strength"))
+        ports.append(Port(f"{lid}_opacity", "float", 1.0, range=(0.0, 1.0),
+                          doc=f"{label}: overall strength"))
         if blend == "alpha" or blend in COLOR_LAYER_BLENDS:
-            ports.append(PortSpec(f"{lid}_mask", "float", 1.0, (0.0, 1.0),
-                                  f"{label}: where the layer covers the ones below"))
+            ports.append(Port(f"{lid}_mask", "float", 1.0, range=(0.0, 1.0),
+                              doc=f"{label}: where the layer covers the ones below"))
         elif blend == "coat":
-            ports.append(PortSpec(f"{lid}_mask", "float", 1.0, (0.0, 1.0),
-                                  f"{label}: where the coat lies (its weight)"))
+            ports.append(Port(f"{lid}_mask", "float", 1.0, range=(0.0, 1.0),
+                              doc=f"{label}: where the coat lies (its weight)"))
         elif blend == "height":
-            ports.append(PortSpec(f"{lid}_mask", "float", 0.5, (0.0, 1.0),
-                                  f"{label}: layer height"))
-            ports.append(PortSpec(f"{lid}_base_height", "float", 0.5, (0.0, 1.0),
-                                  f"{label}: height of the layers below"))
-            ports.append(PortSpec(f"{lid}_contrast", "float", 0.1, (0.001, 1.0),
-                                  f"{label}: transition width"))
+            ports.append(Port(f"{lid}_mask", "float", 0.5, range=(0.0, 1.0),
+                              doc=f"{label}: layer height"))
+            ports.append(Port(f"{lid}_base_height", "float", 0.5, range=(0.0, 1.0),
+                              doc=f"{label}: height of the layers below"))
+            ports.append(Port(f"{lid}_contrast", "float", 0.1, range=(0.001, 1.0),
+                              doc=f"{label}: transition width"))
         elif isinstance(blend, str) and blend.endswith(".json"):
             if resolver is None:
                 raise LookupError(f"cannot resolve blend {blend!r} without a resolver")
@@ -256,8 +241,8 @@ def _layer_stack_inputs(node, resolver, owner) -> list[PortSpec]:
                                 "inputs and a MaterialAttributes output")
             for p in biface.inputs:
                 if p.type != MA:
-                    ports.append(PortSpec(f"{lid}_{p.name}", p.type, p.default, p.range,
-                                          f"{label}: {p.name}"))
+                    ports.append(Port(f"{lid}_{p.name}", p.type, p.default, range=p.range,
+                                      doc=f"{label}: {p.name}"))
         else:
             raise PortError(node.id, f"layers[{index}].blend",
                             f"unknown blend {blend!r} ({', '.join(LAYER_BLENDS)}, "
@@ -307,7 +292,7 @@ def resolve_types(
         if fixed is not None:
             return fixed
 
-    def concrete(spec: PortSpec) -> PortType | None:
+    def concrete(spec: Port) -> PortType | None:
         return None if spec.type == GENERIC else PortType(spec.type)
 
     in_types: dict[str, PortType] = {}

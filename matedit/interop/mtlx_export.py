@@ -42,7 +42,15 @@ import numpy as np
 from matedit.compiler import ops
 from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV, Uni, Var
 from matedit.graph import nodes
-from matedit.graph.nodes import ATTRIBUTE_FIELDS, ATTRIBUTE_NAMES, Role, kind_for, role_of
+from matedit.graph.nodes import (
+    ATTRIBUTE_FIELDS,
+    ATTRIBUTE_NAMES,
+    MxBuilder,
+    Ref,
+    Role,
+    kind_for,
+    role_of,
+)
 from matedit.graph.types import PortType
 from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, stdlib, to_materialx
 from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
@@ -245,25 +253,54 @@ class _Exporter:
         d = nodes.get(op.kind)
         geo = (d is not None and d.geometry) or any(a.geo for a in args)
         kind = kind_for(IR_OP_ROLES[op.kind]) if op.kind in IR_OP_ROLES else op.kind
-        entry = mapping(kind) if op.kind != ops.WEIGHT else MxRecipe("weight")
-        if entry == MxRecipe("normalize_vector") and args[0].type == PortType.FLOAT:
-            entry = BAKE  # the stdlib normalizes vectors only
+        entry = mapping(kind) if op.kind != ops.WEIGHT else _WEIGHT
         outs_t = [t for _, t in op.outs]
+        if isinstance(entry, MxRecipe) and entry.build is not None:
+            makers = entry.build(_Builder(self, op, kind, args, outs_t, hint))
+            if makers is not None:
+                return [V(num, t, (lambda m=m: m()[0]), geo)
+                        for m, num, t in zip(makers, nums, outs_t)]
+            entry = BAKE  # the recipe does not take these operand types
         if entry == BAKE:
             return [self.bake(hint, port, num, t, geo, op.kind)
                     for (port, t), num in zip(op.outs, nums)]
         if isinstance(entry, MxNode):
-            order = [i.name for i in nodes.REGISTRY[kind].inputs]
+            return [V(nums[0], outs_t[0], self.stdlib_node(entry, kind, args, outs_t[0], hint),
+                      geo)]
+        own = self._own_recipe(entry)
+        if own is None:
+            # A kind the catalogue maps to nothing the exporter can write (a lowered kind
+            # that reached it, a recipe with no build): refused by name, never guessed.
+            what = f"recipe {entry.name!r}" if isinstance(entry, MxRecipe) else repr(entry)
+            raise MtlxExportError(f"node {hint}: node kind {kind!r} has no MaterialX mapping "
+                                  f"the exporter can write ({what})")
+        return own(op, args, nums, outs_t, hint, geo)
 
-            def make(entry=entry, args=args, t=outs_t[0], order=order):
-                ins = [(mxname, args[order.index(ours)].ref(),
-                        MX_TYPE[args[order.index(ours)].type]) for ours, mxname in entry.ports]
-                ins += [(name, _const(v, t), MX_TYPE[t]) for name, v in entry.fixed]
-                strings = [("space", "world")] if entry.category in ("position", "normal") \
-                    else []
-                return self.node(entry.category, MX_TYPE[t], hint, ins, strings)
-            return [V(nums[0], outs_t[0], make, geo)]
-        return self.recipe(entry.name, op, args, nums, outs_t, hint, geo)
+    def stdlib_node(self, entry: MxNode, kind: str, args: list[V], t: PortType,
+                    hint: str) -> Callable[[], tuple]:
+        """The maker of one stdlib node: our inputs to its inputs, its fixed ones added."""
+        order = [i.name for i in nodes.REGISTRY[kind].inputs]
+
+        def make():
+            ins = [(mxname, args[order.index(ours)].ref(),
+                    MX_TYPE[args[order.index(ours)].type]) for ours, mxname in entry.ports]
+            ins += [(name, _const(v, t), MX_TYPE[t]) for name, v in entry.fixed]
+            strings = [("space", "world")] if entry.category in ("position", "normal") else []
+            return self.node(entry.category, MX_TYPE[t], hint, ins, strings)
+        return make
+
+    def _own_recipe(self, entry) -> Callable[..., list[V]] | None:
+        """The exporter's own recipes (no `build`): values that are not one reference
+        (material attributes and their blends) and texture reads."""
+        if not isinstance(entry, MxRecipe):
+            return None
+        return {
+            "image_read": self.texture_sample,
+            "attributes": lambda op, args, nums, outs_t, hint, geo:
+                self.attributes(op, args, nums),
+            "blend": lambda op, args, nums, outs_t, hint, geo:
+                [self.blend(op, args, nums[0], hint)],
+        }.get(entry.name)
 
     # --- baking ----------------------------------------------------------------------------
     def bake(self, hint: str, port: str, num, t: PortType, geo: bool, kind: str) -> V:
@@ -283,377 +320,6 @@ class _Exporter:
             self.set_input(n, "texcoord", self.uv0(), "vector2")
             return ("node", n, None)
         return V(num, t, make, geo)
-
-    # --- recipes ---------------------------------------------------------------------------
-    def recipe(self, name: str, op, args, nums, outs_t, hint, geo) -> list[V]:
-        mt = MX_TYPE.get(outs_t[0]) if outs_t else None
-
-        def one(make):
-            return [V(nums[0], outs_t[0], make, geo)]
-
-        def arg(i):
-            return (args[i].ref(), MX_TYPE[args[i].type])
-
-        def extract(v: V, i: int) -> tuple:
-            if v.type == PortType.FLOAT:
-                return v.ref()
-            if v.type.components <= i:
-                return ("value", 0.0)
-            r = v.ref()
-            if r[0] == "value":
-                return ("value", float(r[1][i]))
-            return self._extract(r, v.type, i, hint)
-
-        def combine(parts: list[tuple], t: PortType) -> tuple:
-            if len(parts) == 1:
-                return parts[0]
-            if all(p[0] == "value" for p in parts):
-                return ("value", tuple(p[1] for p in parts))
-            return self.node(f"combine{len(parts)}", MX_TYPE[t], hint,
-                             [(f"in{i + 1}", p, "float") for i, p in enumerate(parts)])
-
-        if name == "subtract_from_one":
-            return one(lambda: self.node("subtract", mt, hint, [
-                ("in1", _const(1.0, outs_t[0]), mt), ("in2", *arg(0))]))
-        if name == "positive_power":
-            return one(lambda: self.node("power", mt, hint, [
-                ("in1", self.node("max", mt, f"{hint}_max", [
-                    ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt),
-                ("in2", *arg(1))]))
-        if name == "multiply_then_add":
-            return one(lambda: self.node("add", mt, hint, [
-                ("in1", self.node("multiply", mt, f"{hint}_mul",
-                                  [("in1", *arg(0)), ("in2", *arg(1))]), mt),
-                ("in2", *arg(2))]))
-        if name == "floored_log":
-            return one(lambda: self.node("ln", mt, hint, [
-                ("in", self.node("max", mt, f"{hint}_max", [
-                    ("in1", *arg(0)), ("in2", _const(1e-30, outs_t[0]), mt)]), mt)]))
-        if name in ("clamped_asin", "clamped_acos"):
-            return one(lambda: self.node(name[len("clamped_"):], mt, hint, [
-                ("in", self.node("clamp", mt, f"{hint}_clamp", [
-                    ("in", *arg(0)), ("low", _const(-1.0, outs_t[0]), mt),
-                    ("high", _const(1.0, outs_t[0]), mt)]), mt)]))
-        if name == "floor_of_half_up":
-            return one(lambda: self.node("floor", mt, hint, [
-                ("in", self.node("add", mt, f"{hint}_half", [
-                    ("in1", *arg(0)), ("in2", _const(0.5, outs_t[0]), mt)]), mt)]))
-        if name == "signed_floor_of_abs":
-            return one(lambda: self.node("multiply", mt, hint, [
-                ("in1", self.node("sign", mt, f"{hint}_sign", [("in", *arg(0))]), mt),
-                ("in2", self.node("floor", mt, f"{hint}_floor", [
-                    ("in", self.node("absval", mt, f"{hint}_abs", [("in", *arg(0))]), mt)]),
-                 mt)]))
-        if name == "distance_or_absval":
-            if args[0].type == PortType.FLOAT:
-                return one(lambda: self.node("absval", "float", hint, [
-                    ("in", self.node("subtract", "float", f"{hint}_d",
-                                     [("in1", *arg(0)), ("in2", *arg(1))]), "float")]))
-            return one(lambda: self.node("distance", "float", hint,
-                                         [("in1", *arg(0)), ("in2", *arg(1))]))
-        if name == "within_tolerance":
-            def make_equal():
-                diff = self.node("absval", "float", f"{hint}_diff", [
-                    ("in", self.node("subtract", "float", f"{hint}_d",
-                                     [("in1", *arg(0)), ("in2", *arg(1))]), "float")])
-                # |a - b| > tolerance picks if_false: the same as |a - b| <= tolerance
-                # picking if_true
-                return self.node("ifgreater", mt, hint, [
-                    ("value1", diff, "float"), ("value2", *arg(2)), ("in1", *arg(4)),
-                    ("in2", *arg(3))])
-            return one(make_equal)
-        if name == "hsvtorgb_on_color3":
-            return one(lambda: self.node("convert", "vector3", hint, [
-                ("in", self.node("hsvtorgb", "color3", f"{hint}_rgb", [
-                    ("in", self.node("convert", "color3", f"{hint}_hsv", [("in", *arg(0))]),
-                     "color3")]), "color3")]))
-        if name == "floor_in_steps":
-            def make_steps():
-                st = self.node("max", mt, f"{hint}_steps",
-                               [("in1", *arg(1)), ("in2", _const(1.0, outs_t[0]), mt)])
-                f = self.node("floor", mt, f"{hint}_floor", [
-                    ("in", self.node("multiply", mt, f"{hint}_scaled",
-                                     [("in1", *arg(0)), ("in2", st, mt)]), mt)])
-                return self.node("divide", mt, hint, [("in1", f, mt), ("in2", st, mt)])
-            return one(make_steps)
-        if name == "weighted_sum":
-            def make_sum():
-                w = args[3].ref()
-                terms = [self.node("multiply", mt, f"{hint}_{c}", [
-                    ("in1", *arg(i)), ("in2", self._extract(w, PortType.VEC3, i, hint),
-                                       "float")]) for i, c in enumerate("xyz")]
-                s = self.node("add", mt, f"{hint}_xy", [("in1", terms[0], mt),
-                                                        ("in2", terms[1], mt)])
-                return self.node("add", mt, hint, [("in1", s, mt), ("in2", terms[2], mt)])
-            return one(make_sum)
-        if name == "mix_towards_inverse":
-            return one(lambda: self.node("mix", "vector3", hint, [
-                ("bg", *arg(0)),
-                ("fg", self.node("subtract", "vector3", f"{hint}_inverse", [
-                    ("in1", ("value", (1.0, 1.0, 1.0)), "vector3"), ("in2", *arg(0))]),
-                 "vector3"),
-                ("mix", *arg(1))]))
-        if name == "mix_from_grey":
-            from matedit.compiler.cpu_nodes import LUMA_REC709
-
-            def make_saturation():
-                y = self.node("dotproduct", "float", f"{hint}_luma", [
-                    ("in1", *arg(0)), ("in2", ("value", tuple(LUMA_REC709)), "vector3")])
-                grey = self.node("convert", "vector3", f"{hint}_grey", [("in", y, "float")])
-                return self.node("mix", "vector3", hint, [("bg", grey, "vector3"),
-                                                          ("fg", *arg(0)), ("mix", *arg(1))])
-            return one(make_saturation)
-        if name == "scale_about_mid_grey":
-            def make_bc():
-                gain = self.node("add", "float", f"{hint}_gain",
-                                 [("in1", ("value", 1.0), "float"), ("in2", *arg(2))])
-                lift = self.node("subtract", "float", f"{hint}_lift", [
-                    ("in1", *arg(1)),
-                    ("in2", self.node("multiply", "float", f"{hint}_half", [
-                        ("in1", *arg(2)), ("in2", ("value", 0.5), "float")]), "float")])
-                y = self.node("add", "vector3", f"{hint}_lifted", [
-                    ("in1", self.node("multiply", "vector3", f"{hint}_scaled", [
-                        ("in1", *arg(0)), ("in2", gain, "float")]), "vector3"),
-                    ("in2", lift, "float")])
-                return self.node("max", "vector3", hint, [("in1", y, "vector3"),
-                                                          ("in2", ("value", 0.0), "float")])
-            return one(make_bc)
-        if name == "falloff_from_centre":
-            def make_falloff():
-                r = self.node("magnitude", "float", f"{hint}_r", [
-                    ("in", self.node("subtract", "vector2", f"{hint}_d",
-                                     [("in1", *arg(0)), ("in2", *arg(1))]), "vector2")])
-                rad = self.node("max", "float", f"{hint}_radius",
-                                [("in1", *arg(2)), ("in2", ("value", 1e-6), "float")])
-                f = self.node("subtract", "float", f"{hint}_falloff", [
-                    ("in1", ("value", 1.0), "float"),
-                    ("in2", self.node("divide", "float", f"{hint}_ratio",
-                                      [("in1", r, "float"), ("in2", rad, "float")]), "float")])
-                return self.node("clamp", "float", hint, [("in", f, "float"),
-                                                          ("low", ("value", 0.0), "float"),
-                                                          ("high", ("value", 1.0), "float")])
-            return one(make_falloff)
-        if name.startswith("composite_"):
-            mode = name.removeprefix("composite_")
-
-            def make_composite():
-                def v3(cat, suffix, *ins):
-                    names = ("in1", "in2") if len(ins) == 2 else ("in",)
-                    return self.node(cat, "vector3", f"{hint}_{suffix}",
-                                     [(k, r, t) for k, (r, t) in zip(names, ins)])
-                base, blend = arg(0), arg(1)
-                one3 = (("value", (1.0, 1.0, 1.0)), "vector3")
-                if mode == "screen":
-                    r = v3("subtract", "screen", one3, (v3(
-                        "multiply", "darks", (v3("subtract", "base_inv", one3, base), "vector3"),
-                        (v3("subtract", "blend_inv", one3, blend), "vector3")), "vector3"))
-                elif mode == "difference":
-                    r = v3("absval", "difference",
-                           (v3("subtract", "d", base, blend), "vector3"))
-                else:
-                    cat = {"lighten": "max", "darken": "min"}.get(mode, mode)
-                    r = v3(cat, mode, base, blend)
-                return self.node("mix", "vector3", hint, [("bg", *base), ("fg", r, "vector3"),
-                                                          ("mix", *arg(2))])
-            return one(make_composite)
-        if name in ("srgb_decode_per_component", "srgb_encode_per_component"):
-            decode = name.startswith("srgb_decode")
-
-            def make_srgb():
-                def v3(cat, suffix, *ins):
-                    return self.node(cat, "vector3", f"{hint}_{suffix}",
-                                     [(k, r, t) for k, (r, t) in zip(("in1", "in2"), ins)])
-
-                def f(x):
-                    return (("value", x), "float")
-                c = v3("max", "positive", arg(0), f(0.0))
-                cv = (c, "vector3")
-                if decode:  # IEC 61966-2-1
-                    edge = 0.04045
-                    linear = v3("divide", "linear", cv, f(12.92))
-                    curve = v3("power", "curve", (v3("divide", "scaled", (v3(
-                        "add", "offset", cv, f(0.055)), "vector3"), f(1.055)), "vector3"),
-                        f(2.4))
-                else:
-                    edge = 0.0031308
-                    linear = v3("multiply", "linear", cv, f(12.92))
-                    curve = v3("subtract", "curve", (v3("multiply", "scaled", (v3(
-                        "power", "root", cv, f(1.0 / 2.4)), "vector3"), f(1.055)), "vector3"),
-                        f(0.055))
-                parts = []
-                for i in range(3):
-                    # c <= edge is the linear segment: c > edge picks the curve
-                    parts.append(self.node("ifgreater", "float", f"{hint}_{'xyz'[i]}", [
-                        ("value1", self._extract(c, PortType.VEC3, i, hint), "float"),
-                        ("value2", ("value", edge), "float"),
-                        ("in1", self._extract(curve, PortType.VEC3, i, hint), "float"),
-                        ("in2", self._extract(linear, PortType.VEC3, i, hint), "float")]))
-                return combine(parts, PortType.VEC3)
-            return one(make_srgb)
-        if name == "rec709_dot":
-            from matedit.compiler.cpu_nodes import LUMA_REC709
-
-            return one(lambda: self.node("dotproduct", "float", hint, [
-                ("in1", *arg(0)), ("in2", ("value", tuple(LUMA_REC709)), "vector3")]))
-        if name == "rotate_about_pivot":
-            def make_rotate():
-                d = self.node("subtract", "vector2", f"{hint}_centred",
-                              [("in1", *arg(0)), ("in2", *arg(2))])
-                turn = self.node("multiply", "float", f"{hint}_cw",
-                                 [("in1", *arg(1)), ("in2", ("value", -1.0), "float")])
-                r = self.node("rotate2d", "vector2", f"{hint}_rotate",
-                              [("in", d, "vector2"), ("amount", turn, "float")])
-                return self.node("add", "vector2", hint, [("in1", r, "vector2"),
-                                                          ("in2", *arg(2))])
-            return one(make_rotate)
-        if name == "positive_sqrt":
-            return one(lambda: self.node("sqrt", mt, hint, [
-                ("in", self.node("max", mt, f"{hint}_max", [
-                    ("in1", *arg(0)), ("in2", _const(0.0, outs_t[0]), mt)]), mt)]))
-        if name == "floor_step":
-            def make_step():
-                d = self.node("subtract", mt, f"{hint}_d", [("in1", *arg(1)), ("in2", *arg(0))])
-                f = self.node("floor", mt, f"{hint}_floor", [("in", d, mt)])
-                a = self.node("add", mt, f"{hint}_add", [("in1", f, mt),
-                                                         ("in2", _const(1.0, outs_t[0]), mt)])
-                return self.node("clamp", mt, hint, [("in", a, mt),
-                                                     ("low", _const(0.0, outs_t[0]), mt),
-                                                     ("high", _const(1.0, outs_t[0]), mt)])
-            return one(make_step)
-        if name == "dot_or_multiply":
-            if args[0].type == PortType.FLOAT:
-                return one(lambda: self.node("multiply", "float", hint,
-                                             [("in1", *arg(0)), ("in2", *arg(1))]))
-            return one(lambda: self.node("dotproduct", "float", hint,
-                                         [("in1", *arg(0)), ("in2", *arg(1))]))
-        if name == "magnitude_or_absval":
-            cat = "absval" if args[0].type == PortType.FLOAT else "magnitude"
-            return one(lambda: self.node(cat, "float", hint, [("in", *arg(0))]))
-        if name == "normalize_vector":
-            return one(lambda: self.node("normalize", mt, hint, [("in", *arg(0))]))
-        if name == "weight":
-            return one(lambda: self.node("clamp", "float", hint, [
-                ("in", self.node("multiply", "float", f"{hint}_mul",
-                                 [("in1", *arg(0)), ("in2", *arg(1))]), "float"),
-                ("low", ("value", 0.0), "float"), ("high", ("value", 1.0), "float")]))
-        if name == "mask":
-            idx = ["xyzw".index(c) for c in op.data["channels"]]
-            return one(lambda: combine([extract(args[0], i) for i in idx], outs_t[0]))
-        if name == "concatenate":
-            def make_append():
-                parts = []
-                for a in args:
-                    parts += [extract(a, i) for i in range(a.type.components)]
-                return combine(parts, outs_t[0])
-            return one(make_append)
-        if name == "extract_each":
-            return [V(n, t, (lambda i=i: extract(args[0], i)), geo)
-                    for i, (n, t) in enumerate(zip(nums, outs_t))]
-        if name == "combine_n":
-            sizes = (2, 3, 4)
-            return [V(n, t, (lambda k=k, t=t: combine([a.ref() for a in args[:k]], t)), geo)
-                    for k, n, t in zip(sizes, nums, outs_t)]
-        if name == "tiled_texcoord":
-            return one(lambda: self.node("add", "vector2", hint, [
-                ("in1", self.node("multiply", "vector2", f"{hint}_tile", [
-                    ("in1", self.uv0(), "vector2"), ("in2", *arg(0))]), "vector2"),
-                ("in2", *arg(1))]))
-        if name == "negated_viewdirection":
-            return one(lambda: self.node("multiply", "vector3", hint, [
-                ("in1", self.node("viewdirection", "vector3", f"{hint}_eye", [],
-                                  [("space", "world")]), "vector3"),
-                ("in2", ("value", -1.0), "float")]))
-        if name == "vector_and_xyz":
-            return [V(nums[0], outs_t[0], args[0].ref, geo),
-                    V(nums[1], outs_t[1], lambda: self._to3(args[0].ref(), hint), geo)]
-        if name in ("checkerboard", "linear_ramp", "decode_normal", "reoriented_normals",
-                    "mix_towards_z"):
-            return self.procedural(name, op, args, nums, outs_t, hint, geo)
-        if name == "image_read":
-            return self.texture_sample(op, args, nums, outs_t, hint, geo)
-        if name == "attributes":
-            return self.attributes(op, args, nums)
-        if name == "blend":
-            return [self.blend(op, args, nums[0], hint)]
-        raise MtlxExportError(f"node {hint}: no MaterialX recipe {name!r}")
-
-    def procedural(self, name, op, args, nums, outs_t, hint, geo) -> list[V]:
-        """Our procedural and normal nodes as small stdlib subgraphs (shaders/nodes/*.glsl
-        written out node by node)."""
-        order = [i.name for i in nodes.REGISTRY[op.kind].inputs]
-
-        def a(port):
-            v = args[order.index(port)]
-            return (v.ref(), MX_TYPE[v.type])
-
-        def n(cat, t, suffix, *ins):
-            names = {"mix": ("bg", "fg", "mix"), "clamp": ("in", "low", "high")}.get(
-                cat, ("in1", "in2") if len(ins) == 2 else ("in",))
-            return (self.node(cat, t, f"{hint}_{suffix}" if suffix else hint,
-                              [(k, r, rt) for k, (r, rt) in zip(names, ins)]), t)
-
-        def val(v, t="float"):
-            return (("value", v), t)
-
-        shared: dict[str, tuple] = {}
-        if name == "linear_ramp":
-            def make():
-                ang = n("multiply", "float", "rad", a("angle"), val(math.pi / 180.0))
-                c = n("cos", "float", "cos", ang)
-                s = n("sin", "float", "sin", ang)
-                d = (self.node("combine2", "vector2", f"{hint}_dir",
-                               [("in1", c[0], "float"), ("in2", s[0], "float")]), "vector2")
-                ext = n("add", "float", "extent", n("absval", "float", "abs_x", c),
-                        n("absval", "float", "abs_y", s))
-                p = n("subtract", "vector2", "centred", a("uv"), val((0.5, 0.5), "vector2"))
-                proj = n("dotproduct", "float", "proj", p, d)
-                v = n("add", "float", "ramp", n("divide", "float", "norm", proj, ext),
-                      val(0.5))
-                return n("clamp", "float", "", v, val(0.0), val(1.0))[0]
-            return [V(nums[0], outs_t[0], make, geo)]
-        if name == "checkerboard":
-            def mask():
-                if "mask" not in shared:
-                    cell = n("floor", "vector2", "cell",
-                             n("multiply", "vector2", "scaled", a("uv"), a("scale")))
-                    s = (self.node("add", "float", f"{hint}_parity_sum", [
-                        ("in1", self._extract(cell[0], PortType.VEC2, 0, hint), "float"),
-                        ("in2", self._extract(cell[0], PortType.VEC2, 1, hint), "float")]),
-                         "float")
-                    shared["mask"] = n("modulo", "float", "mask", s, val(2.0))[0]
-                return shared["mask"]
-
-            def color():
-                return n("mix", "vector3", "", a("color_a"), a("color_b"),
-                         (mask(), "float"))[0]
-            return [V(nums[0], outs_t[0], color, geo), V(nums[1], outs_t[1], mask, geo)]
-        if name == "decode_normal":
-            def make():
-                x = n("subtract", "vector3", "signed",
-                      n("multiply", "vector3", "twice", a("packed"), val(2.0)), val(1.0))
-                st = a("strength")
-                k = (self.node("combine3", "vector3", f"{hint}_strength",
-                               [("in1", st[0], "float"), ("in2", st[0], "float"),
-                                ("in3", ("value", 1.0), "float")]), "vector3")
-                return n("normalize", "vector3", "", n("multiply", "vector3", "scaled", x, k))[0]
-            return [V(nums[0], outs_t[0], make, geo)]
-        if name == "mix_towards_z":
-            def make():
-                m = n("mix", "vector3", "towards_z", a("normal"),
-                      val((0.0, 0.0, 1.0), "vector3"), a("flatness"))
-                return n("normalize", "vector3", "", m)[0]
-            return [V(nums[0], outs_t[0], make, geo)]
-        # blend_normals: Barre-Brisebois & Hill 2012, reoriented normal mapping
-        def make_rnm():
-            t = n("add", "vector3", "t", a("base"), val((0.0, 0.0, 1.0), "vector3"))
-            u = n("multiply", "vector3", "u", a("detail"), val((-1.0, -1.0, 1.0), "vector3"))
-            tu = n("dotproduct", "float", "tu", t, u)
-            tz = (self._extract(t[0], PortType.VEC3, 2, hint), "float")
-            r = n("subtract", "vector3", "r",
-                  n("divide", "vector3", "scaled", n("multiply", "vector3", "tdot", t, tu), tz),
-                  u)
-            return n("normalize", "vector3", "", r)[0]
-        return [V(nums[0], outs_t[0], make_rnm, geo)]
 
     def _extract(self, r: tuple, t: PortType, i: int, hint: str) -> tuple:
         n = self.ng.addNode("extract", self.name(f"{hint}_{'xyzw'[i]}"), "float")
@@ -912,6 +578,90 @@ class _Exporter:
             out.setOutputString(r[2])
         inp.setNodeGraphString(self.ng.getName())
         inp.setOutputString(out.getName())
+
+
+# A layer's alpha weight (the IR's own op, ops.WEIGHT): saturate(mask * opacity).
+def _weight_recipe(b: MxBuilder):
+    return [lambda: b.node("clamp", "float", "", (
+        "in", b.node("multiply", "float", "mul", ("in1", b.arg(0)), ("in2", b.arg(1)))),
+        ("low", b.value(0.0, "float")), ("high", b.value(1.0, "float")))]
+
+
+_WEIGHT = MxRecipe("weight", _weight_recipe)
+_PORT_TYPE = {mx: t for t, mx in MX_TYPE.items()}
+
+
+class _Builder:
+    """The exporter's side of `MxBuilder`, for one op: references are (MaterialX reference,
+    MaterialX type) pairs; nodes are named after the op (its hint) and a suffix."""
+
+    def __init__(self, ex: _Exporter, op, kind: str, args: list[V], outs_t: list[PortType],
+                 hint: str) -> None:
+        self.ex, self.op, self.args, self.hint = ex, op, args, hint
+        self.outs_t = outs_t
+        d = nodes.get(kind)
+        self.order = [i.name for i in d.inputs] if d is not None else []
+
+    @property
+    def result_type(self) -> str:
+        return MX_TYPE[self.outs_t[0]]
+
+    @property
+    def data(self) -> dict[str, Any]:
+        return self.op.data
+
+    @property
+    def operands(self) -> int:
+        return len(self.args)
+
+    def _arg(self, port: int | str) -> V:
+        return self.args[port if isinstance(port, int) else self.order.index(port)]
+
+    def arg(self, port: int | str) -> Ref:
+        v = self._arg(port)
+        return (v.ref(), MX_TYPE[v.type])
+
+    def arg_type(self, port: int | str) -> str:
+        return MX_TYPE[self._arg(port).type]
+
+    def value(self, v, mxtype: str | None = None) -> Ref:
+        if mxtype is None:
+            return (_const(v, self.outs_t[0]), self.result_type)
+        return (("value", v), mxtype)
+
+    def constant(self, ref: Ref):
+        return ref[0][1] if ref[0][0] == "value" else None
+
+    def node(self, category: str, mxtype: str | None, suffix: str, *inputs: tuple[str, Ref],
+             space: str | None = None) -> Ref:
+        t = self.result_type if mxtype is None else mxtype
+        name = f"{self.hint}_{suffix}" if suffix else self.hint
+        strings = [("space", space)] if space else []
+        return (self.ex.node(category, t, name, [(k, r, rt) for k, (r, rt) in inputs],
+                             strings), t)
+
+    def extract(self, ref: Ref, index: int) -> Ref:
+        return (self.ex._extract(ref[0], _PORT_TYPE[ref[1]], index, self.hint), "float")
+
+    def component(self, source: Ref | int, index: int) -> Ref:
+        t = self.arg_type(source) if isinstance(source, int) else source[1]
+        if _PORT_TYPE[t].components <= index and t != "float":
+            return (("value", 0.0), "float")
+        ref = self.arg(source) if isinstance(source, int) else source
+        if t == "float" or ref[0][0] != "value":
+            return ref if t == "float" else self.extract(ref, index)
+        return (("value", float(ref[0][1][index])), "float")
+
+    def combine(self, parts, mxtype: str) -> Ref:
+        if len(parts) == 1:
+            return parts[0]
+        if all(p[0][0] == "value" for p in parts):
+            return (("value", tuple(p[0][1] for p in parts)), mxtype)
+        return self.node(f"combine{len(parts)}", mxtype, "",
+                         *[(f"in{i + 1}", (p[0], "float")) for i, p in enumerate(parts)])
+
+    def uv(self) -> Ref:
+        return (self.ex.uv0(), "vector2")
 
 
 def validate(text: str) -> tuple[bool, str]:

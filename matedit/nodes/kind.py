@@ -1,17 +1,16 @@
-"""The data of a node kind (`NodeDef` and its parts) and the registry of kinds.
+"""The data of a node kind (`NodeDef` and its parts), the registry of kinds, and the
+helpers that keep the category modules' tables short.
 
-`matedit.graph.nodes` (the basic kinds) and `matedit.graph.library` (the rest) build the
-catalogue from these and register it; code reads the catalogue through `matedit.graph.nodes`,
-which exports every name here. Two modules, so that the library's kinds import this one and
-not the catalogue that loads them.
+The category modules of `matedit.nodes` build the catalogue from these and register it;
+code reads the catalogue through `matedit.graph.nodes`, which exports every name here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import Enum, auto
-from typing import Any
+from typing import Any, Protocol
 
 GENERIC = "T"
 # Default marker: an unconnected input with this default reads the mesh's first UV set.
@@ -19,10 +18,13 @@ MESH_UV = "mesh_uv"
 
 
 @dataclass(frozen=True)
-class InputDef:
+class Port:
+    """A port of a node: an input (with its default and range) or an output. The one record
+    for ports, from a kind's definition or from the dynamic rules of `matedit.graph.ports`."""
+
     name: str
-    type: str
-    default: Any = 0.0
+    type: str  # a PortType value or "T"
+    default: Any = None
     doc: str = ""
     range: tuple[float, float] | None = None
     required: bool = False
@@ -35,12 +37,9 @@ class InputDef:
     lobe: bool = False
 
 
-@dataclass(frozen=True)
-class OutputDef:
-    name: str
-    type: str
-    doc: str = ""
-    group: str = ""  # as InputDef.group (Break Material Attributes' fields)
+# The names the catalogue uses for the two sides (one type).
+InputDef = Port
+OutputDef = Port
 
 
 @dataclass(frozen=True)
@@ -123,12 +122,88 @@ class MxNode:
     output: str = "out"
 
 
+class MxBuilder(Protocol):
+    """What a MaterialX recipe builds through (`MxRecipe.build`): the exporter passes one in,
+    so a recipe names MaterialX stdlib nodes without importing MaterialX. A reference (`Ref`)
+    is opaque to the recipe: an operand of the op, a node built here, or a constant; each
+    carries its MaterialX type (float, vector2, vector3, vector4)."""
+
+    @property
+    def result_type(self) -> str:
+        """The MaterialX type of the op's first output."""
+        ...
+
+    @property
+    def data(self) -> Mapping[str, Any]:
+        """The op's own data (a component mask's channels)."""
+        ...
+
+    @property
+    def operands(self) -> int:
+        """How many operands the op has."""
+        ...
+
+    def arg(self, port: int | str) -> Ref:
+        """The op's operand: by position, or by the kind's input name."""
+        ...
+
+    def arg_type(self, port: int | str) -> str:
+        """The MaterialX type of that operand."""
+        ...
+
+    def value(self, v: float | tuple[float, ...], mxtype: str | None = None) -> Ref:
+        """A constant of `mxtype`; None: a number splatted to the op's result type."""
+        ...
+
+    def constant(self, ref: Ref) -> Any:
+        """The value of a constant reference; None for any other."""
+        ...
+
+    def node(self, category: str, mxtype: str | None, suffix: str, *inputs: tuple[str, Ref],
+             space: str | None = None) -> Ref:
+        """A stdlib node of `category` and output type `mxtype` (None: the op's result type)
+        on (MaterialX input, reference) pairs, named after the op plus `suffix` ("" for the
+        op's own result); `space` sets a geometric node's space."""
+        ...
+
+    def extract(self, ref: Ref, index: int) -> Ref:
+        """An `extract` node of component `index` of a vector reference."""
+        ...
+
+    def component(self, source: Ref | int, index: int) -> Ref:
+        """Component `index` of a reference or of an operand (by position, referenced only
+        if needed): a float is its own, a missing one reads 0, a constant's is a constant,
+        a vector's is extracted."""
+        ...
+
+    def combine(self, parts: Sequence[Ref], mxtype: str) -> Ref:
+        """A vector of `mxtype` from float references (one part: itself; constants fold)."""
+        ...
+
+    def uv(self) -> Ref:
+        """The texture coordinates of the mesh's first UV set."""
+        ...
+
+
+# A MaterialX reference as a recipe holds it (see MxBuilder).
+Ref = tuple[Any, str]
+# A recipe's result: one function per output of the op (see RecipeFn).
+Makers = list[Callable[[], Ref]]
+# A recipe: fn(builder) -> one function per output of the op, each building that output on
+# demand (so an output nothing reads builds nothing) and returning its reference; or None
+# where the recipe cannot express the op's operand types (the exporter then bakes it).
+RecipeFn = Callable[[MxBuilder], "Sequence[Callable[[], Ref]] | None"]
+
+
 @dataclass(frozen=True)
 class MxRecipe:
-    """A few stdlib nodes, built by `matedit.interop.mtlx_export` (the recipe of that name)
-    and read back by `matedit.interop.mtlx_import`."""
+    """A few stdlib nodes that compute the kind: `build` writes them through the builder the
+    exporter passes in. A recipe without `build` is one of the exporter's own, for the kinds
+    whose values are not one reference (material attributes and their blends) or that read
+    textures. `matedit.interop.mtlx_import` reads recipes back by `name`."""
 
     name: str
+    build: RecipeFn | None = field(default=None, compare=False, repr=False)
 
 
 # A kind's MaterialX mapping when no stdlib node or recipe expresses it: the exporter bakes
@@ -149,8 +224,10 @@ class NodeDef:
     inputs: tuple[InputDef, ...] = ()
     outputs: tuple[OutputDef, ...] = ()
     settings: tuple[SettingDef, ...] = ()
-    glsl: str | None = None  # GLSL function name in shaders/nodes/<kind>.glsl
-    inline: str | None = None  # inline GLSL template, e.g. "({a} + {b})"
+    # Its GLSL, one of: the function's name in shaders/nodes/<kind>.glsl (called with `out`
+    # parameters), or an inline template, e.g. "({a} + {b})" (the back-end reads both here).
+    glsl: str | None = None
+    inline: str | None = None
     ports_rule: PortsRule | None = None  # dynamic ports, see matedit.graph.ports
     # Extra value fields that are not ports (a parameter's value): edits are value edits.
     values: tuple[InputDef, ...] = ()
@@ -171,6 +248,9 @@ class NodeDef:
     # A named parameter an instance may override: its instance type ("scalar", "vector",
     # "color", "texture", "switch"); None: not a parameter.
     parameter: str | None = None
+    # Its numpy twin: fn(surface, *inputs) -> its outputs, a tuple in declaration order (one
+    # output may come bare); every kind the compiler does not lower has one.
+    numpy: Callable[..., Any] | None = field(default=None, repr=False)
 
     def input(self, name: str) -> InputDef | None:
         return next((i for i in self.inputs if i.name == name), None)
@@ -191,8 +271,13 @@ REGISTRY: dict[str, NodeDef] = {}
 def register(defn: NodeDef) -> NodeDef:
     if defn.kind in REGISTRY:
         raise ValueError(f"node kind {defn.kind!r} registered twice")
-    if (defn.glsl is None) == (defn.inline is None) and not defn.lowered:
+    if defn.lowered:
+        if defn.glsl is not None or defn.inline is not None or defn.numpy is not None:
+            raise ValueError(f"node kind {defn.kind!r} is lowered: no glsl=, inline= or numpy=")
+    elif (defn.glsl is None) == (defn.inline is None):
         raise ValueError(f"node kind {defn.kind!r} needs exactly one of glsl= or inline=")
+    elif defn.numpy is None:
+        raise ValueError(f"node kind {defn.kind!r} needs its numpy twin (numpy=)")
     if defn.role is not None and any(d.role == defn.role for d in REGISTRY.values()):
         raise ValueError(f"node kind {defn.kind!r}: role {defn.role.name} taken")
     REGISTRY[defn.kind] = defn
@@ -257,25 +342,44 @@ def categories() -> dict[str, list[NodeDef]]:
     return out
 
 
-# --- helpers to keep the table short -------------------------------------------------------
+# --- helpers to keep the tables short ------------------------------------------------------
+T = GENERIC
+UNIT = (0.0, 1.0)
+IOR_RANGE = (1.0, 3.0)
+# Inputs several categories share, as _i(*...) arguments.
+_UV = ("uv", "vec2", MESH_UV)
+_FILTER = ("filter_width", "float", 1.0, "edge blur in pixels (0: hard edges)", (0.0, 4.0))
+_SEED = ("seed", "float", 0.0, "integer seed: another seed, another pattern", (0.0, 1000.0))
+
 
 def _i(name: str, type_: str, default: Any = 0.0, doc: str = "",
-       rng: tuple[float, float] | None = None, required: bool = False) -> InputDef:
-    return InputDef(name, type_, default, doc, rng, required)
+       rng: tuple[float, float] | None = None, required: bool = False) -> Port:
+    return Port(name, type_, default, doc, rng, required)
 
 
-def _o(name: str, type_: str, doc: str = "", group: str = "") -> OutputDef:
-    return OutputDef(name, type_, doc, group)
+def _o(name: str, type_: str, doc: str = "", group: str = "") -> Port:
+    return Port(name, type_, doc=doc, group=group)
 
 
-def _op(kind: str, title: str, inline: str | None, inputs: Iterable[InputDef], doc: str,
+def _op(kind: str, title: str, inline: str | None, inputs: Iterable[Port], doc: str,
         out_type: str = GENERIC, category: str = "Math", glsl: str | None = None,
-        mtlx: Mtlx = BAKE, reads: MxNode | None = None) -> NodeDef:
+        mtlx: Mtlx = BAKE, reads: MxNode | None = None,
+        numpy: Callable[..., Any] | None = None) -> NodeDef:
+    """A kind with one output `result`: an inline template or a GLSL function."""
     return register(NodeDef(
         kind=kind, title=title, category=category, description=doc,
         inputs=tuple(inputs), outputs=(_o("result", out_type),),
         inline=inline if glsl is None else None, glsl=glsl, mtlx=mtlx, mtlx_reads=reads,
+        numpy=numpy,
     ))
+
+
+def _fn(kind: str, title: str, category: str, description: str, inputs: Iterable[Port],
+        outputs: Iterable[Port], **facts: Any) -> NodeDef:
+    """A kind with a GLSL function `node_<kind>`; `facts` are further NodeDef fields
+    (numpy, thumbnail, geometry...)."""
+    return register(NodeDef(kind, title, category, description, inputs=tuple(inputs),
+                            outputs=tuple(outputs), glsl=f"node_{kind}", **facts))
 
 
 def _bin(category: str) -> MxNode:
