@@ -14,8 +14,8 @@ from matedit.io.inputs import declare_inputs
 
 # matedit.shading.views.VIEWS, spelled here so parsing the command line imports no numpy
 # (tests/test_views.py checks the two agree)
-VIEW_NAMES = ("lit", "base", "coat", "sheen", "specular", "roughness", "normal", "coat-weight",
-              "anisotropy")
+VIEW_NAMES = ("lit", "base", "coat", "sheen", "subsurface", "specular", "roughness", "normal",
+              "coat-weight", "anisotropy")
 
 
 def register(sub) -> None:
