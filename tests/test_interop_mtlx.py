@@ -96,7 +96,9 @@ SURFACE_INPUTS = {
     "coat": "coat", "coat_color": "coatColor", "coat_roughness": "coatRoughness",
     "coat_IOR": "coatIor", "coat_normal": "coatNormal", "specular_color": "specularColor",
     "specular_IOR": "ior", "sheen_color": "sheenColor", "sheen_roughness": "sheenRoughness",
-    "specular_anisotropy": "anisotropy",
+    "specular_anisotropy": "anisotropy", "subsurface": "subsurface",
+    "subsurface_color": "subsurfaceColor", "subsurface_radius": "subsurfaceRadius",
+    "subsurface_scale": "thickness",  # as 1 / thickness (docs/shading.md, Subsurface)
 }
 # The talk's inputs, which every exported material has.
 TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",
@@ -130,6 +132,11 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
             k = want.shape[-1]
             if inp.getName() == "opacity":
                 got, k = got[..., :1], 1
+            if inp.getName() == "subsurface_scale":  # 1 / thickness: relative, 1e-3
+                np.testing.assert_allclose(got[..., :k], 1.0 / np.maximum(want, 1e-4),
+                                           rtol=1e-3, err_msg=f"{path.stem}: subsurface_scale")
+                checked.append(inp.getName())
+                continue
             np.testing.assert_allclose(got[..., :k], want, atol=2e-3,
                                        err_msg=f"{path.stem}: {inp.getName()}")
             checked.append(inp.getName())
