@@ -17,6 +17,9 @@ const float MIN_ANALYTIC_ROUGHNESS = 0.03;
 #if defined(MATERIAL_HAS_ANISOTROPY)
 #include "anisotropy.glsl"
 #endif
+#if defined(MATERIAL_HAS_SUBSURFACE)
+#include "subsurface.glsl"
+#endif
 
 struct Light {
     int type;               // LIGHT_TYPE_*
@@ -54,6 +57,9 @@ struct ShadingContext {
     float sheenMax;         // max component of the material's sheenColor
     float sheenScaleV;      // the base's albedo scaling towards the eye
 #endif
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    SubsurfaceLobe subsurface;  // the subsurface diffuse (subsurface.glsl), set by shadeSurface
+#endif
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -74,7 +80,24 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
     // isotropic until shadeSurface sets the material's direction and anisotropy
     s.aniso = makeAnisotropicLobe(s.a, 0.0, vec3(1.0, 0.0, 0.0), N, N, N);
 #endif
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    // none until shadeSurface sets the material's
+    s.subsurface = makeSubsurfaceLobe(0.0, vec3(1.0), vec3(1.0), 1.0, 0.0, 1.0);
+#endif
     return s;
+}
+
+// The diffuse lobe's f NoL for a light of signed cosine NoL to the shading normal: Lambert
+// of the clamped cosine, plus the subsurface lobe (wrapped, and transmitted from behind)
+// where the material has one.
+vec3 diffuseTowards(ShadingContext s, float NoL) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", diffuse BRDF: Lambert; the subsurface
+    // diffuse of subsurface.glsl (docs/shading.md, Subsurface)
+    vec3 diffuse = diffuseLobe(s.diffuseColor) * saturate(NoL);
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    diffuse += subsurfaceCosine(s.subsurface, NoL);
+#endif
+    return diffuse;
 }
 
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
@@ -145,7 +168,7 @@ vec3 pointLight(ShadingContext s, Light light) {
     float d = length(Lc);
     vec3 L = Lc / max(d, 1e-8);
     float NoL = saturate(dot(s.N, L));
-    vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+    vec3 radiance = diffuseTowards(s, dot(s.N, L)) + specularTowards(s, L);
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
     radiance = sheenLayer(s, radiance, L, NoL);
 #endif
@@ -159,7 +182,7 @@ vec3 directionalLight(ShadingContext s, Light light) {
     // Karis 2013, "Real Shading in Unreal Engine 4", punctual lights: directional, no falloff
     vec3 L = -light.direction;
     float NoL = saturate(dot(s.N, L));
-    vec3 radiance = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+    vec3 radiance = diffuseTowards(s, dot(s.N, L)) + specularTowards(s, L);
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
     radiance = sheenLayer(s, radiance, L, NoL);
 #endif
@@ -176,7 +199,7 @@ vec3 sphereLight(ShadingContext s, Light light) {
     float falloff = distanceFalloff(d, light.influenceRadius);
     // Diffuse: the irradiance of a point light at the centre.
     float NoLc = saturate(dot(s.N, Lc / max(d, 1e-8)));
-    vec3 diffuse = diffuseLobe(s.diffuseColor) * NoLc;
+    vec3 diffuse = diffuseTowards(s, dot(s.N, Lc / max(d, 1e-8)));
     // Specular: the point of the sphere closest to the reflection ray, energy renormalised.
     vec3 R = reflect(-s.V, s.N);
 #if defined(MATERIAL_HAS_ANISOTROPY)
@@ -207,20 +230,30 @@ vec3 sphereLight(ShadingContext s, Light light) {
     return (diffuse + specular) * light.color * (light.intensity * falloff);
 }
 
-// Average irradiance factor of a segment from L0 to L1 (unnormalised, from P), without the window.
-float tubeIrradiance(vec3 N, vec3 L0, vec3 L1) {
+// The segment's mean cosine to N of its two ends' directions (signed: below the horizon
+// negative), the numerator of the tube's irradiance.
+float tubeCosine(vec3 N, vec3 L0, vec3 L1) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 16: (N.L0 / |L0| + N.L1 / |L1|) / 2
+    return dot(N, L0) / (2.0 * length(L0)) + dot(N, L1) / (2.0 * length(L1));
+}
+
+// The denominator of the tube's irradiance, |L0||L1| + L0.L1 + 2 eps^2.
+float tubeDenominator(vec3 L0, vec3 L1) {
     // Karis 2013, "Real Shading in Unreal Engine 4", eq 16, eps^2 terms as in eq 9
-    float l0 = length(L0);
-    float l1 = length(L1);
-    float cosTerm = saturate(dot(N, L0) / (2.0 * l0) + dot(N, L1) / (2.0 * l1));
     // |L0||L1| + L0.L1 cancels when P lies near the segment between its ends (L0, L1
     // opposed); there use the equal |L0 x L1|^2 / (|L0||L1| - L0.L1), which does not.
-    float l0l1 = l0 * l1;
+    float l0l1 = length(L0) * length(L1);
     float d01 = dot(L0, L1);
     vec3 c = cross(L0, L1);
     float den = d01 >= 0.0 ? l0l1 + d01 : dot(c, c) / (l0l1 - d01);
     float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
-    return 2.0 * cosTerm / (den + 2.0 * eps2);
+    return den + 2.0 * eps2;
+}
+
+// Average irradiance factor of a segment from L0 to L1 (unnormalised, from P), without the window.
+float tubeIrradiance(vec3 N, vec3 L0, vec3 L1) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 16, eps^2 terms as in eq 9
+    return 2.0 * saturate(tubeCosine(N, L0, L1)) / tubeDenominator(L0, L1);
 }
 
 // Point of a segment closest to the reflection ray, as an unnormalised vector from P.
@@ -241,6 +274,11 @@ vec3 tubeLight(ShadingContext s, Light light) {
     vec3 L1 = Lc + halfAxis;
     float window = distanceWindow(d, light.influenceRadius);
     vec3 diffuse = diffuseLobe(s.diffuseColor) * tubeIrradiance(s.N, L0, L1);
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    // the subsurface lobe of the segment's signed mean cosine (wrapped and transmitted)
+    diffuse += subsurfaceCosine(s.subsurface, tubeCosine(s.N, L0, L1))
+             * (2.0 / tubeDenominator(L0, L1));
+#endif
     // Specular: the sphere step around the closest point on the segment; our choice of
     // falloff is the inverse square to that point (the tube's limit is the sphere light).
     vec3 R = reflect(-s.V, s.N);

@@ -21,8 +21,9 @@
 // anisotropy (MATERIAL_HAS_ANISOTROPY, anisotropy.glsl).
 vec3 brdfCosine(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4": diffuse + D Vis F, times NoL
-    float NoL = saturate(dot(s.N, L));
-    vec3 base = diffuseLobe(s.diffuseColor) * NoL + specularTowards(s, L);
+    // the diffuse of the signed cosine: the subsurface lobe's wrap and transmission reach
+    // below the horizon (lights.glsl diffuseTowards)
+    vec3 base = diffuseTowards(s, dot(s.N, L)) + specularTowards(s, L);
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
     base = sheenLayerCosine(s, base, L);  // the sheen over the base (sheen_shading.glsl)
 #endif

@@ -22,6 +22,10 @@ struct MaterialAttributes {
     float sheenRoughness;
     float anisotropy;          // 0: isotropic GGX
     vec3 anisotropyDirection;  // tangent space; +X is the mesh tangent
+    float subsurface;          // weight of the subsurface diffuse (subsurface.glsl)
+    vec3 subsurfaceColor;      // its albedo
+    vec3 subsurfaceRadius;     // mean free path per channel, metres
+    float thickness;           // of the part, metres
 };
 
 // The values an unconnected material output reads.
@@ -46,6 +50,10 @@ MaterialAttributes defaultMaterialAttributes() {
     m.sheenRoughness = 0.3;
     m.anisotropy = 0.0;
     m.anisotropyDirection = vec3(1.0, 0.0, 0.0);
+    m.subsurface = 0.0;
+    m.subsurfaceColor = vec3(1.0);
+    m.subsurfaceRadius = vec3(1.0);
+    m.thickness = 1.0;
     return m;
 }
 

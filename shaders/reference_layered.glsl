@@ -1,9 +1,9 @@
 // The reference mode's estimator for a material with lobes beyond the talk (clear coat,
-// sheen, anisotropic GGX): the whole layered BRDF, coat over sheen over base, exactly as the
+// sheen, anisotropic GGX, subsurface): the whole layered BRDF, coat over sheen over base, exactly as the
 // analytic lights layer it (lights.glsl: sheenLayer, then coatLayer), integrated against the
 // unfiltered environment by the MIS estimator of ibl.glsl (one BRDF and one environment
 // sample a step, balance heuristic). The BRDF sample picks one lobe (diffuse, base specular,
-// sheen, coat) by chances from estimated lobe weights; its density is the whole mixture's.
+// sheen, coat, the subsurface's front and back) by chances from estimated lobe weights; its density is the whole mixture's.
 // surface.glsl includes this file only where a lobe is compiled in and the reference is
 // (MATEDIT_LAYERED_REFERENCE); a material without lobes keeps referenceEnvironmentIBL.
 #include "common.glsl"
@@ -14,11 +14,12 @@
 
 // The layered surface: the shading context (its lobes), the base as ibl.glsl's reference
 // surface (the material's unclamped roughness: the alpha floor is referenceAlpha's), and
-// the chances of the four lobes.
+// the chances of the lobes.
 struct LayeredReference {
     ShadingContext s;
     ReferenceSurface base;
-    float chance[4];  // base specular, diffuse, sheen, coat: one-sample model chances
+    float chance[6];  // base specular, diffuse, sheen, coat, subsurface front and back:
+                      // one-sample model chances
 };
 
 // The base's two lobes in ibl.glsl's order (its specular first), so that a lobe at weight 0
@@ -27,6 +28,11 @@ const int LAYER_SPECULAR = 0;
 const int LAYER_DIFFUSE = 1;
 const int LAYER_SHEEN = 2;
 const int LAYER_COAT = 3;
+// The subsurface lobe by two samplings: the cosine about N (its reflected part above the
+// horizon) and the cosine about -N (its transmitted part, and the wrap below the horizon).
+const int LAYER_SUBSURFACE = 4;
+const int LAYER_SUBSURFACE_BACK = 5;
+const int LAYER_COUNT = 6;
 
 // The lobes' chances: each lobe's estimated reflectance towards the eye (luminance), the
 // lobes under the coat and the sheen scaled by what those let through towards the eye.
@@ -39,9 +45,11 @@ LayeredReference makeLayeredReference(ShadingContext s, float roughness) {
     const vec3 Y = vec3(0.2126, 0.7152, 0.0722);
     float NoV = saturate(dot(s.N, s.V));
     float under = 1.0;
-    float w[4];
+    float w[LAYER_COUNT];
     w[LAYER_SHEEN] = 0.0;
     w[LAYER_COAT] = 0.0;
+    w[LAYER_SUBSURFACE] = 0.0;
+    w[LAYER_SUBSURFACE_BACK] = 0.0;
 #if defined(MATERIAL_HAS_COAT)
     under *= dot(coatTransmittance(s.coat, s.coat.NoV), Y);
     w[LAYER_COAT] = coatFresnel(s.coat, s.coat.NoV) * s.coat.scale;
@@ -52,10 +60,22 @@ LayeredReference makeLayeredReference(ShadingContext s, float roughness) {
     w[LAYER_SHEEN] = under * dot(s.sheenColor, Y) * E;
     under *= s.sheenScaleV;
 #endif
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    // the subsurface's albedo split: above the horizon (1 - T)(1 - b), below T + (1 - T) b,
+    // b = w^2 / (1 + w)^2 the wrapped cosine's share below the horizon
+    SubsurfaceLobe sl = s.subsurface;
+    vec3 wrapBelow = sl.wrap * sl.wrap / ((1.0 + sl.wrap) * (1.0 + sl.wrap));
+    vec3 front = (1.0 - sl.transmittance) * (1.0 - wrapBelow);
+    w[LAYER_SUBSURFACE] = under * dot(sl.color * front, Y);
+    w[LAYER_SUBSURFACE_BACK] = under * dot(sl.color * (1.0 - front), Y);
+#endif
     w[LAYER_DIFFUSE] = under * dot(s.diffuseColor, Y);
     w[LAYER_SPECULAR] = under * dot(F_SchlickExact(s.F0, NoV) * s.specularScale, Y);
-    float total = w[0] + w[1] + w[2] + w[3];
-    for (int i = 0; i < 4; i++) r.chance[i] = total > 0.0 ? w[i] / total : 0.25;
+    float total = 0.0;
+    for (int i = 0; i < LAYER_COUNT; i++) total += w[i];
+    for (int i = 0; i < LAYER_COUNT; i++) {
+        r.chance[i] = total > 0.0 ? w[i] / total : 1.0 / float(LAYER_COUNT);
+    }
     return r;
 }
 
@@ -78,6 +98,9 @@ vec3 layeredBrdfCosine(LayeredReference r, vec3 L) {
     }
 #else
     f = referenceBrdfCosine(r.base, L);
+#endif
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    f += subsurfaceCosine(s.subsurface, dot(s.N, L));  // part of the base (lights.glsl)
 #endif
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
     f = f * sheenBaseScale(s, saturate(dot(s.N, L)))
@@ -108,6 +131,10 @@ float layeredLobePdf(LayeredReference r, int lobe, vec3 L) {
 #if defined(MATERIAL_HAS_COAT)
     if (lobe == LAYER_COAT) return coatPdf(s.coat, s.V, L);
 #endif
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    if (lobe == LAYER_SUBSURFACE) return max(dot(s.N, L), 0.0) * INV_PI;
+    if (lobe == LAYER_SUBSURFACE_BACK) return max(-dot(s.N, L), 0.0) * INV_PI;
+#endif
     return 0.0;
 }
 
@@ -115,7 +142,7 @@ float layeredLobePdf(LayeredReference r, int lobe, vec3 L) {
 float layeredBrdfPdf(LayeredReference r, vec3 L) {
     // the one-sample mixture's density (Veach 1997, 9.2.4)
     float p = 0.0;
-    for (int i = 0; i < 4; i++) p += r.chance[i] * layeredLobePdf(r, i, L);
+    for (int i = 0; i < LAYER_COUNT; i++) p += r.chance[i] * layeredLobePdf(r, i, L);
     return p;
 }
 
@@ -130,9 +157,9 @@ float layeredBrdfPdf(LayeredReference r, vec3 L) {
 vec3 layeredBrdfSample(LayeredReference r, vec2 Xi, out float pdf) {
     // Veach 1997, 9.2.4: choose strategy i with chance c_i, sample it, density sum c_j p_j
     ShadingContext s = r.s;
-    int lobe = LAYER_COAT;
+    int lobe = LAYER_COUNT - 1;
     float start = 0.0;
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < LAYER_COUNT - 1; i++) {
         if (Xi.x < start + r.chance[i]) { lobe = i; break; }
         start += r.chance[i];
     }
@@ -154,12 +181,16 @@ vec3 layeredBrdfSample(LayeredReference r, vec2 Xi, out float pdf) {
 #else
         L = importanceSampleCosine(X, s.N);  // chance 0 without a sheen
 #endif
-    } else {
+    } else if (lobe == LAYER_COAT) {
 #if defined(MATERIAL_HAS_COAT)
         L = coatSampleDirection(s.coat, s.V, X, unused);
 #else
         L = importanceSampleCosine(X, s.N);  // chance 0 without a coat
 #endif
+    } else if (lobe == LAYER_SUBSURFACE) {
+        L = importanceSampleCosine(X, s.N);  // chance 0 without a subsurface lobe
+    } else {
+        L = importanceSampleCosine(X, -s.N);  // the back: chance 0 without one
     }
     pdf = layeredLobePdf(r, lobe, L) > 0.0 ? layeredBrdfPdf(r, L) : 0.0;
     return L;

@@ -12,7 +12,7 @@
 #endif
 #ifndef MATEDIT_SPLIT_SUM_ONLY
 #include "lights_reference.glsl"
-#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY)
+#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY) || defined(MATERIAL_HAS_SUBSURFACE)
 // The reference of a material with lobes integrates the whole layered BRDF at once.
 #define MATEDIT_LAYERED_REFERENCE
 #include "reference_layered.glsl"
@@ -20,15 +20,16 @@
 #endif
 
 // The lobes a view shows: MATEDIT_LOBES is a mask of LOBE_* bits (unset: every lobe). The
-// viewport's lobe views set it (base, coat, sheen, specular only); each lobe's contribution,
+// viewport's lobe views set it (base, coat, sheen, subsurface, specular only); each lobe's contribution,
 // direct and image-based, is scaled by lobeOn of its bit.
 #define LOBE_DIFFUSE 1
 #define LOBE_SPECULAR 2
 #define LOBE_COAT 4
 #define LOBE_SHEEN 8
 #define LOBE_EMISSIVE 16
+#define LOBE_SUBSURFACE 32
 #ifndef MATEDIT_LOBES
-#define MATEDIT_LOBES 31
+#define MATEDIT_LOBES 63
 #endif
 
 // 1 where the view shows the lobe, 0 where it hides it (a constant: the compiler folds it).
@@ -60,6 +61,18 @@ vec3 directLightingReference(ShadingContext s) {
         sum += evaluateLightReference(s, getLight(i), count, uIbl.sampleOffset.xy);
     }
     return sum;
+}
+#endif
+
+#if defined(MATERIAL_HAS_SUBSURFACE)
+// The subsurface lobe's split-sum image-based light: the SH environment's wrapped irradiance
+// at N and its irradiance about -N (subsurface.glsl, subsurfaceIrradiance).
+vec3 subsurfaceImageBasedLighting(SubsurfaceLobe l, vec3 N) {
+    // Ramamoorthi and Hanrahan 2001 eq 13 with the wrapped kernel's band factors
+    vec3 sh[9];
+    for (int i = 0; i < 9; i++) sh[i] = uIbl.sh[i].xyz;
+    return subsurfaceIrradiance(l, wrappedIrradianceSH9(sh, N, l.wrap), irradianceSH9(sh, -N))
+         * uIbl.params.y;
 }
 #endif
 
@@ -135,6 +148,13 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     // anisotropic GGX: the material's direction (tangent space of (T, B, Ng)) in N's plane
     s.aniso = makeAnisotropicLobe(s.a, m.anisotropy, m.anisotropyDirection, T, B, N);
 #endif
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    // The subsurface diffuse (subsurface.glsl) takes its weight's share of the Lambert lobe.
+    s.subsurface = makeSubsurfaceLobe(m.subsurface, m.subsurfaceColor, m.subsurfaceRadius,
+                                      m.thickness, m.metallic, lobeOn(LOBE_SUBSURFACE));
+    s.diffuseColor *= 1.0 - saturate(m.subsurface);
+    diffuseColor *= 1.0 - saturate(m.subsurface);
+#endif
 #ifdef MATEDIT_ENERGY_COMPENSATION
     // Beyond the talk (off by default): multiple-scattering compensation of the specular,
     // the diffuse keeping what the specular leaves (ibl.glsl, energyCompensation)
@@ -143,8 +163,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                        s.specularScale, diffuseScale);
     s.diffuseColor *= diffuseScale;
     diffuseColor *= diffuseScale;
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    s.subsurface.color *= diffuseScale;  // a diffuse lobe too
 #endif
-#if MATEDIT_LOBES != 31
+#endif
+#if MATEDIT_LOBES != 63
     // A lobe view: the base's diffuse and specular shown or hidden (every light and the IBL
     // read them through diffuseColor and specularScale).
     s.diffuseColor *= lobeOn(LOBE_DIFFUSE);
@@ -185,6 +208,12 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                                  , s.aniso
 #endif
                                  );
+#if defined(MATERIAL_HAS_SUBSURFACE)
+        // The subsurface diffuse's, part of the base (under the sheen and the coat).
+        if (int(uIbl.params.w + 0.5) == IBL_MODE_SPLIT_SUM) {
+            ibl += subsurfaceImageBasedLighting(s.subsurface, N);
+        }
+#endif
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
         // The base's IBL is linear in its diffuse colour and specular scale: scaling the sum
         // is scaling both by the view's albedo scaling.

@@ -96,7 +96,9 @@ SURFACE_INPUTS = {
     "coat": "coat", "coat_color": "coatColor", "coat_roughness": "coatRoughness",
     "coat_IOR": "coatIor", "coat_normal": "coatNormal", "specular_color": "specularColor",
     "specular_IOR": "ior", "sheen_color": "sheenColor", "sheen_roughness": "sheenRoughness",
-    "specular_anisotropy": "anisotropy",
+    "specular_anisotropy": "anisotropy", "subsurface": "subsurface",
+    "subsurface_color": "subsurfaceColor", "subsurface_radius": "subsurfaceRadius",
+    "subsurface_scale": "thickness",  # as 1 / thickness (docs/shading.md, Subsurface)
 }
 # The talk's inputs, which every exported material has.
 TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",
@@ -130,6 +132,11 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
             k = want.shape[-1]
             if inp.getName() == "opacity":
                 got, k = got[..., :1], 1
+            if inp.getName() == "subsurface_scale":  # 1 / thickness: relative, 1e-3
+                np.testing.assert_allclose(got[..., :k], 1.0 / np.maximum(want, 1e-4),
+                                           rtol=1e-3, err_msg=f"{path.stem}: subsurface_scale")
+                checked.append(inp.getName())
+                continue
             np.testing.assert_allclose(got[..., :k], want, atol=2e-3,
                                        err_msg=f"{path.stem}: {inp.getName()}")
             checked.append(inp.getName())
@@ -258,6 +265,19 @@ def test_import_foreign_standard_surface_with_defaults_and_hostile_names(tmp_pat
     ("open_pbr_surface", '<input name="base_color" type="color3" value="0.5, 0.5, 0.1" />'
                          '<input name="base_metalness" type="float" value="0.25" />',
      {"baseColor": [0.5, 0.5, 0.1], "metallic": [0.25]}),
+    # OpenPBR's mean free path: subsurface_radius x subsurface_radius_scale (at thickness 1)
+    ("open_pbr_surface", '<input name="subsurface_weight" type="float" value="0.75" />'
+                         '<input name="subsurface_color" type="color3" value="0.9, 0.4, 0.3" />'
+                         '<input name="subsurface_radius" type="float" value="0.5" />'
+                         '<input name="subsurface_radius_scale" type="color3" '
+                         'value="1, 0.5, 0.25" />',
+     {"subsurface": [0.75], "subsurfaceColor": [0.9, 0.4, 0.3],
+      "subsurfaceRadius": [0.5, 0.25, 0.125], "thickness": [1.0]}),
+    # standard_surface: subsurface_scale is 1 / thickness
+    ("standard_surface", '<input name="subsurface" type="float" value="1" />'
+                         '<input name="subsurface_radius" type="color3" value="1, 0.4, 0.2" />'
+                         '<input name="subsurface_scale" type="float" value="0.5" />',
+     {"subsurface": [1.0], "subsurfaceRadius": [1.0, 0.4, 0.2], "thickness": [2.0]}),
 ])
 def test_import_other_surfaces(tmp_path, surface, inputs, expect):
     text = _doc(f'''
@@ -868,6 +888,8 @@ _LOBE_VALUES = {
     "specularColor": [0.9, 0.8, 0.7], "ior": 1.8, "coat": 0.75, "coatRoughness": 0.08,
     "coatColor": [0.96, 0.64, 0.54], "coatIor": 1.6, "sheenColor": [0.2, 0.3, 0.4],
     "sheenRoughness": 0.6, "anisotropy": 0.7, "anisotropyDirection": [0.0, 1.0, 0.0],
+    "subsurface": 0.6, "subsurfaceColor": [0.9, 0.5, 0.4], "subsurfaceRadius": [0.3, 0.1, 0.05],
+    "thickness": 0.25,
 }
 
 
@@ -904,6 +926,7 @@ def test_every_lobe_field_exports_to_standard_surface_and_imports_back(tmp_path)
     assert float(sets["coat"]) == pytest.approx(0.75)
     assert float(sets["specular_rotation"]) == pytest.approx(0.25)  # +Y: a quarter turn
     assert float(sets["sheen"]) == 1.0
+    assert float(sets["subsurface_scale"]) == pytest.approx(4.0)  # 1 / thickness
     back = tmp_path / "back.json"
     r = cli("import", str(out), "-o", str(back))
     assert r.returncode == 0, r.stderr

@@ -34,7 +34,8 @@ def test_the_talks_seven_fields_come_first_and_every_lobe_field_has_a_group():
                                              "normal", "emissive", "opacity"]
     assert nodes.ATTRIBUTE_NAMES[:7] == tuple(f.name for f in BASE_FIELDS)
     assert {f.group for f in BASE_FIELDS} == {"Base"}
-    assert {f.group for f in LOBE_FIELDS} == {"Specular", "Coat", "Sheen", "Anisotropy"}
+    assert {f.group for f in LOBE_FIELDS} == {"Specular", "Coat", "Sheen", "Anisotropy",
+                                              "Subsurface"}
 
 
 def test_lobe_inputs_left_at_their_defaults_compile_out_with_no_uniform():
@@ -157,7 +158,7 @@ def test_blending_two_attribute_structs_on_the_gpu_equals_the_cpu_evaluator(ctx)
         *({f.name: vals.get(f"{s}_{f.name}", np.broadcast_to(
             np.asarray(f.default, dtype=np.float64), (n,) + np.shape(f.default)))
            for f in defaults} for s in "ab"), t)
-    for chunk in (LOBE_FIELDS[:6], LOBE_FIELDS[6:]):
+    for chunk in [LOBE_FIELDS[i:i + 6] for i in range(0, len(LOBE_FIELDS), 6)]:
         inputs = {k: v for k, v in vals.items() if k.split("_", 1)[1] in
                   {f.name for f in chunk}} | {"t": t}
         body = ("MaterialAttributes a = defaultMaterialAttributes(); "

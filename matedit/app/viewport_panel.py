@@ -35,6 +35,7 @@ VIEW_TIPS = {
     "base": "The base's diffuse and specular only",
     "coat": "The clear coat's reflection only",
     "sheen": "The sheen only",
+    "subsurface": "The subsurface diffuse only: wrapped, and transmitted from behind",
     "specular": "Every specular reflection: the base's and the coat's",
     "roughness": "Roughness as a grey level (linear)",
     "normal": "The world shading normal, N / 2 + 1/2",

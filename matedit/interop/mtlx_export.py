@@ -60,6 +60,8 @@ MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "ve
 # The compiler's own ops that stand for a catalogue kind's mapping.
 IR_OP_ROLES = {ops.BLEND: Role.MASK_BLEND, ops.MASK: Role.COMPONENT_MASK}
 MTLX_VERSION = "1.39"
+# The thinnest part standard_surface's subsurface_scale = 1 / thickness stands for (metres).
+_MIN_THICKNESS = 1e-4
 
 
 class MtlxExportError(ValueError):
@@ -546,7 +548,10 @@ class _Exporter:
                  ("coat", "coat", "float"), ("coatRoughness", "coat_roughness", "float"),
                  ("coatColor", "coat_color", "color3"), ("coatIor", "coat_IOR", "float"),
                  ("sheenRoughness", "sheen_roughness", "float"),
-                 ("anisotropy", "specular_anisotropy", "float"))
+                 ("anisotropy", "specular_anisotropy", "float"),
+                 ("subsurface", "subsurface", "float"),
+                 ("subsurfaceColor", "subsurface_color", "color3"),
+                 ("subsurfaceRadius", "subsurface_radius", "color3"))
         # standard_surface's own defaults differ from ours where they would change the look
         # of a lobe the material turns on: coat_roughness 0.1 (ours 0), sheen_roughness 0.3.
         for ours, theirs, t in plain:
@@ -569,7 +574,24 @@ class _Exporter:
                     "a rotation; a varying direction cannot be exported (use a constant)")
             turn = math.atan2(float(d[1][1]), float(d[1][0])) / (2.0 * math.pi)
             out.append(("specular_rotation", "float", ("value", turn % 1.0)))
+        if "subsurface" in written and "subsurfaceColor" not in written:
+            # standard_surface's subsurface_color default is 0.8; ours is white
+            out.append(("subsurface_color", "color3", ("value", [1.0, 1.0, 1.0])))
+        if "thickness" in written:
+            out.append(("subsurface_scale", "float", self.inverse_thickness(f["thickness"])))
         return out
+
+    def inverse_thickness(self, v: V) -> tuple:
+        """Our thickness as standard_surface's subsurface_scale, 1 / thickness: the shading
+        reads only radius / thickness, and standard_surface's mean free path is radius x
+        scale (docs/shading.md, Subsurface); the thickness kept off 0 (MIN_SUBSURFACE_RADIUS)."""
+        d = v.ref()
+        if d[0] == "value":
+            return ("value", 1.0 / max(float(np.ravel(d[1])[0]), _MIN_THICKNESS))
+        safe = self.node("max", "float", "thickness_min",
+                         [("in1", d, "float"), ("in2", ("value", _MIN_THICKNESS), "float")])
+        return self.node("divide", "float", "subsurface_scale",
+                         [("in1", ("value", 1.0), "float"), ("in2", safe, "float")])
 
     def _output(self, inp, name: str, t: str, r: tuple) -> None:
         out = self.ng.addOutput(self.name(f"out_{name}"), t)

@@ -70,14 +70,21 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         "coatNormal": ("coat_normal", None), "sheenColor": ("sheen_color", "sheen"),
         "sheenRoughness": ("sheen_roughness", None),
         "anisotropy": ("specular_anisotropy", None),
-        "anisotropyDirection": ("specular_rotation", None)},
+        "anisotropyDirection": ("specular_rotation", None),
+        # subsurface_scale is 1 / our thickness: the mean free path radius x scale is our
+        # radius / thickness, all the shading reads (docs/shading.md, Subsurface)
+        "subsurface": ("subsurface", None), "subsurfaceColor": ("subsurface_color", None),
+        "subsurfaceRadius": ("subsurface_radius", None), "thickness": ("subsurface_scale", None)},
     "open_pbr_surface": {
         "specularColor": ("specular_color", None), "ior": ("specular_ior", None),
         "coat": ("coat_weight", None), "coatRoughness": ("coat_roughness", None),
         "coatColor": ("coat_color", None), "coatIor": ("coat_ior", None),
         "coatNormal": ("geometry_coat_normal", None), "sheenColor": ("fuzz_color", "fuzz_weight"),
         "sheenRoughness": ("fuzz_roughness", None),
-        "anisotropy": ("specular_roughness_anisotropy", None)},
+        "anisotropy": ("specular_roughness_anisotropy", None),
+        # the mean free path subsurface_radius x subsurface_radius_scale, at our thickness 1
+        "subsurface": ("subsurface_weight", None), "subsurfaceColor": ("subsurface_color", None),
+        "subsurfaceRadius": ("subsurface_radius_scale", "subsurface_radius")},
     "gltf_pbr": {
         "ior": ("ior", None), "coat": ("clearcoat", None),
         "coatRoughness": ("clearcoat_roughness", None), "coatNormal": ("clearcoat_normal", None),
@@ -613,6 +620,16 @@ class _Importer:
                     continue
                 angle = src.value[0] * _ROTATION_TO_RADIANS[cat]
                 src = Src(value=[math.cos(angle), math.sin(angle), 0.0], width=3)
+            if attr == "thickness":  # standard_surface's subsurface_scale: 1 / thickness
+                if src.node is None:
+                    if src.value[0] <= 0.0:
+                        self.err(f"{where}: input {inp}: subsurface_scale must be positive")
+                        continue
+                    src = Src(value=[1.0 / src.value[0]], width=1)
+                else:
+                    inv = self.add("thickness_of_scale", _kind("divide"), values={"a": 1.0})
+                    self.connect(src, inv, "b")
+                    src = Src(inv, "result", width=1)
             if weight is not None:
                 w = self.surface_input(shader, weight)
                 if w is not None and w.node is not None:

@@ -64,6 +64,16 @@ ATTRIBUTE_FIELDS: tuple[InputDef, ...] = tuple(replace(f, group="Base") for f in
     _lobe("anisotropyDirection", "vec3", [1.0, 0.0, 0.0],
           "tangent-space direction the highlight stretches along (+X: the mesh tangent)",
           None, "Anisotropy"),
+    _lobe("subsurface", "float", 0.0,
+          "weight of the subsurface diffuse (wrapped diffuse and transmission from behind)",
+          UNIT, "Subsurface"),
+    _lobe("subsurfaceColor", "vec3", [1.0, 1.0, 1.0], "albedo of the subsurface diffuse",
+          UNIT, "Subsurface"),
+    _lobe("subsurfaceRadius", "vec3", [1.0, 1.0, 1.0],
+          "mean free path per channel, metres (scene units)", (0.0, 2.0), "Subsurface"),
+    _lobe("thickness", "float", 1.0,
+          "thickness of the part, metres: wraps and transmits against the radius",
+          (0.0, 2.0), "Subsurface"),
 )
 ATTRIBUTE_NAMES = tuple(f.name for f in ATTRIBUTE_FIELDS)
 

@@ -13,6 +13,7 @@ from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
 from matedit.shading.sheen import sheenLayer
+from matedit.shading.subsurface import SubsurfaceLobe, subsurfaceCosine
 
 LIGHT_TYPE_POINT = 0
 LIGHT_TYPE_DIRECTIONAL = 1
@@ -72,6 +73,8 @@ class ShadingContext:
     sheenMax: object = None
     sheenScaleV: object = None
     sheenLut: object = None
+    # MATERIAL_HAS_SUBSURFACE: the subsurface diffuse (subsurface.SubsurfaceLobe); None: off
+    subsurface: SubsurfaceLobe | None = None
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -81,6 +84,15 @@ def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
         P=f64(P), N=N, V=V, NoV=np.maximum(dot(N, V), 1e-4), diffuseColor=f64(diffuseColor),
         F0=f64(F0), roughness=r, a=r * r, k=k_Analytic(r),
     )  # fmt: skip
+
+
+def diffuseTowards(s: ShadingContext, NoL) -> np.ndarray:
+    """Lambert of the clamped cosine plus the subsurface lobe of the signed cosine NoL."""
+    NoL = f64(NoL)
+    diffuse = diffuseLobe(s.diffuseColor) * saturate(NoL)[..., None]
+    if s.subsurface is not None:
+        diffuse = diffuse + subsurfaceCosine(s.subsurface, NoL)
+    return diffuse
 
 
 def distanceWindow(d, influenceRadius) -> np.ndarray:
@@ -141,7 +153,7 @@ def pointLight(s: ShadingContext, light: Light) -> np.ndarray:
     d = length(Lc)
     L = Lc / np.maximum(d, 1e-8)[..., None]
     NoL = saturate(dot(s.N, L))
-    radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    radiance = diffuseTowards(s, dot(s.N, L)) + specularTowards(s, L)
     if s.sheenColor is not None:
         radiance = sheenLayer(s, radiance, L, NoL)
     if s.coat is not None:
@@ -152,7 +164,7 @@ def pointLight(s: ShadingContext, light: Light) -> np.ndarray:
 def directionalLight(s: ShadingContext, light: Light) -> np.ndarray:
     L = np.broadcast_to(-f64(light.direction), s.N.shape)
     NoL = saturate(dot(s.N, L))
-    radiance = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    radiance = diffuseTowards(s, dot(s.N, L)) + specularTowards(s, L)
     if s.sheenColor is not None:
         radiance = sheenLayer(s, radiance, L, NoL)
     if s.coat is not None:
@@ -165,7 +177,7 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
     d = length(Lc)
     falloff = distanceFalloff(d, light.influence_radius)
     NoLc = saturate(dot(s.N, Lc / np.maximum(d, 1e-8)[..., None]))
-    diffuse = diffuseLobe(s.diffuseColor) * NoLc[..., None]
+    diffuse = diffuseTowards(s, dot(s.N, Lc / np.maximum(d, 1e-8)[..., None]))
     R = reflect(-s.V, s.N)
     if s.aniso is not None:
         R = _aniso.anisotropicReflection(s.aniso, s.N, s.V)
@@ -188,15 +200,21 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
     return (diffuse + specular) * _scale(light, falloff)
 
 
-def tubeIrradiance(N, L0, L1) -> np.ndarray:
-    l0, l1 = length(L0), length(L1)
-    cos_term = saturate(dot(N, L0) / (2.0 * l0) + dot(N, L1) / (2.0 * l1))
-    l0l1, d01 = l0 * l1, dot(L0, L1)
+def tubeCosine(N, L0, L1) -> np.ndarray:
+    return dot(N, L0) / (2.0 * length(L0)) + dot(N, L1) / (2.0 * length(L1))
+
+
+def tubeDenominator(L0, L1) -> np.ndarray:
+    l0l1, d01 = length(L0) * length(L1), dot(L0, L1)
     c = np.cross(f64(L0), f64(L1))
     with np.errstate(divide="ignore", invalid="ignore"):
         opposed = dot(c, c) / (l0l1 - d01)
     den = np.where(d01 >= 0.0, l0l1 + d01, opposed)
-    return 2.0 * cos_term / (den + 2.0 * LIGHT_FALLOFF_EPS**2)
+    return den + 2.0 * LIGHT_FALLOFF_EPS**2
+
+
+def tubeIrradiance(N, L0, L1) -> np.ndarray:
+    return 2.0 * saturate(tubeCosine(N, L0, L1)) / tubeDenominator(L0, L1)
 
 
 def tubeRepresentativePoint(L0, L1, R) -> np.ndarray:
@@ -214,6 +232,9 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
     L0, L1 = Lc - half_axis, Lc + half_axis
     window = distanceWindow(d, light.influence_radius)
     diffuse = diffuseLobe(s.diffuseColor) * tubeIrradiance(s.N, L0, L1)[..., None]
+    if s.subsurface is not None:  # the segment's signed mean cosine
+        diffuse = diffuse + subsurfaceCosine(s.subsurface, tubeCosine(s.N, L0, L1)) * (
+            2.0 / tubeDenominator(L0, L1))[..., None]
     R = reflect(-s.V, s.N)
     if s.aniso is not None:
         R = _aniso.anisotropicReflection(s.aniso, s.N, s.V)

@@ -10,12 +10,13 @@ import numpy as np
 
 from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat
-from matedit.shading.brdf import D_GGX, diffuseLobe
+from matedit.shading.brdf import D_GGX
 from matedit.shading.common import PI, dot, f64, length, saturate, sq
 from matedit.shading.ibl import rotatedHammersley
 from matedit.shading.lights import (
     Light,
     ShadingContext,
+    diffuseTowards,
     distanceWindow,
     evaluateLight,
     pointLight,
@@ -28,8 +29,7 @@ from matedit.shading.sheen import sheenLayerCosine
 
 
 def brdfCosine(s: ShadingContext, L) -> np.ndarray:
-    NoL = saturate(dot(s.N, L))
-    base = diffuseLobe(s.diffuseColor) * NoL[..., None] + specularTowards(s, L)
+    base = diffuseTowards(s, dot(s.N, L)) + specularTowards(s, L)
     if s.sheenColor is not None:
         base = sheenLayerCosine(s, base, L)
     if s.coat is not None:

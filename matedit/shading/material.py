@@ -36,6 +36,10 @@ class MaterialAttributes:
     sheenRoughness: np.ndarray | float = 0.3
     anisotropy: np.ndarray | float = 0.0
     anisotropyDirection: np.ndarray = _v(1.0, 0.0, 0.0)
+    subsurface: np.ndarray | float = 0.0
+    subsurfaceColor: np.ndarray = _v(1.0, 1.0, 1.0)
+    subsurfaceRadius: np.ndarray = _v(1.0, 1.0, 1.0)
+    thickness: np.ndarray | float = 1.0
 
 
 def defaultMaterialAttributes() -> MaterialAttributes:

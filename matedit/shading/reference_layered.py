@@ -1,5 +1,6 @@
 """Twin of shaders/reference_layered.glsl: reference mode's MIS estimator of the whole
-layered BRDF (coat over sheen over base, anisotropic GGX where the material has it), with
+layered BRDF (coat over sheen over base, anisotropic GGX and the subsurface diffuse where the
+material has them), with
 a one-sample lobe mixture as the BRDF strategy. Loops over samples, vectorised over pixels."""
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import numpy as np
 from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat as _coat
 from matedit.shading import sheen as _sheen
+from matedit.shading import subsurface as _sss
 from matedit.shading.brdf import F_SchlickExact
 from matedit.shading.common import INV_PI, dot, f64, saturate
 from matedit.shading.env_sampling import environmentPdf, sampleEnvironmentDirection
@@ -26,7 +28,10 @@ from matedit.shading.ibl import (
 from matedit.shading.lights import ShadingContext
 from matedit.shading.sampling import importanceSampleCosine
 
-LAYER_SPECULAR, LAYER_DIFFUSE, LAYER_SHEEN, LAYER_COAT = range(4)  # the GLSL's order
+# the GLSL's order; the subsurface lobe's front (cosine about N) and back (about -N) samplings
+LAYER_SPECULAR, LAYER_DIFFUSE, LAYER_SHEEN, LAYER_COAT, LAYER_SUBSURFACE, LAYER_SUBSURFACE_BACK = (
+    range(6))
+LAYER_COUNT = 6
 _LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 _ONE_BELOW = float(np.float32(0.99999994))
 
@@ -35,7 +40,7 @@ _ONE_BELOW = float(np.float32(0.99999994))
 class LayeredReference:
     s: ShadingContext
     base: ReferenceSurface
-    chance: np.ndarray  # (..., 4): base specular, diffuse, sheen, coat
+    chance: np.ndarray  # (..., 6): base specular, diffuse, sheen, coat, subsurface front, back
 
 
 def makeLayeredReference(s: ShadingContext, roughness) -> LayeredReference:
@@ -56,12 +61,20 @@ def makeLayeredReference(s: ShadingContext, roughness) -> LayeredReference:
                          0.0)
         w_sheen = under * (f64(s.sheenColor) @ _LUMINANCE) * E
         under = under * f64(s.sheenScaleV)
+    w_front = np.zeros(shape)
+    w_back = np.zeros(shape)
+    if s.subsurface is not None:
+        sl = s.subsurface
+        below = sl.wrap * sl.wrap / ((1.0 + sl.wrap) * (1.0 + sl.wrap))
+        front = (1.0 - sl.transmittance) * (1.0 - below)
+        w_front = under * ((sl.color * front) @ _LUMINANCE)
+        w_back = under * ((sl.color * (1.0 - front)) @ _LUMINANCE)
     w_diff = under * (f64(s.diffuseColor) @ _LUMINANCE)
     w_spec = under * ((F_SchlickExact(f64(s.F0), NoV) * f64(s.specularScale)) @ _LUMINANCE)
-    w = np.stack(np.broadcast_arrays(w_spec, w_diff, w_sheen, w_coat), -1)
+    w = np.stack(np.broadcast_arrays(w_spec, w_diff, w_sheen, w_coat, w_front, w_back), -1)
     total = w.sum(-1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
-        chance = np.where(total > 0.0, w / np.where(total > 0, total, 1.0), 0.25)
+        chance = np.where(total > 0.0, w / np.where(total > 0, total, 1.0), 1.0 / LAYER_COUNT)
     return LayeredReference(s, base, chance)
 
 
@@ -80,6 +93,8 @@ def layeredBrdfCosine(r: LayeredReference, L) -> np.ndarray:
         f = np.where((NoL > 0.0)[..., None], f, 0.0)
     else:
         f = referenceBrdfCosine(r.base, L)
+    if s.subsurface is not None:  # part of the base
+        f = f + _sss.subsurfaceCosine(s.subsurface, dot(s.N, L))
     if s.sheenMax is not None:
         f = (f * _sheen.sheenBaseScale(s, saturate(dot(s.N, L)))[..., None]
              + _sheen.sheenBrdfCosine(s.N, s.V, L, s.sheenColor, s.sheenAlpha))
@@ -103,22 +118,27 @@ def layeredLobePdf(r: LayeredReference, lobe: int, L) -> np.ndarray:
         return _sheen.sheenSamplePdf(s.N, L)
     if lobe == LAYER_COAT and s.coat is not None:
         return _coat.coatPdf(s.coat, s.V, L)
+    if lobe == LAYER_SUBSURFACE and s.subsurface is not None:
+        return np.maximum(dot(s.N, L), 0.0) * INV_PI
+    if lobe == LAYER_SUBSURFACE_BACK and s.subsurface is not None:
+        return np.maximum(-dot(s.N, L), 0.0) * INV_PI
     return np.zeros(np.broadcast_shapes(s.N.shape, L.shape)[:-1])
 
 
 def layeredBrdfPdf(r: LayeredReference, L) -> np.ndarray:
     """The mixture's density: sum of chance_i p_i(L)."""
-    return sum(r.chance[..., i] * layeredLobePdf(r, i, L) for i in range(4))
+    return sum(r.chance[..., i] * layeredLobePdf(r, i, L) for i in range(LAYER_COUNT))
 
 
 def layeredBrdfSample(r: LayeredReference, Xi) -> tuple[np.ndarray, np.ndarray]:
     """(L, pdf): one lobe picked by Xi.x, which is stretched back to [0, 1) for it."""
     s, Xi, c = r.s, f64(Xi), r.chance
     x = Xi[..., 0]
-    before = np.concatenate([np.zeros(c.shape[:-1] + (1,)), np.cumsum(c, -1)[..., :3]], -1)
-    # the GLSL's loop: the first lobe i < 3 with x < start_i + c_i, else the coat
-    ends = before[..., :3] + c[..., :3]
-    lobe = np.where((x[..., None] < ends).any(-1), np.argmax(x[..., None] < ends, -1), 3)
+    last = LAYER_COUNT - 1
+    before = np.concatenate([np.zeros(c.shape[:-1] + (1,)), np.cumsum(c, -1)[..., :last]], -1)
+    # the GLSL's loop: the first lobe i < last with x < start_i + c_i, else the last
+    ends = before[..., :last] + c[..., :last]
+    lobe = np.where((x[..., None] < ends).any(-1), np.argmax(x[..., None] < ends, -1), last)
     start = np.take_along_axis(before, lobe[..., None], -1)[..., 0]
     width = np.maximum(np.take_along_axis(c, lobe[..., None], -1)[..., 0], 1e-20)
     X = np.stack(np.broadcast_arrays(np.clip((x - start) / width, 0.0, _ONE_BELOW),
@@ -134,9 +154,10 @@ def layeredBrdfSample(r: LayeredReference, Xi) -> tuple[np.ndarray, np.ndarray]:
     if s.coat is not None:
         L = np.where((lobe == LAYER_COAT)[..., None],
                      _coat.coatSampleDirection(s.coat, s.V, X)[0], L)
+    L = np.where((lobe == LAYER_SUBSURFACE_BACK)[..., None], importanceSampleCosine(X, -s.N), L)
     # a draw the chosen lobe's own density does not count (V below its normal, V.H < 0) fails
     own = np.zeros(L.shape[:-1])
-    for i in range(4):
+    for i in range(LAYER_COUNT):
         own = np.where(lobe == i, layeredLobePdf(r, i, L), own)
     return L, np.where(own > 0.0, layeredBrdfPdf(r, L), 0.0)
 

@@ -10,6 +10,7 @@ import numpy as np
 from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat as _coat
 from matedit.shading import reference_layered as _layered
+from matedit.shading import subsurface as _sss
 from matedit.shading.common import dot, f64, mix, reflect, saturate
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
@@ -19,6 +20,7 @@ from matedit.shading.ibl import (
     diffuseIrradianceSH9,
     energyCompensation,
     environmentBRDF,
+    irradianceSH9,
     makeReferenceSurface,
     prefilteredRadiance,
     referenceEnvironmentIBL,
@@ -42,7 +44,8 @@ from matedit.shading.sheen import lut_of, setupSheen, sheenImageBasedLighting
 
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
-LOBES_ALL = 31
+LOBE_SUBSURFACE = 32
+LOBES_ALL = 63
 
 
 def lobeOn(lobes: int, lobe: int) -> float:
@@ -87,6 +90,13 @@ def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
     return total
 
 
+def subsurfaceImageBasedLighting(lobe: _sss.SubsurfaceLobe, N, ibl: IblInputs) -> np.ndarray:
+    """The subsurface lobe's split sum: wrapped SH irradiance at N, irradiance about -N."""
+    N = f64(N)
+    return _sss.subsurfaceIrradiance(lobe, _sss.wrappedIrradianceSH9(ibl.sh, N, lobe.wrap),
+                                     irradianceSH9(ibl.sh, -N)) * ibl.intensity
+
+
 def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
                        specularScale=1.0, aniso=None) -> np.ndarray:
     """`aniso`: the anisotropic lobe (MATERIAL_HAS_ANISOTROPY), None where it is off."""
@@ -127,6 +137,7 @@ def shadeSurface(
     coat: bool | None = None,
     anisotropic: bool = False,
     sheen: bool | None = None,
+    subsurface: bool | None = None,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
@@ -137,10 +148,13 @@ def shadeSurface(
     `anisotropic`: the GLSL's MATERIAL_HAS_ANISOTROPY (anisotropic GGX from m.anisotropy and
     m.anisotropyDirection in `frame`; without a frame, tangentFrame(N) as the GLSL's
     4-argument overload).
-    `sheen`: the GLSL's MATERIAL_HAS_SHEEN_COLOR; None: where any sheenColor is not 0."""
+    `sheen`: the GLSL's MATERIAL_HAS_SHEEN_COLOR; None: where any sheenColor is not 0.
+    `subsurface`: the GLSL's MATERIAL_HAS_SUBSURFACE; None: where any subsurface is not 0."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     if sheen is None:
         sheen = bool(np.any(f64(m.sheenColor) != 0.0))
+    if subsurface is None:
+        subsurface = bool(np.any(f64(m.subsurface) != 0.0))
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
     if coat is None:
@@ -161,6 +175,12 @@ def shadeSurface(
         else:
             _, T, B = frame
         s.aniso = _aniso.makeAnisotropicLobe(s.a, m.anisotropy, m.anisotropyDirection, T, B, N)
+    if subsurface:  # the subsurface diffuse takes its weight's share of the Lambert lobe
+        s.subsurface = _sss.makeSubsurfaceLobe(m.subsurface, m.subsurfaceColor,
+                                               m.subsurfaceRadius, m.thickness, m.metallic,
+                                               lobeOn(lobes, LOBE_SUBSURFACE))
+        s.diffuseColor = s.diffuseColor * (1.0 - saturate(m.subsurface))[..., None]
+        diffuseColor = s.diffuseColor
     if energy_compensation:
         NoV = saturate(dot(f64(N), f64(V)))
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
@@ -168,6 +188,8 @@ def shadeSurface(
         s.specularScale, diffuse_scale = energyCompensation(F0, AB)
         s.diffuseColor = s.diffuseColor * diffuse_scale
         diffuseColor = s.diffuseColor
+        if s.subsurface is not None:
+            s.subsurface.color = s.subsurface.color * diffuse_scale
     if lobes != LOBES_ALL:
         s.diffuseColor = s.diffuseColor * lobeOn(lobes, LOBE_DIFFUSE)
         diffuseColor = s.diffuseColor
@@ -176,7 +198,7 @@ def shadeSurface(
         setupSheen(s, m.sheenColor, m.sheenRoughness,
                    f64(m.sheenColor) * lobeOn(lobes, LOBE_SHEEN), lut_of(ibl))
     direct = directLighting(s, lights)
-    if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic):
+    if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic or subsurface):
         # the whole layered BRDF by one MIS estimator (reference_layered.glsl)
         if ibl.environment is None or ibl.environment_distribution is None:
             raise ValueError("reference mode needs IblInputs.environment and its distribution")
@@ -187,6 +209,8 @@ def shadeSurface(
     else:
         indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
                                       s.aniso)
+        if s.subsurface is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
+            indirect = indirect + subsurfaceImageBasedLighting(s.subsurface, N, ibl)
         if sheen:  # the base's IBL is linear in diffuseColor and specularScale
             indirect = indirect * f64(s.sheenScaleV)[..., None] + sheenImageBasedLighting(s, ibl)
         if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:

@@ -9,11 +9,18 @@ text and structure hash, the program cache's key).
 
 from __future__ import annotations
 
-from matedit.shading.surface import LOBE_COAT, LOBE_DIFFUSE, LOBE_SHEEN, LOBE_SPECULAR
+from matedit.shading.surface import (
+    LOBE_COAT,
+    LOBE_DIFFUSE,
+    LOBE_SHEEN,
+    LOBE_SPECULAR,
+    LOBE_SUBSURFACE,
+    LOBES_ALL,
+)
 
 # the define of the FORWARD entry's attribute view (matedit.compiler.schedule.ATTRIBUTE_VIEW)
 ATTRIBUTE_VIEW = "MATEDIT_ATTRIBUTE_VIEW"
-ALL_LOBES = 31
+ALL_LOBES = LOBES_ALL
 LOBES_DEFINE = "MATEDIT_LOBES"
 
 # view name -> (title, lobe mask or None, attribute view number or None)
@@ -22,6 +29,7 @@ VIEWS: dict[str, tuple[str, int | None, int | None]] = {
     "base": ("Base only", LOBE_DIFFUSE | LOBE_SPECULAR, None),
     "coat": ("Coat only", LOBE_COAT, None),
     "sheen": ("Sheen only", LOBE_SHEEN, None),
+    "subsurface": ("Subsurface only", LOBE_SUBSURFACE, None),
     "specular": ("Specular only", LOBE_SPECULAR | LOBE_COAT, None),
     "roughness": ("Roughness", None, 1),
     "normal": ("Normal", None, 2),

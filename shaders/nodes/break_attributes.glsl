@@ -7,7 +7,9 @@ void node_break_attributes(MaterialAttributes attributes, out vec3 baseColor,
                            out vec3 specularColor, out float ior, out float coat,
                            out float coatRoughness, out vec3 coatColor, out float coatIor,
                            out vec3 coatNormal, out vec3 sheenColor, out float sheenRoughness,
-                           out float anisotropy, out vec3 anisotropyDirection) {
+                           out float anisotropy, out vec3 anisotropyDirection,
+                           out float subsurface, out vec3 subsurfaceColor,
+                           out vec3 subsurfaceRadius, out float thickness) {
     // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set, then
     // the lobes beyond it (docs/shading.md, Lobes beyond the talk)
     baseColor = attributes.baseColor;
@@ -28,4 +30,8 @@ void node_break_attributes(MaterialAttributes attributes, out vec3 baseColor,
     sheenRoughness = attributes.sheenRoughness;
     anisotropy = attributes.anisotropy;
     anisotropyDirection = attributes.anisotropyDirection;
+    subsurface = attributes.subsurface;
+    subsurfaceColor = attributes.subsurfaceColor;
+    subsurfaceRadius = attributes.subsurfaceRadius;
+    thickness = attributes.thickness;
 }

@@ -31,6 +31,10 @@ MaterialAttributes blendMaterialAttributes(MaterialAttributes a, MaterialAttribu
     // The direction by nlerp too; opposite directions (the same line) fall back to +X.
     m.anisotropyDirection = nodeSafeNormalize(mix(a.anisotropyDirection, b.anisotropyDirection,
                                                   t), vec3(1.0, 0.0, 0.0));
+    m.subsurface = mix(a.subsurface, b.subsurface, t);
+    m.subsurfaceColor = mix(a.subsurfaceColor, b.subsurfaceColor, t);
+    m.subsurfaceRadius = mix(a.subsurfaceRadius, b.subsurfaceRadius, t);
+    m.thickness = mix(a.thickness, b.thickness, t);
     return m;
 }
 

@@ -6,7 +6,8 @@ void node_make_attributes(vec3 baseColor, float metallic, float roughness, float
                           float ior, float coat, float coatRoughness, vec3 coatColor,
                           float coatIor, vec3 coatNormal, vec3 sheenColor,
                           float sheenRoughness, float anisotropy, vec3 anisotropyDirection,
-                          out MaterialAttributes attributes) {
+                          float subsurface, vec3 subsurfaceColor, vec3 subsurfaceRadius,
+                          float thickness, out MaterialAttributes attributes) {
     // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set, then
     // the lobes beyond it (docs/shading.md, Lobes beyond the talk)
     attributes.baseColor = baseColor;
@@ -27,4 +28,8 @@ void node_make_attributes(vec3 baseColor, float metallic, float roughness, float
     attributes.sheenRoughness = sheenRoughness;
     attributes.anisotropy = anisotropy;
     attributes.anisotropyDirection = anisotropyDirection;
+    attributes.subsurface = subsurface;
+    attributes.subsurfaceColor = subsurfaceColor;
+    attributes.subsurfaceRadius = subsurfaceRadius;
+    attributes.thickness = thickness;
 }
