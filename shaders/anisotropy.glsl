@@ -157,6 +157,57 @@ vec3 anisotropicReflection(AnisotropicLobe l, vec3 N, vec3 V) {
     return reflect(-V, bent);
 }
 
+// The anisotropic split sum's prefiltered radiance: the lobe, long along T, is read as
+// ANISOTROPY_IBL_TAPS narrow lobes (alpha ab, isotropic) whose half vectors are spread
+// along T, H_i = normalize(N + s_i w T), each looked up along its own reflection reflect(-V,
+// H_i) and weighted by unit-roughness GGX's slope density (1 + s_i^2)^-2, normalised to 1
+// (the furnace is the environment BRDF's alone). w = sqrt(at^2 - ab^2): the spread the
+// narrow lobes' width leaves to be made up (widths of convolved lobes add in squares), so
+// at = ab (anisotropy 0) puts every tap on N and the sum is the isotropic lookup.
+const int ANISOTROPY_IBL_TAPS = 3;
+
+// Slope offset of tap i along T, in units of the spread w: -0.8, 0, 0.8.
+float anisotropicTapOffset(int i) {
+    // matedit anisotropic split sum (docs/shading.md, Anisotropy; benchmarks/bench_aniso_ibl.py)
+    return 0.8 * float(i - 1);
+}
+
+// Weight of tap i, the taps' weights summing to 1: (1 + s_i^2)^-2 / sum_j (1 + s_j^2)^-2.
+float anisotropicTapWeight(int i) {
+    // GGX's slope density at unit roughness, Walter et al. 2007, eq 33 with Heitz 2014, eq 9:
+    // P22(s) = 1 / (pi (1 + s^2)^2)
+    float total = 0.0;
+    for (int j = 0; j < ANISOTROPY_IBL_TAPS; j++) {
+        total += 1.0 / sq(1.0 + sq(anisotropicTapOffset(j)));
+    }
+    return 1.0 / (sq(1.0 + sq(anisotropicTapOffset(i))) * total);
+}
+
+// The direction tap i reads: V reflected about H_i = normalize(N + s_i w T) (scaled to N's
+// length, so a tap with no offset reflects about N itself, bit for bit); a reflection under
+// the horizon of N is brought onto it (a lobe sees nothing from under the surface).
+vec3 anisotropicTapDirection(AnisotropicLobe l, vec3 N, vec3 V, int i) {
+    // matedit anisotropic split sum (docs/shading.md, Anisotropy)
+    float w = sqrt(max(l.at * l.at - l.ab * l.ab, 0.0));
+    vec3 h = N + (anisotropicTapOffset(i) * w) * l.T;
+    vec3 H = h * (length(N) / length(h));
+    vec3 R = reflect(-V, H);
+    float below = min(dot(R, N), 0.0);
+    if (below < 0.0) {
+        vec3 onHorizon = R - below * N;
+        float hh = dot(onHorizon, onHorizon);
+        R = hh > 1e-12 ? onHorizon * inversesqrt(hh) : N;
+    }
+    return R;
+}
+
+// The roughness the taps are prefiltered at: the narrow alpha's, sqrt(ab); the material's
+// own IBL roughness at anisotropy 0 (ab is made from the analytic lights' clamped one).
+float anisotropicTapRoughness(AnisotropicLobe l, float roughness) {
+    // Karis 2013, eq 7: the prefiltered mips are indexed by roughness = sqrt(alpha)
+    return l.anisotropy > 0.0 ? sqrt(l.ab) : roughness;
+}
+
 // The anisotropic split sum's environment BRDF: the change (dA, dB) of the isotropic LUT's
 // scale and bias of F0 for the anisotropic lobe, tabulated (matedit/ibl/anisotropy_lut.py)
 // over NoV, roughness (x, y: texel centres, as the isotropic LUT), the anisotropy (nodes

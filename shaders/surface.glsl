@@ -67,7 +67,7 @@ vec3 directLightingReference(ShadingContext s) {
 vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughness,
                         vec3 specularScale
 #if defined(MATERIAL_HAS_ANISOTROPY)
-                        , AnisotropicLobe aniso  // the split sum's bent lookup (anisotropy.glsl)
+                        , AnisotropicLobe aniso  // the split sum's taps (anisotropy.glsl)
 #endif
                         ) {
     // Karis 2013, "Real Shading in Unreal Engine 4", image-based lighting (eq 6-8, reference)
@@ -87,13 +87,20 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
     vec3 sh[9];
     for (int i = 0; i < 9; i++) sh[i] = uIbl.sh[i].xyz;
     float NoV = saturate(dot(N, V));
-    vec3 R = reflect(-V, N);
 #if defined(MATERIAL_HAS_ANISOTROPY)
-    // anisotropic split sum: the bent reflection (anisotropy.glsl); the prefiltered lookup
-    // stays at the base roughness (docs/shading.md, Anisotropy)
-    R = anisotropicReflection(aniso, N, V);
-#endif
+    // anisotropic split sum: narrow lookups spread along the lobe's long axis
+    // (anisotropy.glsl, anisotropicTapDirection; docs/shading.md, Anisotropy)
+    vec3 prefiltered = vec3(0.0);
+    float tapRoughness = anisotropicTapRoughness(aniso, roughness);
+    for (int i = 0; i < ANISOTROPY_IBL_TAPS; i++) {
+        vec3 Ri = anisotropicTapDirection(aniso, N, V, i);
+        prefiltered += anisotropicTapWeight(i)
+                     * prefilteredRadiance(uPrefilteredEnv, Ri, tapRoughness, uIbl.params.x);
+    }
+#else
+    vec3 R = reflect(-V, N);
     vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
+#endif
     vec2 AB = environmentBRDF(uBrdfLut, NoV, roughness);
 #if defined(MATERIAL_HAS_ANISOTROPY)
     // the anisotropic lobe's own scale and bias of F0: the isotropic LUT plus the table's

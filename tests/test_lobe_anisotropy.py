@@ -27,7 +27,7 @@ from matedit.ibl.anisotropy_lut import anisotropy_lut, upload_anisotropy_lut
 from matedit.shading import anisotropy, brdf, lights, lights_reference, material, surface
 from matedit.shading import ibl as ibl_twin
 from matedit.shading.lights_block import pack_lights
-from tests.gpu_eval import constant_cubemap, gpu_eval_many
+from tests.gpu_eval import constant_cubemap, gpu_eval_many, write_cube_level
 from tests.test_shading_gpu_twin import (
     _MAKE_LIGHT,
     _all_kinds,
@@ -283,6 +283,85 @@ def test_lobe_terms_gpu_equal_twin(ctx, rng):
           slack=perturbation_spread(ibl_cos, s, rng))  # fmt: skip
 
 
+def test_split_sum_taps_gpu_equal_twin(ctx, rng):
+    """The anisotropic split sum's taps (anisotropicTapDirection, Weight, Roughness)."""
+    s = _lobe_inputs(rng, 4096)
+    body = _MAKE + """
+        tap0 = anisotropicTapDirection(l, N, V, 0);
+        tap1 = anisotropicTapDirection(l, N, V, 1);
+        tap2 = anisotropicTapDirection(l, N, V, 2);
+        weights = vec3(anisotropicTapWeight(0), anisotropicTapWeight(1), anisotropicTapWeight(2));
+        tapRough = anisotropicTapRoughness(l, rough);
+        alphas = vec2(l.at, l.ab);
+    """
+    outs = {"tap0": "vec3", "tap1": "vec3", "tap2": "vec3", "weights": "vec3",
+            "tapRough": "float", "alphas": "vec2"}
+    out = gpu_eval_many(ctx, body, s, outs, includes=["lights.glsl"], defines=ANISO)
+    assert anisotropy.ANISOTROPY_IBL_TAPS == 3
+    # The spread sqrt(at^2 - ab^2) of a lobe at anisotropy ~1e-6 is float32's at - ab, a few
+    # ulps of at (1 + anisotropy rounds): the twin's taps take the GPU's own alphas
+    # (makeAnisotropicLobe is checked against the twin in test_lobe_terms_gpu_equal_twin).
+    s_taps = dict(s, at=out["alphas"][:, 0], ab=out["alphas"][:, 1])
+
+    def gpu_alphas_lobe(v):
+        lo = _np_lobe(v)
+        lo.at, lo.ab = v["at"].astype(np.float64), v["ab"].astype(np.float64)
+        return lo
+
+    for i in range(3):
+        def tap(i=i, **v):
+            return anisotropy.anisotropicTapDirection(gpu_alphas_lobe(v), v["N"], v["V"], i)
+
+        check(f"anisotropicTapDirection[{i}]", out[f"tap{i}"], tap(**s_taps), rtol=0,
+              atol=5e-6, slack=perturbation_spread(tap, s_taps, rng))  # fmt: skip
+        # every tap reads a direction on or above N's horizon, a unit vector
+        got = out[f"tap{i}"].astype(np.float64)
+        assert np.all(np.sum(got * s["N"], 1) >= -1e-5)
+        np.testing.assert_allclose(np.linalg.norm(got, axis=1), 1.0, atol=1e-5)
+    # (1 + s^2)^-2 at s = -0.8, 0, 0.8, normalised: written out from the formula
+    w = np.array([1.64 ** -2, 1.0, 1.64 ** -2]) / (1.0 + 2 * 1.64 ** -2)
+    np.testing.assert_allclose([anisotropy.anisotropicTapWeight(i) for i in range(3)], w,
+                               rtol=1e-15)  # fmt: skip
+    check("anisotropicTapWeight", out["weights"], np.broadcast_to(w, (4096, 3)), rtol=1e-6,
+          atol=0)  # fmt: skip
+
+    def tap_rough(**v):
+        return anisotropy.anisotropicTapRoughness(_np_lobe(v), v["rough"])
+
+    check("anisotropicTapRoughness", out["tapRough"], tap_rough(**s), rtol=1e-6, atol=1e-7)
+    # the narrow alpha's roughness: sqrt(ab) of ref_alphas (the paper's alphas)
+    an = np.clip(s["an"].astype(np.float64), 0, 1)
+    ab = np.array([ref_alphas(r, a)[1] for r, a in zip(s["rough"].astype(np.float64), an)])
+    np.testing.assert_allclose(tap_rough(**s), np.where(an > 0, np.sqrt(ab), s["rough"]),
+                               rtol=1e-7)  # fmt: skip
+
+
+def test_split_sum_taps_spread_along_the_lobe():
+    """The taps' directions against geometry written here: the half vectors N +- 0.8 w T
+    (w = sqrt(at^2 - ab^2)) reflect V, for V along N, to directions tilted in the (N, T)
+    plane by 2 atan(0.8 w) either side; anisotropy 0 (any roughness) puts all three on
+    reflect(-V, N) (1e-15)."""
+    N, T, B = np.eye(3)[2], np.eye(3)[0], np.eye(3)[1]
+    V = N.copy()
+    for rough, an in [(0.5, 0.8), (0.3, 0.5), (0.9, 0.2)]:
+        at, ab = ref_alphas(rough, an)
+        lobe = anisotropy.makeAnisotropicLobe(rough * rough, an, np.array([1.0, 0, 0]), T, B, N)
+        tilt = 2 * np.arctan(0.8 * np.sqrt(at * at - ab * ab))
+        for i, sign in enumerate((-1, 0, 1)):
+            got = anisotropy.anisotropicTapDirection(lobe, N, V, i)
+            want = np.array([np.sin(sign * tilt), 0.0, np.cos(sign * tilt)])
+            np.testing.assert_allclose(got, want, atol=1e-12)
+    rng = np.random.default_rng(3)
+    for _ in range(8):
+        V = rng.normal(size=3)
+        V[2] = abs(V[2])
+        V /= np.linalg.norm(V)
+        lobe = anisotropy.makeAnisotropicLobe(rng.uniform(0, 1), 0.0, rng.normal(size=3), T, B, N)
+        for i in range(3):
+            np.testing.assert_allclose(anisotropy.anisotropicTapDirection(lobe, N, V, i),
+                                       2 * V[2] * N - V, atol=1e-15)  # fmt: skip
+
+
 def test_sampling_gpu_equal_twin(ctx, rng):
     s = _lobe_inputs(rng, 4096)
     s["Xi"] = f32(np.clip(s["Xi"], 0.0, 0.999))  # tan theta finite: y < 1
@@ -378,9 +457,38 @@ def test_area_light_reference_sampling_gpu_equal_twin(ctx, rng):
 # --- written at 0: today's shading ------------------------------------------------------------
 
 
-def _shade_gpu(ctx, rng, inputs, defines, scene, sh, ab_value):
+def _smooth_prefiltered(R, lod):
+    """A prefiltered environment varying smoothly with the direction and the mip (numpy)."""
+    R, lod = np.asarray(R, np.float64), np.asarray(lod, np.float64)[..., None]
+    return (0.6 + 0.3 * R[..., 0:1] + 0.2 * R[..., 1:2] ** 2 - 0.15 * R[..., 2:3]
+            + 0.05 * lod * np.array([1.0, 2.0, 3.0]))
+
+
+def smooth_cubemap(ctx, levels=5):
+    """An RGB32F cubemap of _smooth_prefiltered at the texel centres (GL's face axes), mip m
+    at lod m, trilinear: a lookup varies with its direction and lod (no constant hides them)."""
+    size = 2 ** (levels + 1)
+    tex = ctx.texture_cube((size, size), 3, dtype="f4")
+    tex.build_mipmaps(0, levels - 1)
+    for m in range(levels):
+        n = size >> m
+        c = (np.arange(n) + 0.5) / n * 2 - 1
+        sc, tc = np.meshgrid(c, c)
+        one = np.ones_like(sc)
+        faces = [(one, -tc, -sc), (-one, -tc, sc), (sc, one, tc), (sc, -one, -tc),
+                 (sc, -tc, one), (-sc, -tc, -one)]
+        for face, (x, y, z) in enumerate(faces):
+            d = np.stack([x, y, z], -1)
+            d /= np.linalg.norm(d, axis=-1, keepdims=True)
+            write_cube_level(tex, face, m, _smooth_prefiltered(d, np.full(sc.shape, m)))
+    tex.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
+    return tex
+
+
+def _shade_gpu(ctx, rng, inputs, defines, scene, sh, ab_value, smooth=False):
     env = constant_cubemap(ctx, [np.float32([0.5, 0.7, 1.1])])
-    pref = constant_cubemap(ctx, [np.float32([0.9, 0.6, 0.4])] * 5)
+    pref = (smooth_cubemap(ctx) if smooth
+            else constant_cubemap(ctx, [np.float32([0.9, 0.6, 0.4])] * 5))
     lut = _lut_texture(ctx, np.broadcast_to(ab_value, (4, 4, 2)).copy())
     alut = upload_anisotropy_lut(ctx)
     block = ibl_twin.pack_ibl_block(sh, mip_count=5, intensity=1.7, samples=32,
@@ -405,8 +513,9 @@ def _shade_gpu(ctx, rng, inputs, defines, scene, sh, ab_value):
 
 def test_anisotropy_written_at_zero_is_todays_shading(ctx, rng):
     """MATERIAL_HAS_ANISOTROPY with anisotropy 0 (any direction) against the talk's shading
-    compiled without it, every light kind and the split sum: 1e-6 relative (+1e-7 absolute
-    for values near 0) on the GPU; in numpy (float64) 1e-12."""
+    compiled without it, every light kind and the split sum (its taps, under a prefiltered
+    environment that varies with direction and mip): 1e-6 relative (+1e-7 absolute for values
+    near 0) on the GPU; in numpy (float64) 1e-12."""
     n = 2048
     scene = [_f32_light(x) for x in _all_kinds(rng, 16)]
     sh = f32(rng.uniform(-0.2, 0.2, (9, 3)))
@@ -417,15 +526,15 @@ def test_anisotropy_written_at_zero_is_todays_shading(ctx, rng):
     inputs.update({"P": f32(rng.uniform(-1, 1, (n, 3))), "base": f32(rng.uniform(0, 1, (n, 3))),
                    "metal": unit01(rng, n), "rough": roughness(rng, n, lo=0.0),
                    "an": np.zeros(n)})  # fmt: skip
-    today = _shade_gpu(ctx, rng, inputs, (), scene, sh, ab_value)
-    written = _shade_gpu(ctx, rng, inputs, ANISO, scene, sh, ab_value)
+    today = _shade_gpu(ctx, rng, inputs, (), scene, sh, ab_value, smooth=True)
+    written = _shade_gpu(ctx, rng, inputs, ANISO, scene, sh, ab_value, smooth=True)
     assert np.all(np.isfinite(written))
     err = np.abs(written.astype(np.float64) - today)
     bad = err > 1e-6 * np.abs(today) + 1e-7
     assert not bad.any(), (int(bad.sum()), today[bad][:4], written[bad][:4],
                            inputs["rough"][bad.any(1)][:4])
 
-    ibl_in = surface.IblInputs(sh=sh, prefiltered=np.float32([0.9, 0.6, 0.4]), mip_count=5,
+    ibl_in = surface.IblInputs(sh=sh, prefiltered=_smooth_prefiltered, mip_count=5,
                                brdf_lut=ab_value, lut_values=True, intensity=1.7,
                                mode=ibl_twin.IBL_MODE_SPLIT_SUM,
                                anisotropy_lut=anisotropy_lut())  # fmt: skip

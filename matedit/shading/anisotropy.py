@@ -1,5 +1,6 @@
 """Twin of ``anisotropy.glsl``: anisotropic GGX, its projected-roughness Schlick-Smith
-visibility, the bent reflection vector, the area lights' widening and the sampling.
+visibility, the bent reflection vector (area lights), the split sum's taps, the area lights'
+widening and the sampling.
 
 Same names, same arithmetic, float64; vectorised over leading axes (pixels). The
 convention (see the GLSL header): the lobe's T is the direction the highlight stretches
@@ -212,6 +213,48 @@ def anisotropicSampleIBL(l: AnisotropicLobe, N, V, Xi) -> tuple[np.ndarray, np.n
 
 def anisotropicPdfIBL(l: AnisotropicLobe, N, V, L) -> np.ndarray:
     return ggxAnisotropicDirectionPdf(l, N, V, L)
+
+
+# The anisotropic split sum's prefiltered radiance (the GLSL's comment): ANISOTROPY_IBL_TAPS
+# narrow lookups (roughness sqrt(ab)) along reflect(-V, normalize(N + s_i w T)), w =
+# sqrt(at^2 - ab^2), weights (1 + s_i^2)^-2 normalised; at = ab they all read reflect(-V, N).
+ANISOTROPY_IBL_TAPS = 3
+
+
+def anisotropicTapOffset(i: int) -> float:
+    """Slope offset of tap i along T in units of the spread: -0.8, 0, 0.8."""
+    return 0.8 * float(i - 1)
+
+
+def anisotropicTapWeight(i: int) -> float:
+    """(1 + s_i^2)^-2 / sum_j (1 + s_j^2)^-2: GGX's unit-roughness slope density at s_i
+    (Walter et al. 2007 eq 33, Heitz 2014 eq 9), the taps' weights summing to 1."""
+    total = sum(1.0 / (1.0 + anisotropicTapOffset(j) ** 2) ** 2
+                for j in range(ANISOTROPY_IBL_TAPS))
+    return 1.0 / ((1.0 + anisotropicTapOffset(i) ** 2) ** 2 * total)
+
+
+def anisotropicTapDirection(l: AnisotropicLobe, N, V, i: int) -> np.ndarray:
+    """reflect(-V, normalize(N + s_i w T)), w = sqrt(at^2 - ab^2), H at N's length (no
+    offset: N itself); a direction under N's horizon brought onto it (normalised; N where
+    nothing is left)."""
+    N, V = f64(N), f64(V)
+    w = np.sqrt(np.maximum(f64(l.at) * l.at - f64(l.ab) * l.ab, 0.0))
+    h = N + (anisotropicTapOffset(i) * w)[..., None] * f64(l.T)
+    H = h * (np.sqrt(dot(N, N)) / np.sqrt(dot(h, h)))[..., None]
+    R = reflect(-V, H)
+    below = np.minimum(dot(R, N), 0.0)
+    on_horizon = R - below[..., None] * N
+    hh = dot(on_horizon, on_horizon)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        unit = on_horizon / np.sqrt(hh)[..., None]
+    lifted = np.where((hh > 1e-12)[..., None], unit, np.broadcast_to(N, unit.shape))
+    return np.where((below < 0.0)[..., None], lifted, R)
+
+
+def anisotropicTapRoughness(l: AnisotropicLobe, roughness) -> np.ndarray:
+    """sqrt(ab), the narrow alpha's roughness; the given IBL roughness at anisotropy 0."""
+    return np.where(f64(l.anisotropy) > 0.0, np.sqrt(f64(l.ab)), f64(roughness))
 
 
 def _linear_axis(x, n: int, centred: bool):

@@ -104,13 +104,16 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
                                         count, ibl.sample_offset)
     else:
         NoV = saturate(dot(N, V))
-        R = reflect(-V, N)
-        if aniso is not None:
-            R = _aniso.anisotropicReflection(aniso, N, V)
-        if callable(ibl.prefiltered):
-            pref = prefilteredRadiance(ibl.prefiltered, R, roughness, ibl.mip_count)
-        else:
+        if not callable(ibl.prefiltered):
             pref = f64(ibl.prefiltered)
+        elif aniso is not None:
+            # the anisotropic split sum's taps along the lobe's long axis (anisotropy.glsl)
+            tap_roughness = _aniso.anisotropicTapRoughness(aniso, roughness)
+            pref = sum(_aniso.anisotropicTapWeight(i) * prefilteredRadiance(
+                ibl.prefiltered, _aniso.anisotropicTapDirection(aniso, N, V, i), tap_roughness,
+                ibl.mip_count) for i in range(_aniso.ANISOTROPY_IBL_TAPS))
+        else:
+            pref = prefilteredRadiance(ibl.prefiltered, reflect(-V, N), roughness, ibl.mip_count)
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV, roughness)
         if aniso is not None and ibl.anisotropy_lut is not None:
             AB = AB + _aniso.anisotropicEnvironmentBRDF(
