@@ -12,7 +12,8 @@ the anisotropic table's change ("table": the shader until the taps). The prefilt
 tried at an effective roughness, alpha_eff = sqrt(at ab) ("table + geometric alpha"), and
 along the bent reflection of half the anisotropy ("half bend") or the mirror direction
 ("no bend"), and taps along the lobe's long axis: 3 or 5 at spread at, or the shader's
-(anisotropy.glsl anisotropicTapDirection: 3 at spread sqrt(at^2 - ab^2)).
+(surface.glsl anisotropicPrefilteredRadiance: 3 at spread sqrt(at^2 - ab^2), faded out
+near the horizon).
 Prints the worst and mean error |split - brute| per environment and variant, in units of the
 environment's mean radiance (a relative error is meaningless where the lobe sees a dark
 part of the studio: the brute force is near 0 there).
@@ -24,7 +25,7 @@ import numpy as np
 
 from matedit.ibl.anisotropy_lut import anisotropy_lut, directional_ab
 from matedit.ibl.builtin import builtin_environment
-from matedit.shading import anisotropy
+from matedit.shading import anisotropy, surface
 
 N_SAMPLES = 1 << 17
 LUMA = np.array([0.2126, 0.7152, 0.0722])
@@ -114,18 +115,17 @@ def case(env, u, rough, an, N, theta_v, phi_v):
             acc += w * pref(ab, Ri)
         return acc / w_i.sum()
     p_t3 = taps(np.array([-0.8, 0.0, 0.8]))
-    # (c) the shader's taps (anisotropy.glsl, the twin): spread sqrt(at^2 - ab^2), each
-    # prefiltered at roughness anisotropicTapRoughness (alpha ab), horizon-clamped directions
-    tap_alpha = float(anisotropy.anisotropicTapRoughness(lobe, rough)) ** 2
-    p_shader = sum(anisotropy.anisotropicTapWeight(i)
-                   * pref(tap_alpha, anisotropy.anisotropicTapDirection(lobe, N, V, i))
-                   for i in range(anisotropy.ANISOTROPY_IBL_TAPS))
+    # (c) the shader's taps (the twin, surface.anisotropicPrefilteredRadiance): spread
+    # sqrt(at^2 - ab^2), each prefiltered at alpha ab (the lookup at lod = roughness, mipCount
+    # 2), weights faded out near the horizon
+    p_shader = float(surface.anisotropicPrefilteredRadiance(
+        lambda R, lod: np.full(3, pref(float(lod) ** 2, R)), lobe, N, V, rough, 2)[0])
     p_t5 = taps(np.array([-1.2, -0.6, 0.0, 0.6, 1.2]))
     return brute, {"before": p_base * e_iso, "table": p_base * e_tab,
                    "table + geometric alpha": p_geo * e_tab,
                    "table + half bend": p_half * e_tab, "table + no bend": p_mirror * e_tab,
                    "table + Filament bend": p_fil * e_tab, "table + 3 taps": p_t3 * e_tab,
-                   "table + 5 taps": p_t5 * e_tab, "shader (3 taps, sqrt spread)": p_shader * e_tab}
+                   "table + 5 taps": p_t5 * e_tab, "shader (3 taps, faded)": p_shader * e_tab}
 
 
 def main() -> int:

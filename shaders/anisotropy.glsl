@@ -160,11 +160,18 @@ vec3 anisotropicReflection(AnisotropicLobe l, vec3 N, vec3 V) {
 // The anisotropic split sum's prefiltered radiance: the lobe, long along T, is read as
 // ANISOTROPY_IBL_TAPS narrow lobes (alpha ab, isotropic) whose half vectors are spread
 // along T, H_i = normalize(N + s_i w T), each looked up along its own reflection reflect(-V,
-// H_i) and weighted by unit-roughness GGX's slope density (1 + s_i^2)^-2, normalised to 1
-// (the furnace is the environment BRDF's alone). w = sqrt(at^2 - ab^2): the spread the
-// narrow lobes' width leaves to be made up (widths of convolved lobes add in squares), so
-// at = ab (anisotropy 0) puts every tap on N and the sum is the isotropic lookup.
+// H_i) and weighted by unit-roughness GGX's slope density (1 + s_i^2)^-2, faded out as its
+// reflection nears N's horizon (what the lobe reflects from under the surface is masked:
+// the environment BRDF counts that loss, the prefiltered value is the visible taps' mean);
+// the weights are normalised to 1 (the furnace is the environment BRDF's alone). w =
+// sqrt(at^2 - ab^2): the spread the narrow lobes' width leaves to be made up (widths of
+// convolved lobes add in squares), so at = ab (anisotropy 0) puts every tap on N and the sum
+// is the isotropic lookup.
 const int ANISOTROPY_IBL_TAPS = 3;
+// A tap's weight falls linearly to its floor as N.R_i goes from this to 0; the floor keeps a
+// sum whose taps are all under the horizon (a back-facing shading normal) their mean.
+const float ANISOTROPY_TAP_HORIZON_FADE = 0.25;
+const float ANISOTROPY_TAP_MIN_WEIGHT = 1e-3;
 
 // Slope offset of tap i along T, in units of the spread w: -0.8, 0, 0.8.
 float anisotropicTapOffset(int i) {
@@ -172,33 +179,22 @@ float anisotropicTapOffset(int i) {
     return 0.8 * float(i - 1);
 }
 
-// Weight of tap i, the taps' weights summing to 1: (1 + s_i^2)^-2 / sum_j (1 + s_j^2)^-2.
-float anisotropicTapWeight(int i) {
-    // GGX's slope density at unit roughness, Walter et al. 2007, eq 33 with Heitz 2014, eq 9:
-    // P22(s) = 1 / (pi (1 + s^2)^2)
-    float total = 0.0;
-    for (int j = 0; j < ANISOTROPY_IBL_TAPS; j++) {
-        total += 1.0 / sq(1.0 + sq(anisotropicTapOffset(j)));
-    }
-    return 1.0 / (sq(1.0 + sq(anisotropicTapOffset(i))) * total);
-}
-
 // The direction tap i reads: V reflected about H_i = normalize(N + s_i w T) (scaled to N's
-// length, so a tap with no offset reflects about N itself, bit for bit); a reflection under
-// the horizon of N is brought onto it (a lobe sees nothing from under the surface).
+// length, so a tap with no offset reflects about N itself, bit for bit).
 vec3 anisotropicTapDirection(AnisotropicLobe l, vec3 N, vec3 V, int i) {
     // matedit anisotropic split sum (docs/shading.md, Anisotropy)
     float w = sqrt(max(l.at * l.at - l.ab * l.ab, 0.0));
     vec3 h = N + (anisotropicTapOffset(i) * w) * l.T;
-    vec3 H = h * (length(N) / length(h));
-    vec3 R = reflect(-V, H);
-    float below = min(dot(R, N), 0.0);
-    if (below < 0.0) {
-        vec3 onHorizon = R - below * N;
-        float hh = dot(onHorizon, onHorizon);
-        R = hh > 1e-12 ? onHorizon * inversesqrt(hh) : N;
-    }
-    return R;
+    return reflect(-V, h * (length(N) / length(h)));
+}
+
+// The weight of tap i reading R (not normalised: the caller divides by the taps' sum):
+// (1 + s_i^2)^-2 times max(saturate(N.R / fade), floor).
+float anisotropicTapWeight(vec3 N, vec3 R, int i) {
+    // GGX's slope density at unit roughness, Walter et al. 2007, eq 33 with Heitz 2014, eq 9:
+    // P22(s) = 1 / (pi (1 + s^2)^2); the horizon fade is matedit's (docs/shading.md)
+    float fade = max(saturate(dot(N, R) / ANISOTROPY_TAP_HORIZON_FADE), ANISOTROPY_TAP_MIN_WEIGHT);
+    return fade / sq(1.0 + sq(anisotropicTapOffset(i)));
 }
 
 // The roughness the taps are prefiltered at: the narrow alpha's, sqrt(ab); the material's

@@ -63,6 +63,25 @@ vec3 directLightingReference(ShadingContext s) {
 }
 #endif
 
+#if defined(MATERIAL_HAS_ANISOTROPY)
+// The anisotropic split sum's prefiltered radiance: the taps' lookups (anisotropy.glsl,
+// anisotropicTapDirection), weighted and normalised by their weights' sum.
+vec3 anisotropicPrefilteredRadiance(samplerCube prefilteredEnv, AnisotropicLobe l, vec3 N,
+                                    vec3 V, float roughness, float mipCount) {
+    // matedit anisotropic split sum (docs/shading.md, Anisotropy) of Karis 2013's eq 7 lookup
+    vec3 tapSum = vec3(0.0);
+    float weightSum = 0.0;
+    float tapRoughness = anisotropicTapRoughness(l, roughness);
+    for (int i = 0; i < ANISOTROPY_IBL_TAPS; i++) {
+        vec3 R = anisotropicTapDirection(l, N, V, i);
+        float w = anisotropicTapWeight(N, R, i);
+        tapSum += w * prefilteredRadiance(prefilteredEnv, R, tapRoughness, mipCount);
+        weightSum += w;
+    }
+    return tapSum / weightSum;
+}
+#endif
+
 // Image-based lighting from the block's environment, split sum or reference by uIbl.params.w.
 vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughness,
                         vec3 specularScale
@@ -90,13 +109,8 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
 #if defined(MATERIAL_HAS_ANISOTROPY)
     // anisotropic split sum: narrow lookups spread along the lobe's long axis
     // (anisotropy.glsl, anisotropicTapDirection; docs/shading.md, Anisotropy)
-    vec3 prefiltered = vec3(0.0);
-    float tapRoughness = anisotropicTapRoughness(aniso, roughness);
-    for (int i = 0; i < ANISOTROPY_IBL_TAPS; i++) {
-        vec3 Ri = anisotropicTapDirection(aniso, N, V, i);
-        prefiltered += anisotropicTapWeight(i)
-                     * prefilteredRadiance(uPrefilteredEnv, Ri, tapRoughness, uIbl.params.x);
-    }
+    vec3 prefiltered = anisotropicPrefilteredRadiance(uPrefilteredEnv, aniso, N, V, roughness,
+                                                      uIbl.params.x);
 #else
     vec3 R = reflect(-V, N);
     vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);

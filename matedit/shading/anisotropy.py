@@ -217,8 +217,11 @@ def anisotropicPdfIBL(l: AnisotropicLobe, N, V, L) -> np.ndarray:
 
 # The anisotropic split sum's prefiltered radiance (the GLSL's comment): ANISOTROPY_IBL_TAPS
 # narrow lookups (roughness sqrt(ab)) along reflect(-V, normalize(N + s_i w T)), w =
-# sqrt(at^2 - ab^2), weights (1 + s_i^2)^-2 normalised; at = ab they all read reflect(-V, N).
+# sqrt(at^2 - ab^2), weights (1 + s_i^2)^-2 faded out near N's horizon, normalised by their
+# sum; at = ab they all read reflect(-V, N).
 ANISOTROPY_IBL_TAPS = 3
+ANISOTROPY_TAP_HORIZON_FADE = 0.25
+ANISOTROPY_TAP_MIN_WEIGHT = 1e-3
 
 
 def anisotropicTapOffset(i: int) -> float:
@@ -226,30 +229,21 @@ def anisotropicTapOffset(i: int) -> float:
     return 0.8 * float(i - 1)
 
 
-def anisotropicTapWeight(i: int) -> float:
-    """(1 + s_i^2)^-2 / sum_j (1 + s_j^2)^-2: GGX's unit-roughness slope density at s_i
-    (Walter et al. 2007 eq 33, Heitz 2014 eq 9), the taps' weights summing to 1."""
-    total = sum(1.0 / (1.0 + anisotropicTapOffset(j) ** 2) ** 2
-                for j in range(ANISOTROPY_IBL_TAPS))
-    return 1.0 / ((1.0 + anisotropicTapOffset(i) ** 2) ** 2 * total)
-
-
 def anisotropicTapDirection(l: AnisotropicLobe, N, V, i: int) -> np.ndarray:
     """reflect(-V, normalize(N + s_i w T)), w = sqrt(at^2 - ab^2), H at N's length (no
-    offset: N itself); a direction under N's horizon brought onto it (normalised; N where
-    nothing is left)."""
+    offset: N itself)."""
     N, V = f64(N), f64(V)
     w = np.sqrt(np.maximum(f64(l.at) * l.at - f64(l.ab) * l.ab, 0.0))
     h = N + (anisotropicTapOffset(i) * w)[..., None] * f64(l.T)
-    H = h * (np.sqrt(dot(N, N)) / np.sqrt(dot(h, h)))[..., None]
-    R = reflect(-V, H)
-    below = np.minimum(dot(R, N), 0.0)
-    on_horizon = R - below[..., None] * N
-    hh = dot(on_horizon, on_horizon)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        unit = on_horizon / np.sqrt(hh)[..., None]
-    lifted = np.where((hh > 1e-12)[..., None], unit, np.broadcast_to(N, unit.shape))
-    return np.where((below < 0.0)[..., None], lifted, R)
+    return reflect(-V, h * (np.sqrt(dot(N, N)) / np.sqrt(dot(h, h)))[..., None])
+
+
+def anisotropicTapWeight(N, R, i: int) -> np.ndarray:
+    """Not normalised: (1 + s_i^2)^-2 (GGX's unit-roughness slope density, Walter et al. 2007
+    eq 33, Heitz 2014 eq 9) times max(saturate(N.R / fade), floor)."""
+    fade = np.maximum(saturate(dot(f64(N), f64(R)) / ANISOTROPY_TAP_HORIZON_FADE),
+                      ANISOTROPY_TAP_MIN_WEIGHT)
+    return fade / (1.0 + anisotropicTapOffset(i) ** 2) ** 2
 
 
 def anisotropicTapRoughness(l: AnisotropicLobe, roughness) -> np.ndarray:

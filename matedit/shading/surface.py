@@ -87,6 +87,22 @@ def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
     return total
 
 
+def anisotropicPrefilteredRadiance(prefilteredEnv, l: _aniso.AnisotropicLobe, N, V, roughness,
+                                   mipCount) -> np.ndarray:
+    """The taps' lookups (anisotropy.anisotropicTapDirection) weighted by
+    anisotropicTapWeight, normalised by the weights' sum; `prefilteredEnv` as
+    prefilteredRadiance's (R, lod) -> (..., 3)."""
+    tap_roughness = _aniso.anisotropicTapRoughness(l, roughness)
+    tap_sum: np.ndarray = np.zeros(3)
+    weight_sum: np.ndarray = np.zeros(1)
+    for i in range(_aniso.ANISOTROPY_IBL_TAPS):
+        R = _aniso.anisotropicTapDirection(l, N, V, i)
+        w = _aniso.anisotropicTapWeight(N, R, i)[..., None]
+        tap_sum = tap_sum + w * prefilteredRadiance(prefilteredEnv, R, tap_roughness, mipCount)
+        weight_sum = weight_sum + w
+    return tap_sum / weight_sum
+
+
 def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
                        specularScale=1.0, aniso=None) -> np.ndarray:
     """`aniso`: the anisotropic lobe (MATERIAL_HAS_ANISOTROPY), None where it is off."""
@@ -108,10 +124,8 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
             pref = f64(ibl.prefiltered)
         elif aniso is not None:
             # the anisotropic split sum's taps along the lobe's long axis (anisotropy.glsl)
-            tap_roughness = _aniso.anisotropicTapRoughness(aniso, roughness)
-            pref = sum(_aniso.anisotropicTapWeight(i) * prefilteredRadiance(
-                ibl.prefiltered, _aniso.anisotropicTapDirection(aniso, N, V, i), tap_roughness,
-                ibl.mip_count) for i in range(_aniso.ANISOTROPY_IBL_TAPS))
+            pref = anisotropicPrefilteredRadiance(ibl.prefiltered, aniso, N, V, roughness,
+                                                  ibl.mip_count)
         else:
             pref = prefilteredRadiance(ibl.prefiltered, reflect(-V, N), roughness, ibl.mip_count)
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV, roughness)
