@@ -139,7 +139,8 @@ vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, ve
     return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_Schlick(F0, VoH) * NoL;
 }
 
-// The bent reflection vector of the split sum and the area lights' representative point:
+// The bent reflection vector of the area lights' representative point (the split sum reads
+// the taps below instead):
 // the "anisotropic normal" is V with its component across the stretch (along B) removed,
 // the normal a lobe infinitely long along T would reflect V about; N is bent towards it by
 // the anisotropy. An approximation: it moves the lookup along the stretch, it does not

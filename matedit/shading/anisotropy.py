@@ -134,7 +134,8 @@ def anisotropicSpecularTowards(l: AnisotropicLobe, N, V, NoV, F0, L) -> np.ndarr
 
 
 def anisotropicReflection(l: AnisotropicLobe, N, V) -> np.ndarray:
-    """Revie 2011 / McAuley 2015 (Filament's anisotropic IBL): reflect V about
+    """The area lights' representative-point direction. Revie 2011 / McAuley 2015 (Filament's
+    anisotropic IBL): reflect V about
     normalize(mix(N, (B x V) x B, anisotropy))."""
     N, V = f64(N), f64(V)
     n_a = cross(cross(l.B, V), l.B)
