@@ -8,10 +8,12 @@ metal (F0 = 1), luminance: the brute force integrates the anisotropic lobe (k = 
 against the environment by importance sampling (2^17 half vectors), the split sum is the
 environment prefiltered by Karis 2013's estimator (N = V = R, weights NoL) along the twin's
 bent reflection, times the environment BRDF: the isotropic E(NoV, r) ("before") or E plus
-the anisotropic table's change ("table", the shader now). The prefiltered lookup is also
+the anisotropic table's change ("table": the shader until the taps). The prefiltered lookup is also
 tried at an effective roughness, alpha_eff = sqrt(at ab) ("table + geometric alpha"), and
 along the bent reflection of half the anisotropy ("half bend") or the mirror direction
-("no bend").
+("no bend"), and taps along the lobe's long axis: 3 or 5 at spread at, or the shader's
+(surface.glsl anisotropicPrefilteredRadiance: 3 at spread sqrt(at^2 - ab^2), faded out
+near the horizon).
 Prints the worst and mean error |split - brute| per environment and variant, in units of the
 environment's mean radiance (a relative error is meaningless where the lobe sees a dark
 part of the studio: the brute force is near 0 there).
@@ -23,7 +25,7 @@ import numpy as np
 
 from matedit.ibl.anisotropy_lut import anisotropy_lut, directional_ab
 from matedit.ibl.builtin import builtin_environment
-from matedit.shading import anisotropy
+from matedit.shading import anisotropy, surface
 
 N_SAMPLES = 1 << 17
 LUMA = np.array([0.2126, 0.7152, 0.0722])
@@ -113,12 +115,17 @@ def case(env, u, rough, an, N, theta_v, phi_v):
             acc += w * pref(ab, Ri)
         return acc / w_i.sum()
     p_t3 = taps(np.array([-0.8, 0.0, 0.8]))
+    # (c) the shader's taps (the twin, surface.anisotropicPrefilteredRadiance): spread
+    # sqrt(at^2 - ab^2), each prefiltered at alpha ab (the lookup at lod = roughness, mipCount
+    # 2), weights faded out near the horizon
+    p_shader = float(surface.anisotropicPrefilteredRadiance(
+        lambda R, lod: np.full(3, pref(float(lod) ** 2, R)), lobe, N, V, rough, 2)[0])
     p_t5 = taps(np.array([-1.2, -0.6, 0.0, 0.6, 1.2]))
     return brute, {"before": p_base * e_iso, "table": p_base * e_tab,
                    "table + geometric alpha": p_geo * e_tab,
                    "table + half bend": p_half * e_tab, "table + no bend": p_mirror * e_tab,
                    "table + Filament bend": p_fil * e_tab, "table + 3 taps": p_t3 * e_tab,
-                   "table + 5 taps": p_t5 * e_tab}
+                   "table + 5 taps": p_t5 * e_tab, "shader (3 taps, faded)": p_shader * e_tab}
 
 
 def main() -> int:
@@ -144,7 +151,7 @@ def main() -> int:
             for k, v in split.items():
                 errs.setdefault(k, []).append(abs(v - brute) / scale)
         for k, e in errs.items():
-            print(f"{name:20s} {k:26s} worst {max(e):6.3f}  mean {np.mean(e):6.3f}")
+            print(f"{name:20s} {k:30s} worst {max(e):6.3f}  mean {np.mean(e):6.3f}")
     return 0
 
 

@@ -139,7 +139,8 @@ vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, ve
     return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_Schlick(F0, VoH) * NoL;
 }
 
-// The bent reflection vector of the split sum and the area lights' representative point:
+// The bent reflection vector of the area lights' representative point (the split sum reads
+// the taps below instead):
 // the "anisotropic normal" is V with its component across the stretch (along B) removed,
 // the normal a lobe infinitely long along T would reflect V about; N is bent towards it by
 // the anisotropy. An approximation: it moves the lookup along the stretch, it does not
@@ -155,6 +156,53 @@ vec3 anisotropicReflection(AnisotropicLobe l, vec3 N, vec3 V) {
     float bb = dot(bent, bent);
     bent = bb > 1e-12 ? bent * inversesqrt(bb) : N;
     return reflect(-V, bent);
+}
+
+// The anisotropic split sum's prefiltered radiance: the lobe, long along T, is read as
+// ANISOTROPY_IBL_TAPS narrow lobes (alpha ab, isotropic) whose half vectors are spread
+// along T, H_i = normalize(N + s_i w T), each looked up along its own reflection reflect(-V,
+// H_i) and weighted by unit-roughness GGX's slope density (1 + s_i^2)^-2, faded out as its
+// reflection nears N's horizon (what the lobe reflects from under the surface is masked:
+// the environment BRDF counts that loss, the prefiltered value is the visible taps' mean);
+// the weights are normalised to 1 (the furnace is the environment BRDF's alone). w =
+// sqrt(at^2 - ab^2): the spread the narrow lobes' width leaves to be made up (widths of
+// convolved lobes add in squares), so at = ab (anisotropy 0) puts every tap on N and the sum
+// is the isotropic lookup.
+const int ANISOTROPY_IBL_TAPS = 3;
+// A tap's weight falls linearly to its floor as N.R_i goes from this to 0; the floor keeps a
+// sum whose taps are all under the horizon (a back-facing shading normal) their mean.
+const float ANISOTROPY_TAP_HORIZON_FADE = 0.25;
+const float ANISOTROPY_TAP_MIN_WEIGHT = 1e-3;
+
+// Slope offset of tap i along T, in units of the spread w: -0.8, 0, 0.8.
+float anisotropicTapOffset(int i) {
+    // matedit anisotropic split sum (docs/shading.md, Anisotropy; benchmarks/bench_aniso_ibl.py)
+    return 0.8 * float(i - 1);
+}
+
+// The direction tap i reads: V reflected about H_i = normalize(N + s_i w T) (scaled to N's
+// length, so a tap with no offset reflects about N itself, bit for bit).
+vec3 anisotropicTapDirection(AnisotropicLobe l, vec3 N, vec3 V, int i) {
+    // matedit anisotropic split sum (docs/shading.md, Anisotropy)
+    float w = sqrt(max(l.at * l.at - l.ab * l.ab, 0.0));
+    vec3 h = N + (anisotropicTapOffset(i) * w) * l.T;
+    return reflect(-V, h * (length(N) / length(h)));
+}
+
+// The weight of tap i reading R (not normalised: the caller divides by the taps' sum):
+// (1 + s_i^2)^-2 times max(saturate(N.R / fade), floor).
+float anisotropicTapWeight(vec3 N, vec3 R, int i) {
+    // GGX's slope density at unit roughness, Walter et al. 2007, eq 33 with Heitz 2014, eq 9:
+    // P22(s) = 1 / (pi (1 + s^2)^2); the horizon fade is matedit's (docs/shading.md)
+    float fade = max(saturate(dot(N, R) / ANISOTROPY_TAP_HORIZON_FADE), ANISOTROPY_TAP_MIN_WEIGHT);
+    return fade / sq(1.0 + sq(anisotropicTapOffset(i)));
+}
+
+// The roughness the taps are prefiltered at: the narrow alpha's, sqrt(ab); the material's
+// own IBL roughness at anisotropy 0 (ab is made from the analytic lights' clamped one).
+float anisotropicTapRoughness(AnisotropicLobe l, float roughness) {
+    // Karis 2013, eq 7: the prefiltered mips are indexed by roughness = sqrt(alpha)
+    return l.anisotropy > 0.0 ? sqrt(l.ab) : roughness;
 }
 
 // The anisotropic split sum's environment BRDF: the change (dA, dB) of the isotropic LUT's

@@ -76,11 +76,30 @@ vec3 subsurfaceImageBasedLighting(SubsurfaceLobe l, vec3 N) {
 }
 #endif
 
+#if defined(MATERIAL_HAS_ANISOTROPY)
+// The anisotropic split sum's prefiltered radiance: the taps' lookups (anisotropy.glsl,
+// anisotropicTapDirection), weighted and normalised by their weights' sum.
+vec3 anisotropicPrefilteredRadiance(samplerCube prefilteredEnv, AnisotropicLobe l, vec3 N,
+                                    vec3 V, float roughness, float mipCount) {
+    // matedit anisotropic split sum (docs/shading.md, Anisotropy) of Karis 2013's eq 7 lookup
+    vec3 tapSum = vec3(0.0);
+    float weightSum = 0.0;
+    float tapRoughness = anisotropicTapRoughness(l, roughness);
+    for (int i = 0; i < ANISOTROPY_IBL_TAPS; i++) {
+        vec3 R = anisotropicTapDirection(l, N, V, i);
+        float w = anisotropicTapWeight(N, R, i);
+        tapSum += w * prefilteredRadiance(prefilteredEnv, R, tapRoughness, mipCount);
+        weightSum += w;
+    }
+    return tapSum / weightSum;
+}
+#endif
+
 // Image-based lighting from the block's environment, split sum or reference by uIbl.params.w.
 vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughness,
                         vec3 specularScale
 #if defined(MATERIAL_HAS_ANISOTROPY)
-                        , AnisotropicLobe aniso  // the split sum's bent lookup (anisotropy.glsl)
+                        , AnisotropicLobe aniso  // the split sum's taps (anisotropy.glsl)
 #endif
                         ) {
     // Karis 2013, "Real Shading in Unreal Engine 4", image-based lighting (eq 6-8, reference)
@@ -100,13 +119,15 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
     vec3 sh[9];
     for (int i = 0; i < 9; i++) sh[i] = uIbl.sh[i].xyz;
     float NoV = saturate(dot(N, V));
-    vec3 R = reflect(-V, N);
 #if defined(MATERIAL_HAS_ANISOTROPY)
-    // anisotropic split sum: the bent reflection (anisotropy.glsl); the prefiltered lookup
-    // stays at the base roughness (docs/shading.md, Anisotropy)
-    R = anisotropicReflection(aniso, N, V);
-#endif
+    // anisotropic split sum: narrow lookups spread along the lobe's long axis
+    // (anisotropy.glsl, anisotropicTapDirection; docs/shading.md, Anisotropy)
+    vec3 prefiltered = anisotropicPrefilteredRadiance(uPrefilteredEnv, aniso, N, V, roughness,
+                                                      uIbl.params.x);
+#else
+    vec3 R = reflect(-V, N);
     vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
+#endif
     vec2 AB = environmentBRDF(uBrdfLut, NoV, roughness);
 #if defined(MATERIAL_HAS_ANISOTROPY)
     // the anisotropic lobe's own scale and bias of F0: the isotropic LUT plus the table's

@@ -8,6 +8,7 @@ must also be 0 for our files).
 
 from __future__ import annotations
 
+import copy
 import json
 import re
 import subprocess
@@ -306,3 +307,36 @@ def test_bake_refuses_to_write_over_a_texture_the_material_reads(tmp_path):
     assert "refusing to write over" in r.stderr and len(r.stderr.strip().splitlines()) == 1
     assert trap.read_bytes() == before
     assert not (tmp_path / "textured_orm.png").exists()
+
+
+ANISOTROPIC = [p for p in SAMPLES
+               if "anisotropy" in lower_and_optimise(load(p), FileResolver()).attributes]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("path", ANISOTROPIC, ids=lambda p: p.stem)
+def test_bake_of_an_anisotropic_sample_shades_nothing_and_binds_what_it_declares(ctx, path):
+    """The bake writes attributes, it does not shade: its program (ATTRIBUTES mode) of a
+    material that writes anisotropy declares no anisotropy table (binding 31, the viewport's
+    shading input) nor any other sampler but the material's own textures, which
+    attributes_gpu binds; and anisotropy is no baked map: the maps at the sample's
+    anisotropy equal those at anisotropy 0 (a shaded bake would differ)."""
+    doc = load(path)
+    ir = lower_and_optimise(doc, FileResolver())
+    compiled = compile_document(doc, FileResolver(), "glsl330", mode="attributes", ir=ir)
+    declared = set(re.findall(r"uniform\s+(?:\w+\s+)?sampler\w*\s+(\w+)\s*;",
+                              compiled.fragment_text))  # fmt: skip
+    assert "uAnisotropyLut" not in compiled.fragment_text
+    assert declared <= set(bake.load_textures(ir)), declared
+    flat = copy.deepcopy(doc)
+    changed = 0
+    for n in flat.graph.nodes.values():
+        if n.kind == "scalar_parameter" and n.settings.get("name") == "anisotropy":
+            n.values["value"] = 0.0
+            changed += 1
+    assert changed, "the sample's anisotropy input was not found"
+    at_sample = bake.bake_attributes(ctx, doc, FileResolver(), 16)[0]
+    at_zero = bake.bake_attributes(ctx, flat, FileResolver(), 16)[0]
+    for name in ("baseColor", "metallic", "normal", "roughness", "emissive", "cavity",
+                 "opacity"):
+        np.testing.assert_array_equal(at_sample[name], at_zero[name], err_msg=name)

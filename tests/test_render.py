@@ -264,6 +264,15 @@ def test_bad_obj_is_a_clear_error(fresh, tmp_path):
                         rel_tol=1e-5)
 
 
+# Anisotropic samples whose split sum is further off the reference than the talk's few
+# percent: the three taps along the lobe (docs/shading.md, Anisotropy) read a long lobe of the
+# studio's bright panels as three narrow lookups. Measured (benchmarks/bench_aniso_samples.py):
+# brushed gold 0.223, brushed steel 0.179 (the bent single lookup before the taps: 0.637 and
+# 0.641; with anisotropy 0 both are 0.07); bound = measured x 1.3, so a change that makes
+# them worse fails. The radial disc (0.095; 0.307 before) is under the common 0.12.
+SPLIT_SUM_MEASURED = {"brushed_gold": 0.223, "brushed_steel": 0.179}
+
+
 def test_split_sum_and_reference_agree_on_samples(fresh):
     """Mean |split-sum - reference| over the mesh, relative to the mean radiance."""
     fresh.show_gizmos = False
@@ -272,14 +281,10 @@ def test_split_sum_and_reference_agree_on_samples(fresh):
     try:
         for path in MATERIALS:
             cm = compile_document(fmt.load(path), FileResolver())
-            if {"anisotropy", "sheenColor"} & set(cm.ir.attributes):
-                # The reference integrates the anisotropic lobe (reference_layered.glsl), but the
-                # split sum's bent-reflection IBL is far off it (measured 0.64 on brushed gold
-                # and steel, 0.30 on the radial disc: the split sum has about half the
-                # reference's energy); the sheen's split sum (one lookup around N) is 7 .. 29 %
-                # off its own integral by design (docs/shading.md, Sheen; velvet 0.22, fabric
-                # 0.074). Both are judged against brute-force integrals in
-                # tests/test_reference_layered.py, test_lobe_anisotropy.py, test_lobe_sheen.py.
+            if "sheenColor" in cm.ir.attributes:
+                # The sheen's split sum (one lookup around N) is 7 .. 29 % off its own
+                # integral by design (docs/shading.md, Sheen; velvet 0.22, fabric 0.074); it
+                # is judged against brute-force integrals in tests/test_lobe_sheen.py.
                 continue
             fresh.set_material(cm)
             fresh.mode = "splitsum"
@@ -291,6 +296,8 @@ def test_split_sum_and_reference_agree_on_samples(fresh):
             rel = np.abs(split - ref).mean() / max(ref.mean(), 1e-6)
             # The split sum's known error (N = V = R lobes, separate integrals) is a few
             # percent; 12% bounds it with room for the reference's Monte Carlo noise.
-            assert rel < 0.12, (path.stem, rel)
+            bound = 1.3 * SPLIT_SUM_MEASURED[path.stem] if path.stem in SPLIT_SUM_MEASURED \
+                else 0.12
+            assert rel < bound, (path.stem, rel, bound)
     finally:
         fresh.reference_frames = 64

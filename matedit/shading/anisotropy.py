@@ -1,5 +1,6 @@
 """Twin of ``anisotropy.glsl``: anisotropic GGX, its projected-roughness Schlick-Smith
-visibility, the bent reflection vector, the area lights' widening and the sampling.
+visibility, the bent reflection vector (area lights), the split sum's taps, the area lights'
+widening and the sampling.
 
 Same names, same arithmetic, float64; vectorised over leading axes (pixels). The
 convention (see the GLSL header): the lobe's T is the direction the highlight stretches
@@ -133,7 +134,8 @@ def anisotropicSpecularTowards(l: AnisotropicLobe, N, V, NoV, F0, L) -> np.ndarr
 
 
 def anisotropicReflection(l: AnisotropicLobe, N, V) -> np.ndarray:
-    """Revie 2011 / McAuley 2015 (Filament's anisotropic IBL): reflect V about
+    """The area lights' representative-point direction. Revie 2011 / McAuley 2015 (Filament's
+    anisotropic IBL): reflect V about
     normalize(mix(N, (B x V) x B, anisotropy))."""
     N, V = f64(N), f64(V)
     n_a = cross(cross(l.B, V), l.B)
@@ -212,6 +214,42 @@ def anisotropicSampleIBL(l: AnisotropicLobe, N, V, Xi) -> tuple[np.ndarray, np.n
 
 def anisotropicPdfIBL(l: AnisotropicLobe, N, V, L) -> np.ndarray:
     return ggxAnisotropicDirectionPdf(l, N, V, L)
+
+
+# The anisotropic split sum's prefiltered radiance (the GLSL's comment): ANISOTROPY_IBL_TAPS
+# narrow lookups (roughness sqrt(ab)) along reflect(-V, normalize(N + s_i w T)), w =
+# sqrt(at^2 - ab^2), weights (1 + s_i^2)^-2 faded out near N's horizon, normalised by their
+# sum; at = ab they all read reflect(-V, N).
+ANISOTROPY_IBL_TAPS = 3
+ANISOTROPY_TAP_HORIZON_FADE = 0.25
+ANISOTROPY_TAP_MIN_WEIGHT = 1e-3
+
+
+def anisotropicTapOffset(i: int) -> float:
+    """Slope offset of tap i along T in units of the spread: -0.8, 0, 0.8."""
+    return 0.8 * float(i - 1)
+
+
+def anisotropicTapDirection(l: AnisotropicLobe, N, V, i: int) -> np.ndarray:
+    """reflect(-V, normalize(N + s_i w T)), w = sqrt(at^2 - ab^2), H at N's length (no
+    offset: N itself)."""
+    N, V = f64(N), f64(V)
+    w = np.sqrt(np.maximum(f64(l.at) * l.at - f64(l.ab) * l.ab, 0.0))
+    h = N + (anisotropicTapOffset(i) * w)[..., None] * f64(l.T)
+    return reflect(-V, h * (np.sqrt(dot(N, N)) / np.sqrt(dot(h, h)))[..., None])
+
+
+def anisotropicTapWeight(N, R, i: int) -> np.ndarray:
+    """Not normalised: (1 + s_i^2)^-2 (GGX's unit-roughness slope density, Walter et al. 2007
+    eq 33, Heitz 2014 eq 9) times max(saturate(N.R / fade), floor)."""
+    fade = np.maximum(saturate(dot(f64(N), f64(R)) / ANISOTROPY_TAP_HORIZON_FADE),
+                      ANISOTROPY_TAP_MIN_WEIGHT)
+    return fade / (1.0 + anisotropicTapOffset(i) ** 2) ** 2
+
+
+def anisotropicTapRoughness(l: AnisotropicLobe, roughness) -> np.ndarray:
+    """sqrt(ab), the narrow alpha's roughness; the given IBL roughness at anisotropy 0."""
+    return np.where(f64(l.anisotropy) > 0.0, np.sqrt(f64(l.ab)), f64(roughness))
 
 
 def _linear_axis(x, n: int, centred: bool):

@@ -97,6 +97,22 @@ def subsurfaceImageBasedLighting(lobe: _sss.SubsurfaceLobe, N, ibl: IblInputs) -
                                      irradianceSH9(ibl.sh, -N)) * ibl.intensity
 
 
+def anisotropicPrefilteredRadiance(prefilteredEnv, l: _aniso.AnisotropicLobe, N, V, roughness,
+                                   mipCount) -> np.ndarray:
+    """The taps' lookups (anisotropy.anisotropicTapDirection) weighted by
+    anisotropicTapWeight, normalised by the weights' sum; `prefilteredEnv` as
+    prefilteredRadiance's (R, lod) -> (..., 3)."""
+    tap_roughness = _aniso.anisotropicTapRoughness(l, roughness)
+    tap_sum: np.ndarray = np.zeros(3)
+    weight_sum: np.ndarray = np.zeros(1)
+    for i in range(_aniso.ANISOTROPY_IBL_TAPS):
+        R = _aniso.anisotropicTapDirection(l, N, V, i)
+        w = _aniso.anisotropicTapWeight(N, R, i)[..., None]
+        tap_sum = tap_sum + w * prefilteredRadiance(prefilteredEnv, R, tap_roughness, mipCount)
+        weight_sum = weight_sum + w
+    return tap_sum / weight_sum
+
+
 def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
                        specularScale=1.0, aniso=None) -> np.ndarray:
     """`aniso`: the anisotropic lobe (MATERIAL_HAS_ANISOTROPY), None where it is off."""
@@ -114,13 +130,14 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
                                         count, ibl.sample_offset)
     else:
         NoV = saturate(dot(N, V))
-        R = reflect(-V, N)
-        if aniso is not None:
-            R = _aniso.anisotropicReflection(aniso, N, V)
-        if callable(ibl.prefiltered):
-            pref = prefilteredRadiance(ibl.prefiltered, R, roughness, ibl.mip_count)
-        else:
+        if not callable(ibl.prefiltered):
             pref = f64(ibl.prefiltered)
+        elif aniso is not None:
+            # the anisotropic split sum's taps along the lobe's long axis (anisotropy.glsl)
+            pref = anisotropicPrefilteredRadiance(ibl.prefiltered, aniso, N, V, roughness,
+                                                  ibl.mip_count)
+        else:
+            pref = prefilteredRadiance(ibl.prefiltered, reflect(-V, N), roughness, ibl.mip_count)
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV, roughness)
         if aniso is not None and ibl.anisotropy_lut is not None:
             AB = AB + _aniso.anisotropicEnvironmentBRDF(
