@@ -91,8 +91,9 @@ def test_a_default_node_shows_base_open_and_each_other_group_as_a_header(view):
     assert heads == [(g, n, g == "Base") for g, n in GROUP_SIZES.items()]
     base = {f.name for f in nodes.ATTRIBUTE_FIELDS if f.group == "Base"}
     assert visible_inputs(it) == base
-    # One row per header and per open pin: 5 headers + 7 Base pins.
-    assert it.layout.height == pytest.approx(it.layout.top + 12 * C.ROW_HEIGHT + C.BODY_PAD)
+    # One row per header and per open pin: a header per group + 7 Base pins.
+    rows = len(GROUP_SIZES) + GROUP_SIZES["Base"]
+    assert it.layout.height == pytest.approx(it.layout.top + rows * C.ROW_HEIGHT + C.BODY_PAD)
     assert header(it, "Coat")[0].label == "\u25b8 Coat (5)"
     # A Break folds its outputs the same way; the Material Output has one pin, no groups.
     assert [h.group for h, _ in item(view, "brk").layout.headers] == list(GROUP_SIZES)
