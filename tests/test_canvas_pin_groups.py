@@ -187,27 +187,10 @@ def test_a_new_node_shows_only_base_and_copy_paste_keeps_the_setting(view, qtbot
 def test_a_wire_dragged_over_a_folded_header_opens_it_and_connects(view):
     c = view.controller
     scene = view.scene()
-    c.push(AddNode(Node("r", "scalar_parameter", (0, 400), {"name": "r"}, {"value": 0.2})))
-    QApplication.processEvents()
-    src = view.mapFromScene(item(view, "r").port_scene_pos("value", True))
-    it = item(view, "make")
-    _, y = header(it, "Sheen")
-    over = view.mapFromScene(it.pos() + QPointF(it.layout.width / 2, y))
-    vp = view.viewport()
-    QTest.mousePress(vp, LEFT, Qt.KeyboardModifier.NoModifier, src)
-    for i in range(1, 7):
-        p = QPointF(src) + (QPointF(over) - QPointF(src)) * (i / 6)
-        QApplication.sendEvent(vp, QMouseEvent(QEvent.Type.MouseMove, p,
-                                                QPointF(vp.mapToGlobal(p.toPoint())),
-                                                Qt.MouseButton.NoButton, LEFT,
-                                                Qt.KeyboardModifier.NoModifier))
-    assert "Sheen" in it.expanded  # opened while the wire hovers
-    target = view.mapFromScene(it.port_scene_pos("sheenRoughness", False))
-    QApplication.sendEvent(vp, QMouseEvent(QEvent.Type.MouseMove, QPointF(target),
-                                            QPointF(vp.mapToGlobal(target)),
-                                            Qt.MouseButton.NoButton, LEFT,
-                                            Qt.KeyboardModifier.NoModifier))
-    QTest.mouseRelease(vp, LEFT, Qt.KeyboardModifier.NoModifier, target)
+
+    def sheen_roughness(v):
+        return v.mapFromScene(item(v, "make").port_scene_pos("sheenRoughness", False))
+    _hover_then(view, "Sheen", sheen_roughness)  # opened while the wire hovers
     assert Link("r", "value", "make", "sheenRoughness") in c.document.graph.links
     assert Link("r", "value", "make", "sheenRoughness") in scene.wire_items
     # The group the wire went into stays open, saved with the connection as one undo step.
