@@ -246,9 +246,11 @@ def test_bundle_runs_the_commands_with_no_python(built, workdir):
     assert r2.returncode == 0, r2.stderr
     names = sorted(p.name for p in (workdir / "out").iterdir())
     assert names == sorted(p.name for p in ref.iterdir())
-    cross = {"hlsl", "msl"} if shutil.which("spirv-cross") else set()
+    # GLSL: STEM.TARGET.frag; HLSL and MSL: STEM.frag.hlsl and STEM.frag.metal
     assert {n.split(".")[1] for n in names if n.endswith(".frag")} == {
-        "glsl330", "glsl450", "essl300"} | cross
+        "glsl330", "glsl450", "essl300"}
+    cross = {"hlsl", "metal"} if shutil.which("spirv-cross") else set()
+    assert {n.rsplit(".", 1)[1] for n in names if ".frag." in n} == cross
     for n in names:
         assert (workdir / "out" / n).read_bytes() == (ref / n).read_bytes(), n
 
