@@ -14,9 +14,8 @@ from PySide6.QtCore import QPointF, QRectF
 
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.interaction import kind_ports
-from matedit.app.canvas.node_item import NodeItem, PortRow, measure
-from matedit.app.canvas.scene import describe, expanded_groups
-from matedit.graph import nodes
+from matedit.app.canvas.node_item import NodeItem, measure
+from matedit.app.canvas.scene import describe, expanded_groups, port_rows
 from matedit.graph.model import Node
 
 GAP = 16.0  # the clear space kept around a placed node
@@ -32,12 +31,8 @@ def node_rect(node: Node) -> QRectF:
     if ports is None:
         w, h = C.NODE_MIN_WIDTH, C.HEADER_HEIGHT + 3 * C.ROW_HEIGHT
     else:
-        lay = measure(title, sub,
-                      [PortRow(p.name, p.type, "", False, nodes.port_group(node.kind, p.name))
-                       for p in ports.inputs],
-                      [PortRow(p.name, p.type, "", False, nodes.port_group(node.kind, p.name))
-                       for p in ports.outputs],
-                      expanded=expanded_groups(node))
+        lay = measure(title, sub, port_rows(node.kind, ports.inputs),
+                      port_rows(node.kind, ports.outputs), expanded=expanded_groups(node))
         w, h = lay.width, lay.height
     return QRectF(node.position[0], node.position[1], w, h)
 

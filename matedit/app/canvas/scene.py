@@ -77,6 +77,12 @@ def describe(node: Node, function_name: str = "") -> tuple[str, str, str, str]:
     return title, sub, d.category if d else "", tip
 
 
+def port_rows(kind: str, ports) -> list[PortRow]:
+    """What a node of `kind` shows for these ports (a generic `T` port, its pin group)."""
+    return [PortRow(p.name, p.type, p.doc, p.type == "T", nodes.port_group(kind, p.name))
+            for p in ports]
+
+
 def expanded_groups(node: Node) -> frozenset[str] | None:
     """The pin groups a node shows open (None where its kind folds none): its
     EXPANDED_GROUPS setting, else the setting's default (a new node, an old document)."""
@@ -184,10 +190,7 @@ class NodeScene(QGraphicsScene):
             return
         try:
             ports = node_ports(node, self.controller.resolver, self.controller.document)
-            ins = [PortRow(p.name, p.type, p.doc, p.type == "T",
-                           nodes.port_group(node.kind, p.name)) for p in ports.inputs]
-            outs = [PortRow(p.name, p.type, p.doc, p.type == "T",
-                            nodes.port_group(node.kind, p.name)) for p in ports.outputs]
+            ins, outs = port_rows(node.kind, ports.inputs), port_rows(node.kind, ports.outputs)
         except (LookupError, ValueError):
             ins, outs = [], []  # the analysis reports why, as a badge
         # Keep types the last analysis resolved for generic ports that are still there.
@@ -427,8 +430,7 @@ class NodeScene(QGraphicsScene):
             return
         self._peeked.setdefault(node_id, set()).add(group)
         self._refresh_node(node_id)
-        for link in self._wires_of.get(node_id, ()):
-            self.wire_items[link].update_path()
+        self.node_geometry_changed(node_id)
 
     def end_peeks(self, dropped: Link | None) -> list[SetSetting]:
         """Fold back the groups peek_group opened. The group the dropped wire connects into
@@ -447,8 +449,7 @@ class NodeScene(QGraphicsScene):
                 if command is not None:
                     keep.append(command)
             self._refresh_node(node_id)
-            for link in self._wires_of.get(node_id, ()):
-                self.wire_items[link].update_path()
+            self.node_geometry_changed(node_id)
         return keep
 
     def request_comment_edit(self, comment_id: str, rect, positions: dict) -> None:
