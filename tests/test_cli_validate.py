@@ -59,3 +59,17 @@ def test_validate_reads_light_rigs(tmp_path):
         {"type": "sphere", "radius": -1}]}))
     r = run("validate", str(bad))
     assert r.returncode == 2 and r.stderr.startswith("error: ") and "radius" in r.stderr
+
+
+def test_the_valid_path_orders_the_graph_without_importing_networkx():
+    """networkx's import (with its backend scan) was the largest part of `matedit validate`;
+    a valid file is ordered by graphlib, and networkx loads only to name a cycle."""
+    sample = graphs_dir() / "materials" / "rusty_painted_metal.json"
+    probe = ("import sys\nfrom matedit.cli import main\n"
+             "try:\n    main(['validate', sys.argv[1]])\nexcept SystemExit as e:\n"
+             "    assert not e.code, e.code\n"
+             "print('networkx' in sys.modules)\n")
+    r = subprocess.run([sys.executable, "-c", probe, str(sample)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().splitlines()[-1] == "False"
+

@@ -1,19 +1,24 @@
-"""Validation of material documents with networkx: a list of diagnostics, never an exception.
+"""Validation of material documents: a list of diagnostics, never an exception.
 
 Checks unknown node kinds, bad settings, links to missing nodes or ports, type
 mismatches, missing required links, cycles (inside a graph, and through
 function calls across files), calls to missing functions, and the document's
 output nodes. `check_connect` answers, before a link is made, whether it may be.
+
+The valid path orders the graph with the standard library's `graphlib`; networkx, whose
+import (with its backend scan) costs more than the rest of `matedit validate`, is loaded
+only to name a cycle that was found and for `check_connect`'s reachability question.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import Enum
+from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
-
-import networkx as nx
+from typing import TYPE_CHECKING
 
 from matedit.graph import nodes
 from matedit.graph.model import Link, MaterialDocument
@@ -28,6 +33,9 @@ from matedit.graph.ports import (
     resolve_types,
 )
 from matedit.graph.types import PortType, coerce_value, conversion_reason
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 
 class Severity(str, Enum):
@@ -89,6 +97,8 @@ def _file(doc: MaterialDocument) -> str | None:
 
 
 def dependency_graph(doc: MaterialDocument) -> nx.DiGraph:
+    import networkx as nx
+
     g = nx.DiGraph()
     g.add_nodes_from(doc.graph.nodes)
     for link in doc.graph.links:
@@ -96,10 +106,32 @@ def dependency_graph(doc: MaterialDocument) -> nx.DiGraph:
     return g
 
 
-def stable_order(g: nx.DiGraph) -> list[str]:
+def stable_order(vertices: Iterable[str], edges: Iterable[tuple[str, str]]) -> list[str]:
     """Topological order independent of the file's order: generation by generation (nodes
-    whose inputs are all in earlier generations), ids sorted within each generation."""
-    return [n for gen in nx.topological_generations(g) for n in sorted(gen)]
+    whose inputs are all in earlier generations), ids sorted within each generation.
+    Raises graphlib.CycleError when the edges close a cycle."""
+    sorter: TopologicalSorter[str] = TopologicalSorter({v: () for v in vertices})
+    for src, dst in edges:
+        sorter.add(dst, src)
+    sorter.prepare()
+    order: list[str] = []
+    while sorter.is_active():
+        generation = sorted(sorter.get_ready())
+        order.extend(generation)
+        sorter.done(*generation)
+    return order
+
+
+def _cycle(vertices: Iterable[str], edges: Iterable[tuple[str, str]],
+           source: str | None = None) -> list[tuple[str, str]]:
+    """The edges of one cycle, named the way networkx's find_cycle walks it (only called
+    once graphlib has found that there is one)."""
+    import networkx as nx
+
+    g = nx.DiGraph()
+    g.add_nodes_from(vertices)
+    g.add_edges_from(edges)
+    return list(nx.find_cycle(g, source=source))
 
 
 MAX_CALL_DEPTH = 64  # material functions nested deeper than this are refused
@@ -162,14 +194,12 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
         good_links.append(link)
 
     # Cycles.
-    g = nx.DiGraph()
-    g.add_nodes_from(graph.nodes)
-    g.add_edges_from((l.src, l.dst) for l in good_links)
+    edges = [(l.src, l.dst) for l in good_links]
     order: list[str] = []
     try:
-        order = stable_order(g)
-    except nx.NetworkXUnfeasible:
-        cycle = nx.find_cycle(g)
+        order = stable_order(graph.nodes, edges)
+    except CycleError:
+        cycle = _cycle(graph.nodes, edges)
         path = " -> ".join([a for a, _ in cycle] + [cycle[0][0]])
         diags.append(error(f"cycle: {path}", cycle[0][0], None, f))
 
@@ -373,7 +403,7 @@ def _call_cycles(doc: MaterialDocument, resolver: FunctionResolver | None) -> li
     """Recursion through function calls, across files (a call graph of documents)."""
     if resolver is None:
         return []
-    calls = nx.DiGraph()
+    calls: dict[str, set[str]] = {}  # caller key -> callee keys
     first_hop: dict[str, str] = {}  # callee key -> calling node id in `doc`
     stack = [doc]
     seen = set()
@@ -383,21 +413,29 @@ def _call_cycles(doc: MaterialDocument, resolver: FunctionResolver | None) -> li
         if k in seen:
             continue
         seen.add(k)
-        calls.add_node(k)
+        calls.setdefault(k, set())
         for nid, ref in function_refs(d):
             try:
                 callee = resolver.resolve(ref, d)
             except (LookupError, ValueError):
                 continue  # reported where the ports are resolved
             ck = _doc_key(callee)
-            calls.add_edge(k, ck)
+            calls[k].add(ck)
             if d is doc:
                 first_hop.setdefault(ck, nid)
             stack.append(callee)
+    edges = [(a, b) for a, callees in calls.items() for b in callees]
     try:
-        cycle = nx.find_cycle(calls, source=_doc_key(doc))
-    except nx.NetworkXNoCycle:
-        depth = nx.dag_longest_path_length(calls)
+        order = stable_order(calls, edges)
+    except CycleError:
+        cycle = _cycle(calls, edges, source=_doc_key(doc))
+    else:
+        hops: dict[str, int] = {}  # the longest chain of calls ending at each document
+        for k in order:
+            hops.setdefault(k, 0)
+            for callee_key in calls.get(k, ()):
+                hops[callee_key] = max(hops.get(callee_key, 0), hops[k] + 1)
+        depth = max(hops.values(), default=0)
         if depth > MAX_CALL_DEPTH:
             return [error(f"material functions nest {depth} calls deep; at most "
                           f"{MAX_CALL_DEPTH} levels are allowed", next(iter(first_hop.values()),
@@ -445,6 +483,8 @@ def check_connect(
         return f"{link.src} has no output {link.src_port!r}"
     if dst_ports.input(link.dst_port) is None:
         return f"{link.dst} has no input {link.dst_port!r}"
+    import networkx as nx
+
     dep = dependency_graph(doc)
     if nx.has_path(dep, link.dst, link.src):
         return f"connecting {link.src} to {link.dst} would close a cycle"
