@@ -43,6 +43,10 @@ def test_editor_exports_and_imports(qtbot, tmp_path):
     assert ia.import_mtlx(tmp_path / "m.mtlx", tmp_path / "back.json"), ia.last_message
     assert w.controller.document.path == tmp_path / "back.json"
     assert any(n.kind == "texture_sample" for n in w.controller.document.graph.nodes.values())
+    # the import is arranged before it is saved: no overlaps, no wire through a node
+    from matedit.app.canvas.arrange import layout_problems
+
+    assert layout_problems(w.canvas.scene()) == []
 
 
 def test_editor_import_error_names_the_node(qtbot, tmp_path, monkeypatch):

@@ -4,7 +4,8 @@ through the body of a node other than the two it joins.
 Each sample is loaded into the real canvas scene, so node sizes are the editor's own, and
 every node of a kind that always shows a thumbnail gets one (its tallest size: a node without
 its thumbnail is shorter, with its ports where they were, so it can only clear more room).
-The check is geometric, on the scene's items. tools/layout_samples.py writes the layouts.
+The check is geometric, on the scene's items (`layout_problems`, which Edit › Arrange also
+uses). tools/layout_samples.py writes the layouts.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import pytest  # noqa: E402
 from PySide6.QtGui import QColor, QImage  # noqa: E402
 
 from matedit.app.canvas import NodeCanvasView  # noqa: E402
+from matedit.app.canvas.arrange import layout_problems  # noqa: E402
 from matedit.app.controller import DocumentController  # noqa: E402
 from matedit.app.previews import SIZE  # noqa: E402
 from matedit.graph.nodes import Thumbnail, definition  # noqa: E402
@@ -29,12 +31,6 @@ pytestmark = pytest.mark.gui
 GRAPHS = Path(__file__).resolve().parent.parent / "graphs"
 SAMPLES = sorted(p for sub in ("materials", "functions", "layers", "instances")
                  for p in (GRAPHS / sub).glob("*.json") if '"position"' in p.read_text())
-
-NODE_MARGIN = 6.0  # scene units kept clear around each node's bounding rect (ports included)
-WIRE_STEPS = 200  # samples along each wire
-END_ALLOWANCE = 0.03  # the first and last 3 % of a wire sit at its ports: not checked
-BODY_INSET = 1.0  # a wire grazing a body's edge by under a unit is not "through" it
-
 
 def with_thumbnails(scene):
     """Give each node that always shows a thumbnail in the editor a (grey) one."""
@@ -50,34 +46,6 @@ def sample_scene(qtbot, path: Path):
     view = NodeCanvasView(DocumentController(load(path)))
     qtbot.addWidget(view)
     return with_thumbnails(view.scene())
-
-
-def layout_problems(scene) -> list[str]:
-    """Overlapping node pairs and wires through foreign node bodies, as readable lines."""
-    items = dict(sorted(scene.node_items.items()))
-    rects = {nid: it.sceneBoundingRect().adjusted(-NODE_MARGIN, -NODE_MARGIN, NODE_MARGIN,
-                                                  NODE_MARGIN) for nid, it in items.items()}
-    problems = []
-    ids = list(rects)
-    for i, a in enumerate(ids):
-        for b in ids[i + 1:]:
-            if rects[a].intersects(rects[b]):
-                problems.append(f"nodes {a} and {b} overlap")
-    bodies = {nid: it.mapRectToScene(it.shape().boundingRect()).adjusted(
-        BODY_INSET, BODY_INSET, -BODY_INSET, -BODY_INSET) for nid, it in items.items()}
-    for link, wire in sorted(scene.wire_items.items(), key=lambda kv: str(kv[0])):
-        path = wire.mapToScene(wire.path())
-        lo, hi = int(END_ALLOWANCE * WIRE_STEPS), int((1 - END_ALLOWANCE) * WIRE_STEPS)
-        hit = set()
-        for k in range(lo, hi + 1):
-            pt = path.pointAtPercent(k / WIRE_STEPS)
-            for nid, body in bodies.items():
-                if nid not in (link.src, link.dst) and body.contains(pt):
-                    hit.add(nid)
-        for nid in sorted(hit):
-            problems.append(f"wire {link.src}.{link.src_port} -> {link.dst}.{link.dst_port} "
-                            f"crosses node {nid}")
-    return problems
 
 
 @pytest.mark.parametrize("path", SAMPLES, ids=lambda p: f"{p.parent.name}/{p.stem}")

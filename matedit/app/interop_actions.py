@@ -284,6 +284,7 @@ class InteropActions:
             self.last_message = text
             return False
 
+        from matedit.app.canvas.arrange import arrange_document
         from matedit.interop.mtlx_import import MtlxImportError, import_mtlx
         from matedit.io.atomic import atomic_write_text
         from matedit.io.document import dumps
@@ -292,6 +293,7 @@ class InteropActions:
         try:
             refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
             doc = import_mtlx(src, out, material)
+            arrange_document(doc)  # the importer's own columns, made readable
             if not self.host.actions.maybe_save():
                 return False
             atomic_write_text(out, dumps(doc))

@@ -75,6 +75,9 @@ TABLE: tuple[CanvasCommand, ...] = (
                   tip="Frame the selected nodes in a comment", enabled=_has_nodes_selected),
     CanvasCommand("rename", "&Rename Node", lambda v: v.rename_selected(), ("F2",),
                   tip="Rename the selected node", enabled=_one_node_selected),
+    CanvasCommand("arrange", "Arran&ge", lambda v: v.arrange_selection(), ("L",),
+                  tip="Lay out the selected nodes (everything when fewer than two are "
+                      "selected) in columns, outputs on the right"),
     CanvasCommand("frame_all", "Frame &All", lambda v: v.frame_all(), ("Home", "A"), "frame",
                   "Frame the whole graph"),
     CanvasCommand("frame_selection", "Frame &Selection", lambda v: v.frame_selection(),
@@ -87,9 +90,9 @@ TABLE: tuple[CanvasCommand, ...] = (
 )
 
 EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", None,
-             "add_node")
+             "arrange", "add_node")
 VIEW_MENU = ("frame_all", "frame_selection", "minimap")
-CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename",
+CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename", "arrange",
                 "frame_all")
 
 
