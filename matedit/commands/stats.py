@@ -199,6 +199,8 @@ def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
     attributed = sum(f.instructions for f in shares.values())
     total = totals.figures.instructions
     scale = total / attributed if attributed else 1.0
+    attributed_samples = sum(f.samples for f in shares.values())
+    sample_scale = totals.figures.samples / attributed_samples if attributed_samples else 1.0
     # per op of the material's main scope, and per (layer call op, inner op)
     main_ops = cm.ir.main.ops
     per_node: dict[str, cost.Figures] = {}
@@ -222,7 +224,7 @@ def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
 
     def row(fig: cost.Figures) -> dict[str, float]:
         return {"instructions": _round(fig.instructions * scale),
-                "samples": _round(fig.samples * scale)}
+                "samples": _round(fig.samples * sample_scale)}
 
     nodes = []
     for n in doc.graph.nodes.values():
@@ -276,13 +278,16 @@ def material_stats(doc, resolver, targets: list[str]) -> dict[str, Any]:
     glsl = sorted({t if t in TARGETS else "glsl450" for t in targets})
     compiled = compile_all(doc, resolver, glsl)
     out: dict[str, Any] = {}
-    with tempfile.TemporaryDirectory(prefix="matedit-stats-") as tmp:
+    from concurrent.futures import ThreadPoolExecutor
+
+    with tempfile.TemporaryDirectory(prefix="matedit-stats-") as tmp, \
+            ThreadPoolExecutor(4) as pool:  # the tools run as processes: in parallel
         folder = Path(tmp)
+        jobs = {(t, dbg): pool.submit(spirv_text, compiled[t].fragment_text, t, dbg, folder)
+                for t in glsl for dbg in (True, False)}
         for t in glsl:
-            cm = compiled[t]
-            rel = spirv_text(cm.fragment_text, t, False, folder)
-            dbg = spirv_text(cm.fragment_text, t, True, folder)
-            out[t] = target_figures(cm, doc, rel, dbg)
+            out[t] = target_figures(compiled[t], doc, jobs[(t, False)].result(),
+                                    jobs[(t, True)].result())
             out[t]["module"] = ("glslangValidator -V" if TARGETS[t].vulkan else
                                 "glslangValidator -G") + " | spirv-opt -O" + \
                 (" (as #version 310 es)" if t == "essl300" else "")
@@ -424,6 +429,7 @@ def text_report(rep: dict, top: int = 10) -> str:
         lines.append(f"\nmeasured ({m['size']}x{m['size']}, {m['runs']} runs, {m['renderer']}):"
                      f" frame {m['frame_ms']['median']:.3f} ms median")
         for r in m["rows"]:
+            note = "  (clamped at 0)" if r["clamped"] else ""
             lines.append(f"  {r['what']:<6} {r['id']:<24} {r['cost_ms']['median']:>8.3f} ms "
-                         f"(IQR {r['cost_ms']['iqr']:.3f}){'  clamped at 0' if r['clamped'] else ''}")
+                         f"(IQR {r['cost_ms']['iqr']:.3f}){note}")
     return "\n".join(lines) + "\n"

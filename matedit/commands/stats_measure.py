@@ -122,8 +122,9 @@ def _stats(xs: list[float]) -> dict[str, float]:
 
 
 def measure_costs(doc, resolver, per_target: dict, size: int = 256, runs: int = 9,
-                  top: int = TOP_NODES) -> dict[str, Any]:
-    """The timed report (see the module's docstring)."""
+                  top: int = TOP_NODES, only: list[str] | None = None) -> dict[str, Any]:
+    """The timed report (see the module's docstring); `only`: time just these nodes' subtrees
+    (no layers) instead of the layers and the `top` costliest nodes."""
     os.environ["MESA_SHADER_CACHE_DISABLE"] = "true"  # every variant compiled afresh
     from matedit.compiler import compile_document
     from matedit.render import Renderer
@@ -132,13 +133,15 @@ def measure_costs(doc, resolver, per_target: dict, size: int = 256, runs: int = 
     counted = per_target.get("glsl450") or next(iter(per_target.values()))
     means = mean_values(doc, resolver)
     variants: list[tuple[str, str, Any]] = []
-    for layer in counted["layers"]:
+    for layer in counted["layers"] if only is None else []:
         d = layer_removed(doc, layer["stack"], layer["id"])
         if d is not None:
             variants.append(("layer", layer["id"], d))
     skip = {"make_attributes", "material_output", "layer_stack"}
-    for row in [r for r in counted["nodes"] if r["instructions"] > 0 and
-                r["kind"] not in skip][:top]:
+    chosen = [r for r in counted["nodes"] if r["instructions"] > 0 and
+              r["kind"] not in skip][:top] if only is None else \
+        [r for r in counted["nodes"] if r["id"] in only]
+    for row in chosen:
         d = replaced_by_constant(doc, row["id"], means)
         if d is not None:
             variants.append(("node", row["id"], d))
@@ -175,9 +178,9 @@ def measure_costs(doc, resolver, per_target: dict, size: int = 256, runs: int = 
         diffs = [f - v for f, v in zip(full, times[k])]
         st = _stats(diffs)
         clamped = st["median"] < 0
+        q1, med, q3 = (max(0.0, st[k]) for k in ("q1", "median", "q3"))
         rows.append({"what": what, "id": ident,
-                     "cost_ms": {key: max(0.0, v) if key != "iqr" else v
-                                 for key, v in st.items()},
+                     "cost_ms": {"median": med, "q1": q1, "q3": q3, "iqr": q3 - q1},
                      "clamped": bool(clamped or st["q1"] < 0),
                      "runs_ms": [round(x, 4) for x in diffs]})
     rows.sort(key=lambda r: -r["cost_ms"]["median"])

@@ -228,13 +228,3 @@ def _int(text: str) -> int | None:
         return int(text)
     except ValueError:
         return None
-
-
-def scaled(shares: dict[str, float], total: int) -> dict[str, float]:
-    """`shares` scaled so they sum to `total` (used when the attributed module and the
-    counted one differ: debug information can keep a few values alive)."""
-    s = sum(shares.values())
-    if s <= 0:
-        return {k: 0.0 for k in shares}
-    f = total / s
-    return {k: v * f for k, v in shares.items()}
