@@ -429,7 +429,9 @@ def text_report(rep: dict, top: int = 10) -> str:
         lines.append(f"\nmeasured ({m['size']}x{m['size']}, {m['runs']} runs, {m['renderer']}):"
                      f" frame {m['frame_ms']['median']:.3f} ms median")
         for r in m["rows"]:
-            note = "  (clamped at 0)" if r["clamped"] else ""
+            c = r["cost_ms"]
+            note = "" if not r["clamped"] else "  (clamped at 0)" if c["median"] == 0 else \
+                "  (lower quartile clamped at 0)"
             lines.append(f"  {r['what']:<6} {r['id']:<24} {r['cost_ms']['median']:>8.3f} ms "
                          f"(IQR {r['cost_ms']['iqr']:.3f}){note}")
     return "\n".join(lines) + "\n"
