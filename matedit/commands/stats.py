@@ -433,5 +433,9 @@ def text_report(rep: dict, top: int = 10) -> str:
             note = "" if not r["clamped"] else "  (clamped at 0)" if c["median"] == 0 else \
                 "  (lower quartile clamped at 0)"
             lines.append(f"  {r['what']:<6} {r['id']:<24} {r['cost_ms']['median']:>8.3f} ms "
-                         f"(IQR {r['cost_ms']['iqr']:.3f}){note}")
+                         f"(IQR {r['cost_ms']['iqr']:.3f}), counted "
+                         f"{r['counted_instructions']} instr{note}")
+        rc = m["rank_correlation"]
+        lines.append("  rank correlation, measured vs counted (Spearman): " +
+                     ("n/a" if rc is None else f"{rc:.2f}"))
     return "\n".join(lines) + "\n"

@@ -115,6 +115,45 @@ def layer_removed(doc, stack: str, layer_id: str):
     return d
 
 
+def _counted_differences(full: int, variants, resolver) -> list[int]:
+    """glsl450 instructions of the full material minus each variant's (the counted cost of
+    what the variant takes out, to compare with the measured one)."""
+    import tempfile
+    from pathlib import Path
+
+    from matedit.commands.stats import spirv_text
+    from matedit.compiler import compile_document, cost
+
+    out = []
+    with tempfile.TemporaryDirectory(prefix="matedit-measure-") as tmp:
+        for _, _, d in variants:
+            cm = compile_document(d, resolver, "glsl450")
+            m = cost.parse(spirv_text(cm.fragment_text, "glsl450", False, Path(tmp)))
+            out.append(full - cost.count(m).figures.instructions)
+    return out
+
+
+def rank_correlation(a: list[float], b: list[float]) -> float | None:
+    """Spearman's rank correlation (ties take their mean rank); None under 3 pairs or when
+    either side is constant."""
+    if len(a) < 3:
+        return None
+
+    def ranks(xs: list[float]) -> np.ndarray:
+        x = np.asarray(xs, dtype=np.float64)
+        order = np.argsort(x, kind="mergesort")
+        r = np.empty(len(x))
+        r[order] = np.arange(len(x), dtype=np.float64)
+        for v in np.unique(x):  # ties: the mean of their ranks
+            r[x == v] = r[x == v].mean()
+        return r
+
+    ra, rb = ranks(a), ranks(b)
+    if ra.std() == 0 or rb.std() == 0:
+        return None
+    return float(np.corrcoef(ra, rb)[0, 1])
+
+
 def _stats(xs: list[float]) -> dict[str, float]:
     a = np.asarray(xs, dtype=np.float64)
     q1, med, q3 = np.percentile(a, [25, 50, 75])
@@ -148,6 +187,7 @@ def measure_costs(doc, resolver, per_target: dict, size: int = 256, runs: int = 
     programs = [("full", "", compile_document(doc, resolver, "glsl330"))]
     for what, ident, d in variants:
         programs.append((what, ident, compile_document(d, resolver, "glsl330")))
+    counted_diff = _counted_differences(counted["instructions"], variants, resolver)
     ctx = headless_context()
     try:
         renderer = Renderer(ctx, (size, size), samples=1, environment=None)
@@ -179,12 +219,14 @@ def measure_costs(doc, resolver, per_target: dict, size: int = 256, runs: int = 
         st = _stats(diffs)
         clamped = st["median"] < 0
         q1, med, q3 = (max(0.0, st[k]) for k in ("q1", "median", "q3"))
-        rows.append({"what": what, "id": ident,
+        rows.append({"what": what, "id": ident, "counted_instructions": counted_diff[k - 1],
                      "cost_ms": {"median": med, "q1": q1, "q3": q3, "iqr": q3 - q1},
                      "clamped": bool(clamped or st["q1"] < 0),
                      "runs_ms": [round(x, 4) for x in diffs]})
     rows.sort(key=lambda r: -r["cost_ms"]["median"])
     return {"size": size, "runs": runs, "renderer": str(info), "frame_ms": _stats(full),
             "rows": rows,
+            "rank_correlation": rank_correlation([r["counted_instructions"] for r in rows],
+                                                 [r["cost_ms"]["median"] for r in rows]),
             "method": "median and IQR over rounds of (full frame - variant frame), each "
                       "figure clamped at 0"}
