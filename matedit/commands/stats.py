@@ -34,8 +34,9 @@ MAX_PERMUTATIONS = 16  # all combinations up to 4 switches; beyond, each switch 
 ATTRIBUTION = (
     "Each instruction of the optimised SPIR-V (spirv-opt -O) is charged to the outermost "
     "material node whose generated line it was inlined from (glslang -gV debug scopes, kept "
-    "by spirv-opt); code spirv-opt shares between nodes stays with the node whose copy it "
-    "kept, whole; folded constants and dead nodes have no instructions and cost 0; code no "
+    "by spirv-opt); code spirv-opt shares between nodes (one copy computing a value that "
+    "another node also uses without being fed by the first) is split evenly between them; "
+    "folded constants and dead nodes have no instructions and cost 0; code no "
     "node owns (shading model, lights, entry point) is the 'shading' row. The debug module "
     "is attributed and its shares are scaled to the release module's total.")
 
@@ -187,6 +188,42 @@ def _round(x: float) -> float:
     return round(x, 1)
 
 
+def _depends(ops) -> list[set[int]]:
+    """For each op of a scope, the indices of the ops it depends on, transitively."""
+    from matedit.compiler.ir import Splat, Var
+
+    by_name: dict[str, int] = {}
+    for k, op in enumerate(ops):
+        for port, _ in op.outs:
+            by_name[op.out(port).name] = k
+    deps: list[set[int]] = []
+    for op in ops:
+        d: set[int] = set()
+        for a in op.args:
+            while isinstance(a, Splat):
+                a = a.expr
+            if isinstance(a, Var) and a.name in by_name:
+                k = by_name[a.name]
+                d.add(k)
+                d |= deps[k]
+        deps.append(d)
+    return deps
+
+
+class _Share:
+    """Instructions and samples (floats: shared code is split) of one owner."""
+
+    def __init__(self) -> None:
+        self.instructions = 0.0
+        self.samples = 0.0
+
+    def add(self, f: dict) -> None:
+        from matedit.compiler.cost import instructions
+
+        self.instructions += instructions(f)
+        self.samples += f["samples"]
+
+
 def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
     """The figures of one GLSL target's compile (`release`, `debug`: disassembled modules)."""
     from matedit.compiler import cost
@@ -194,62 +231,74 @@ def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
 
     totals = cost.count(cost.parse(release))
     mod = cost.parse(debug)
-    owner, lines = _owner_fn(cm)
-    shares = cost.attribute(mod, owner)
-    attributed = sum(f.instructions for f in shares.values())
+    owner, _lines = _owner_fn(cm)
+    main_ops = cm.ir.main.ops
+    deps = _depends(main_ops)
+
+    def root(key: str) -> int:
+        return int(key.split("/", 1)[0][1:])
+
+    def shared(a: str, b: str) -> bool:  # b uses a's value, and b's op is not fed by a's
+        ka, kb = root(a), root(b)
+        return ka != kb and ka not in deps[kb]
+
+    shares = cost.attribute(mod, owner, shared)
+    attributed = sum(cost.instructions(f) for f in shares.values())
     total = totals.figures.instructions
     scale = total / attributed if attributed else 1.0
-    attributed_samples = sum(f.samples for f in shares.values())
+    attributed_samples = sum(f["samples"] for f in shares.values())
     sample_scale = totals.figures.samples / attributed_samples if attributed_samples else 1.0
-    # per op of the material's main scope, and per (layer call op, inner op)
-    main_ops = cm.ir.main.ops
-    per_node: dict[str, cost.Figures] = {}
-    per_op: dict[int, cost.Figures] = {}
-    inner: dict[tuple[int, str], cost.Figures] = {}
-    shading = cost.Figures()
+    # per op of the material's main scope, and per (layer call op, inner node)
+    per_node: dict[str, _Share] = {}
+    per_op: dict[int, _Share] = {}
+    inner: dict[tuple[int, str], _Share] = {}
+    shading = _Share()
     for key, fig in shares.items():
         if key is None:
-            shading += fig
+            shading.add(fig)
             continue
         parts = key.split("/")
-        k = int(parts[0][1:])
-        per_op.setdefault(k, cost.Figures()).__iadd__(fig)
-        per_node.setdefault(main_ops[k].node, cost.Figures()).__iadd__(fig)
+        k = root(key)
+        per_op.setdefault(k, _Share()).add(fig)
+        per_node.setdefault(main_ops[k].node, _Share()).add(fig)
+        inner_node = ""
         if len(parts) > 1:
             fname, idx = parts[1].split(":")
             fn = next(f for f in cm.ir.functions if f.name == fname)
-            inner.setdefault((k, fn.ops[int(idx)].node), cost.Figures()).__iadd__(fig)
-        else:
-            inner.setdefault((k, ""), cost.Figures()).__iadd__(fig)
+            inner_node = fn.ops[int(idx)].node
+        inner.setdefault((k, inner_node), _Share()).add(fig)
 
-    def row(fig: cost.Figures) -> dict[str, float]:
+    def row(fig: _Share) -> dict[str, float]:
         return {"instructions": _round(fig.instructions * scale),
                 "samples": _round(fig.samples * sample_scale)}
 
     nodes = []
     for n in doc.graph.nodes.values():
-        fig = per_node.get(n.id, cost.Figures())
+        fig = per_node.get(n.id, _Share())
         nodes.append({"id": n.id, "kind": n.kind, **row(fig),
                       "share": round(fig.instructions / attributed, 4) if attributed else 0.0})
     nodes.sort(key=lambda r: (-r["instructions"], r["id"]))
     layers = []
     for stack, entries in _layer_info(doc).items():
         for e in entries:
-            own = cost.Figures()
-            blend = cost.Figures()
-            layer_nodes: dict[str, cost.Figures] = {}
+            own, blend = _Share(), _Share()
+            layer_nodes: dict[str, _Share] = {}
             for k, op in enumerate(main_ops):
                 parts = op.var.split(".")
                 if op.node != stack or len(parts) < 2 or parts[1] != e["id"]:
                     continue
-                fig = per_op.get(k, cost.Figures())
-                own += fig
+                fig = per_op.get(k, _Share())
+                own.instructions += fig.instructions
+                own.samples += fig.samples
                 if len(parts) > 2:  # the blend's ops: weight, blend, height blend, ...
-                    blend += fig
-                else:
-                    for (kk, inner_node), f in inner.items():
-                        if kk == k and inner_node:
-                            layer_nodes.setdefault(inner_node, cost.Figures()).__iadd__(f)
+                    blend.instructions += fig.instructions
+                    blend.samples += fig.samples
+                    continue
+                for (kk, inner_node), f in inner.items():
+                    if kk == k and inner_node:
+                        acc = layer_nodes.setdefault(inner_node, _Share())
+                        acc.instructions += f.instructions
+                        acc.samples += f.samples
             layers.append({"stack": stack, "id": e["id"], "name": e["name"],
                            "blend": e["blend"], "visible": bool(e["visible"]), **row(own),
                            "blend_cost": row(blend),
@@ -263,7 +312,7 @@ def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
         "varyings": totals.inputs,
         "outputs": totals.outputs,
         "uniform_bytes": ubytes,
-        "attributed_instructions": attributed,
+        "attributed_instructions": int(round(attributed)),
         "scale": round(scale, 4),
         "shading": row(shading),
         "nodes": nodes,

@@ -14,10 +14,12 @@ here. Two things are read:
   "unattributed" key. Lines are matedit's encoded `#line` numbers (source * 100000 + line,
   `matedit.glsl.include`), so a line says which file it is in.
 
-An instruction has exactly one owner, so owners' figures sum to the module's. Code that
-spirv-opt shares between nodes (common subexpressions, hoisted loads) keeps the location of
-the copy it kept, so it is charged to that node whole, not split; code folded to a constant
-is no instruction at all and costs nothing.
+Each instruction is counted once, so owners' figures sum to the module's. Code that
+spirv-opt shares between nodes (a common subexpression, a hoisted load) keeps the location
+of the copy it kept; `attribute` splits it evenly between that owner and the others that use
+its value without being fed by it (the caller says which uses are inputs). Code folded to a
+constant is no instruction at all and costs nothing. Owner keys are paths, 'root/inner/...':
+keys with the same root (the part before the first '/') are one owner's.
 """
 
 from __future__ import annotations
@@ -64,11 +66,6 @@ class Figures:
         setattr(self, cls, getattr(self, cls) + 1)
         if sample:
             self.samples += 1
-
-    def __iadd__(self, other: Figures) -> Figures:
-        for f in ("alu", "texture", "memory", "control", "samples"):
-            setattr(self, f, getattr(self, f) + getattr(other, f))
-        return self
 
     def as_dict(self) -> dict[str, int]:
         return {"instructions": self.instructions, "alu": self.alu, "texture": self.texture,
@@ -191,15 +188,26 @@ def chain_of(m: Module, line: int | None, inlined_at: str | None) -> list[int]:
     return out
 
 
-def attribute(m: Module, owner: Callable[[list[int]], str | None]) -> dict[str | None, Figures]:
-    """Each executed instruction's figures under `owner(chain)`. The current line and scope
-    carry across block boundaries within a function (spirv-opt leaves the first instructions
-    of a merge block, phis and loads, without a scope of their own)."""
-    out: dict[str | None, Figures] = {}
+@dataclass
+class Owned:
+    """One instruction of a function body with its owner: `cls` is (class, is a sample) of
+    an executed one, None for one that only passes values on (a phi)."""
+
+    key: str | None
+    cls: tuple[str, bool] | None
+    rid: str | None
+    uses: list[str]
+
+
+def owned(m: Module, owner: Callable[[list[int]], str | None]) -> list[Owned]:
+    """Every instruction that computes or passes a value, with `owner(chain)`. The current
+    line and scope carry across block boundaries within a function (spirv-opt leaves the
+    first instructions of a merge block, phis and loads, without a scope of their own)."""
+    out: list[Owned] = []
     line: int | None = None
     scope_inlined: str | None = None
     cache: dict[tuple[int | None, str | None], str | None] = {}
-    for _, op, args in m.body:
+    for rid, op, args in m.body:
         if op == "OpFunction":
             line, scope_inlined = None, None
             continue
@@ -214,13 +222,73 @@ def attribute(m: Module, owner: Callable[[list[int]], str | None]) -> dict[str |
                 scope_inlined = args[4] if len(args) > 4 else None
             continue
         c = _classify(op)
-        if c is None:
+        if c is None and op != "OpPhi":
             continue
         key = (line, scope_inlined)
         if key not in cache:
             cache[key] = owner(chain_of(m, line, scope_inlined))
-        out.setdefault(cache[key], Figures()).add(*c)
+        out.append(Owned(cache[key], c, rid, [a for a in args if a.startswith("%")]))
     return out
+
+
+def attribute(m: Module, owner: Callable[[list[int]], str | None],
+              shared: Callable[[str, str], bool] | None = None) -> dict[str | None, dict]:
+    """Each executed instruction's figures (floats) under its owner. With `shared`, an
+    instruction owned by a node whose value another owner also uses, where `shared(own,
+    other)` says that use is not the other's own input (spirv-opt merged two copies of the
+    same code), is split evenly between its owner and those others, with the instructions
+    of the owner that compute it. The split moves instructions between owners, never adds
+    or drops one: the total is the module's."""
+    ins = owned(m, owner)
+    n = len(ins)
+    sharers: list[frozenset[str]] = [frozenset()] * n
+    if shared is not None:
+        defs = {x.rid: i for i, x in enumerate(ins) if x.rid}
+        users: list[list[int]] = [[] for _ in range(n)]
+        for j, x in enumerate(ins):
+            for u in x.uses:
+                i = defs.get(u)
+                if i is not None and i != j:
+                    users[i].append(j)
+        for i in range(n - 1, -1, -1):
+            ki = ins[i].key
+            if ki is None:
+                continue  # the shading's own code stays the shading's
+            found: set[str] = set()
+            for j in users[i]:
+                kj = ins[j].key
+                if kj is None:
+                    continue
+                if not shared(ki, kj):
+                    if kj == ki or _same_root(ki, kj):
+                        found |= sharers[j]  # the owner's own chain: its sharers' too
+                    continue
+                found.add(kj)
+            found.discard(ki)
+            sharers[i] = frozenset(found)
+    out: dict[str | None, dict] = {}
+    for i, x in enumerate(ins):
+        if x.cls is None:
+            continue
+        owners: list[str | None] = [x.key, *sorted(sharers[i])]
+        w = 1.0 / len(owners)
+        cls, sample = x.cls
+        for k in owners:
+            f = out.setdefault(k, {"alu": 0.0, "texture": 0.0, "memory": 0.0,
+                                   "control": 0.0, "samples": 0.0})
+            f[cls] += w
+            if sample:
+                f["samples"] += w
+    return out
+
+
+def _same_root(a: str, b: str) -> bool:
+    return a.split("/", 1)[0] == b.split("/", 1)[0]
+
+
+def instructions(f: dict) -> float:
+    """The instructions of one owner's figures from `attribute`."""
+    return f["alu"] + f["texture"] + f["memory"] + f["control"]
 
 
 def _int(text: str) -> int | None:
