@@ -338,3 +338,62 @@ def test_bad_input_is_one_error_line(tmp_path, args, needle):
     assert len(lines) == 1 and lines[0].startswith("error: ") and needle in lines[0], lines
     r = _cli(str(bad))
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "bad.json" in r.stderr
+
+
+# --- the attribution rule on a module written by hand ------------------------------------------
+_HAND = """
+%1 = OpExtInstImport "NonSemantic.Shader.DebugInfo.100"
+%u = OpConstant %int 0
+%l1 = OpConstant %int 3300001
+%l2 = OpConstant %int 3300002
+%l3 = OpConstant %int 3300003
+%l9 = OpConstant %int 1600009
+%l50 = OpConstant %int 3300050
+%in = OpExtInst %void %1 DebugInlinedAt %l1 %s
+%main = OpFunction %void None %f
+%lab = OpLabel
+%d1 = OpExtInst %void %1 DebugLine %src %l1 %l1 %u %u
+%a = OpFMul %float %x %x
+%b = OpFAdd %float %a %x
+%d2 = OpExtInst %void %1 DebugLine %src %l2 %l2 %u %u
+%c = OpFMul %float %a %y
+%d3 = OpExtInst %void %1 DebugLine %src %l3 %l3 %u %u
+%e = OpFSub %float %b %c
+%sc = OpExtInst %void %1 DebugScope %s %in
+%d9 = OpExtInst %void %1 DebugLine %src %l9 %l9 %u %u
+%g = OpImageSampleImplicitLod %v4float %si %b
+%s0 = OpExtInst %void %1 DebugScope %s
+%d0 = OpExtInst %void %1 DebugLine %src %l50 %l50 %u %u
+OpReturn
+OpFunctionEnd
+"""
+
+
+def test_attribution_rule_on_a_hand_written_module():
+    """Lines 1, 2, 3 of the material (source 33) are nodes A, B, C; C is fed by A and B, B is
+    not fed by A. %a (A's) is used by A's own %b and by B's %c: B shares it, so %a is split
+    A 1/2, B 1/2; %b is A's alone (C's use of it is C's input). The sample at a library line
+    (source 16) inlined at line 1 is A's. OpReturn, at line 50 (the entry point's, no node),
+    is the shading's."""
+    from matedit.compiler import cost
+
+    m = cost.parse(_HAND)
+    names = {1: "A", 2: "B", 3: "C"}
+
+    def owner(chain):
+        for line in reversed(chain):
+            src, n = divmod(line, 100_000)
+            if src == 33 and n in names:
+                return f"{names[n]}:0"
+        return None
+
+    fed_by = {"A": set(), "B": set(), "C": {"A", "B"}}
+    split = cost.attribute(m, owner, lambda a, b: a[0] != b[0] and a[0] not in fed_by[b[0]])
+    got = {k: cost.instructions(f) for k, f in split.items()}
+    assert got == {"A:0": 2.5, "B:0": 1.5, "C:0": 1.0, None: 1.0}
+    assert split["A:0"]["samples"] == 1.0 and split["A:0"]["texture"] == 1.0
+    whole = cost.attribute(m, owner)  # without the rule: each instruction to its line
+    assert {k: cost.instructions(f) for k, f in whole.items()} == \
+        {"A:0": 3.0, "B:0": 1.0, "C:0": 1.0, None: 1.0}
+    t = cost.count(m)
+    assert t.figures.instructions == 6 and t.figures.samples == 1
