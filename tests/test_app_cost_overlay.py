@@ -55,8 +55,22 @@ def test_cost_overlay_tints_nodes_and_tooltips_carry_the_figures(qtbot):
     assert item.cost[0] == pytest.approx(rows["mask_noise"]["instructions"] / top)
     assert max(i.cost[0] for i in canvas.scene().node_items.values() if i.cost) == 1.0
 
+    # an edit while the overlay is on: the figures follow it (the noise's node gone, what it
+    # fed keeps its own cost, and the material's total drops by about the noise's share)
+    from matedit.graph.commands import RemoveNode
+
+    before = canvas.cost_overlay.report
+    assert canvas.controller.push(RemoveNode("mask_noise"))
+    qtbot.waitUntil(lambda: canvas.cost_overlay.report is not before, timeout=120_000)
+    after = canvas.cost_overlay.report
+    assert "mask_noise" not in {r["id"] for r in after["nodes"]}
+    assert "mask_noise" not in canvas.scene().costs
+    assert after["instructions"] < before["instructions"]
+    assert before["instructions"] - after["instructions"] == pytest.approx(
+        rows["mask_noise"]["instructions"], rel=0.25)
+
     action.trigger()
     table.refresh(canvas)
     assert not action.isChecked()
     qtbot.waitUntil(lambda: not canvas.scene().costs, timeout=5_000)
-    assert item.toolTip() == plain and item.cost is None
+    assert all(i.cost is None for i in canvas.scene().node_items.values())

@@ -1,8 +1,8 @@
 """The canvas's cost overlay (View ▸ Cost Overlay): each node tinted by its share of the
 material's instructions, the figures in its tooltip. The figures are `matedit stats`'s for
 glsl450 (`matedit.commands.stats.material_stats`: glslang and spirv-opt, a second or two),
-computed on a worker thread from a copy of the document; a newer request supersedes an older
-one, whose answer is dropped."""
+computed on a worker thread from a copy of the document, one at a time; a request made while
+one runs waits for it and supersedes it (the older answer is dropped)."""
 
 from __future__ import annotations
 
@@ -49,6 +49,8 @@ class CostOverlay(QObject):
         self.active = False
         self.report: dict | None = None  # the last figures shown
         self._generation = 0
+        self._busy = False  # a worker is running: a new request waits for it
+        self._pending = False
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.setInterval(400)  # edits in a burst: one computation after them
@@ -72,6 +74,9 @@ class CostOverlay(QObject):
     def request(self) -> None:
         if not self.active:
             return
+        if self._busy:  # one worker at a time: edits in a row never pile up computations
+            self._pending = True
+            return
         doc = self._document()
         self._generation += 1
         gen = self._generation
@@ -80,6 +85,7 @@ class CostOverlay(QObject):
                              "this function")
             return
         work = document_copy(doc)
+        self._busy = True
         threading.Thread(target=self._work, args=(gen, work), daemon=True,
                          name="matedit-cost-overlay").start()
 
@@ -94,6 +100,11 @@ class CostOverlay(QObject):
         self._done.emit(gen, result)
 
     def _finished(self, gen: int, result: object) -> None:
+        self._busy = False
+        if self._pending:
+            self._pending = False
+            self.request()
+            return
         if gen != self._generation or not self.active:
             return
         if isinstance(result, BaseException):
