@@ -201,8 +201,7 @@ def measure_costs(doc, resolver, per_target: dict, size: int = 256, runs: int = 
             ctx.finish()
         for _ in range(runs):
             for k, (_, _, cm) in enumerate(programs):
-                renderer.set_material(cm)
-                renderer.render()  # the switch itself is not timed
+                renderer.set_material(cm)  # linked once above: a switch of program
                 ctx.finish()
                 t0 = time.perf_counter()
                 renderer.render()
