@@ -6,7 +6,7 @@ Bad input raises `matedit.cli_support.UsageError` (one line, exit 2).
 """
 
 from matedit.commands import bake as bake_cmd
-from matedit.commands import bake_ibl, brdf_lut, contact_sheet, nodes, render, validate
+from matedit.commands import bake_ibl, brdf_lut, contact_sheet, nodes, render, stats, validate
 from matedit.commands import compile as compile_cmd
 from matedit.commands import export as export_cmd
 from matedit.commands import import_ as import_cmd
@@ -22,4 +22,5 @@ REGISTRY = [
     bake_cmd.register,
     export_cmd.register,
     import_cmd.register,
+    stats.register,
 ]

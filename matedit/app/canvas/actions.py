@@ -85,13 +85,17 @@ TABLE: tuple[CanvasCommand, ...] = (
     CanvasCommand("minimap", "&Minimap", lambda v: v.toggle_minimap(), ("M",),
                   tip="Show or hide the canvas minimap",
                   checked=lambda v: not v.minimap.isHidden()),
+    CanvasCommand("cost_overlay", "&Cost Overlay", lambda v: v.toggle_cost_overlay(),
+                  tip="Tint each node by its share of the material's instructions (glsl450, "
+                  "after spirv-opt -O); the figures are in its tooltip",
+                  checked=lambda v: v.cost_overlay.active),
     CanvasCommand("node_docs", "&Node Reference", lambda v: v.request_docs(), ("F1",),
                   tip="Documentation of the selected node kind", enabled=_one_node_selected),
 )
 
 EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", None,
              "arrange", "add_node")
-VIEW_MENU = ("frame_all", "frame_selection", "minimap")
+VIEW_MENU = ("frame_all", "frame_selection", "minimap", "cost_overlay")
 CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename", "arrange",
                 "frame_all")
 

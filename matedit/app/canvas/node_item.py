@@ -198,6 +198,8 @@ class NodeItem(QGraphicsRectItem):
         self.connected_inputs: set[str] = set()
         self.connected_outputs: set[str] = set()
         self.diagnostics: list[tuple[str, str]] = []  # (severity, message)
+        self._tooltip = ""  # the node's own tooltip, before the cost overlay's lines
+        self.cost: tuple[float, str] | None = None  # the cost overlay's (tint 0-1, text)
         self._preview: QPixmap | None = None
         self._ports: dict[tuple[str, bool], PortItem] = {}
         self._badge: BadgeItem | None = None
@@ -222,8 +224,25 @@ class NodeItem(QGraphicsRectItem):
         self.title, self.subtitle, self.category = title, subtitle, category
         self.inputs, self.outputs = list(inputs), list(outputs)
         self.expanded = expanded
-        self.setToolTip(tooltip)
+        self._tooltip = tooltip
+        self._show_tooltip()
         self._relayout()
+
+    def set_cost(self, cost: tuple[float, str] | None) -> None:
+        """The cost overlay: tint (0 none, 1 the costliest node) and the figures' text for the
+        tooltip; None: no overlay."""
+        if cost == self.cost:
+            return
+        self.cost = cost
+        self._show_tooltip()
+        self.update()
+
+    def _show_tooltip(self) -> None:
+        if self.cost is None:
+            self.setToolTip(self._tooltip)
+        else:
+            extra = escape(self.cost[1]).replace("\n", "<br>")
+            self.setToolTip(f"{self._tooltip}<br><br>{extra}" if self._tooltip else extra)
 
     def set_types(self, in_types: dict[str, str], out_types: dict[str, str]) -> bool:
         """Concrete types from the analysis (generic `T` ports resolve); True if any changed."""
@@ -423,6 +442,10 @@ class NodeItem(QGraphicsRectItem):
         painter.setBrush(QBrush(grad))
         painter.drawPath(body)
         painter.restore()
+        if self.cost is not None and self.cost[0] > 0:  # the cost overlay: a warm veil,
+            tint = min(1.0, self.cost[0])  # denser for costlier nodes; none on free ones
+            painter.setBrush(QColor(255, 96, 32, int(24 + 168 * tint)))
+            painter.drawPath(body)
         if self.isSelected():
             edge = QPen(C.NODE_SELECTED, 2.0 if not overview else 2.0 / max(lod, 0.1))
         elif self.has_error():

@@ -115,6 +115,7 @@ class NodeScene(QGraphicsScene):
         self._node_errors: dict[str, str] = {}  # GLSL errors mapped to nodes, from the window
         self.snap_to_grid = False  # moves end on the minor grid
         self._previews: dict[str, QImage] = {}
+        self.costs: dict[str, tuple[float, str]] = {}  # the cost overlay (set_node_costs)
         self.selected_wires: set[Link] = set()  # wires keep their own selection (see WireItem)
         self.hairline = False  # wires draw as hairlines when zoomed far out
         self.ports_visible = True  # ports hide when zoomed too far out to aim at them
@@ -181,6 +182,8 @@ class NodeScene(QGraphicsScene):
         self.addItem(item)
         if node_id in self._previews:
             item.set_preview(self._previews[node_id])
+        if node_id in self.costs:
+            item.set_cost(self.costs[node_id])
 
     def _refresh_node(self, node_id: str, item: NodeItem | None = None) -> None:
         """Title, ports and subtitle from the model (a setting may add or remove ports)."""
@@ -349,6 +352,14 @@ class NodeScene(QGraphicsScene):
             item = self.node_items.get(nid)
             if item is not None:
                 self._apply_diagnostics(item, last.get(nid, []))
+
+    def set_node_costs(self, costs: dict[str, tuple[float, str]]) -> None:
+        """The cost overlay: node id -> (tint 0-1, tooltip text); {} removes it."""
+        for nid in set(self.costs) | set(costs):
+            item = self.node_items.get(nid)
+            if item is not None:
+                item.set_cost(costs.get(nid))
+        self.costs = dict(costs)
 
     def set_node_preview(self, node_id: str, image: QImage | None) -> None:
         if image is None or image.isNull():

@@ -30,6 +30,7 @@ from matedit.app.canvas import arrange, clipboard, placement
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.actions import CONTEXT_MENU, CanvasActions
 from matedit.app.canvas.comment_item import CommentItem
+from matedit.app.canvas.cost_overlay import CostOverlay
 from matedit.app.canvas.drops import CanvasDrops
 from matedit.app.canvas.interaction import WireDrag, compatible_port, kind_ports, port_at
 from matedit.app.canvas.minimap import MiniMap
@@ -131,6 +132,11 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self.horizontalScrollBar().valueChanged.connect(self.minimap.update)
         self.verticalScrollBar().valueChanged.connect(self.minimap.update)
         self.minimap.invalidate()
+        self.cost_overlay = CostOverlay(self, lambda: self.controller.document)
+        self.cost_overlay.ready.connect(self._scene.set_node_costs)
+        self.cost_overlay.failed.connect(self.refuse)
+        controller.changed.connect(lambda _ev: self.cost_overlay.document_changed())
+        controller.documentReplaced.connect(self.cost_overlay.document_changed)
 
     # --- public API --------------------------------------------------------------------------
     def scene(self) -> NodeScene:  # type: ignore[override]
@@ -211,6 +217,10 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
 
     def toggle_minimap(self) -> None:
         self.minimap.setVisible(not self.minimap.isVisible())
+
+    def toggle_cost_overlay(self) -> None:
+        """View ▸ Cost Overlay: tint the nodes by what they cost (computed off the UI thread)."""
+        self.cost_overlay.set_active(not self.cost_overlay.active)
 
     def rename_selected(self) -> QLineEdit | None:
         """The inline title editor over the one selected node (None otherwise)."""
