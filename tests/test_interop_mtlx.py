@@ -99,6 +99,7 @@ SURFACE_INPUTS = {
     "specular_anisotropy": "anisotropy", "subsurface": "subsurface",
     "subsurface_color": "subsurfaceColor", "subsurface_radius": "subsurfaceRadius",
     "subsurface_scale": "thickness",  # as 1 / thickness (docs/shading.md, Subsurface)
+    "thin_film_thickness": "thinFilmThickness", "thin_film_IOR": "thinFilmIor",
 }
 # The talk's inputs, which every exported material has.
 TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",
@@ -889,7 +890,7 @@ _LOBE_VALUES = {
     "coatColor": [0.96, 0.64, 0.54], "coatIor": 1.6, "sheenColor": [0.2, 0.3, 0.4],
     "sheenRoughness": 0.6, "anisotropy": 0.7, "anisotropyDirection": [0.0, 1.0, 0.0],
     "subsurface": 0.6, "subsurfaceColor": [0.9, 0.5, 0.4], "subsurfaceRadius": [0.3, 0.1, 0.05],
-    "thickness": 0.25,
+    "thickness": 0.25, "thinFilmThickness": 420.0, "thinFilmIor": 1.45,
 }
 
 
@@ -927,6 +928,8 @@ def test_every_lobe_field_exports_to_standard_surface_and_imports_back(tmp_path)
     assert float(sets["specular_rotation"]) == pytest.approx(0.25)  # +Y: a quarter turn
     assert float(sets["sheen"]) == 1.0
     assert float(sets["subsurface_scale"]) == pytest.approx(4.0)  # 1 / thickness
+    assert float(sets["thin_film_thickness"]) == pytest.approx(420.0)  # nm, both
+    assert float(sets["thin_film_IOR"]) == pytest.approx(1.45)
     back = tmp_path / "back.json"
     r = cli("import", str(out), "-o", str(back))
     assert r.returncode == 0, r.stderr

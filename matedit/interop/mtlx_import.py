@@ -74,7 +74,10 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         # subsurface_scale is 1 / our thickness: the mean free path radius x scale is our
         # radius / thickness, all the shading reads (docs/shading.md, Subsurface)
         "subsurface": ("subsurface", None), "subsurfaceColor": ("subsurface_color", None),
-        "subsurfaceRadius": ("subsurface_radius", None), "thickness": ("subsurface_scale", None)},
+        "subsurfaceRadius": ("subsurface_radius", None), "thickness": ("subsurface_scale", None),
+        # the thin film's thickness in nm, as ours (docs/materialx.md)
+        "thinFilmThickness": ("thin_film_thickness", None),
+        "thinFilmIor": ("thin_film_IOR", None)},
     "open_pbr_surface": {
         "specularColor": ("specular_color", None), "ior": ("specular_ior", None),
         "coat": ("coat_weight", None), "coatRoughness": ("coat_roughness", None),
