@@ -274,6 +274,15 @@ def test_import_foreign_standard_surface_with_defaults_and_hostile_names(tmp_pat
                          'value="1, 0.5, 0.25" />',
      {"subsurface": [0.75], "subsurfaceColor": [0.9, 0.4, 0.3],
       "subsurfaceRadius": [0.5, 0.25, 0.125], "thickness": [1.0]}),
+    # OpenPBR's thin film: thickness in micrometres (ours nm), times its weight
+    ("open_pbr_surface", '<input name="thin_film_weight" type="float" value="1" />'
+                         '<input name="thin_film_thickness" type="float" value="0.42" />'
+                         '<input name="thin_film_ior" type="float" value="1.45" />',
+     {"thinFilmThickness": [420.0], "thinFilmIor": [1.45]}),
+    # standard_surface's thin film: thickness in nm, as ours
+    ("standard_surface", '<input name="thin_film_thickness" type="float" value="380" />'
+                         '<input name="thin_film_IOR" type="float" value="1.6" />',
+     {"thinFilmThickness": [380.0], "thinFilmIor": [1.6]}),
     # standard_surface: subsurface_scale is 1 / thickness
     ("standard_surface", '<input name="subsurface" type="float" value="1" />'
                          '<input name="subsurface_radius" type="color3" value="1, 0.4, 0.2" />'
