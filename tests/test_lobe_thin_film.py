@@ -466,3 +466,26 @@ def test_sample_oil_slick_metal_is_a_film_over_steel():
     cm = compile_document(doc, FileResolver(), "glsl330")
     assert "#define MATERIAL_HAS_THIN_FILM_THICKNESS 1" in cm.fragment_text
     assert "filmMaterialAttributes(" in cm.fragment_text
+
+
+def test_the_film_compiles_in_only_where_the_material_writes_a_thickness():
+    """Unused, the lobe is no code: a material that leaves thinFilmThickness at 0 (even one
+    that sets the film's IOR) defines no MATERIAL_HAS_THIN_FILM_THICKNESS, so every line of
+    the film (thin_film.glsl's include, the context's field, the Fresnel's branch, the
+    layered reference) is left out by the preprocessor; one that sets a thickness defines
+    it."""
+    from matedit.compiler import compile_document
+    from tests.graphs_util import link, material, node
+
+    def doc(values):
+        d = material()
+        node(d, "make", "make_attributes", values={"metallic": 1.0, **values})
+        node(d, "out", "material_output")
+        link(d, "make", "attributes", "out", "attributes")
+        return d
+
+    for values in ({}, {"thinFilmIor": 1.6}):
+        text = compile_document(doc(values)).fragment_text
+        assert "#define MATERIAL_HAS_THIN_FILM_THICKNESS 1" not in text
+    film = compile_document(doc({"thinFilmThickness": 400.0})).fragment_text
+    assert "#define MATERIAL_HAS_THIN_FILM_THICKNESS 1" in film
