@@ -7,6 +7,7 @@
 #define ATTRIBUTE_VIEW_NORMAL 2
 #define ATTRIBUTE_VIEW_COAT 3
 #define ATTRIBUTE_VIEW_ANISOTROPY 4
+#define ATTRIBUTE_VIEW_THIN_FILM 6
 // Stripes a UV unit across the anisotropy direction (the preview meshes' UVs span 0..1).
 #define ATTRIBUTE_VIEW_STRIPES 32.0
 
@@ -35,7 +36,8 @@ vec3 anisotropyStripes(MaterialAttributes m, vec2 uv) {
 
 // The view `view` (ATTRIBUTE_VIEW_*) of the material at one fragment: roughness and coat
 // weight as grey levels (saturated, as the shading reads them), the world shading normal
-// encoded N / 2 + 1/2, the anisotropy direction as stripes.
+// encoded N / 2 + 1/2, the anisotropy direction as stripes, the thin film's thickness in
+// micrometres (nm / 1000) as a grey level.
 vec3 attributeView(int view, MaterialAttributes m, vec2 uv, vec3 N) {
     // A debug view, no shading model: the values as the shading reads them.
     // Karis 2013, "Real Shading in Unreal Engine 4" (the buffer visualisations of its
@@ -43,5 +45,7 @@ vec3 attributeView(int view, MaterialAttributes m, vec2 uv, vec3 N) {
     if (view == ATTRIBUTE_VIEW_ROUGHNESS) return vec3(saturate(m.roughness));
     if (view == ATTRIBUTE_VIEW_NORMAL) return N * 0.5 + 0.5;
     if (view == ATTRIBUTE_VIEW_COAT) return vec3(saturate(m.coat));
+    // glTF KHR_materials_iridescence's thickness (nm), drawn in micrometres, unclamped
+    if (view == ATTRIBUTE_VIEW_THIN_FILM) return vec3(max(m.thinFilmThickness, 0.0) * 1e-3);
     return anisotropyStripes(m, uv);
 }

@@ -20,6 +20,9 @@ const float MIN_ANALYTIC_ROUGHNESS = 0.03;
 #if defined(MATERIAL_HAS_SUBSURFACE)
 #include "subsurface.glsl"
 #endif
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+#include "thin_film.glsl"
+#endif
 
 struct Light {
     int type;               // LIGHT_TYPE_*
@@ -60,6 +63,9 @@ struct ShadingContext {
 #if defined(MATERIAL_HAS_SUBSURFACE)
     SubsurfaceLobe subsurface;  // the subsurface diffuse (subsurface.glsl), set by shadeSurface
 #endif
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    ThinFilm film;          // the thin film on the base (thin_film.glsl), set by shadeSurface
+#endif
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -84,7 +90,20 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
     // none until shadeSurface sets the material's
     s.subsurface = makeSubsurfaceLobe(0.0, vec3(1.0), vec3(1.0), 1.0, 0.0, 1.0);
 #endif
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    s.film = makeThinFilm(0.0, 1.3, 1.0, F0);  // none until shadeSurface sets the material's
+#endif
     return s;
+}
+
+// The base specular's Fresnel at VoH: Schlick's (spherical-Gaussian weight), or the thin
+// film's Airy reflectance where the material has a film there.
+vec3 specularFresnel(ShadingContext s, float VoH) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 5; Belcour & Barla 2017 (thin_film.glsl)
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    if (s.film.thickness > 0.0) return thinFilmFresnel(s.film, VoH);
+#endif
+    return F_Schlick(s.F0, VoH);
 }
 
 // The diffuse lobe's f NoL for a light of signed cosine NoL to the shading normal: Lambert
@@ -125,6 +144,15 @@ float distanceFalloff(float d, float influenceRadius) {
 vec3 specularTowards(ShadingContext s, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4", specular D Vis F, times NoL
 #if defined(MATERIAL_HAS_ANISOTROPY)
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    if (s.film.thickness > 0.0) {
+        // F0 = 1 makes the lobe's Schlick factor exactly 1; the film's reflectance at V.H
+        vec3 hf = L + s.V;
+        float VoHf = saturate(dot(s.V, hf * inversesqrt(max(dot(hf, hf), 1e-30))));
+        return anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, vec3(1.0), L)
+             * thinFilmFresnel(s.film, VoHf) * s.specularScale;
+    }
+#endif
     return anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, s.F0, L) * s.specularScale;
 #endif
     float NoL = saturate(dot(s.N, L));
@@ -137,7 +165,7 @@ vec3 specularTowards(ShadingContext s, vec3 L) {
     float VoH = saturate(dot(s.V, H));
     vec3 NxH = cross(s.N, H);
     float D = D_GGX(NoH, s.a, dot(NxH, NxH));
-    return D * V_SchlickSmith(s.NoV, NoL, s.k) * F_Schlick(s.F0, VoH) * NoL * s.specularScale;
+    return D * V_SchlickSmith(s.NoV, NoL, s.k) * specularFresnel(s, VoH) * NoL * s.specularScale;
 }
 
 // Point on a sphere closest to the reflection ray, as an unnormalised vector from P.

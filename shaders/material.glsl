@@ -26,6 +26,8 @@ struct MaterialAttributes {
     vec3 subsurfaceColor;      // its albedo
     vec3 subsurfaceRadius;     // mean free path per channel, metres
     float thickness;           // of the part, metres
+    float thinFilmThickness;   // nm; 0: no film (thin_film.glsl)
+    float thinFilmIor;         // the film's IOR
 };
 
 // The values an unconnected material output reads.
@@ -54,6 +56,8 @@ MaterialAttributes defaultMaterialAttributes() {
     m.subsurfaceColor = vec3(1.0);
     m.subsurfaceRadius = vec3(1.0);
     m.thickness = 1.0;
+    m.thinFilmThickness = 0.0;
+    m.thinFilmIor = 1.3;
     return m;
 }
 

@@ -90,14 +90,27 @@ vec3 layeredBrdfCosine(LayeredReference r, vec3 L) {
     // none of the lobe, as referenceBrdfCosine: its sampling cannot reach it, and D's
     // cross-product form would be unbounded there (H = -N) with a density of 0.
     vec3 H = normalize(L + s.V);
+    // the base specular's Fresnel: Schlick's of F0, or the thin film's Airy reflectance at
+    // V.H with the lobe's own Fresnel made exactly 1 by F0 = 1 (thin_film.glsl)
+    vec3 specF0 = s.F0;
+    vec3 filmF = vec3(1.0);
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    if (s.film.thickness > 0.0) {
+        specF0 = vec3(1.0);
+        filmF = thinFilmFresnel(s.film, saturate(dot(s.V, H)));
+    }
+#endif
 #if defined(MATERIAL_HAS_ANISOTROPY)
     float NoL = dot(s.N, L);
     f = NoL > 0.0 ? s.diffuseColor * (INV_PI * NoL) : vec3(0.0);
     if (NoL > 0.0 && dot(s.N, H) > 0.0) {
-        f += anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L) * s.specularScale;
+        f += anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, specF0, L) * s.specularScale * filmF;
     }
 #else
-    f = referenceBrdfCosine(r.base, L);
+    ReferenceSurface rb = r.base;
+    rb.F0 = specF0;
+    rb.specularScale *= filmF;
+    f = referenceBrdfCosine(rb, L);
 #endif
 #if defined(MATERIAL_HAS_SUBSURFACE)
     f += subsurfaceCosine(s.subsurface, dot(s.N, L));  // part of the base (lights.glsl)

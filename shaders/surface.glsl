@@ -12,7 +12,7 @@
 #endif
 #ifndef MATEDIT_SPLIT_SUM_ONLY
 #include "lights_reference.glsl"
-#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY) || defined(MATERIAL_HAS_SUBSURFACE)
+#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY) || defined(MATERIAL_HAS_SUBSURFACE) || defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
 // The reference of a material with lobes integrates the whole layered BRDF at once.
 #define MATEDIT_LAYERED_REFERENCE
 #include "reference_layered.glsl"
@@ -101,6 +101,9 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
 #if defined(MATERIAL_HAS_ANISOTROPY)
                         , AnisotropicLobe aniso  // the split sum's taps (anisotropy.glsl)
 #endif
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+                        , ThinFilm film  // the split sum's F0 term (thin_film.glsl)
+#endif
                         ) {
     // Karis 2013, "Real Shading in Unreal Engine 4", image-based lighting (eq 6-8, reference)
     int mode = int(uIbl.params.w + 0.5);
@@ -136,6 +139,11 @@ vec3 imageBasedLighting(vec3 N, vec3 V, vec3 diffuseColor, vec3 F0, float roughn
         AB += anisotropicEnvironmentBRDF(uAnisotropyLut, NoV, roughness, aniso.anisotropy,
                                          anisotropicViewCos2(aniso, N, V));
     }
+#endif
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    // The film's Airy reflectance at N.V in place of the F0 term, F_film(NoV) A + B, as glTF
+    // KHR_materials_iridescence's split sum (docs/shading.md, Thin film)
+    if (film.thickness > 0.0) F0 = thinFilmFresnel(film, NoV);
 #endif
     vec3 color = diffuseIrradianceSH9(sh, N, diffuseColor)
                + splitSumSpecular(prefiltered, AB, F0) * specularScale;
@@ -175,6 +183,15 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                                       m.thickness, m.metallic, lobeOn(LOBE_SUBSURFACE));
     s.diffuseColor *= 1.0 - saturate(m.subsurface);
     diffuseColor *= 1.0 - saturate(m.subsurface);
+#endif
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    // The thin film on the base, under the coat where there is one: its outside medium the
+    // coat's IOR by the coat's weight; the base's IOR from its F0 against air (thin_film.glsl)
+    float filmOutside = 1.0;
+#if defined(MATERIAL_HAS_COAT)
+    filmOutside = mix(1.0, m.coatIor, saturate(m.coat));
+#endif
+    s.film = makeThinFilm(m.thinFilmThickness, m.thinFilmIor, filmOutside, materialF0(m));
 #endif
 #ifdef MATEDIT_ENERGY_COMPENSATION
     // Beyond the talk (off by default): multiple-scattering compensation of the specular,
@@ -227,6 +244,9 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
         ibl = imageBasedLighting(N, V, diffuseColor, F0, roughness, s.specularScale
 #if defined(MATERIAL_HAS_ANISOTROPY)
                                  , s.aniso
+#endif
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+                                 , s.film
 #endif
                                  );
 #if defined(MATERIAL_HAS_SUBSURFACE)

@@ -140,8 +140,9 @@ def test_layers_cost_a_blend_not_a_brdf(path):
     cm = compiled(fmt.load(path))
     body = cm.fragment_text.split("MaterialAttributes evaluateMaterial()")[1]
     assert body.count("shadeSurface(") == 1
-    # a layer blends by the mask (alpha, height, colour modes) or lies on as a coat
-    assert "blendMaterialAttributes(" in body or "coatMaterialAttributes(" in body
+    # a layer blends by the mask (alpha, height, colour modes), lies on as a coat or as a
+    # thin film
+    assert any(f"{f}MaterialAttributes(" in body for f in ("blend", "coat", "film"))
     # each material function is defined once, whatever the number of calls
     for f in cm.ir.functions:
         assert cm.fragment_text.count(f"void {f.name}(") == 1

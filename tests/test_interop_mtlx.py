@@ -99,6 +99,7 @@ SURFACE_INPUTS = {
     "specular_anisotropy": "anisotropy", "subsurface": "subsurface",
     "subsurface_color": "subsurfaceColor", "subsurface_radius": "subsurfaceRadius",
     "subsurface_scale": "thickness",  # as 1 / thickness (docs/shading.md, Subsurface)
+    "thin_film_thickness": "thinFilmThickness", "thin_film_IOR": "thinFilmIor",
 }
 # The talk's inputs, which every exported material has.
 TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",
@@ -273,6 +274,15 @@ def test_import_foreign_standard_surface_with_defaults_and_hostile_names(tmp_pat
                          'value="1, 0.5, 0.25" />',
      {"subsurface": [0.75], "subsurfaceColor": [0.9, 0.4, 0.3],
       "subsurfaceRadius": [0.5, 0.25, 0.125], "thickness": [1.0]}),
+    # OpenPBR's thin film: thickness in micrometres (ours nm), times its weight
+    ("open_pbr_surface", '<input name="thin_film_weight" type="float" value="1" />'
+                         '<input name="thin_film_thickness" type="float" value="0.42" />'
+                         '<input name="thin_film_ior" type="float" value="1.45" />',
+     {"thinFilmThickness": [420.0], "thinFilmIor": [1.45]}),
+    # standard_surface's thin film: thickness in nm, as ours
+    ("standard_surface", '<input name="thin_film_thickness" type="float" value="380" />'
+                         '<input name="thin_film_IOR" type="float" value="1.6" />',
+     {"thinFilmThickness": [380.0], "thinFilmIor": [1.6]}),
     # standard_surface: subsurface_scale is 1 / thickness
     ("standard_surface", '<input name="subsurface" type="float" value="1" />'
                          '<input name="subsurface_radius" type="color3" value="1, 0.4, 0.2" />'
@@ -889,7 +899,7 @@ _LOBE_VALUES = {
     "coatColor": [0.96, 0.64, 0.54], "coatIor": 1.6, "sheenColor": [0.2, 0.3, 0.4],
     "sheenRoughness": 0.6, "anisotropy": 0.7, "anisotropyDirection": [0.0, 1.0, 0.0],
     "subsurface": 0.6, "subsurfaceColor": [0.9, 0.5, 0.4], "subsurfaceRadius": [0.3, 0.1, 0.05],
-    "thickness": 0.25,
+    "thickness": 0.25, "thinFilmThickness": 420.0, "thinFilmIor": 1.45,
 }
 
 
@@ -927,6 +937,8 @@ def test_every_lobe_field_exports_to_standard_surface_and_imports_back(tmp_path)
     assert float(sets["specular_rotation"]) == pytest.approx(0.25)  # +Y: a quarter turn
     assert float(sets["sheen"]) == 1.0
     assert float(sets["subsurface_scale"]) == pytest.approx(4.0)  # 1 / thickness
+    assert float(sets["thin_film_thickness"]) == pytest.approx(420.0)  # nm, both
+    assert float(sets["thin_film_IOR"]) == pytest.approx(1.45)
     back = tmp_path / "back.json"
     r = cli("import", str(out), "-o", str(back))
     assert r.returncode == 0, r.stderr

@@ -270,7 +270,10 @@ def test_bad_obj_is_a_clear_error(fresh, tmp_path):
 # brushed gold 0.223, brushed steel 0.179 (the bent single lookup before the taps: 0.637 and
 # 0.641; with anisotropy 0 both are 0.07); bound = measured x 1.3, so a change that makes
 # them worse fails. The radial disc (0.095; 0.307 before) is under the common 0.12.
-SPLIT_SUM_MEASURED = {"brushed_gold": 0.223, "brushed_steel": 0.179}
+# oil_slick_metal 0.110: the thin film's split sum looks its Airy colour up at N.V only,
+# where the reference's varies with V.H across the lobe (docs/shading.md, Thin film; the
+# variants F0 + (F_film - F_Schlick) and F_film (A + B) measure 0.107 and 0.108).
+SPLIT_SUM_MEASURED = {"brushed_gold": 0.223, "brushed_steel": 0.179, "oil_slick_metal": 0.110}
 
 
 def test_split_sum_and_reference_agree_on_samples(fresh):

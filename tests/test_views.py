@@ -27,13 +27,15 @@ SIZE = (48, 48)
 OAK = graphs_dir() / "materials" / "varnished_oak.json"
 
 
-def plain(roughness=0.3, coat=None, emissive=(0.0, 0.0, 0.0)):
+def plain(roughness=0.3, coat=None, emissive=(0.0, 0.0, 0.0), film=None):
     """A talk material (a constant one, so that every mesh pixel reads the same field)."""
     d = material()
     values = {"baseColor": [0.7, 0.4, 0.2], "metallic": 0.0, "roughness": roughness,
               "emissive": list(emissive)}
     if coat is not None:
         values |= {"coat": coat, "coatRoughness": 0.1}
+    if film is not None:
+        values |= {"thinFilmThickness": film}
     node(d, "make", "make_attributes", values=values)
     node(d, "out", "material_output")
     link(d, "make", "attributes", "out", "attributes")
@@ -66,7 +68,8 @@ def _frame(r: Renderer, view: str) -> np.ndarray:
 
 def test_the_views_and_the_cli_agree():
     assert tuple(VIEWS) == VIEW_NAMES
-    assert set(ATTRIBUTE_VIEWS) == {"roughness", "normal", "coat-weight", "anisotropy"}
+    assert set(ATTRIBUTE_VIEWS) == {"roughness", "normal", "coat-weight", "anisotropy",
+                                    "thin-film"}
     assert lobe_mask("base") == 1 | 2 and lobe_mask("specular") == 2 | 4
     assert lobe_mask("coat") == 4 and lobe_mask("sheen") == 8 and lobe_mask("lit") == 63
     assert lobe_mask("subsurface") == 32
@@ -142,7 +145,7 @@ def test_roughness_and_coat_weight_views_read_the_field_linear(gl_ctx, deferred)
                  deferred=deferred)
     r.show_background = r.show_gizmos = False
     try:
-        assert r.set_material(compile_document(plain(0.3, coat=0.7))).ok
+        assert r.set_material(compile_document(plain(0.3, coat=0.7, film=640.0))).ok
         _frame(r, "lit")
         # the centre of the sphere is covered by every sample: the field exactly, in float32
         rough = _frame(r, "roughness")
@@ -150,6 +153,8 @@ def test_roughness_and_coat_weight_views_read_the_field_linear(gl_ctx, deferred)
         c = SIZE[0] // 2
         np.testing.assert_allclose(rough[c, c], 0.3, rtol=0, atol=1e-6)
         np.testing.assert_allclose(_frame(r, "coat-weight")[c, c], 0.7, rtol=0, atol=1e-6)
+        # the thin film's 640 nm in micrometres
+        np.testing.assert_allclose(_frame(r, "thin-film")[c, c], 0.64, rtol=0, atol=1e-6)
         normal = _frame(r, "normal")
         n = 2.0 * normal[c, c] - 1.0  # the sphere's centre faces the camera: |n| = 1
         assert abs(np.linalg.norm(n) - 1.0) < 1e-3

@@ -57,6 +57,8 @@ STRUCTURAL_BLENDS = {
     "height": ("Height", "Shows the layer where its height rises above the base's"),
     "coat": ("Coat", "Lays the layer over the ones below as a clear coat: its roughness, "
              "colour, IOR and normal become the coat's, mask × opacity its weight"),
+    "film": ("Thin film", "Lays the layer's thin film (thickness, IOR) over the ones below by "
+             "mask × opacity, keeping their other fields: an oil film on a metal"),
 }
 
 

@@ -42,6 +42,7 @@ VIEW_TIPS = {
     "coat-weight": "The clear coat's weight as a grey level (linear)",
     "anisotropy": "Stripes along the anisotropy direction over the dimmed surface; grey to "
                   "amber with the anisotropy",
+    "thin-film": "The thin film's thickness in micrometres as a grey level (linear)",
 }
 MODES = {"Split-sum": "splitsum", "Reference": "reference", "Difference": "difference"}
 SAVE_FILTER = "PNG image, as shown (*.png);;OpenEXR, linear radiance (*.exr)"

@@ -417,7 +417,7 @@ class _Lowerer:
             blend = layer.get("blend", "alpha")
             opacity = port(f"{lid}_opacity")
             written = self._w(acc) | self._w(value)
-            if blend in ("alpha", "coat") or blend in COLOR_LAYER_BLENDS:
+            if blend in ("alpha", "coat", "film") or blend in COLOR_LAYER_BLENDS:
                 w = self.emit(Op(f"{nid}.{lid}.w", nid, "weight", [port(f"{lid}_mask"), opacity],
                                  [("result", PortType.FLOAT)], {}))
                 if blend == "coat":
@@ -425,6 +425,11 @@ class _Lowerer:
                                            [acc, value, w.out("result")],
                                            [("result", PortType.MATERIAL)], {}))
                     written = self._w(acc) | _coat_written(self._w(value))
+                elif blend == "film":
+                    blended = self.emit(Op(f"{nid}.{lid}.blend", nid, "film",
+                                           [acc, value, w.out("result")],
+                                           [("result", PortType.MATERIAL)], {}))
+                    written = self._w(acc) | _film_written(self._w(value))
                 else:
                     blended = self.emit(Op(f"{nid}.{lid}.blend", nid, "blend",
                                            [acc, value, w.out("result")],
@@ -464,6 +469,17 @@ class _Lowerer:
         # keep "written" for the alias
         if isinstance(acc, Var):
             self.written.setdefault(acc.key(), ALL_FIELDS)
+
+
+FILM_FIELDS = frozenset({"thinFilmThickness", "thinFilmIor"})
+
+
+def _film_written(layer: frozenset) -> frozenset:
+    """The fields a `film` layer writes (filmMaterialAttributes): the thin film's, those its
+    layer function writes (both where it may: a field passed through from an input, `@name`)."""
+    if any(f.startswith("@") for f in layer):
+        return FILM_FIELDS
+    return layer & FILM_FIELDS
 
 
 def _coat_written(layer: frozenset) -> frozenset:

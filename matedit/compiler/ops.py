@@ -35,6 +35,7 @@ SET_ATTRIBUTES = Role.SET_ATTRIBUTES  # a MaterialAttributes with op.data["field
 WEIGHT = "weight"  # a layer's alpha weight: saturate(mask * opacity)
 BLEND = "blend"  # blendMaterialAttributes(base, layer, weight)
 COAT = "coat"  # coatMaterialAttributes(base, layer, weight): a layer laid on as a clear coat
+FILM = "film"  # filmMaterialAttributes(base, layer, weight): the layer's thin film laid on
 CALL = "call"  # a material function, op.data["function"]
 
 # The numpy column: fn(op, operand values, env) -> output values in `op.outs` order; env is a
@@ -88,6 +89,12 @@ def _coat(op: Op, args: list, env) -> tuple:
     return (coat_material_attributes(args[0], args[1], np.asarray(args[2])),)
 
 
+def _film(op: Op, args: list, env) -> tuple:
+    from matedit.nodes.material import film_material_attributes
+
+    return (film_material_attributes(args[0], args[1], np.asarray(args[2])),)
+
+
 def _call(op: Op, args: list, env) -> tuple:
     if env is None:
         raise TypeError("a material function call is not folded")
@@ -101,6 +108,7 @@ BUILTINS: dict[str | Role, OpImpl] = {o.kind: o for o in (
     OpImpl(WEIGHT, _weight, glsl="clamp({0} * {1}, 0.0, 1.0)"),
     OpImpl(BLEND, _blend, glsl="blendMaterialAttributes({args})", units=("nodes/layer_blend",)),
     OpImpl(COAT, _coat, glsl="coatMaterialAttributes({args})", units=("nodes/layer_blend",)),
+    OpImpl(FILM, _film, glsl="filmMaterialAttributes({args})", units=("nodes/layer_blend",)),
     OpImpl(CALL, _call),  # the back-end's call convention, on op.data["function"]
 )}
 

@@ -58,8 +58,9 @@ class FunctionResolver(Protocol):
 COLOR_LAYER_BLENDS = tuple(
     kind[len("blend_"):] for kind, d in nodes.REGISTRY.items()
     if kind.startswith("blend_") and [i.name for i in d.inputs] == ["base", "blend", "opacity"])
-# alpha: a lerp by mask x opacity; height: by the heights; coat: laid over as a clear coat.
-LAYER_BLENDS = ("alpha", "height", "coat", *COLOR_LAYER_BLENDS)
+# alpha: a lerp by mask x opacity; height: by the heights; coat: laid over as a clear coat;
+# film: the layer's thin film laid over the stack.
+LAYER_BLENDS = ("alpha", "height", "coat", "film", *COLOR_LAYER_BLENDS)
 _VALID_CHANNELS = "xyzw"
 _CHANNEL_ALIASES = str.maketrans("rgba", "xyzw")
 
@@ -223,6 +224,9 @@ def _layer_stack_inputs(node, resolver, owner) -> list[Port]:
         elif blend == "coat":
             ports.append(Port(f"{lid}_mask", "float", 1.0, range=(0.0, 1.0),
                               doc=f"{label}: where the coat lies (its weight)"))
+        elif blend == "film":
+            ports.append(Port(f"{lid}_mask", "float", 1.0, range=(0.0, 1.0),
+                              doc=f"{label}: where the thin film lies"))
         elif blend == "height":
             ports.append(Port(f"{lid}_mask", "float", 0.5, range=(0.0, 1.0),
                               doc=f"{label}: layer height"))

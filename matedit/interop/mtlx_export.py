@@ -252,6 +252,8 @@ class _Exporter:
         nums = eval_op(op, [a.num for a in args], self.env)
         if op.kind == "coat":
             return [self.coat(args, nums[0], hint)]
+        if op.kind == ops.FILM:
+            return [self.film(args, nums[0], hint)]
         d = nodes.get(op.kind)
         geo = (d is not None and d.geometry) or any(a.geo for a in args)
         kind = kind_for(IR_OP_ROLES[op.kind]) if op.kind in IR_OP_ROLES else op.kind
@@ -474,6 +476,20 @@ class _Exporter:
             fields[name] = V(num[name], ft, make, geo)
         return V(num, PortType.MATERIAL, None, False, fields)
 
+    def film(self, args, num, hint) -> V:
+        """The `film` layer blend (filmMaterialAttributes, shaders/nodes/layer_blend.glsl):
+        the thin film's thickness and IOR mixed towards the layer's by w, the rest kept."""
+        a, b, w = args
+        geo = a.geo or b.geo or w.geo
+        fields = dict(a.fields)
+        for name in ("thinFilmThickness", "thinFilmIor"):
+            def make(x=a.fields[name], y=b.fields[name], name=name):
+                return self.node("mix", "float", f"{hint}_{name}",
+                                 [("fg", y.ref(), "float"), ("bg", x.ref(), "float"),
+                                  ("mix", w.ref(), "float")])
+            fields[name] = V(num[name], PortType.FLOAT, make, geo)
+        return V(num, PortType.MATERIAL, None, False, fields)
+
     # --- the surface -----------------------------------------------------------------------
     def surface(self, attrs: V) -> None:
         mx = self.mx
@@ -551,7 +567,9 @@ class _Exporter:
                  ("anisotropy", "specular_anisotropy", "float"),
                  ("subsurface", "subsurface", "float"),
                  ("subsurfaceColor", "subsurface_color", "color3"),
-                 ("subsurfaceRadius", "subsurface_radius", "color3"))
+                 ("subsurfaceRadius", "subsurface_radius", "color3"),
+                 ("thinFilmThickness", "thin_film_thickness", "float"),
+                 ("thinFilmIor", "thin_film_IOR", "float"))
         # standard_surface's own defaults differ from ours where they would change the look
         # of a lobe the material turns on: coat_roughness 0.1 (ours 0), sheen_roughness 0.3.
         for ours, theirs, t in plain:
@@ -577,6 +595,9 @@ class _Exporter:
         if "subsurface" in written and "subsurfaceColor" not in written:
             # standard_surface's subsurface_color default is 0.8; ours is white
             out.append(("subsurface_color", "color3", ("value", [1.0, 1.0, 1.0])))
+        if "thinFilmThickness" in written and "thinFilmIor" not in written:
+            # standard_surface's thin_film_IOR default is 1.5; ours 1.3 (both nm thickness)
+            out.append(("thin_film_IOR", "float", ("value", 1.3)))
         if "thickness" in written:
             out.append(("subsurface_scale", "float", self.inverse_thickness(f["thickness"])))
         return out

@@ -74,7 +74,10 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         # subsurface_scale is 1 / our thickness: the mean free path radius x scale is our
         # radius / thickness, all the shading reads (docs/shading.md, Subsurface)
         "subsurface": ("subsurface", None), "subsurfaceColor": ("subsurface_color", None),
-        "subsurfaceRadius": ("subsurface_radius", None), "thickness": ("subsurface_scale", None)},
+        "subsurfaceRadius": ("subsurface_radius", None), "thickness": ("subsurface_scale", None),
+        # the thin film's thickness in nm, as ours (docs/materialx.md)
+        "thinFilmThickness": ("thin_film_thickness", None),
+        "thinFilmIor": ("thin_film_IOR", None)},
     "open_pbr_surface": {
         "specularColor": ("specular_color", None), "ior": ("specular_ior", None),
         "coat": ("coat_weight", None), "coatRoughness": ("coat_roughness", None),
@@ -84,7 +87,11 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         "anisotropy": ("specular_roughness_anisotropy", None),
         # the mean free path subsurface_radius x subsurface_radius_scale, at our thickness 1
         "subsurface": ("subsurface_weight", None), "subsurfaceColor": ("subsurface_color", None),
-        "subsurfaceRadius": ("subsurface_radius_scale", "subsurface_radius")},
+        "subsurfaceRadius": ("subsurface_radius_scale", "subsurface_radius"),
+        # thin_film_thickness in micrometres (libraries/bxdf/open_pbr_surface.mtlx scales it
+        # by 1000 to nm), scaled by thin_film_weight: weight 0 is no film (ours: thickness 0)
+        "thinFilmThickness": ("thin_film_thickness", "thin_film_weight"),
+        "thinFilmIor": ("thin_film_ior", None)},
     "gltf_pbr": {
         "ior": ("ior", None), "coat": ("clearcoat", None),
         "coatRoughness": ("clearcoat_roughness", None), "coatNormal": ("clearcoat_normal", None),
@@ -630,6 +637,13 @@ class _Importer:
                     inv = self.add("thickness_of_scale", _kind("divide"), values={"a": 1.0})
                     self.connect(src, inv, "b")
                     src = Src(inv, "result", width=1)
+            if attr == "thinFilmThickness" and cat == "open_pbr_surface":  # um to our nm
+                if src.node is None:
+                    src = Src(value=[1000.0 * src.value[0]], width=1)
+                else:
+                    nm = self.add("thin_film_nm", _kind("multiply"), values={"b": 1000.0})
+                    self.connect(src, nm, "a")
+                    src = Src(nm, "result", width=1)
             if weight is not None:
                 w = self.surface_input(shader, weight)
                 if w is not None and w.node is not None:

@@ -74,6 +74,11 @@ ATTRIBUTE_FIELDS: tuple[InputDef, ...] = tuple(replace(f, group="Base") for f in
     _lobe("thickness", "float", 1.0,
           "thickness of the part, metres: wraps and transmits against the radius",
           (0.0, 2.0), "Subsurface"),
+    _lobe("thinFilmThickness", "float", 0.0,
+          "thickness of a thin film on the base, nm (0: no film): iridescence", (0.0, 2000.0),
+          "Thin film"),
+    _lobe("thinFilmIor", "float", 1.3, "index of refraction of the thin film", (1.0, 3.0),
+          "Thin film"),
 )
 ATTRIBUTE_NAMES = tuple(f.name for f in ATTRIBUTE_FIELDS)
 
@@ -114,6 +119,17 @@ def coat_material_attributes(base: Attributes, layer: Attributes, w: np.ndarray)
     out["coatColor"] = _mix(base["coatColor"], layer["baseColor"], _col(s))
     out["coatIor"] = _mix(base["coatIor"], layer["ior"], s)
     out["coatNormal"] = _safe_normalize(_mix(base["coatNormal"], layer["normal"], _col(s)), _Z)
+    return out
+
+
+def film_material_attributes(base: Attributes, layer: Attributes, w: np.ndarray) -> Attributes:
+    """filmMaterialAttributes (shaders/nodes/layer_blend.glsl): the `film` layer blend. The
+    layer's thin film (thickness, IOR) lerped over the base's by w; the base's other fields
+    kept. glTF KHR_materials_iridescence (docs/shading.md, Thin film)"""
+    out = {name: np.array(base[name], copy=True) for name in ATTRIBUTE_NAMES}
+    w = np.asarray(w, dtype=base["thinFilmThickness"].dtype)
+    for name in ("thinFilmThickness", "thinFilmIor"):
+        out[name] = _mix(base[name], layer[name], w)
     return out
 
 

@@ -14,6 +14,7 @@ from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, 
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
 from matedit.shading.sheen import sheenLayer
 from matedit.shading.subsurface import SubsurfaceLobe, subsurfaceCosine
+from matedit.shading.thin_film import ThinFilm, filmOrFresnel, thinFilmFresnel
 
 LIGHT_TYPE_POINT = 0
 LIGHT_TYPE_DIRECTIONAL = 1
@@ -75,6 +76,8 @@ class ShadingContext:
     sheenLut: object = None
     # MATERIAL_HAS_SUBSURFACE: the subsurface diffuse (subsurface.SubsurfaceLobe); None: off
     subsurface: SubsurfaceLobe | None = None
+    # MATERIAL_HAS_THIN_FILM_THICKNESS: the thin film on the base (thin_film.ThinFilm); None: off
+    film: ThinFilm | None = None
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -108,8 +111,17 @@ def distanceFalloff(d, influenceRadius) -> np.ndarray:
 
 def specularTowards(s: ShadingContext, L) -> np.ndarray:
     if s.aniso is not None:
-        return _aniso.anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, s.F0, L) * f64(
-            s.specularScale)
+        if s.film is None:
+            return _aniso.anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, s.F0, L) * f64(
+                s.specularScale)
+        # F0 = 1: the lobe's Schlick factor exactly 1, times the film's Fresnel at V.H
+        hf = f64(L) + s.V
+        VoHf = saturate(dot(s.V, hf / np.sqrt(np.maximum(dot(hf, hf), 1e-30))[..., None]))
+        lobe = _aniso.anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, np.ones(3), L)
+        return np.where((s.film.thickness > 0.0)[..., None],
+                        lobe * thinFilmFresnel(s.film, VoHf),
+                        _aniso.anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, s.F0, L)
+                        ) * f64(s.specularScale)
     NoL = saturate(dot(s.N, L))
     h = f64(L) + s.V
     H = h / np.sqrt(np.maximum(dot(h, h), 1e-30))[..., None]
@@ -120,7 +132,7 @@ def specularTowards(s: ShadingContext, L) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         D = D_GGX(NoH, s.a, dot(NxH, NxH))
         lobe = np.where(NoL > 0.0, D * V_SchlickSmith(s.NoV, NoL, s.k) * NoL, 0.0)
-    return lobe[..., None] * F_Schlick(s.F0, VoH) * f64(s.specularScale)
+    return lobe[..., None] * filmOrFresnel(s.film, s.F0, VoH, F_Schlick) * f64(s.specularScale)
 
 
 def sphereRepresentativePoint(Lc, R, sourceRadius) -> np.ndarray:

@@ -40,6 +40,8 @@ class MaterialAttributes:
     subsurfaceColor: np.ndarray = _v(1.0, 1.0, 1.0)
     subsurfaceRadius: np.ndarray = _v(1.0, 1.0, 1.0)
     thickness: np.ndarray | float = 1.0
+    thinFilmThickness: np.ndarray | float = 0.0
+    thinFilmIor: np.ndarray | float = 1.3
 
 
 def defaultMaterialAttributes() -> MaterialAttributes:

@@ -13,6 +13,7 @@ from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat as _coat
 from matedit.shading import sheen as _sheen
 from matedit.shading import subsurface as _sss
+from matedit.shading import thin_film as _film
 from matedit.shading.brdf import F_SchlickExact
 from matedit.shading.common import INV_PI, dot, f64, saturate
 from matedit.shading.env_sampling import environmentPdf, sampleEnvironmentDirection
@@ -84,15 +85,23 @@ def layeredBrdfCosine(r: LayeredReference, L) -> np.ndarray:
     # no lobe where the half vector is below its normal (the GLSL's comment)
     h = L + s.V
     H = h / np.sqrt(np.maximum(dot(h, h), 1e-30))[..., None]
+    # the base specular's Fresnel: Schlick's, or the film's at V.H with F0 = 1 in the lobe
+    spec_f0, film_f = f64(s.F0), np.ones(1)
+    if s.film is not None:
+        on = (f64(s.film.thickness) > 0.0)[..., None]
+        spec_f0 = np.where(on, 1.0, spec_f0)
+        film_f = np.where(on, _film.thinFilmFresnel(s.film, saturate(dot(s.V, H))), 1.0)
     if s.aniso is not None:
         NoL = dot(s.N, L)
-        spec = _aniso.anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, s.F0, L) * f64(
-            s.specularScale)
+        spec = _aniso.anisotropicBrdfCosineIBL(s.aniso, s.N, s.V, spec_f0, L) * f64(
+            s.specularScale) * film_f
         f = (f64(s.diffuseColor) * (INV_PI * NoL)[..., None]
              + np.where((dot(s.N, H) > 0.0)[..., None], np.nan_to_num(spec), 0.0))
         f = np.where((NoL > 0.0)[..., None], f, 0.0)
     else:
-        f = referenceBrdfCosine(r.base, L)
+        b = r.base
+        f = referenceBrdfCosine(ReferenceSurface(b.N, b.V, b.diffuseColor, spec_f0, b.roughness,
+                                                 f64(b.specularScale) * film_f), L)
     if s.subsurface is not None:  # part of the base
         f = f + _sss.subsurfaceCosine(s.subsurface, dot(s.N, L))
     if s.sheenMax is not None:

@@ -11,6 +11,7 @@ from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat as _coat
 from matedit.shading import reference_layered as _layered
 from matedit.shading import subsurface as _sss
+from matedit.shading import thin_film as _film
 from matedit.shading.common import dot, f64, mix, reflect, saturate
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
@@ -114,8 +115,10 @@ def anisotropicPrefilteredRadiance(prefilteredEnv, l: _aniso.AnisotropicLobe, N,
 
 
 def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
-                       specularScale=1.0, aniso=None) -> np.ndarray:
-    """`aniso`: the anisotropic lobe (MATERIAL_HAS_ANISOTROPY), None where it is off."""
+                       specularScale=1.0, aniso=None, film=None) -> np.ndarray:
+    """`aniso`: the anisotropic lobe (MATERIAL_HAS_ANISOTROPY), None where it is off.
+    `film`: the thin film (MATERIAL_HAS_THIN_FILM_THICKNESS), whose Airy reflectance at N.V
+    replaces F0 in the split sum where its thickness is not 0; None where it is off."""
     N, V = f64(N), f64(V)
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(N.shape, V.shape))
@@ -143,6 +146,9 @@ def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
             AB = AB + _aniso.anisotropicEnvironmentBRDF(
                 ibl.anisotropy_lut, NoV, roughness, aniso.anisotropy,
                 _aniso.anisotropicViewCos2(aniso, N, V))
+        if film is not None:  # F_film(NoV) A + B (thin_film.glsl)
+            F0 = np.where((f64(film.thickness) > 0.0)[..., None],
+                          _film.thinFilmFresnel(film, NoV), f64(F0))
         color = diffuseIrradianceSH9(ibl.sh, N, diffuseColor) + splitSumSpecular(
             pref, AB, F0) * f64(specularScale)
     return color * ibl.intensity
@@ -155,6 +161,7 @@ def shadeSurface(
     anisotropic: bool = False,
     sheen: bool | None = None,
     subsurface: bool | None = None,
+    thin_film: bool | None = None,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
@@ -166,7 +173,9 @@ def shadeSurface(
     m.anisotropyDirection in `frame`; without a frame, tangentFrame(N) as the GLSL's
     4-argument overload).
     `sheen`: the GLSL's MATERIAL_HAS_SHEEN_COLOR; None: where any sheenColor is not 0.
-    `subsurface`: the GLSL's MATERIAL_HAS_SUBSURFACE; None: where any subsurface is not 0."""
+    `subsurface`: the GLSL's MATERIAL_HAS_SUBSURFACE; None: where any subsurface is not 0.
+    `thin_film`: the GLSL's MATERIAL_HAS_THIN_FILM_THICKNESS; None: where any
+    thinFilmThickness is not 0."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     if sheen is None:
         sheen = bool(np.any(f64(m.sheenColor) != 0.0))
@@ -198,6 +207,11 @@ def shadeSurface(
                                                lobeOn(lobes, LOBE_SUBSURFACE))
         s.diffuseColor = s.diffuseColor * (1.0 - saturate(m.subsurface))[..., None]
         diffuseColor = s.diffuseColor
+    if thin_film is None:
+        thin_film = bool(np.any(f64(m.thinFilmThickness) != 0.0))
+    if thin_film:  # on the base, under the coat where there is one (surface.glsl)
+        outside = 1.0 + (f64(m.coatIor) - 1.0) * saturate(m.coat) if coat else 1.0
+        s.film = _film.makeThinFilm(m.thinFilmThickness, m.thinFilmIor, outside, materialF0(m))
     if energy_compensation:
         NoV = saturate(dot(f64(N), f64(V)))
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
@@ -215,7 +229,8 @@ def shadeSurface(
         setupSheen(s, m.sheenColor, m.sheenRoughness,
                    f64(m.sheenColor) * lobeOn(lobes, LOBE_SHEEN), lut_of(ibl))
     direct = directLighting(s, lights)
-    if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic or subsurface):
+    if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic or subsurface
+                                           or thin_film):
         # the whole layered BRDF by one MIS estimator (reference_layered.glsl)
         if ibl.environment is None or ibl.environment_distribution is None:
             raise ValueError("reference mode needs IblInputs.environment and its distribution")
@@ -225,7 +240,7 @@ def shadeSurface(
             ibl.sample_offset) * ibl.intensity
     else:
         indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
-                                      s.aniso)
+                                      s.aniso, s.film)
         if s.subsurface is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
             indirect = indirect + subsurfaceImageBasedLighting(s.subsurface, N, ibl)
         if sheen:  # the base's IBL is linear in diffuseColor and specularScale

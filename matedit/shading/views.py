@@ -35,6 +35,7 @@ VIEWS: dict[str, tuple[str, int | None, int | None]] = {
     "normal": ("Normal", None, 2),
     "coat-weight": ("Coat weight", None, 3),
     "anisotropy": ("Anisotropy direction", None, 4),
+    "thin-film": ("Thin film thickness", None, 6),
 }
 ATTRIBUTE_VIEWS = tuple(v for v, (_, _, a) in VIEWS.items() if a is not None)
 

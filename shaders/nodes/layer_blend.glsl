@@ -35,6 +35,8 @@ MaterialAttributes blendMaterialAttributes(MaterialAttributes a, MaterialAttribu
     m.subsurfaceColor = mix(a.subsurfaceColor, b.subsurfaceColor, t);
     m.subsurfaceRadius = mix(a.subsurfaceRadius, b.subsurfaceRadius, t);
     m.thickness = mix(a.thickness, b.thickness, t);
+    m.thinFilmThickness = mix(a.thinFilmThickness, b.thinFilmThickness, t);
+    m.thinFilmIor = mix(a.thinFilmIor, b.thinFilmIor, t);
     return m;
 }
 
@@ -74,5 +76,18 @@ MaterialAttributes coatMaterialAttributes(MaterialAttributes base, MaterialAttri
     m.coatIor = mix(base.coatIor, layer.ior, s);
     m.coatNormal = nodeSafeNormalize(mix(base.coatNormal, layer.normal, s),
                                      vec3(0.0, 0.0, 1.0));
+    return m;
+}
+
+// The `film` layer blend: the layer's thin film laid over the stack by the weight w (mask x
+// opacity); every other field of the stack kept, so w = 0 keeps the stack exactly.
+MaterialAttributes filmMaterialAttributes(MaterialAttributes base, MaterialAttributes layer,
+                                          float w) {
+    // An oil film on a metal: vertical layering of a film the thickness of a few hundred
+    // nanometres, its fields lerped by its coverage (docs/shading.md, Thin film);
+    // glTF KHR_materials_iridescence (iridescenceThickness, iridescenceIor)
+    MaterialAttributes m = base;
+    m.thinFilmThickness = mix(base.thinFilmThickness, layer.thinFilmThickness, w);
+    m.thinFilmIor = mix(base.thinFilmIor, layer.thinFilmIor, w);
     return m;
 }
