@@ -26,6 +26,10 @@ struct MaterialAttributes {
     vec3 subsurfaceColor;      // its albedo
     vec3 subsurfaceRadius;     // mean free path per channel, metres
     float thickness;           // of the part, metres
+    float transmission;        // weight of the specular transmission (transmission.glsl)
+    vec3 transmissionColor;    // its tint
+    vec3 attenuationColor;     // the colour white light takes after attenuationDistance
+    float attenuationDistance; // metres; 0: no absorption
 };
 
 // The values an unconnected material output reads.
@@ -54,6 +58,10 @@ MaterialAttributes defaultMaterialAttributes() {
     m.subsurfaceColor = vec3(1.0);
     m.subsurfaceRadius = vec3(1.0);
     m.thickness = 1.0;
+    m.transmission = 0.0;
+    m.transmissionColor = vec3(1.0);
+    m.attenuationColor = vec3(1.0);
+    m.attenuationDistance = 0.0;
     return m;
 }
 

@@ -40,6 +40,10 @@ class MaterialAttributes:
     subsurfaceColor: np.ndarray = _v(1.0, 1.0, 1.0)
     subsurfaceRadius: np.ndarray = _v(1.0, 1.0, 1.0)
     thickness: np.ndarray | float = 1.0
+    transmission: np.ndarray | float = 0.0
+    transmissionColor: np.ndarray = _v(1.0, 1.0, 1.0)
+    attenuationColor: np.ndarray = _v(1.0, 1.0, 1.0)
+    attenuationDistance: np.ndarray | float = 0.0
 
 
 def defaultMaterialAttributes() -> MaterialAttributes:

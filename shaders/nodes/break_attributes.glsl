@@ -9,7 +9,9 @@ void node_break_attributes(MaterialAttributes attributes, out vec3 baseColor,
                            out vec3 coatNormal, out vec3 sheenColor, out float sheenRoughness,
                            out float anisotropy, out vec3 anisotropyDirection,
                            out float subsurface, out vec3 subsurfaceColor,
-                           out vec3 subsurfaceRadius, out float thickness) {
+                           out vec3 subsurfaceRadius, out float thickness,
+                           out float transmission, out vec3 transmissionColor,
+                           out vec3 attenuationColor, out float attenuationDistance) {
     // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set, then
     // the lobes beyond it (docs/shading.md, Lobes beyond the talk)
     baseColor = attributes.baseColor;
@@ -34,4 +36,8 @@ void node_break_attributes(MaterialAttributes attributes, out vec3 baseColor,
     subsurfaceColor = attributes.subsurfaceColor;
     subsurfaceRadius = attributes.subsurfaceRadius;
     thickness = attributes.thickness;
+    transmission = attributes.transmission;
+    transmissionColor = attributes.transmissionColor;
+    attenuationColor = attributes.attenuationColor;
+    attenuationDistance = attributes.attenuationDistance;
 }

@@ -35,6 +35,10 @@ MaterialAttributes blendMaterialAttributes(MaterialAttributes a, MaterialAttribu
     m.subsurfaceColor = mix(a.subsurfaceColor, b.subsurfaceColor, t);
     m.subsurfaceRadius = mix(a.subsurfaceRadius, b.subsurfaceRadius, t);
     m.thickness = mix(a.thickness, b.thickness, t);
+    m.transmission = mix(a.transmission, b.transmission, t);
+    m.transmissionColor = mix(a.transmissionColor, b.transmissionColor, t);
+    m.attenuationColor = mix(a.attenuationColor, b.attenuationColor, t);
+    m.attenuationDistance = mix(a.attenuationDistance, b.attenuationDistance, t);
     return m;
 }
 

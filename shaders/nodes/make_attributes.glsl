@@ -7,7 +7,9 @@ void node_make_attributes(vec3 baseColor, float metallic, float roughness, float
                           float coatIor, vec3 coatNormal, vec3 sheenColor,
                           float sheenRoughness, float anisotropy, vec3 anisotropyDirection,
                           float subsurface, vec3 subsurfaceColor, vec3 subsurfaceRadius,
-                          float thickness, out MaterialAttributes attributes) {
+                          float thickness, float transmission, vec3 transmissionColor,
+                          vec3 attenuationColor, float attenuationDistance,
+                          out MaterialAttributes attributes) {
     // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set, then
     // the lobes beyond it (docs/shading.md, Lobes beyond the talk)
     attributes.baseColor = baseColor;
@@ -32,4 +34,8 @@ void node_make_attributes(vec3 baseColor, float metallic, float roughness, float
     attributes.subsurfaceColor = subsurfaceColor;
     attributes.subsurfaceRadius = subsurfaceRadius;
     attributes.thickness = thickness;
+    attributes.transmission = transmission;
+    attributes.transmissionColor = transmissionColor;
+    attributes.attenuationColor = attenuationColor;
+    attributes.attenuationDistance = attenuationDistance;
 }
