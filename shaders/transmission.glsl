@@ -22,24 +22,34 @@ struct TransmissionLobe {
     vec3 exitRay;  // the view ray leaving the part, the environment lookup's direction
 };
 
-// The view ray refracted into the part through N: refract(-V, N, 1 / eta).
+// GLSL's refract of I through n (n.I < 0) at the index ratio eta, with the root's argument
+// kept at 0 or more: at the edge of total internal reflection the ray goes tangent, and it
+// moves continuously there (float rounding cannot flip it to 0).
+vec3 refractClamped(vec3 I, vec3 n, float eta) {
+    // Snell's law in vector form (the GLSL specification's refract)
+    float c = dot(n, I);
+    float k = max(1.0 - eta * eta * (1.0 - c * c), 0.0);
+    return eta * I - (eta * c + sqrt(k)) * n;
+}
+
+// The view ray refracted into the part through N, refract(-V, N, 1 / eta).
 vec3 transmissionEntry(vec3 N, vec3 V, float eta) {
     // Snell's law, Walter et al. 2007, "Microfacet Models for Refraction through Rough
-    // Surfaces", eq 40 with the macro normal (GLSL refract)
-    return refract(-V, N, 1.0 / eta);
+    // Surfaces", eq 40 with the macro normal
+    return refractClamped(-V, N, 1.0 / eta);
 }
 
 // The ray inside a sphere of diameter D whose surface it entered at P with normal N leaves
 // it after the chord D cos, cos = -N.inside; the exit's outward normal is 2 cos inside + N.
-// Returns the ray refracted out (by the sphere's symmetry never totally reflected).
+// Returns the ray refracted out (by the sphere's symmetry never totally reflected: it leaves
+// at the entry's angle).
 vec3 transmissionSphereExit(vec3 N, vec3 inside, float eta) {
     // matedit's solid model (docs/shading.md, Transmission), after Filament's "refraction
     // through a solid sphere" (Filament Materials documentation, Refraction): the centre is
     // P - N D / 2, the exit point P + inside D cos
     float c = max(-dot(N, inside), 0.0);
     vec3 nOut = normalize(2.0 * c * inside + N);
-    vec3 out_ = refract(inside, -nOut, eta);
-    return dot(out_, out_) > 0.0 ? out_ : inside;
+    return normalize(refractClamped(inside, -nOut, eta));
 }
 
 // Beer-Lambert transmittance over a path of length d: attenuationColor^(d / distance);

@@ -21,26 +21,23 @@ class TransmissionLobe:
     exitRay: np.ndarray  # (..., 3): the ray leaving the part
 
 
-def refract(incident, n, eta) -> np.ndarray:
-    """GLSL's refract: 0 on total internal reflection."""
+def refractClamped(incident, n, eta) -> np.ndarray:
+    """GLSL's refract with the root's argument kept at 0 or more (tangent at the edge)."""
     incident, n, eta = f64(incident), f64(n), f64(eta)
     c = dot(n, incident)
-    k = 1.0 - eta * eta * (1.0 - c * c)
-    out = (eta[..., None] * incident
-           - (eta * c + np.sqrt(np.maximum(k, 0.0)))[..., None] * n)
-    return np.where((k < 0.0)[..., None], 0.0, out)
+    k = np.maximum(1.0 - eta * eta * (1.0 - c * c), 0.0)
+    return eta[..., None] * incident - (eta * c + np.sqrt(k))[..., None] * n
 
 
 def transmissionEntry(N, V, eta) -> np.ndarray:
-    return refract(-f64(V), N, 1.0 / f64(eta))
+    return refractClamped(-f64(V), N, 1.0 / f64(eta))
 
 
 def transmissionSphereExit(N, inside, eta) -> np.ndarray:
     N, inside = f64(N), f64(inside)
     c = np.maximum(-dot(N, inside), 0.0)
     nOut = normalize(2.0 * c[..., None] * inside + N)
-    out = refract(inside, -nOut, eta)
-    return np.where((dot(out, out) > 0.0)[..., None], out, inside)
+    return normalize(refractClamped(inside, -nOut, eta))
 
 
 def beerLambert(attenuationColor, attenuationDistance, d) -> np.ndarray:
