@@ -99,6 +99,8 @@ SURFACE_INPUTS = {
     "specular_anisotropy": "anisotropy", "subsurface": "subsurface",
     "subsurface_color": "subsurfaceColor", "subsurface_radius": "subsurfaceRadius",
     "subsurface_scale": "thickness",  # as 1 / thickness (docs/shading.md, Subsurface)
+    "transmission": "transmission", "transmission_depth": "attenuationDistance",
+    "transmission_color": "transmissionColor",  # attenuationColor where a depth is set
 }
 # The talk's inputs, which every exported material has.
 TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",

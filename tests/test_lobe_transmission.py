@@ -418,3 +418,109 @@ def test_lobe_functions_gpu_twin(ctx, rng):
           rtol=2e-3, atol=1e-4)
     check("thin btdf", got["thin"], tr.thinWalledBtdfCosine(N, V, L, a, F0), rtol=2e-3,
           atol=1e-4)
+
+
+# --- MaterialX ----------------------------------------------------------------------------------
+
+
+def _cli(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "matedit", *args], capture_output=True,
+                          text=True)
+
+
+def _material(path, values, thin=False):
+    import json
+
+    out = {"id": "out", "kind": "material_output"}
+    if thin:
+        out["settings"] = {"thin_walled": True}
+    path.write_text(json.dumps({
+        "format": "matedit.material", "version": 2, "name": "glass",
+        "nodes": [{"id": "make", "kind": "make_attributes", "values": values}, out],
+        "links": [{"from": ["make", "attributes"], "to": ["out", "attributes"]}]}))
+    return path
+
+
+def _attributes(path):
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    return bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), 4)
+
+
+@pytest.mark.parametrize("values, thin", [
+    ({"transmission": 0.8, "transmissionColor": [0.9, 0.8, 0.7], "roughness": 0.2}, True),
+    ({"transmission": 1.0, "attenuationColor": [0.9, 0.5, 0.1], "attenuationDistance": 0.3,
+      "thickness": 0.5, "ior": 1.45}, False),
+])
+def test_materialx_round_trip(tmp_path, values, thin):
+    """The fields and the thin-walled setting survive export to standard_surface
+    (transmission, transmission_color, transmission_depth, thin_walled) and import, 1e-6."""
+    mx = pytest.importorskip("MaterialX")
+    src = _material(tmp_path / "glass.json", values, thin)
+    out = tmp_path / "glass.mtlx"
+    r = _cli("export", str(src), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    doc = mx.createDocument()
+    mx.readFromXmlFile(doc, str(out))
+    shader = next(n for n in doc.getNodes() if n.getCategory() == "standard_surface")
+    sets = {i.getName(): i.getValueString() for i in shader.getInputs()}
+    assert float(sets["transmission"]) == pytest.approx(values["transmission"])
+    assert (sets.get("thin_walled") == "true") == thin
+    back = tmp_path / "back.json"
+    r = _cli("import", str(out), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    import json
+
+    settings = next(n for n in json.loads(back.read_text())["nodes"]
+                    if n["kind"] == "material_output").get("settings", {})
+    assert bool(settings.get("thin_walled", False)) == thin
+    a, b = _attributes(src), _attributes(back)
+    for k in ("transmission", "transmissionColor", "attenuationColor", "attenuationDistance",
+              "thickness", "baseColor", "cavity", "roughness", "ior"):
+        np.testing.assert_allclose(b[k], a[k], atol=1e-6, err_msg=k)
+
+
+@pytest.mark.parametrize("base", [1.0, 0.0])
+def test_standard_surface_glass_does_not_import_black(tmp_path, base):
+    """A standard_surface glass (transmission 1) keeps cavity 1 whatever its `base`: the base
+    weight becomes a base-colour multiplier (it scales the diffuse only), and the imported
+    glass in a white furnace returns about all the light."""
+    pytest.importorskip("MaterialX")
+    text = ('<?xml version="1.0"?>\n<materialx version="1.39">\n'
+            '<standard_surface name="glass" type="surfaceshader">'
+            f'<input name="base" type="float" value="{base}" />'
+            '<input name="base_color" type="color3" value="0.8, 0.8, 0.8" />'
+            '<input name="specular_roughness" type="float" value="0.05" />'
+            '<input name="transmission" type="float" value="1" />'
+            '<input name="transmission_color" type="color3" value="0.9, 1, 0.95" />'
+            '</standard_surface>\n'
+            '<surfacematerial name="M" type="material">'
+            '<input name="surfaceshader" type="surfaceshader" nodename="glass" />'
+            '</surfacematerial>\n</materialx>\n')
+    src = tmp_path / "glass.mtlx"
+    src.write_text(text)
+    back = tmp_path / "glass.json"
+    r = _cli("import", str(src), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    a = _attributes(back)
+    assert np.allclose(a["cavity"], 1.0)
+    assert np.allclose(a["baseColor"], 0.8 * base)
+    assert np.allclose(a["transmission"], 1.0)
+    assert np.allclose(a["transmissionColor"], [0.9, 1.0, 0.95])
+    sh = np.zeros((9, 3))
+    sh[0] = 2.0 * math.sqrt(math.pi)
+    m = material.MaterialAttributes(
+        baseColor=a["baseColor"][0, 0], metallic=float(a["metallic"][0, 0, 0]),
+        roughness=float(a["roughness"][0, 0, 0]), transmission=1.0,
+        transmissionColor=a["transmissionColor"][0, 0], cavity=float(a["cavity"][0, 0, 0]))
+    ibl_in = surface.IblInputs(sh=sh, prefiltered=lambda R, lod: np.ones(np.shape(R)),
+                               brdf_lut=np.array([0.9, 0.03]), lut_values=True,
+                               mode=ibl.IBL_MODE_SPLIT_SUM)
+    out = surface.shadeSurface(m, np.zeros(3), np.array([0.0, 0.0, 1.0]),
+                               np.array([0.0, 0.0, 1.0]), (), ibl_in, transmission=True)
+    assert np.all(out >= 0.85), out
