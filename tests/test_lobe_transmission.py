@@ -123,7 +123,7 @@ def test_furnace_walter_brute_force(rough, thin):
     for mu in (0.9, 0.5, 0.2):
         V = view(mu)
         R = np.sum(w_reflect_cos(V, L, a, F0)) * dw
-        T = np.sum((w_thin_cos(V, L, a, F0) if thin else w_refract_cos(V, L, a, eta, F0))) * dw
+        T = np.sum(w_thin_cos(V, L, a, F0) if thin else w_refract_cos(V, L, a, eta, F0)) * dw
         assert R + T <= 1.0 + 2e-3, (mu, R, T)
         assert R + T >= (0.8 if rough == 0.5 else 0.4), (mu, R, T)
 

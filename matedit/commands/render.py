@@ -47,8 +47,8 @@ def register(sub) -> None:
                    help="reference-mode samples a pixel (default 2048)")
     p.add_argument("--view", default="lit", choices=VIEW_NAMES, metavar="VIEW",
                    help="what the mesh shows: lit (default), a lobe view (base, coat, sheen, "
-                   "subsurface, transmission, specular) or an attribute view (roughness, normal, coat-weight, "
-                   "anisotropy); see docs/cli.md")
+                   "subsurface, transmission, specular) or an attribute view (roughness, "
+                   "normal, coat-weight, anisotropy); see docs/cli.md")
     p.add_argument("--half", action="store_true", help="EXR output as half floats")
     p.add_argument("--energy-compensation", action="store_true",
                    help="multiple-scattering specular compensation (Fdez-Aguera 2019), beyond "

@@ -63,7 +63,8 @@ from matedit.nodes.parameters import PARAMETER_KINDS
 
 __all__ = [
     "ATTRIBUTE_FIELDS", "ATTRIBUTE_NAMES", "BAKE", "BREAK_ATTRIBUTES", "EXPANDED_GROUPS",
-    "EXPANDED_GROUPS_SETTING", "GENERIC", "LOWERED", "MA", "MESH_UV", "PARAMETER_KINDS", "THIN_WALLED",
+    "EXPANDED_GROUPS_SETTING", "GENERIC", "LOWERED", "MA", "MESH_UV", "PARAMETER_KINDS",
+    "THIN_WALLED",
     "LUMA_REC709", "RAMP_STOPS", "REGISTRY", "InputDef", "Mtlx", "MxBuilder", "MxNode", "MxRecipe",
     "NodeDef", "OutputDef", "Port", "PortsRule", "Ref", "Role", "SettingDef", "Thumbnail",
     "attribute_group", "categories", "definition", "get", "is_impure", "is_parameter",

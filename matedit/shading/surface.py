@@ -124,8 +124,12 @@ def transmissionImageBasedLighting(lobe: _trans.TransmissionLobe, reflected, rou
     the reflection leaves."""
     if ibl.transmission_prefiltered is not None:
         pref = f64(ibl.transmission_prefiltered)
-    else:
+    elif callable(ibl.prefiltered):
         pref = prefilteredRadiance(ibl.prefiltered, lobe.exitRay, roughness, ibl.mip_count)
+    else:
+        raise ValueError("the transmission looks the environment up along its own ray: "
+                         "IblInputs.prefiltered must be callable, or give "
+                         "transmission_prefiltered")
     return _trans.transmissionRadiance(lobe, pref, reflected) * ibl.intensity
 
 
