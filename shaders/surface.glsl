@@ -12,7 +12,7 @@
 #endif
 #ifndef MATEDIT_SPLIT_SUM_ONLY
 #include "lights_reference.glsl"
-#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY) || defined(MATERIAL_HAS_SUBSURFACE)
+#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY) || defined(MATERIAL_HAS_SUBSURFACE) || defined(MATERIAL_HAS_TRANSMISSION)
 // The reference of a material with lobes integrates the whole layered BRDF at once.
 #define MATEDIT_LAYERED_REFERENCE
 #include "reference_layered.glsl"
@@ -80,10 +80,11 @@ vec3 subsurfaceImageBasedLighting(SubsurfaceLobe l, vec3 N) {
 #if defined(MATERIAL_HAS_TRANSMISSION)
 // The transmission's image-based light: the prefiltered environment along the ray leaving
 // the part, at the material's roughness, times what the reflection leaves (transmission.glsl).
-vec3 transmissionImageBasedLighting(TransmissionLobe l, vec3 reflectedAlbedo,
-                                    float roughness) {
+vec3 transmissionImageBasedLighting(TransmissionLobe l, vec3 N, vec3 reflectedAlbedo,
+                                    float roughness, float thin) {
     // Karis 2013, "Real Shading in Unreal Engine 4", eq 7 lookup along the refracted ray
-    vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, l.exitRay, roughness, uIbl.params.x);
+    vec3 R = transmissionLookupRay(l, N, roughness, thin);
+    vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
     return transmissionRadiance(l, prefiltered, reflectedAlbedo) * uIbl.params.y;
 }
 #endif
@@ -254,7 +255,9 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                                     makeLayeredReference(s, roughness), count,
                                     uIbl.sampleOffset.xy) * uIbl.params.y;
 #if defined(MATERIAL_HAS_TRANSMISSION)
-        ibl += transmissionImageBasedLighting(s.transmission, transmissionReflected, roughness);
+        // the transmitted part by sampling the BTDF (reference_layered.glsl)
+        ibl += transmissionEnvironmentIBL(uEnvironment, s, roughness, count,
+                                          uIbl.sampleOffset.xy) * uIbl.params.y;
 #endif
     }
 #endif
@@ -274,8 +277,8 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
         // The transmitted environment, part of the base; the reference mode takes the same
         // lookup (docs/shading.md, Transmission).
         if (int(uIbl.params.w + 0.5) != IBL_MODE_NONE) {
-            ibl += transmissionImageBasedLighting(s.transmission, transmissionReflected,
-                                                  roughness);
+            ibl += transmissionImageBasedLighting(s.transmission, N, transmissionReflected,
+                                                  roughness, thinWalled);
         }
 #endif
 #if defined(MATERIAL_HAS_SHEEN_COLOR)

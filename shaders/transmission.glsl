@@ -13,13 +13,12 @@
 #include "common.glsl"
 #include "brdf.glsl"
 
-// The lobe at one point: its weight, tint (colour and absorption) and the rays it follows.
+// The lobe at one point: its weight, tint (colour and absorption) and the ray inside.
 struct TransmissionLobe {
     float weight;  // transmission x (1 - metallic) x lobe view, in [0, 1]
     vec3 tint;     // transmissionColor x the absorption along the path
     float eta;     // the part's index of refraction over the outside's (>= 1)
     vec3 inside;   // the view ray after the first interface (thin-walled: -V)
-    vec3 exitRay;  // the view ray leaving the part, the environment lookup's direction
 };
 
 // GLSL's refract of I through n (n.I < 0) at the index ratio eta, with the root's argument
@@ -78,15 +77,25 @@ TransmissionLobe makeTransmissionLobe(float weight, vec3 color, vec3 attenuation
     if (thin > 0.5) {
         // the wall crossed along the refracted ray, thickness / cos; the ray leaves unbent
         l.inside = -V;
-        l.exitRay = -V;
         d = thickness / c;
     } else {
         l.inside = entry;
-        l.exitRay = transmissionSphereExit(N, entry, l.eta);
         d = thickness * c;  // the sphere's chord
     }
     l.tint = saturate(color) * beerLambert(attenuationColor, attenuationDistance, d);
     return l;
+}
+
+// The direction the preview looks the environment up along: the lobe's dominant direction,
+// the ray inside pulled towards -N as the lobe widens (as the specular peak shifts towards
+// N), then out of the part (solid) or straight on (thin-walled).
+vec3 transmissionLookupRay(TransmissionLobe l, vec3 N, float roughness, float thin) {
+    // Lagarde and de Rousiers 2014, "Moving Frostbite to PBR", the specular's dominant
+    // direction, mirrored below the surface: mix(-N, ray, (1 - a)(sqrt(1 - a) + a)), a = r^2
+    float a = roughness * roughness;
+    float f = (1.0 - a) * (sqrt(1.0 - a) + a);
+    vec3 inside = normalize(mix(-N, l.inside, f));
+    return thin > 0.5 ? inside : transmissionSphereExit(N, inside, l.eta);
 }
 
 // Smith's masking of GGX for one direction, exact: 2 |NoX| / (|NoX| + sqrt(a^2 + (1 - a^2) NoX^2)).

@@ -173,10 +173,11 @@ def test_sphere_exit_geometry(rng):
     centre = np.array([0.0, 0.0, -0.5])
     n_out = (exit_point - centre) / 0.5
     assert np.allclose(np.linalg.norm(exit_point - centre, axis=-1), 0.5, atol=1e-12)
-    cos_out = np.sum(lobe.exitRay * n_out, -1)
+    exit_ray = tr.transmissionSphereExit(N, lobe.inside, eta)
+    cos_out = np.sum(exit_ray * n_out, -1)
     assert np.allclose(cos_out, mu, atol=1e-9)  # leaves at the entry's angle
     # and in the plane of incidence, bent by Snell's law
-    assert np.allclose(np.cross(lobe.exitRay, n_out)[:, 1] ** 2,
+    assert np.allclose(np.cross(exit_ray, n_out)[:, 1] ** 2,
                        (1 - mu * mu), atol=1e-9)
 
 
@@ -196,27 +197,32 @@ def test_beer_lambert_slab_cpu():
     assert np.all(lobe.tint == 1.0)
 
 
+def split_sum_ab(NoV, r):
+    """The split sum's A and B (Karis 2013, k = a / 2) by brute force over the hemisphere."""
+    a = max(float(r) ** 2, 1e-4)
+    L, dw = sphere_grid(400)
+    V = view(float(np.ravel(NoV)[0]))
+    H = V + L
+    H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+    nl = L[..., 2]
+    vh = np.clip(np.sum(V * H, -1), 0, 1)
+    k = a / 2
+
+    def g(c):
+        return c / (c * (1 - k) + k)
+
+    base = w_D(H[..., 2], a) * g(V[2]) * g(np.clip(nl, 0, 1)) / (4 * V[2])
+    fc = (1 - vh) ** 5
+    A = np.sum(np.where(nl > 0, base * (1 - fc) * nl, 0)) * dw
+    B = np.sum(np.where(nl > 0, base * fc * nl, 0)) * dw
+    return np.array([A, B])
+
+
 def _white_furnace(rough, thin, mu):
     """The preview's output in a white furnace (environment 1 everywhere), no lights."""
     sh = np.zeros((9, 3))
     sh[0] = 2.0 * math.sqrt(math.pi)  # L00 of a constant radiance 1
-
-    def lut(NoV, r):  # the split sum's A and B (Karis 2013) by brute force, k = a / 2
-        a = max(float(r) ** 2, 1e-4)
-        L, dw = sphere_grid(400)
-        V = view(float(np.ravel(NoV)[0]))
-        H = V + L
-        H = H / np.linalg.norm(H, axis=-1, keepdims=True)
-        nl = L[..., 2]
-        vh = np.clip(np.sum(V * H, -1), 0, 1)
-        k = a / 2
-        g = lambda c: c / (c * (1 - k) + k)  # noqa: E731
-        base = w_D(H[..., 2], a) * g(V[2]) * g(np.clip(nl, 0, 1)) / (4 * V[2])
-        fc = (1 - vh) ** 5
-        A = np.sum(np.where(nl > 0, base * (1 - fc) * nl, 0)) * dw
-        B = np.sum(np.where(nl > 0, base * fc * nl, 0)) * dw
-        return np.array([A, B])
-
+    lut = split_sum_ab
     V = view(mu)
     N = np.array([0.0, 0.0, 1.0])
     AB = lut(mu, rough)
@@ -406,12 +412,18 @@ def test_lobe_functions_gpu_twin(ctx, rng):
         absorb = beerLambert(ac, ad, d);
         solid = refractionBtdfCosine(N, V, L, a, eta, F0);
         thin = thinWalledBtdfCosine(N, V, L, a, F0);
+        look = transmissionLookupRay(makeTransmissionLobe(1.0, vec3(1.0), vec3(1.0), 0.0, 1.0,
+                                                          eta, 0.0, 0.0, N, V, 1.0), N, a, 0.0);
     """, {"N": N, "V": V, "L": L, "a": a, "eta": eta, "F0": F0, "ac": ac, "ad": ad, "d": d},
-        {"exitRay": "vec3", "absorb": "vec3", "solid": "vec3", "thin": "vec3"},
+        {"exitRay": "vec3", "absorb": "vec3", "solid": "vec3", "thin": "vec3", "look": "vec3"},
         includes=["transmission.glsl"])
     check("exit ray", got["exitRay"],
           tr.transmissionSphereExit(N, tr.transmissionEntry(N, V, eta), eta), rtol=5e-3,
           atol=2e-3)  # two float32 refractions: grazing rays amplify rounding
+    lobe = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 1.0, eta, 0.0, False, N, V,
+                                   1.0)
+    check("lookup ray", got["look"], tr.transmissionLookupRay(lobe, N, a, False), rtol=5e-3,
+          atol=2e-3)
     check("beer-lambert", got["absorb"], tr.beerLambert(ac, ad, d), rtol=1e-4, atol=1e-6)
     assert abs(got["absorb"][0, 0] - math.exp(-1.0)) <= 1e-3
     check("walter btdf", got["solid"], tr.refractionBtdfCosine(N, V, L, a, eta, F0),
@@ -524,3 +536,76 @@ def test_standard_surface_glass_does_not_import_black(tmp_path, base):
     out = surface.shadeSurface(m, np.zeros(3), np.array([0.0, 0.0, 1.0]),
                                np.array([0.0, 0.0, 1.0]), (), ibl_in, transmission=True)
     assert np.all(out >= 0.85), out
+
+
+# --- the environment seen through: preview and reference against brute force ------------------
+
+
+def smooth_env(d):
+    d = np.asarray(d, np.float64)
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    return np.stack([1.0 + 0.6 * x, 1.0 + 0.4 * z, 0.7 - 0.3 * y + 0.2 * x * z], -1)
+
+
+def _through(V, a, thin, eta=1.5, F0=0.04):
+    """Brute force over the sphere of the transmitted radiance under smooth_env, and the
+    transmitted albedo (env 1)."""
+    L, dw = sphere_grid(1500)
+    f = w_thin_cos(V, L, a, F0) if thin else w_refract_cos(V, L, a, eta, F0)
+    return np.sum(f[..., None] * smooth_env(L), axis=(0, 1)) * dw, np.sum(f) * dw
+
+
+@pytest.mark.parametrize("rough", [0.3, 0.6])
+def test_reference_converges_to_brute_force_thin_walled(rough):
+    """Reference mode's BTDF-sampled transmission (numpy twin, 4096 samples) equals the
+    brute-force integral of the thin wall's BTDF over a smooth environment, within 1 %."""
+    from matedit.shading import lights as _lights
+    from matedit.shading import reference_layered as rl
+
+    mu = 0.7
+    V, N = view(mu), np.array([0.0, 0.0, 1.0])
+    want, _ = _through(V, rough * rough, True)
+    s = _lights.makeShadingContext(np.zeros(3), N, V, np.zeros(3), np.full(3, 0.04), rough)
+    s.transmission = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 0.0, 1.5, 0.0,
+                                             True, N, V, 1.0)
+    s.thin_walled = True
+    got = rl.transmissionEnvironmentIBL(smooth_env, s, rough, 4096, (0.1, 0.7))
+    np.testing.assert_allclose(got, want, rtol=1e-2)
+
+
+def _prefiltered_env(R, r):
+    """Karis' prefiltered environment by brute force: N = V = R, the GGX-weighted mean of
+    the radiance with weight NoL (Karis 2013, PrefilterEnvMap, integrated exactly)."""
+    R = np.asarray(R, np.float64).reshape(-1, 3)
+    a = max(r * r, 1e-4)
+    L, _ = sphere_grid(300)
+    out = []
+    for Ri in R:
+        Ri = Ri / np.linalg.norm(Ri)
+        H = Ri + L
+        H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+        nl = np.sum(L * Ri, -1)
+        w = np.where(nl > 0, w_D(np.sum(H * Ri, -1), a) * nl, 0.0)
+        out.append(np.sum(w[..., None] * smooth_env(L), axis=(0, 1)) / np.sum(w))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("rough", [0.3, 0.6])
+def test_preview_thin_slab_against_the_btdf_integral(rough):
+    """The preview's transmitted radiance through a thin-walled rough slab (split sum:
+    (1 - E_R) x the prefiltered environment along -V) against the brute-force integral of the
+    thin wall's BTDF over the environment, normalised to the same albedo: the split sum's
+    lobe-shape approximation (with the dominant direction), within 5 % on this smooth
+    environment (measured 0.8 % at roughness 0.3, 4.2 % at 0.6)."""
+    mu = 0.7
+    V, N = view(mu), np.array([0.0, 0.0, 1.0])
+    AB = split_sum_ab(mu, rough)
+    ibl_in = surface.IblInputs(prefiltered=lambda R, lod: _prefiltered_env(R, lod / 4.0),
+                               mip_count=5, brdf_lut=AB, lut_values=True,
+                               mode=ibl.IBL_MODE_SPLIT_SUM)
+    m = material.MaterialAttributes(metallic=0.0, roughness=rough, transmission=1.0)
+    got = surface.shadeSurface(m, np.zeros(3), N, V, (), ibl_in, transmission=True,
+                               thin_walled=True, lobes=surface.LOBE_TRANSMISSION)
+    radiance, albedo = _through(V, rough * rough, True)
+    want = (1.0 - (0.04 * AB[0] + AB[1])) * radiance / albedo
+    np.testing.assert_allclose(np.ravel(got), want, rtol=5e-2)

@@ -118,14 +118,15 @@ def anisotropicPrefilteredRadiance(prefilteredEnv, l: _aniso.AnisotropicLobe, N,
     return tap_sum / weight_sum
 
 
-def transmissionImageBasedLighting(lobe: _trans.TransmissionLobe, reflected, roughness,
-                                   ibl: IblInputs) -> np.ndarray:
+def transmissionImageBasedLighting(lobe: _trans.TransmissionLobe, N, reflected, roughness,
+                                   thin: bool, ibl: IblInputs) -> np.ndarray:
     """Twin of surface.glsl's: the prefiltered environment along the exit ray, times what
     the reflection leaves."""
     if ibl.transmission_prefiltered is not None:
         pref = f64(ibl.transmission_prefiltered)
     elif callable(ibl.prefiltered):
-        pref = prefilteredRadiance(ibl.prefiltered, lobe.exitRay, roughness, ibl.mip_count)
+        R = _trans.transmissionLookupRay(lobe, N, roughness, thin)
+        pref = prefilteredRadiance(ibl.prefiltered, R, roughness, ibl.mip_count)
     else:
         raise ValueError("the transmission looks the environment up along its own ray: "
                          "IblInputs.prefiltered must be callable, or give "
@@ -257,7 +258,8 @@ def shadeSurface(
         setupSheen(s, m.sheenColor, m.sheenRoughness,
                    f64(m.sheenColor) * lobeOn(lobes, LOBE_SHEEN), lut_of(ibl))
     direct = directLighting(s, lights)
-    if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic or subsurface):
+    if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic or subsurface
+                                           or transmission):
         # the whole layered BRDF by one MIS estimator (reference_layered.glsl)
         if ibl.environment is None or ibl.environment_distribution is None:
             raise ValueError("reference mode needs IblInputs.environment and its distribution")
@@ -265,17 +267,18 @@ def shadeSurface(
             ibl.environment, ibl.environment_distribution,
             _layered.makeLayeredReference(s, roughness), max(int(ibl.samples), 1),
             ibl.sample_offset) * ibl.intensity
-        if s.transmission is not None:
-            indirect = indirect + transmissionImageBasedLighting(s.transmission, reflected,
-                                                                 roughness, ibl)
+        if s.transmission is not None:  # by sampling the BTDF (reference_layered.glsl)
+            indirect = indirect + _layered.transmissionEnvironmentIBL(
+                ibl.environment, s, roughness, max(int(ibl.samples), 1),
+                ibl.sample_offset) * ibl.intensity
     else:
         indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
                                       s.aniso)
         if s.subsurface is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
             indirect = indirect + subsurfaceImageBasedLighting(s.subsurface, N, ibl)
         if s.transmission is not None and ibl.mode != IBL_MODE_NONE:
-            indirect = indirect + transmissionImageBasedLighting(s.transmission, reflected,
-                                                                 roughness, ibl)
+            indirect = indirect + transmissionImageBasedLighting(
+                s.transmission, N, reflected, roughness, thin_walled, ibl)
         if sheen:  # the base's IBL is linear in diffuseColor and specularScale
             indirect = indirect * f64(s.sheenScaleV)[..., None] + sheenImageBasedLighting(s, ibl)
         if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:

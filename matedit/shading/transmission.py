@@ -18,7 +18,6 @@ class TransmissionLobe:
     tint: np.ndarray     # (..., 3): transmissionColor x the absorption along the path
     eta: np.ndarray      # (...,)
     inside: np.ndarray   # (..., 3): the view ray after the first interface (thin: -V)
-    exitRay: np.ndarray  # (..., 3): the ray leaving the part
 
 
 def refractClamped(incident, n, eta) -> np.ndarray:
@@ -60,14 +59,20 @@ def makeTransmissionLobe(weight, color, attenuationColor, attenuationDistance, t
     thickness = f64(thickness)
     if thin:
         inside = np.broadcast_to(-V, shape + (3,))
-        exit_ray = inside
         d = thickness / c
     else:
         inside = entry
-        exit_ray = transmissionSphereExit(N, entry, eta)
         d = thickness * c
     tint = saturate(color) * beerLambert(attenuationColor, attenuationDistance, d)
-    return TransmissionLobe(w, np.broadcast_to(tint, shape + (3,)), eta, inside, exit_ray)
+    return TransmissionLobe(w, np.broadcast_to(tint, shape + (3,)), eta, inside)
+
+
+def transmissionLookupRay(lobe: TransmissionLobe, N, roughness, thin: bool) -> np.ndarray:
+    a = f64(roughness) ** 2
+    f = ((1.0 - a) * (np.sqrt(1.0 - a) + a))[..., None]
+    N = f64(N)
+    inside = normalize(f * f64(lobe.inside) + (1.0 - f) * -N)
+    return inside if thin else transmissionSphereExit(N, inside, lobe.eta)
 
 
 def smithG1GGX(NoX, a) -> np.ndarray:
