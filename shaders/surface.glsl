@@ -274,8 +274,8 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
         }
 #endif
 #if defined(MATERIAL_HAS_TRANSMISSION)
-        // The transmitted environment, part of the base; the reference mode takes the same
-        // lookup (docs/shading.md, Transmission).
+        // The transmitted environment, part of the base (docs/shading.md, Transmission); the
+        // reference mode samples the BTDF above, a split-sum-only program looks it up here.
         if (int(uIbl.params.w + 0.5) != IBL_MODE_NONE) {
             ibl += transmissionImageBasedLighting(s.transmission, N, transmissionReflected,
                                                   roughness, thinWalled);
