@@ -84,7 +84,9 @@ vec3 transmissionImageBasedLighting(TransmissionLobe l, vec3 N, vec3 reflectedAl
                                     float roughness, float thin) {
     // Karis 2013, "Real Shading in Unreal Engine 4", eq 7 lookup along the refracted ray
     vec3 R = transmissionLookupRay(l, N, roughness, thin);
-    vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R, roughness, uIbl.params.x);
+    vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R,
+                                           transmissionLookupRoughness(l, roughness, thin),
+                                           uIbl.params.x);
     return transmissionRadiance(l, prefiltered, reflectedAlbedo) * uIbl.params.y;
 }
 #endif

@@ -86,16 +86,27 @@ TransmissionLobe makeTransmissionLobe(float weight, vec3 color, vec3 attenuation
     return l;
 }
 
-// The direction the preview looks the environment up along: the lobe's dominant direction,
-// the ray inside pulled towards -N as the lobe widens (as the specular peak shifts towards
-// N), then out of the part (solid) or straight on (thin-walled).
+// The direction the preview looks the environment up along. Thin-walled: the mirrored lobe's
+// dominant direction, -V pulled towards -N as the lobe widens (as the specular peak shifts
+// towards N). Solid: the refracted ray out of the sphere (the exit undoes much of the
+// entry's spread, and the pull measured worse there: docs/shading.md, Transmission).
 vec3 transmissionLookupRay(TransmissionLobe l, vec3 N, float roughness, float thin) {
     // Lagarde and de Rousiers 2014, "Moving Frostbite to PBR", the specular's dominant
     // direction, mirrored below the surface: mix(-N, ray, (1 - a)(sqrt(1 - a) + a)), a = r^2
+    if (thin < 0.5) return transmissionSphereExit(N, l.inside, l.eta);
     float a = roughness * roughness;
     float f = (1.0 - a) * (sqrt(1.0 - a) + a);
-    vec3 inside = normalize(mix(-N, l.inside, f));
-    return thin > 0.5 ? inside : transmissionSphereExit(N, inside, l.eta);
+    return normalize(mix(-N, l.inside, f));
+}
+
+// The roughness the preview's environment lookup takes: the material's for a thin wall (its
+// mirrored lobe is the reflection's); for a solid the refracted lobe's spread, a microfacet
+// tilt t deviating the ray by about (1 - 1/eta) t where a reflection deviates it by 2 t,
+// so the lookup's alpha (1 - 1/eta) / 2 of the material's: r sqrt((1 - 1/eta) / 2).
+float transmissionLookupRoughness(TransmissionLobe l, float roughness, float thin) {
+    // matedit's small-angle mapping (docs/shading.md, Transmission) of the refraction's
+    // deviation, Snell's law to first order in the microfacet tilt
+    return thin > 0.5 ? roughness : roughness * sqrt(0.5 * (1.0 - 1.0 / l.eta));
 }
 
 // Smith's masking of GGX for one direction, exact: 2 |NoX| / (|NoX| + sqrt(a^2 + (1 - a^2) NoX^2)).

@@ -270,7 +270,10 @@ def test_bad_obj_is_a_clear_error(fresh, tmp_path):
 # brushed gold 0.223, brushed steel 0.179 (the bent single lookup before the taps: 0.637 and
 # 0.641; with anisotropy 0 both are 0.07); bound = measured x 1.3, so a change that makes
 # them worse fails. The radial disc (0.095; 0.307 before) is under the common 0.12.
-SPLIT_SUM_MEASURED = {"brushed_gold": 0.223, "brushed_steel": 0.179}
+# Frosted glass 0.205 (docs/shading.md, Transmission): the rough solid's single lookup along
+# the exit ray against reference mode's sampled refraction through the sphere, largest at
+# the silhouette, where the exit bends the rays most.
+SPLIT_SUM_MEASURED = {"brushed_gold": 0.223, "brushed_steel": 0.179, "frosted_glass": 0.205}
 
 
 def test_split_sum_and_reference_agree_on_samples(fresh):

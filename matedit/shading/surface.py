@@ -126,7 +126,9 @@ def transmissionImageBasedLighting(lobe: _trans.TransmissionLobe, N, reflected, 
         pref = f64(ibl.transmission_prefiltered)
     elif callable(ibl.prefiltered):
         R = _trans.transmissionLookupRay(lobe, N, roughness, thin)
-        pref = prefilteredRadiance(ibl.prefiltered, R, roughness, ibl.mip_count)
+        pref = prefilteredRadiance(ibl.prefiltered, R,
+                                   _trans.transmissionLookupRoughness(lobe, roughness, thin),
+                                   ibl.mip_count)
     else:
         raise ValueError("the transmission looks the environment up along its own ray: "
                          "IblInputs.prefiltered must be callable, or give "

@@ -68,11 +68,17 @@ def makeTransmissionLobe(weight, color, attenuationColor, attenuationDistance, t
 
 
 def transmissionLookupRay(lobe: TransmissionLobe, N, roughness, thin: bool) -> np.ndarray:
+    N = f64(N)
+    if not thin:
+        return transmissionSphereExit(N, lobe.inside, lobe.eta)
     a = f64(roughness) ** 2
     f = ((1.0 - a) * (np.sqrt(1.0 - a) + a))[..., None]
-    N = f64(N)
-    inside = normalize(f * f64(lobe.inside) + (1.0 - f) * -N)
-    return inside if thin else transmissionSphereExit(N, inside, lobe.eta)
+    return normalize(f * f64(lobe.inside) + (1.0 - f) * -N)
+
+
+def transmissionLookupRoughness(lobe: TransmissionLobe, roughness, thin: bool) -> np.ndarray:
+    r = f64(roughness)
+    return r if thin else r * np.sqrt(0.5 * (1.0 - 1.0 / f64(lobe.eta)))
 
 
 def smithG1GGX(NoX, a) -> np.ndarray:
