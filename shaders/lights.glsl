@@ -23,6 +23,9 @@ const float MIN_ANALYTIC_ROUGHNESS = 0.03;
 #if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
 #include "thin_film.glsl"
 #endif
+#if defined(MATERIAL_HAS_TRANSMISSION)
+#include "transmission.glsl"
+#endif
 
 struct Light {
     int type;               // LIGHT_TYPE_*
@@ -66,6 +69,9 @@ struct ShadingContext {
 #if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
     ThinFilm film;          // the thin film on the base (thin_film.glsl), set by shadeSurface
 #endif
+#if defined(MATERIAL_HAS_TRANSMISSION)
+    TransmissionLobe transmission;  // specular transmission (transmission.glsl), by shadeSurface
+#endif
 };
 
 ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec3 F0,
@@ -92,6 +98,11 @@ ShadingContext makeShadingContext(vec3 P, vec3 N, vec3 V, vec3 diffuseColor, vec
 #endif
 #if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
     s.film = makeThinFilm(0.0, 1.3, 1.0, F0);  // none until shadeSurface sets the material's
+#endif
+#if defined(MATERIAL_HAS_TRANSMISSION)
+    // none until shadeSurface sets the material's
+    s.transmission = makeTransmissionLobe(0.0, vec3(1.0), vec3(1.0), 0.0, 0.0, 1.5, 0.0, 0.0,
+                                          N, V, 1.0);
 #endif
     return s;
 }
@@ -348,11 +359,61 @@ vec3 tubeLight(ShadingContext s, Light light) {
     return (diffuse + specular) * light.color * (light.intensity * window);
 }
 
+#if defined(MATERIAL_HAS_TRANSMISSION)
+// f |NoL| of the transmission lobe towards L (below the surface), thin-walled or solid.
+vec3 transmissionTowards(ShadingContext s, vec3 L) {
+    // Walter et al. 2007 (transmission.glsl): the solid's BTDF, or the thin wall's
+#if defined(MATERIAL_THIN_WALLED)
+    vec3 f = thinWalledBtdfCosine(s.N, s.V, L, s.a, s.F0);
+#else
+    vec3 f = refractionBtdfCosine(s.N, s.V, L, s.a, s.transmission.eta, s.F0);
+#endif
+    return f * s.transmission.tint * s.transmission.weight;
+}
+
+// Radiance transmitted towards V from a light behind the surface: each type as its
+// specular, with the transmitted view ray (s.transmission.inside) in place of the reflected
+// one for the sphere's and the tube's representative points.
+vec3 transmissionLight(ShadingContext s, Light light) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", representative point (eq 10-11, 16-20)
+    // of the view ray through the part (docs/shading.md, Transmission)
+    vec3 ray = s.transmission.inside;
+    if (light.type == LIGHT_TYPE_DIRECTIONAL) {
+        return transmissionTowards(s, -light.direction) * light.color * light.intensity;
+    }
+    vec3 Lc = light.position - s.P;
+    float d = length(Lc);
+    if (light.type == LIGHT_TYPE_SPHERE) {
+        vec3 L = normalize(sphereRepresentativePoint(Lc, ray, light.sourceRadius));
+        return transmissionTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d)
+             * light.color * (light.intensity * distanceFalloff(d, light.influenceRadius));
+    }
+    if (light.type == LIGHT_TYPE_TUBE) {
+        vec3 halfAxis = 0.5 * light.sourceLength * light.direction;
+        vec3 Lp = tubeRepresentativePoint(Lc - halfAxis, Lc + halfAxis, ray);
+        float dp = length(Lp);
+        vec3 L = normalize(sphereRepresentativePoint(Lp, ray, light.sourceRadius));
+        float energy = lineNormalization(s.a, light.sourceLength, d)
+                     * sphereNormalization(s.a, light.sourceRadius, dp);
+        float eps2 = LIGHT_FALLOFF_EPS * LIGHT_FALLOFF_EPS;
+        return transmissionTowards(s, L) * (energy / (dp * dp + eps2)) * light.color
+             * (light.intensity * distanceWindow(d, light.influenceRadius));
+    }
+    return transmissionTowards(s, Lc / max(d, 1e-8)) * light.color
+         * (light.intensity * distanceFalloff(d, light.influenceRadius));
+}
+#endif
+
 // Radiance reflected towards V from one light, by type.
 vec3 evaluateLight(ShadingContext s, Light light) {
     // Karis 2013, "Real Shading in Unreal Engine 4", dispatch over the light types
-    if (light.type == LIGHT_TYPE_DIRECTIONAL) return directionalLight(s, light);
-    if (light.type == LIGHT_TYPE_SPHERE) return sphereLight(s, light);
-    if (light.type == LIGHT_TYPE_TUBE) return tubeLight(s, light);
-    return pointLight(s, light);
+#if defined(MATERIAL_HAS_TRANSMISSION)
+    vec3 through = transmissionLight(s, light);  // from behind the surface
+#else
+    const vec3 through = vec3(0.0);
+#endif
+    if (light.type == LIGHT_TYPE_DIRECTIONAL) return directionalLight(s, light) + through;
+    if (light.type == LIGHT_TYPE_SPHERE) return sphereLight(s, light) + through;
+    if (light.type == LIGHT_TYPE_TUBE) return tubeLight(s, light) + through;
+    return pointLight(s, light) + through;
 }

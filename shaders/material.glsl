@@ -28,6 +28,10 @@ struct MaterialAttributes {
     float thickness;           // of the part, metres
     float thinFilmThickness;   // nm; 0: no film (thin_film.glsl)
     float thinFilmIor;         // the film's IOR
+    float transmission;        // weight of the specular transmission (transmission.glsl)
+    vec3 transmissionColor;    // its tint
+    vec3 attenuationColor;     // the colour white light takes after attenuationDistance
+    float attenuationDistance; // metres; 0: no absorption
 };
 
 // The values an unconnected material output reads.
@@ -58,6 +62,10 @@ MaterialAttributes defaultMaterialAttributes() {
     m.thickness = 1.0;
     m.thinFilmThickness = 0.0;
     m.thinFilmIor = 1.3;
+    m.transmission = 0.0;
+    m.transmissionColor = vec3(1.0);
+    m.attenuationColor = vec3(1.0);
+    m.attenuationDistance = 0.0;
     return m;
 }
 

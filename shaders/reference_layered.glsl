@@ -233,4 +233,44 @@ vec3 layeredEnvironmentIBL(samplerCube env, sampler2D dist, LayeredReference r,
     return sum / float(sampleCount);
 }
 
+#if defined(MATERIAL_HAS_TRANSMISSION)
+// The transmitted radiance under the unfiltered environment `env`, by sampling the BTDF:
+// a GGX microfacet normal m (density D |N.m|), then the view ray refracted through m (solid;
+// the environment looked up along its exit from the sphere, transmission.glsl) or reflected
+// about m and mirrored through the tangent plane (thin-walled, exactly the lobe the lights
+// use). The reflection is the layered estimator's; this one takes the transmitted part.
+vec3 transmissionEnvironmentIBL(samplerCube env, ShadingContext s, float roughness,
+                                uint sampleCount, vec2 offset) {
+    // Walter et al. 2007, "Microfacet Models for Refraction through Rough Surfaces", eq 35-41:
+    // with m drawn by D |N.m| the weight f |N.L| / p is (1 - F) G |V.m| / (|N.V| |N.m|), for
+    // the refraction (the Jacobian of eq 17 cancels) and the mirrored reflection alike
+    TransmissionLobe l = s.transmission;
+    float NoV = dot(s.N, s.V);
+    if (NoV <= 0.0 || l.weight <= 0.0) return vec3(0.0);
+    float a = max(roughness * roughness, 1e-4);
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < sampleCount; i++) {
+        vec2 Xi = rotatedHammersley(i, sampleCount, fract(offset + vec2(0.5, 0.25)));
+        vec3 H = importanceSampleGGX(Xi, a, s.N);
+        float VoH = dot(s.V, H);
+        float NoH = dot(s.N, H);
+        if (VoH <= 0.0 || NoH <= 0.0) continue;
+#if defined(MATERIAL_THIN_WALLED)
+        vec3 R = 2.0 * VoH * H - s.V;
+        vec3 L = R - 2.0 * dot(s.N, R) * s.N;
+        vec3 dir = L;
+#else
+        vec3 L = refractClamped(-s.V, H, 1.0 / l.eta);
+        vec3 dir = transmissionSphereExit(s.N, L, l.eta);
+#endif
+        float NoL = dot(s.N, L);
+        if (NoL >= 0.0) continue;
+        float G = smithG1GGX(NoV, a) * smithG1GGX(NoL, a);
+        sum += (1.0 - F_Schlick(s.F0, VoH)) * (G * VoH / (NoV * NoH))
+             * textureLod(env, dir, 0.0).rgb;
+    }
+    return sum * l.tint * (l.weight / float(sampleCount));
+}
+#endif
+
 #endif

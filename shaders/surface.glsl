@@ -12,7 +12,7 @@
 #endif
 #ifndef MATEDIT_SPLIT_SUM_ONLY
 #include "lights_reference.glsl"
-#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY) || defined(MATERIAL_HAS_SUBSURFACE) || defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+#if defined(MATERIAL_HAS_COAT) || defined(MATERIAL_HAS_SHEEN_COLOR) || defined(MATERIAL_HAS_ANISOTROPY) || defined(MATERIAL_HAS_SUBSURFACE) || defined(MATERIAL_HAS_THIN_FILM_THICKNESS) || defined(MATERIAL_HAS_TRANSMISSION)
 // The reference of a material with lobes integrates the whole layered BRDF at once.
 #define MATEDIT_LAYERED_REFERENCE
 #include "reference_layered.glsl"
@@ -28,8 +28,9 @@
 #define LOBE_SHEEN 8
 #define LOBE_EMISSIVE 16
 #define LOBE_SUBSURFACE 32
+#define LOBE_TRANSMISSION 64
 #ifndef MATEDIT_LOBES
-#define MATEDIT_LOBES 63
+#define MATEDIT_LOBES 127
 #endif
 
 // 1 where the view shows the lobe, 0 where it hides it (a constant: the compiler folds it).
@@ -73,6 +74,20 @@ vec3 subsurfaceImageBasedLighting(SubsurfaceLobe l, vec3 N) {
     for (int i = 0; i < 9; i++) sh[i] = uIbl.sh[i].xyz;
     return subsurfaceIrradiance(l, wrappedIrradianceSH9(sh, N, l.wrap), irradianceSH9(sh, -N))
          * uIbl.params.y;
+}
+#endif
+
+#if defined(MATERIAL_HAS_TRANSMISSION)
+// The transmission's image-based light: the prefiltered environment along the ray leaving
+// the part, at the material's roughness, times what the reflection leaves (transmission.glsl).
+vec3 transmissionImageBasedLighting(TransmissionLobe l, vec3 N, vec3 reflectedAlbedo,
+                                    float roughness, float thin) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 7 lookup along the refracted ray
+    vec3 R = transmissionLookupRay(l, N, roughness, thin);
+    vec3 prefiltered = prefilteredRadiance(uPrefilteredEnv, R,
+                                           transmissionLookupRoughness(l, roughness, thin),
+                                           uIbl.params.x);
+    return transmissionRadiance(l, prefiltered, reflectedAlbedo) * uIbl.params.y;
 }
 #endif
 
@@ -193,6 +208,26 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
 #endif
     s.film = makeThinFilm(m.thinFilmThickness, m.thinFilmIor, filmOutside, materialF0(m));
 #endif
+#if defined(MATERIAL_HAS_TRANSMISSION)
+    // Specular transmission (transmission.glsl): the diffuse keeps 1 - transmission; the
+    // transmitted part takes what the specular reflection leaves, 1 - (F0 A + B).
+#if defined(MATERIAL_THIN_WALLED)
+    const float thinWalled = 1.0;
+#else
+    const float thinWalled = 0.0;
+#endif
+    s.transmission = makeTransmissionLobe(m.transmission, m.transmissionColor,
+                                          m.attenuationColor, m.attenuationDistance,
+                                          m.thickness, m.ior, m.metallic, thinWalled, N, V,
+                                          lobeOn(LOBE_TRANSMISSION));
+    vec2 transmissionAB = environmentBRDF(uBrdfLut, saturate(dot(N, V)), roughness);
+    vec3 transmissionReflected = saturate(F0 * transmissionAB.x + transmissionAB.y);
+    s.diffuseColor *= 1.0 - saturate(m.transmission);
+    diffuseColor *= 1.0 - saturate(m.transmission);
+#if defined(MATERIAL_HAS_SUBSURFACE)
+    s.subsurface.color *= 1.0 - saturate(m.transmission);
+#endif
+#endif
 #ifdef MATEDIT_ENERGY_COMPENSATION
     // Beyond the talk (off by default): multiple-scattering compensation of the specular,
     // the diffuse keeping what the specular leaves (ibl.glsl, energyCompensation)
@@ -205,7 +240,7 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     s.subsurface.color *= diffuseScale;  // a diffuse lobe too
 #endif
 #endif
-#if MATEDIT_LOBES != 63
+#if MATEDIT_LOBES != 127
     // A lobe view: the base's diffuse and specular shown or hidden (every light and the IBL
     // read them through diffuseColor and specularScale).
     s.diffuseColor *= lobeOn(LOBE_DIFFUSE);
@@ -238,6 +273,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
         ibl = layeredEnvironmentIBL(uEnvironment, uEnvDistribution,
                                     makeLayeredReference(s, roughness), count,
                                     uIbl.sampleOffset.xy) * uIbl.params.y;
+#if defined(MATERIAL_HAS_TRANSMISSION)
+        // the transmitted part by sampling the BTDF (reference_layered.glsl)
+        ibl += transmissionEnvironmentIBL(uEnvironment, s, roughness, count,
+                                          uIbl.sampleOffset.xy) * uIbl.params.y;
+#endif
     }
 #endif
     if (!layeredReference) {
@@ -253,6 +293,14 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
         // The subsurface diffuse's, part of the base (under the sheen and the coat).
         if (int(uIbl.params.w + 0.5) == IBL_MODE_SPLIT_SUM) {
             ibl += subsurfaceImageBasedLighting(s.subsurface, N);
+        }
+#endif
+#if defined(MATERIAL_HAS_TRANSMISSION)
+        // The transmitted environment, part of the base (docs/shading.md, Transmission); the
+        // reference mode samples the BTDF above, a split-sum-only program looks it up here.
+        if (int(uIbl.params.w + 0.5) != IBL_MODE_NONE) {
+            ibl += transmissionImageBasedLighting(s.transmission, N, transmissionReflected,
+                                                  roughness, thinWalled);
         }
 #endif
 #if defined(MATERIAL_HAS_SHEEN_COLOR)

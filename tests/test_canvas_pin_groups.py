@@ -30,7 +30,7 @@ from matedit.io.document import dumps, loads  # noqa: E402
 pytestmark = pytest.mark.gui
 LEFT = Qt.MouseButton.LeftButton
 GROUP_SIZES = {"Base": 7, "Specular": 2, "Coat": 5, "Sheen": 2, "Anisotropy": 2,
-               "Subsurface": 4, "Thin film": 2}
+               "Subsurface": 4, "Thin film": 2, "Transmission": 4}
 
 
 def coat_material() -> MaterialDocument:

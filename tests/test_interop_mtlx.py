@@ -100,6 +100,8 @@ SURFACE_INPUTS = {
     "subsurface_color": "subsurfaceColor", "subsurface_radius": "subsurfaceRadius",
     "subsurface_scale": "thickness",  # as 1 / thickness (docs/shading.md, Subsurface)
     "thin_film_thickness": "thinFilmThickness", "thin_film_IOR": "thinFilmIor",
+    "transmission": "transmission", "transmission_depth": "attenuationDistance",
+    "transmission_color": "transmissionColor",  # attenuationColor where a depth is set
 }
 # The talk's inputs, which every exported material has.
 TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",
@@ -128,6 +130,8 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
             out = doc.getNodeGraph(inp.getNodeGraphString()).getOutput(inp.getOutputString())
             got = drawer.draw(doc, out, folder)
             want = cpu[SURFACE_INPUTS[inp.getName()]]
+            if inp.getName() == "transmission_color" and shader.getInput("transmission_depth"):
+                want = cpu["attenuationColor"]  # the absorption colour at that depth
             if inp.getName() in ("normal", "coat_normal"):  # normalmap: T = +X, B = +Y, N = +Z
                 want = want / np.linalg.norm(want, axis=-1, keepdims=True)
             k = want.shape[-1]

@@ -35,7 +35,7 @@ def test_the_talks_seven_fields_come_first_and_every_lobe_field_has_a_group():
     assert nodes.ATTRIBUTE_NAMES[:7] == tuple(f.name for f in BASE_FIELDS)
     assert {f.group for f in BASE_FIELDS} == {"Base"}
     assert {f.group for f in LOBE_FIELDS} == {"Specular", "Coat", "Sheen", "Anisotropy",
-                                              "Subsurface", "Thin film"}
+                                              "Subsurface", "Thin film", "Transmission"}
 
 
 def test_lobe_inputs_left_at_their_defaults_compile_out_with_no_uniform():

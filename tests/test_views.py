@@ -71,8 +71,8 @@ def test_the_views_and_the_cli_agree():
     assert set(ATTRIBUTE_VIEWS) == {"roughness", "normal", "coat-weight", "anisotropy",
                                     "thin-film"}
     assert lobe_mask("base") == 1 | 2 and lobe_mask("specular") == 2 | 4
-    assert lobe_mask("coat") == 4 and lobe_mask("sheen") == 8 and lobe_mask("lit") == 63
-    assert lobe_mask("subsurface") == 32
+    assert lobe_mask("coat") == 4 and lobe_mask("sheen") == 8 and lobe_mask("lit") == 127
+    assert lobe_mask("subsurface") == 32 and lobe_mask("transmission") == 64
 
 
 def test_lit_is_the_default_program_byte_for_byte():

@@ -36,6 +36,7 @@ VIEW_TIPS = {
     "coat": "The clear coat's reflection only",
     "sheen": "The sheen only",
     "subsurface": "The subsurface diffuse only: wrapped, and transmitted from behind",
+    "transmission": "The specular transmission only: the environment and lights seen through",
     "specular": "Every specular reflection: the base's and the coat's",
     "roughness": "Roughness as a grey level (linear)",
     "normal": "The world shading normal, N / 2 + 1/2",

@@ -14,8 +14,8 @@ from matedit.io.inputs import declare_inputs
 
 # matedit.shading.views.VIEWS, spelled here so parsing the command line imports no numpy
 # (tests/test_views.py checks the two agree)
-VIEW_NAMES = ("lit", "base", "coat", "sheen", "subsurface", "specular", "roughness", "normal",
-              "coat-weight", "anisotropy", "thin-film")
+VIEW_NAMES = ("lit", "base", "coat", "sheen", "subsurface", "transmission", "specular",
+              "roughness", "normal", "coat-weight", "anisotropy", "thin-film")
 
 
 def register(sub) -> None:
@@ -47,8 +47,8 @@ def register(sub) -> None:
                    help="reference-mode samples a pixel (default 2048)")
     p.add_argument("--view", default="lit", choices=VIEW_NAMES, metavar="VIEW",
                    help="what the mesh shows: lit (default), a lobe view (base, coat, sheen, "
-                   "subsurface, specular) or an attribute view (roughness, normal, coat-weight, "
-                   "anisotropy, thin-film); see docs/cli.md")
+                   "subsurface, transmission, specular) or an attribute view (roughness, "
+                   "normal, coat-weight, anisotropy, thin-film); see docs/cli.md")
     p.add_argument("--half", action="store_true", help="EXR output as half floats")
     p.add_argument("--energy-compensation", action="store_true",
                    help="multiple-scattering specular compensation (Fdez-Aguera 2019), beyond "

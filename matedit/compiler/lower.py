@@ -35,6 +35,7 @@ from matedit.graph.nodes import (
     ATTRIBUTE_NAMES,
     MA,
     MESH_UV,
+    THIN_WALLED,
     Role,
     kind_for,
     lobe_value_is_default,
@@ -82,6 +83,9 @@ def convert(expr: Expr, to: PortType) -> Expr:
     raise TypeError(f"no implicit conversion from {expr.type} to {to}")
 
 
+THIN_WALLED_DEFINE = "MATERIAL_THIN_WALLED"  # the Material Output's thin_walled setting
+
+
 @dataclass
 class _Ctx:
     resolver: FunctionResolver | None
@@ -95,6 +99,7 @@ class _Ctx:
     input_uniforms: dict[tuple[str, str], str] = field(default_factory=dict)
     input_uniform_names: set[str] = field(default_factory=set)  # its values, to look up
     switches: dict[str, tuple[bool, str]] = field(default_factory=dict)  # name -> (on, node)
+    thin_walled: bool = False  # the top Material Output's thin_walled setting
 
 
 class _Lowerer:
@@ -322,6 +327,8 @@ class _Lowerer:
     def _k_material_output(self, nid, node) -> None:
         (arg,) = self._inputs(nid)
         self.scope.outputs.append(("attributes", PortType.MATERIAL, arg))
+        if self.top and node.settings.get(THIN_WALLED) is True:
+            self.ctx.thin_walled = True
 
     def _k_function_input(self, nid, node) -> None:
         t = self.a.out_types[nid]["value"]
@@ -560,4 +567,7 @@ def lower_document(doc: MaterialDocument, resolver: FunctionResolver | None) -> 
         node_kinds=ctx.kinds,
         attributes=attributes,
         switches={k: on for k, (on, _) in sorted(ctx.switches.items())},
+        # thin-walled transmission (transmission.glsl), only where the material transmits
+        defines=[THIN_WALLED_DEFINE] if ctx.thin_walled and "transmission" in attributes
+        else [],
     )

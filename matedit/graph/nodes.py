@@ -53,6 +53,7 @@ from matedit.nodes.material import (
     EXPANDED_GROUPS,
     EXPANDED_GROUPS_SETTING,
     MA,
+    THIN_WALLED,
     attribute_group,
     lobe_input,
     lobe_value_is_default,
@@ -63,6 +64,7 @@ from matedit.nodes.parameters import PARAMETER_KINDS
 __all__ = [
     "ATTRIBUTE_FIELDS", "ATTRIBUTE_NAMES", "BAKE", "BREAK_ATTRIBUTES", "EXPANDED_GROUPS",
     "EXPANDED_GROUPS_SETTING", "GENERIC", "LOWERED", "MA", "MESH_UV", "PARAMETER_KINDS",
+    "THIN_WALLED",
     "LUMA_REC709", "RAMP_STOPS", "REGISTRY", "InputDef", "Mtlx", "MxBuilder", "MxNode", "MxRecipe",
     "NodeDef", "OutputDef", "Port", "PortsRule", "Ref", "Role", "SettingDef", "Thumbnail",
     "attribute_group", "categories", "definition", "get", "is_impure", "is_parameter",

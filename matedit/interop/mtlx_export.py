@@ -41,6 +41,7 @@ import numpy as np
 
 from matedit.compiler import ops
 from matedit.compiler.ir import Lit, MaterialIR, Param, Scope, Splat, SurfaceUV, Uni, Var
+from matedit.compiler.lower import THIN_WALLED_DEFINE
 from matedit.graph import nodes
 from matedit.graph.nodes import (
     ATTRIBUTE_FIELDS,
@@ -528,6 +529,8 @@ class _Exporter:
                     c = ("value", (c[1],) * 3)
                 outputs.append(("opacity", "color3", c))
         outputs += self.lobes(f, written, color)
+        if THIN_WALLED_DEFINE in self.ir.defines:  # the Material Output's setting
+            shader.setInputValue("thin_walled", True)
         for name, t, r in outputs:
             inp = shader.addInput(name, t)
             if r[0] == "value":
@@ -600,6 +603,16 @@ class _Exporter:
             out.append(("thin_film_IOR", "float", ("value", 1.3)))
         if "thickness" in written:
             out.append(("subsurface_scale", "float", self.inverse_thickness(f["thickness"])))
+        if "transmission" in written:
+            out.append(("transmission", "float", f["transmission"].ref()))
+        if "attenuationDistance" in written:
+            # standard_surface's transmission_color is the absorption colour reached at
+            # transmission_depth where the depth is above 0 (then our transmissionColor has
+            # no counterpart), a surface tint at depth 0 (docs/materialx.md, Transmission)
+            out.append(("transmission_depth", "float", f["attenuationDistance"].ref()))
+            out.append(("transmission_color", "color3", color(f["attenuationColor"])))
+        elif "transmissionColor" in written:
+            out.append(("transmission_color", "color3", color(f["transmissionColor"])))
         return out
 
     def inverse_thickness(self, v: V) -> tuple:

@@ -24,7 +24,7 @@ from typing import Any
 
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.names import identifier_problem, mangle
-from matedit.graph.nodes import Role, definition, kind_for
+from matedit.graph.nodes import THIN_WALLED, Role, definition, kind_for
 from matedit.graph.numbers import gpu_number_problem
 from matedit.interop import mtlx_map
 from matedit.interop.mtlx_colorspace import from_materialx
@@ -102,6 +102,16 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         "ior": ("ior", None), "coat": ("clearcoat", None),
         "coatRoughness": ("clearcoatRoughness", None)},
 }
+# Transmission, read apart from LOBES (docs/materialx.md, Transmission): category ->
+# (weight, colour, depth, thin-walled flag, the base weight). The colour is a surface tint
+# at depth 0 and the absorption colour reached at `depth` otherwise (both surfaces' rule).
+TRANSMISSION: dict[str, tuple[str, str, str, str, str]] = {
+    "standard_surface": ("transmission", "transmission_color", "transmission_depth",
+                         "thin_walled", "base"),
+    "open_pbr_surface": ("transmission_weight", "transmission_color", "transmission_depth",
+                         "geometry_thin_walled", "base_weight"),
+}
+
 # Rotations of the anisotropy direction from the tangent: standard_surface's in turns (0..1),
 # glTF's in radians.
 _ROTATION_TO_RADIANS = {"standard_surface": 2.0 * 3.141592653589793, "gltf_pbr": 1.0}
@@ -555,9 +565,24 @@ class _Importer:
         except ValueError:
             return None
 
+    def transmits(self, shader, cat: str) -> bool:
+        """Whether the file sets the surface's transmission weight (connected, or above 0)."""
+        names = TRANSMISSION.get(cat)
+        if names is None or shader.getInput(names[0]) is None:
+            return False
+        src = self.surface_input(shader, names[0])
+        return src is not None and (src.node is not None or src.value[0] > 0.0)
+
     def build(self, shader) -> MaterialDocument:
         cat = shader.getCategory()
-        table = SURFACES[cat]
+        table = dict(SURFACES[cat])
+        if self.transmits(shader, cat):
+            # The base weight scales the diffuse only: our cavity (all lighting) would darken
+            # the transmission too (a glass of base 0 would import black). It becomes a
+            # base-colour multiplier instead.
+            inp, _, factor = table["baseColor"]
+            table["baseColor"] = (inp, TRANSMISSION[cat][4], factor)
+            del table["cavity"]
         make = self.add("make", kind_for(Role.MAKE_ATTRIBUTES))
         out = self.add("out", kind_for(Role.MATERIAL_OUTPUT))
         self.mat.graph.nodes[out].position = (260.0, 0.0)
@@ -605,7 +630,33 @@ class _Importer:
                     src = Src(mul, "result", width=src.width)
             self.connect(src, make, attr)
         self.lobes(shader, cat, make)
+        if cat in TRANSMISSION:
+            self.transmission(shader, cat, make, out)
         return self.mat
+
+    def transmission(self, shader, cat: str, make: str, out: str) -> None:
+        """The transmission inputs (TRANSMISSION): weight, tint or absorption colour by the
+        depth, and the thin-walled flag (the Material Output's setting)."""
+        weight, color, depth, thin, _ = TRANSMISSION[cat]
+        flag = shader.getInput(thin)
+        if flag is not None:
+            if flag.getConnectedNode() is not None or flag.getNodeGraphString():
+                self.err(f"node {self.name_of(shader)}: input {thin}: only a constant is "
+                         "supported (our thin_walled is the material output's setting)")
+            elif flag.getValueString().strip().lower() in ("true", "1"):
+                self.mat.graph.nodes[out].settings[THIN_WALLED] = True
+        if shader.getInput(weight) is not None:
+            src = self.surface_input(shader, weight)
+            if src is not None:
+                self.connect(src, make, "transmission")
+        c = self.surface_input(shader, color) if shader.getInput(color) is not None else None
+        d = self.surface_input(shader, depth) if shader.getInput(depth) is not None else None
+        if d is not None and (d.node is not None or d.value[0] > 0.0):
+            self.connect(d, make, "attenuationDistance")
+            if c is not None:
+                self.connect(c, make, "attenuationColor")
+        elif c is not None:
+            self.connect(c, make, "transmissionColor")
 
     def lobes(self, shader, cat: str, make: str) -> None:
         """The lobes beyond the talk that the file sets (LOBES)."""

@@ -124,4 +124,29 @@ def document() -> str:
     lines += [", ".join(f"`{k}`" for k in baked), ""]
     lines += ["## Kinds lowered before export", ""]
     lines += [", ".join(f"`{k}`" for k in lowered), ""]
+    lines += _TRANSMISSION_TEXT
     return "\n".join(lines)
+
+
+# The surface inputs of the transmission lobe (matedit.interop.mtlx_export / mtlx_import).
+_TRANSMISSION_TEXT = [
+    "## Transmission",
+    "",
+    "standard_surface, both ways: `transmission` is our `transmission`; `thin_walled` is the",
+    "Material Output's thin_walled setting (a constant only). `transmission_color` is a",
+    "surface tint at `transmission_depth` 0 and the absorption colour reached at that depth",
+    "otherwise (standard_surface's rule), so: a material with `attenuationDistance` writes",
+    "`transmission_depth` = attenuationDistance and `transmission_color` = attenuationColor",
+    "(its `transmissionColor` has no counterpart then and is not written); one without writes",
+    "`transmission_color` = transmissionColor. The import reads the same rule back, and",
+    "OpenPBR's `transmission_weight`, `transmission_color`, `transmission_depth` and",
+    "`geometry_thin_walled` alike. The part's `thickness` travels as `subsurface_scale`",
+    "(1 / thickness, see Subsurface in docs/shading.md).",
+    "",
+    "The base weight: our `cavity` multiplies all lighting, standard_surface's `base`",
+    "(OpenPBR's `base_weight`) only the diffuse and the metal. A surface whose transmission",
+    "weight is set (connected, or above 0) imports its base weight as a multiplier of the",
+    "base colour, not as cavity, so a glass of `base` 0 does not import black; other surfaces",
+    "keep base as cavity (the export writes cavity to `base` and `specular`).",
+    "",
+]

@@ -79,6 +79,17 @@ ATTRIBUTE_FIELDS: tuple[InputDef, ...] = tuple(replace(f, group="Base") for f in
           "Thin film"),
     _lobe("thinFilmIor", "float", 1.3, "index of refraction of the thin film", (1.0, 3.0),
           "Thin film"),
+    _lobe("transmission", "float", 0.0,
+          "weight of the specular transmission (glass: 1; what the reflection leaves passes)",
+          UNIT, "Transmission"),
+    _lobe("transmissionColor", "vec3", [1.0, 1.0, 1.0], "tint of the transmitted light",
+          UNIT, "Transmission"),
+    _lobe("attenuationColor", "vec3", [1.0, 1.0, 1.0],
+          "colour white light takes after attenuationDistance inside (Beer-Lambert)", UNIT,
+          "Transmission"),
+    _lobe("attenuationDistance", "float", 0.0,
+          "distance, metres (scene units), light travels inside to reach attenuationColor; "
+          "0: no absorption", (0.0, 2.0), "Transmission"),
 )
 ATTRIBUTE_NAMES = tuple(f.name for f in ATTRIBUTE_FIELDS)
 
@@ -167,6 +178,8 @@ EXPANDED_GROUPS_SETTING = SettingDef(EXPANDED_GROUPS, "list", ["Base"],
                                      "pin groups shown expanded on the canvas",
                                      structural=False)
 BREAK_ATTRIBUTES = "break_attributes"  # the kind that splits a MaterialAttributes (no role)
+# The Material Output's setting: transmission through a thin wall (MATERIAL_THIN_WALLED).
+THIN_WALLED = "thin_walled"
 
 
 def attribute_group(name: str) -> str:
@@ -303,5 +316,8 @@ register(NodeDef(
     "material_output", "Material Output", "Output",
     "The material's result: one MaterialAttributes, shaded once.",
     inputs=(_i("attributes", MA, None, required=True),),
+    settings=(SettingDef(THIN_WALLED, "bool", False,
+                         "thin-walled transmission: a wall of `thickness` with parallel "
+                         "faces (a bubble, a window) instead of a solid part"),),
     role=Role.MATERIAL_OUTPUT, lowered=True, mtlx=LOWERED, thumbnail=Thumbnail.NEVER,
 ))

@@ -114,10 +114,10 @@ class LightingPass:
         self.edges_once = False  # benchmarks only (see program)
 
     def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False,
-                lobes: int = 63) -> moderngl.Program:
+                lobes: int = 127) -> moderngl.Program:
         """`edges_once` (benchmarks only) shades every pixel once, edges too: no anti-aliasing
         of the lighting, to measure what lighting edges per sample costs. `lobes`: the lobe
-        view's MATEDIT_LOBES mask (63, every lobe, adds no define)."""
+        view's MATEDIT_LOBES mask (127, every lobe, adds no define)."""
         key = (bool(split_sum_only), bool(compensation), bool(edges_once), int(lobes))
         prog = self._programs.get(key)
         if prog is None:
@@ -125,7 +125,7 @@ class LightingPass:
                       ([ENERGY_COMPENSATION] if compensation else []) + \
                       (["MATEDIT_EDGES_ONCE"] if edges_once else [])
             lines = [f"#define {d} 1" for d in defines]
-            if int(lobes) != 63:
+            if int(lobes) != 127:
                 lines.append(f"#define MATEDIT_LOBES {int(lobes)}")
             lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")
             prog = render_program(self.ctx, "fullscreen.vert", "lighting.frag",
@@ -140,7 +140,7 @@ class LightingPass:
         return prog
 
     def draw(self, gbuffer: GBuffer, background: moderngl.Texture, eye,
-             split_sum_only: bool, compensation: bool, lobes: int = 63) -> None:
+             split_sum_only: bool, compensation: bool, lobes: int = 127) -> None:
         """Shades the G-buffer over `background` into every sample of the bound target, with
         the lobes of the `lobes` mask."""
         for i, t in enumerate(gbuffer.textures):

@@ -15,6 +15,11 @@ from matedit.shading.common import dot, f64, length, normalize, reflect, saturat
 from matedit.shading.sheen import sheenLayer
 from matedit.shading.subsurface import SubsurfaceLobe, subsurfaceCosine
 from matedit.shading.thin_film import ThinFilm, filmOrFresnel, thinFilmFresnel
+from matedit.shading.transmission import (
+    TransmissionLobe,
+    refractionBtdfCosine,
+    thinWalledBtdfCosine,
+)
 
 LIGHT_TYPE_POINT = 0
 LIGHT_TYPE_DIRECTIONAL = 1
@@ -78,6 +83,10 @@ class ShadingContext:
     subsurface: SubsurfaceLobe | None = None
     # MATERIAL_HAS_THIN_FILM_THICKNESS: the thin film on the base (thin_film.ThinFilm); None: off
     film: ThinFilm | None = None
+    # MATERIAL_HAS_TRANSMISSION: transmission.TransmissionLobe; None: off. thin_walled:
+    # MATERIAL_THIN_WALLED
+    transmission: TransmissionLobe | None = None
+    thin_walled: bool = False
 
 
 def makeShadingContext(P, N, V, diffuseColor, F0, roughness) -> ShadingContext:
@@ -280,6 +289,44 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
     return (diffuse + specular) * _scale(light, window)
 
 
+def transmissionTowards(s: ShadingContext, L) -> np.ndarray:
+    t = s.transmission
+    assert t is not None
+    if s.thin_walled:
+        f = thinWalledBtdfCosine(s.N, s.V, L, s.a, s.F0)
+    else:
+        f = refractionBtdfCosine(s.N, s.V, L, s.a, t.eta, s.F0)
+    return f * f64(t.tint) * f64(t.weight)[..., None]
+
+
+def transmissionLight(s: ShadingContext, light: Light) -> np.ndarray:
+    """Twin of lights.glsl's: each type as its specular, along the transmitted view ray."""
+    assert s.transmission is not None
+    ray = f64(s.transmission.inside)
+    if light.kind == "directional":
+        L = np.broadcast_to(-f64(light.direction), s.N.shape)
+        return transmissionTowards(s, L) * _scale(light, 1.0)
+    Lc = f64(light.position) - s.P
+    d = length(Lc)
+    if light.kind == "sphere":
+        L = normalize(sphereRepresentativePoint(Lc, ray, light.source_radius))
+        return transmissionTowards(s, L) * _scale(
+            light, sphereNormalization(s.a, light.source_radius, d)
+            * distanceFalloff(d, light.influence_radius))
+    if light.kind == "tube":
+        half_axis = 0.5 * f64(light.source_length)[..., None] * f64(light.direction)
+        Lp = tubeRepresentativePoint(Lc - half_axis, Lc + half_axis, ray)
+        dp = length(Lp)
+        L = normalize(sphereRepresentativePoint(Lp, ray, light.source_radius))
+        energy = (lineNormalization(s.a, light.source_length, d)
+                  * sphereNormalization(s.a, light.source_radius, dp))
+        return transmissionTowards(s, L) * _scale(
+            light, energy / (dp * dp + LIGHT_FALLOFF_EPS**2)
+            * distanceWindow(d, light.influence_radius))
+    return transmissionTowards(s, Lc / np.maximum(d, 1e-8)[..., None]) * _scale(
+        light, distanceFalloff(d, light.influence_radius))
+
+
 def evaluateLight(s: ShadingContext, light: Light) -> np.ndarray:
     kind = {
         "point": pointLight,
@@ -287,4 +334,7 @@ def evaluateLight(s: ShadingContext, light: Light) -> np.ndarray:
         "sphere": sphereLight,
         "tube": tubeLight,
     }
-    return kind[light.kind](s, light)
+    out = kind[light.kind](s, light)
+    if s.transmission is not None:  # from behind the surface
+        out = out + transmissionLight(s, light)
+    return out

@@ -42,6 +42,10 @@ class MaterialAttributes:
     thickness: np.ndarray | float = 1.0
     thinFilmThickness: np.ndarray | float = 0.0
     thinFilmIor: np.ndarray | float = 1.3
+    transmission: np.ndarray | float = 0.0
+    transmissionColor: np.ndarray = _v(1.0, 1.0, 1.0)
+    attenuationColor: np.ndarray = _v(1.0, 1.0, 1.0)
+    attenuationDistance: np.ndarray | float = 0.0
 
 
 def defaultMaterialAttributes() -> MaterialAttributes:

@@ -14,7 +14,8 @@ from matedit.shading import coat as _coat
 from matedit.shading import sheen as _sheen
 from matedit.shading import subsurface as _sss
 from matedit.shading import thin_film as _film
-from matedit.shading.brdf import F_SchlickExact
+from matedit.shading import transmission as _trans
+from matedit.shading.brdf import F_Schlick, F_SchlickExact
 from matedit.shading.common import INV_PI, dot, f64, saturate
 from matedit.shading.env_sampling import environmentPdf, sampleEnvironmentDirection
 from matedit.shading.ibl import (
@@ -27,7 +28,7 @@ from matedit.shading.ibl import (
     rotatedHammersley,
 )
 from matedit.shading.lights import ShadingContext
-from matedit.shading.sampling import importanceSampleCosine
+from matedit.shading.sampling import importanceSampleCosine, importanceSampleGGX
 
 # the GLSL's order; the subsurface lobe's front (cosine about N) and back (about -N) samplings
 LAYER_SPECULAR, LAYER_DIFFUSE, LAYER_SHEEN, LAYER_COAT, LAYER_SUBSURFACE, LAYER_SUBSURFACE_BACK = (
@@ -188,3 +189,37 @@ def layeredEnvironmentIBL(env, dist, r: LayeredReference, sampleCount: int,
         fe = np.nan_to_num(layeredBrdfCosine(r, Le))
         total = total + fb * f64(env(Lb)) * wb[..., None] + fe * f64(env(Le)) * we[..., None]
     return total / sampleCount
+
+
+def transmissionEnvironmentIBL(env, s: ShadingContext, roughness, sampleCount: int,
+                               offset) -> np.ndarray:
+    """Twin of reference_layered.glsl's: the transmitted radiance by sampling the BTDF (a GGX
+    normal, refracted through it and out of the sphere, or reflected and mirrored for a thin
+    wall), weight (1 - F) G V.m / (N.V N.m)."""
+    t = s.transmission
+    assert t is not None
+    N, V = f64(s.N), f64(s.V)
+    NoV = dot(N, V)
+    a = np.maximum(f64(roughness) ** 2, 1e-4)
+    shape = np.broadcast_shapes(N.shape, V.shape)
+    total = np.zeros(shape)
+    offset = np.mod(f64(offset) + np.array([0.5, 0.25]), 1.0)
+    for i in range(sampleCount):
+        Xi = np.broadcast_to(rotatedHammersley(i, sampleCount, offset), shape[:-1] + (2,))
+        H = importanceSampleGGX(Xi, a, N)
+        VoH, NoH = dot(V, H), dot(N, H)
+        if s.thin_walled:
+            R = 2.0 * VoH[..., None] * H - V
+            L = R - 2.0 * dot(N, R)[..., None] * N
+            direction = L
+        else:
+            L = _trans.refractClamped(-V, H, 1.0 / f64(t.eta))
+            direction = _trans.transmissionSphereExit(N, L, t.eta)
+        NoL = dot(N, L)
+        ok = (VoH > 0.0) & (NoH > 0.0) & (NoL < 0.0) & (NoV > 0.0)
+        G = _trans.smithG1GGX(NoV, a) * _trans.smithG1GGX(NoL, a)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            w = np.where(ok, G * VoH / (NoV * NoH), 0.0)
+        f = (1.0 - F_Schlick(s.F0, np.where(ok, VoH, 1.0))) * w[..., None]
+        total = total + np.where(ok[..., None], f * f64(env(direction)), 0.0)
+    return total * f64(t.tint) * (f64(t.weight) / sampleCount)[..., None]

@@ -12,6 +12,7 @@ from matedit.shading import coat as _coat
 from matedit.shading import reference_layered as _layered
 from matedit.shading import subsurface as _sss
 from matedit.shading import thin_film as _film
+from matedit.shading import transmission as _trans
 from matedit.shading.common import dot, f64, mix, reflect, saturate
 from matedit.shading.ibl import (
     IBL_MODE_NONE,
@@ -46,7 +47,8 @@ from matedit.shading.sheen import lut_of, setupSheen, sheenImageBasedLighting
 # The lobe bits of MATEDIT_LOBES (surface.glsl).
 LOBE_DIFFUSE, LOBE_SPECULAR, LOBE_COAT, LOBE_SHEEN, LOBE_EMISSIVE = 1, 2, 4, 8, 16
 LOBE_SUBSURFACE = 32
-LOBES_ALL = 63
+LOBE_TRANSMISSION = 64
+LOBES_ALL = 127
 
 
 def lobeOn(lobes: int, lobe: int) -> float:
@@ -82,6 +84,9 @@ class IblInputs:
     # The anisotropic environment BRDF table the renderer binds at ANISOTROPY_LUT
     # (matedit.ibl.anisotropy_lut.anisotropy_lut()); None: the isotropic LUT alone.
     anisotropy_lut: object = None
+    # The transmission's lookup along its exit ray where `prefiltered` holds looked-up
+    # values; None: `prefiltered` (then callable).
+    transmission_prefiltered: object = None
 
 
 def directLighting(s: ShadingContext, lights: Sequence[Light]) -> np.ndarray:
@@ -112,6 +117,24 @@ def anisotropicPrefilteredRadiance(prefilteredEnv, l: _aniso.AnisotropicLobe, N,
         tap_sum = tap_sum + w * prefilteredRadiance(prefilteredEnv, R, tap_roughness, mipCount)
         weight_sum = weight_sum + w
     return tap_sum / weight_sum
+
+
+def transmissionImageBasedLighting(lobe: _trans.TransmissionLobe, N, reflected, roughness,
+                                   thin: bool, ibl: IblInputs) -> np.ndarray:
+    """Twin of surface.glsl's: the prefiltered environment along the exit ray, times what
+    the reflection leaves."""
+    if ibl.transmission_prefiltered is not None:
+        pref = f64(ibl.transmission_prefiltered)
+    elif callable(ibl.prefiltered):
+        R = _trans.transmissionLookupRay(lobe, N, roughness, thin)
+        pref = prefilteredRadiance(ibl.prefiltered, R,
+                                   _trans.transmissionLookupRoughness(lobe, roughness, thin),
+                                   ibl.mip_count)
+    else:
+        raise ValueError("the transmission looks the environment up along its own ray: "
+                         "IblInputs.prefiltered must be callable, or give "
+                         "transmission_prefiltered")
+    return _trans.transmissionRadiance(lobe, pref, reflected) * ibl.intensity
 
 
 def imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl: IblInputs,
@@ -162,6 +185,8 @@ def shadeSurface(
     sheen: bool | None = None,
     subsurface: bool | None = None,
     thin_film: bool | None = None,
+    transmission: bool | None = None,
+    thin_walled: bool = False,
 ) -> np.ndarray:
     """(direct + ibl) * cavity + emissive; N is the world shading normal.
     `energy_compensation`: the GLSL's MATEDIT_ENERGY_COMPENSATION (Fdez-Aguera 2019).
@@ -175,12 +200,16 @@ def shadeSurface(
     `sheen`: the GLSL's MATERIAL_HAS_SHEEN_COLOR; None: where any sheenColor is not 0.
     `subsurface`: the GLSL's MATERIAL_HAS_SUBSURFACE; None: where any subsurface is not 0.
     `thin_film`: the GLSL's MATERIAL_HAS_THIN_FILM_THICKNESS; None: where any
-    thinFilmThickness is not 0."""
+    thinFilmThickness is not 0.
+    `transmission`: MATERIAL_HAS_TRANSMISSION; None: where any transmission is not 0.
+    `thin_walled`: MATERIAL_THIN_WALLED."""
     ibl = ibl or IblInputs(mode=IBL_MODE_NONE)
     if sheen is None:
         sheen = bool(np.any(f64(m.sheenColor) != 0.0))
     if subsurface is None:
         subsurface = bool(np.any(f64(m.subsurface) != 0.0))
+    if transmission is None:
+        transmission = bool(np.any(f64(m.transmission) != 0.0))
     diffuseColor = computeDiffuseColor(m.baseColor, m.metallic)
     F0 = materialF0(m)
     if coat is None:
@@ -212,6 +241,22 @@ def shadeSurface(
     if thin_film:  # on the base, under the coat where there is one (surface.glsl)
         outside = 1.0 + (f64(m.coatIor) - 1.0) * saturate(m.coat) if coat else 1.0
         s.film = _film.makeThinFilm(m.thinFilmThickness, m.thinFilmIor, outside, materialF0(m))
+    reflected = None
+    if transmission:  # the diffuse keeps 1 - transmission (transmission.glsl)
+        s.transmission = _trans.makeTransmissionLobe(
+            m.transmission, m.transmissionColor, m.attenuationColor, m.attenuationDistance,
+            m.thickness, m.ior, m.metallic, thin_walled, N, V,
+            lobeOn(lobes, LOBE_TRANSMISSION))
+        s.thin_walled = thin_walled
+        NoV = saturate(dot(f64(N), f64(V)))
+        AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
+                                                                      roughness)
+        reflected = saturate(f64(F0) * AB[..., 0:1] + AB[..., 1:2])
+        keep = (1.0 - saturate(m.transmission))[..., None]
+        s.diffuseColor = s.diffuseColor * keep
+        diffuseColor = s.diffuseColor
+        if s.subsurface is not None:
+            s.subsurface.color = s.subsurface.color * keep
     if energy_compensation:
         NoV = saturate(dot(f64(N), f64(V)))
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
@@ -230,7 +275,7 @@ def shadeSurface(
                    f64(m.sheenColor) * lobeOn(lobes, LOBE_SHEEN), lut_of(ibl))
     direct = directLighting(s, lights)
     if ibl.mode == IBL_MODE_REFERENCE and (coat or sheen or anisotropic or subsurface
-                                           or thin_film):
+                                           or thin_film or transmission):
         # the whole layered BRDF by one MIS estimator (reference_layered.glsl)
         if ibl.environment is None or ibl.environment_distribution is None:
             raise ValueError("reference mode needs IblInputs.environment and its distribution")
@@ -238,11 +283,18 @@ def shadeSurface(
             ibl.environment, ibl.environment_distribution,
             _layered.makeLayeredReference(s, roughness), max(int(ibl.samples), 1),
             ibl.sample_offset) * ibl.intensity
+        if s.transmission is not None:  # by sampling the BTDF (reference_layered.glsl)
+            indirect = indirect + _layered.transmissionEnvironmentIBL(
+                ibl.environment, s, roughness, max(int(ibl.samples), 1),
+                ibl.sample_offset) * ibl.intensity
     else:
         indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
                                       s.aniso, s.film)
         if s.subsurface is not None and ibl.mode == IBL_MODE_SPLIT_SUM:
             indirect = indirect + subsurfaceImageBasedLighting(s.subsurface, N, ibl)
+        if s.transmission is not None and ibl.mode != IBL_MODE_NONE:
+            indirect = indirect + transmissionImageBasedLighting(
+                s.transmission, N, reflected, roughness, thin_walled, ibl)
         if sheen:  # the base's IBL is linear in diffuseColor and specularScale
             indirect = indirect * f64(s.sheenScaleV)[..., None] + sheenImageBasedLighting(s, ibl)
         if coat and s.coat is not None and ibl.mode == IBL_MODE_SPLIT_SUM:

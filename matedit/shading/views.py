@@ -15,6 +15,7 @@ from matedit.shading.surface import (
     LOBE_SHEEN,
     LOBE_SPECULAR,
     LOBE_SUBSURFACE,
+    LOBE_TRANSMISSION,
     LOBES_ALL,
 )
 
@@ -30,6 +31,7 @@ VIEWS: dict[str, tuple[str, int | None, int | None]] = {
     "coat": ("Coat only", LOBE_COAT, None),
     "sheen": ("Sheen only", LOBE_SHEEN, None),
     "subsurface": ("Subsurface only", LOBE_SUBSURFACE, None),
+    "transmission": ("Transmission only", LOBE_TRANSMISSION, None),
     "specular": ("Specular only", LOBE_SPECULAR | LOBE_COAT, None),
     "roughness": ("Roughness", None, 1),
     "normal": ("Normal", None, 2),

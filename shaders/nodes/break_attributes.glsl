@@ -10,7 +10,9 @@ void node_break_attributes(MaterialAttributes attributes, out vec3 baseColor,
                            out float anisotropy, out vec3 anisotropyDirection,
                            out float subsurface, out vec3 subsurfaceColor,
                            out vec3 subsurfaceRadius, out float thickness,
-                           out float thinFilmThickness, out float thinFilmIor) {
+                           out float thinFilmThickness, out float thinFilmIor,
+                           out float transmission, out vec3 transmissionColor,
+                           out vec3 attenuationColor, out float attenuationDistance) {
     // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set, then
     // the lobes beyond it (docs/shading.md, Lobes beyond the talk)
     baseColor = attributes.baseColor;
@@ -37,4 +39,8 @@ void node_break_attributes(MaterialAttributes attributes, out vec3 baseColor,
     thickness = attributes.thickness;
     thinFilmThickness = attributes.thinFilmThickness;
     thinFilmIor = attributes.thinFilmIor;
+    transmission = attributes.transmission;
+    transmissionColor = attributes.transmissionColor;
+    attenuationColor = attributes.attenuationColor;
+    attenuationDistance = attributes.attenuationDistance;
 }

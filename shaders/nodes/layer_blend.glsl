@@ -37,6 +37,10 @@ MaterialAttributes blendMaterialAttributes(MaterialAttributes a, MaterialAttribu
     m.thickness = mix(a.thickness, b.thickness, t);
     m.thinFilmThickness = mix(a.thinFilmThickness, b.thinFilmThickness, t);
     m.thinFilmIor = mix(a.thinFilmIor, b.thinFilmIor, t);
+    m.transmission = mix(a.transmission, b.transmission, t);
+    m.transmissionColor = mix(a.transmissionColor, b.transmissionColor, t);
+    m.attenuationColor = mix(a.attenuationColor, b.attenuationColor, t);
+    m.attenuationDistance = mix(a.attenuationDistance, b.attenuationDistance, t);
     return m;
 }
 

@@ -8,6 +8,8 @@ void node_make_attributes(vec3 baseColor, float metallic, float roughness, float
                           float sheenRoughness, float anisotropy, vec3 anisotropyDirection,
                           float subsurface, vec3 subsurfaceColor, vec3 subsurfaceRadius,
                           float thickness, float thinFilmThickness, float thinFilmIor,
+                          float transmission, vec3 transmissionColor,
+                          vec3 attenuationColor, float attenuationDistance,
                           out MaterialAttributes attributes) {
     // Karis 2013, "Real Shading in Unreal Engine 4", material model: the parameter set, then
     // the lobes beyond it (docs/shading.md, Lobes beyond the talk)
@@ -35,4 +37,8 @@ void node_make_attributes(vec3 baseColor, float metallic, float roughness, float
     attributes.thickness = thickness;
     attributes.thinFilmThickness = thinFilmThickness;
     attributes.thinFilmIor = thinFilmIor;
+    attributes.transmission = transmission;
+    attributes.transmissionColor = transmissionColor;
+    attributes.attenuationColor = attenuationColor;
+    attributes.attenuationDistance = attenuationDistance;
 }

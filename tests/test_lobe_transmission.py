@@ -1,0 +1,641 @@
+"""Specular transmission (issue 25): Walter et al. 2007's rough refraction for solids, the
+mirrored reflection lobe for thin walls, a sphere exit and Beer-Lambert absorption
+(docs/shading.md, Transmission).
+
+The independent references here are written from the papers' formulas (Walter et al. 2007,
+eq 16, 20, 21, 33, 34; Snell's law; Beer-Lambert) and integrated by brute force over the
+sphere of directions; none of them imports matedit.shading.transmission.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+
+import numpy as np
+import pytest
+
+from matedit.shading import ibl, material, surface
+from matedit.shading import transmission as tr
+from matedit.shading.lights_block import pack_lights
+from tests.gpu_eval import constant_cubemap as _constant_cube
+from tests.gpu_eval import gpu_eval_many
+from tests.test_shading_gpu_twin import (
+    _all_kinds,
+    _distribution_texture,
+    _f32_light,
+    _random_distribution,
+    check,
+    check_monte_carlo,
+    f32,
+    normal_and_view,
+    perturbation_spread,
+    roughness,
+    unit01,
+)
+
+
+@pytest.fixture
+def rng(request):
+    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
+
+
+# --- independent references (float64, from Walter et al. 2007) -----------------------------
+
+
+def w_D(cos_m, a):
+    """GGX, Walter eq 33: a^2 chi(m.n) / (pi cos^4 (a^2 + tan^2)^2)."""
+    c2 = np.clip(cos_m, 1e-12, 1.0) ** 2
+    tan2 = (1.0 - c2) / c2
+    return np.where(cos_m > 0, a * a / (math.pi * c2 * c2 * (a * a + tan2) ** 2), 0.0)
+
+
+def w_G1(cos_v, a):
+    """Smith G1 of GGX, Walter eq 34: 2 / (1 + sqrt(1 + a^2 tan^2))."""
+    c2 = np.clip(cos_v * cos_v, 1e-12, 1.0)
+    return 2.0 / (1.0 + np.sqrt(1.0 + a * a * (1.0 - c2) / c2))
+
+
+def w_F(F0, c):
+    """Schlick's Fresnel in matedit's spherical-Gaussian form (brdf.glsl, F_Schlick)."""
+    c = np.clip(c, 0.0, 1.0)
+    return F0 + (1.0 - F0) * 2.0 ** ((-5.55473 * c - 6.98316) * c)
+
+
+def w_reflect_cos(V, L, a, F0):
+    """Walter eq 20 times |n.l|, n = +z."""
+    H = V + L
+    H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+    nv, nl = V[..., 2], L[..., 2]
+    f = w_F(F0, np.sum(V * H, -1)) * w_G1(nv, a) * w_G1(nl, a) * w_D(H[..., 2], a) / (4 * nv)
+    return np.where(nl > 0, f, 0.0)
+
+
+def w_refract_cos(V, L, a, eta, F0):
+    """Walter eq 21 times |n.l| for V outside (index 1), L inside (index eta), n = +z."""
+    eta = np.asarray(eta, np.float64)
+    Ht = -(V + eta[..., None] * L)
+    Ht = Ht / np.linalg.norm(Ht, axis=-1, keepdims=True)
+    Ht = Ht * np.sign(Ht[..., 2:3])
+    vh, lh = np.sum(V * Ht, -1), np.sum(L * Ht, -1)
+    nv, nl = V[..., 2], L[..., 2]
+    f = (vh * np.abs(lh) / (nv * np.abs(nl)) * eta**2 * (1 - w_F(F0, vh)) * w_G1(nv, a)
+         * w_G1(nl, a) * w_D(Ht[..., 2], a) / (vh + eta * lh) ** 2)
+    return np.where((nl < 0) & (vh > 0) & (lh < 0), f * np.abs(nl), 0.0)
+
+
+def w_thin_cos(V, L, a, F0):
+    """The thin wall's lobe: Walter eq 20's microfacet lobe about L mirrored through the
+    tangent plane, with 1 - F in place of F, times |n.l|."""
+    Lm = L * np.array([1.0, 1.0, -1.0])
+    H = V + Lm
+    H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+    nv, nl = V[..., 2], L[..., 2]
+    f = ((1 - w_F(F0, np.sum(V * H, -1))) * w_G1(nv, a) * w_G1(nl, a) * w_D(H[..., 2], a)
+         / (4 * nv))
+    return np.where(nl < 0, f, 0.0)
+
+
+def sphere_grid(n=1500):
+    """Midpoint grid over the sphere, uniform in cos and phi: directions and the solid angle."""
+    ct = (np.arange(2 * n) + 0.5) / n - 1.0
+    ph = (np.arange(2 * n) + 0.5) / (2 * n) * 2 * math.pi
+    C, P = np.meshgrid(ct, ph, indexing="ij")
+    S = np.sqrt(1 - C * C)
+    return np.stack([S * np.cos(P), S * np.sin(P), C], -1), (2.0 / (2 * n)) * (math.pi / n)
+
+
+def view(mu):
+    return np.array([math.sqrt(1 - mu * mu), 0.0, mu])
+
+
+# --- the independent references' own checks ---------------------------------------------------
+
+
+@pytest.mark.parametrize("rough", [0.5, 0.9])
+@pytest.mark.parametrize("thin", [False, True])
+def test_furnace_walter_brute_force(rough, thin):
+    """Reflected + transmitted energy of the single-scattering model, brute force over the
+    sphere: never above 1 (+2e-3 quadrature); the loss of single scattering grows with
+    roughness (docs/shading.md, Transmission: measured figures)."""
+    L, dw = sphere_grid(1200)
+    a, eta, F0 = rough * rough, 1.5, 0.04
+    for mu in (0.9, 0.5, 0.2):
+        V = view(mu)
+        R = np.sum(w_reflect_cos(V, L, a, F0)) * dw
+        T = np.sum(w_thin_cos(V, L, a, F0) if thin else w_refract_cos(V, L, a, eta, F0)) * dw
+        assert R + T <= 1.0 + 2e-3, (mu, R, T)
+        assert R + T >= (0.8 if rough == 0.5 else 0.4), (mu, R, T)
+
+
+@pytest.mark.parametrize("thin", [False, True])
+def test_btdf_matches_walter(rng, thin):
+    """The twin's BTDF equals Walter's formulas written here, at random directions."""
+    n = 4000
+    V = rng.normal(size=(n, 3))
+    V[:, 2] = np.abs(V[:, 2]) + 0.05
+    V /= np.linalg.norm(V, axis=-1, keepdims=True)
+    L = rng.normal(size=(n, 3))
+    L[:, 2] = -np.abs(L[:, 2]) - 0.05
+    L /= np.linalg.norm(L, axis=-1, keepdims=True)
+    a = rng.uniform(0.05, 1.0, n)
+    eta = rng.uniform(1.1, 2.0, n)
+    F0 = ((eta - 1) / (eta + 1)) ** 2
+    N = np.broadcast_to([0.0, 0.0, 1.0], (n, 3))
+    F0v = np.repeat(F0[:, None], 3, 1)
+    if thin:
+        got = tr.thinWalledBtdfCosine(N, V, L, a, F0v)[:, 0]
+        want = w_thin_cos(V, L, a, F0)
+    else:
+        got = tr.refractionBtdfCosine(N, V, L, a, eta, F0v)[:, 0]
+        want = w_refract_cos(V, L, a, eta, F0)
+    assert np.allclose(got, want, rtol=1e-9, atol=1e-12)
+    assert np.all(tr.refractionBtdfCosine(N, V, L * [1, 1, -1], a, eta, F0v) == 0.0)
+
+
+def test_sphere_exit_geometry(rng):
+    """The exit ray is Snell's law at the far side of a sphere: the chord from the entry along
+    the refracted ray meets the sphere again at the returned normal, and the exit angle equals
+    the entry angle (the sphere's symmetry)."""
+    n = 500
+    N = np.broadcast_to([0.0, 0.0, 1.0], (n, 3))
+    mu = rng.uniform(0.05, 1.0, n)
+    V = np.stack([np.sqrt(1 - mu * mu), np.zeros(n), mu], -1)
+    eta = rng.uniform(1.01, 2.4, n)
+    lobe = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 1.0, eta, 0.0, False, N, V,
+                                   1.0)
+    # independent: Snell in, the chord of a unit-diameter sphere, Snell out
+    sin_t = np.sqrt(1 - mu * mu) / eta
+    cos_t = np.sqrt(1 - sin_t**2)
+    inside = np.stack([-np.sqrt(1 - mu * mu) / eta, np.zeros(n), -cos_t], -1)
+    assert np.allclose(lobe.inside, inside, atol=1e-12)
+    exit_point = inside * cos_t[:, None]  # chord D cos with D = 1, from the entry at 0
+    centre = np.array([0.0, 0.0, -0.5])
+    n_out = (exit_point - centre) / 0.5
+    assert np.allclose(np.linalg.norm(exit_point - centre, axis=-1), 0.5, atol=1e-12)
+    exit_ray = tr.transmissionSphereExit(N, lobe.inside, eta)
+    cos_out = np.sum(exit_ray * n_out, -1)
+    assert np.allclose(cos_out, mu, atol=1e-9)  # leaves at the entry's angle
+    # and in the plane of incidence, bent by Snell's law
+    assert np.allclose(np.cross(exit_ray, n_out)[:, 1] ** 2,
+                       (1 - mu * mu), atol=1e-9)
+
+
+def test_beer_lambert_slab_cpu():
+    """A 1 cm wall with attenuation distance 1 cm transmits e^-1 of the colour (normal view),
+    thin-walled and solid (the sphere's chord at the centre is its thickness)."""
+    c = np.array([math.exp(-1.0), 0.5, 0.9])
+    for thin in (True, False):
+        lobe = tr.makeTransmissionLobe(1.0, [0.8, 1.0, 1.0], c, 0.01, 0.01, 1.5, 0.0, thin,
+                                       np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]),
+                                       1.0)
+        assert np.allclose(lobe.tint, [0.8 * math.exp(-1.0), 0.5, 0.9], atol=1e-3)
+        assert abs(lobe.tint[0] / 0.8 - math.exp(-1.0)) <= 1e-3
+    # no absorption at distance 0 (the default), whatever the colour
+    lobe = tr.makeTransmissionLobe(1.0, [1, 1, 1], [0.1, 0.2, 0.3], 0.0, 1.0, 1.5, 0.0, False,
+                                   np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]), 1.0)
+    assert np.all(lobe.tint == 1.0)
+
+
+def split_sum_ab(NoV, r):
+    """The split sum's A and B (Karis 2013, k = a / 2) by brute force over the hemisphere."""
+    a = max(float(r) ** 2, 1e-4)
+    L, dw = sphere_grid(400)
+    V = view(float(np.ravel(NoV)[0]))
+    H = V + L
+    H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+    nl = L[..., 2]
+    vh = np.clip(np.sum(V * H, -1), 0, 1)
+    k = a / 2
+
+    def g(c):
+        return c / (c * (1 - k) + k)
+
+    base = w_D(H[..., 2], a) * g(V[2]) * g(np.clip(nl, 0, 1)) / (4 * V[2])
+    fc = (1 - vh) ** 5
+    A = np.sum(np.where(nl > 0, base * (1 - fc) * nl, 0)) * dw
+    B = np.sum(np.where(nl > 0, base * fc * nl, 0)) * dw
+    return np.array([A, B])
+
+
+def _white_furnace(rough, thin, mu):
+    """The preview's output in a white furnace (environment 1 everywhere), no lights."""
+    sh = np.zeros((9, 3))
+    sh[0] = 2.0 * math.sqrt(math.pi)  # L00 of a constant radiance 1
+    lut = split_sum_ab
+    V = view(mu)
+    N = np.array([0.0, 0.0, 1.0])
+    AB = lut(mu, rough)
+    ibl_in = surface.IblInputs(sh=sh, prefiltered=lambda R, lod: np.ones(np.shape(R)),
+                               mip_count=5, brdf_lut=AB, lut_values=True,
+                               mode=ibl.IBL_MODE_SPLIT_SUM)
+    m = material.MaterialAttributes(baseColor=np.array([1.0, 1.0, 1.0]), metallic=0.0,
+                                    roughness=rough, transmission=1.0)
+    return surface.shadeSurface(m, np.zeros(3), N, V, (), ibl_in, transmission=True,
+                                thin_walled=thin)
+
+
+@pytest.mark.parametrize("rough", [0.1, 0.5, 0.9])
+@pytest.mark.parametrize("thin", [False, True])
+def test_furnace_preview(rough, thin):
+    """The preview's glass (transmission 1, IOR 1.5) in a white furnace: reflected +
+    transmitted in [0.95, 1 + 2e-3]: the transmission takes what the reflection leaves."""
+    for mu in (0.95, 0.5, 0.2):
+        out = _white_furnace(rough, thin, mu)
+        assert np.all(out <= 1.0 + 2e-3) and np.all(out >= 0.95), (mu, out)
+
+
+def test_defaults_unchanged_cpu(rng):
+    """Transmission compiled in at weight 0 changes nothing (CPU twin, to 1e-12)."""
+    n = 256
+    N, V = normal_and_view(rng, n)
+    P = rng.uniform(-1, 1, (n, 3))
+    scene = _all_kinds(rng, 8)
+    sh = rng.uniform(-0.2, 0.2, (9, 3))
+    sh[0] += 1.5
+    ibl_in = surface.IblInputs(sh=sh, prefiltered=np.array([0.9, 0.6, 0.4]), mip_count=5,
+                               brdf_lut=np.array([0.7, 0.05]), lut_values=True,
+                               transmission_prefiltered=np.array([0.3, 0.2, 0.1]),
+                               mode=ibl.IBL_MODE_SPLIT_SUM)
+    m = material.MaterialAttributes(baseColor=rng.uniform(0, 1, (n, 3)),
+                                    metallic=unit01(rng, n), roughness=roughness(rng, n))
+    on = surface.shadeSurface(m, P, N, V, scene, ibl_in, transmission=True)
+    off = surface.shadeSurface(m, P, N, V, scene, ibl_in, transmission=False)
+    assert np.all(np.abs(on - off) <= 1e-12 * (1.0 + np.abs(off)))
+
+
+# --- GPU against the twin ---------------------------------------------------------------------
+
+
+def _lut_texture(ctx, lut):
+    tex = ctx.texture((lut.shape[1], lut.shape[0]), lut.shape[2],
+                      lut.astype(np.float32).tobytes(), dtype="f4")  # fmt: skip
+    tex.repeat_x = tex.repeat_y = False
+    tex.filter = (ctx.LINEAR, ctx.LINEAR)
+    return tex
+
+
+def _shade(ctx, rng, mode, compiled, zero, thin=False, n=1024, lobes=None):
+    """GPU shadeSurface (with or without MATERIAL_HAS_TRANSMISSION) and the inputs/twin."""
+    scene = _all_kinds(rng, 16)
+    env_c = np.float32([0.5, 0.7, 1.1])
+    pref_c = np.float32([0.9, 0.6, 0.4])
+    lut_v = np.float32([0.7, 0.05, 0.45])
+    sh = f32(rng.uniform(-0.2, 0.2, (9, 3)))
+    sh[0] += 1.5
+    block = ibl.pack_ibl_block(sh, mip_count=5, intensity=1.7, samples=32, mode=mode,
+                               sample_offset=(0.25, 0.6))  # fmt: skip
+    env = _constant_cube(ctx, [env_c])
+    env.filter = (ctx.LINEAR, ctx.LINEAR)
+    pref = _constant_cube(ctx, [pref_c] * 5)
+    lut = _lut_texture(ctx, np.broadcast_to(lut_v, (4, 4, 3)).copy())
+    N, V = normal_and_view(rng, n)
+    P = f32(rng.uniform(-1, 1, (n, 3)))
+    base = f32(rng.uniform(0, 1, (n, 3)))
+    metal, rough = unit01(rng, n), roughness(rng, n, lo=0.0)
+    tw = np.zeros(n, np.float32) if zero else unit01(rng, n)
+    tc = f32(rng.uniform(0, 1, (n, 3)))
+    ac = f32(rng.uniform(0.05, 1, (n, 3)))
+    ad = f32(np.where(rng.uniform(size=n) < 0.2, 0.0, 10.0 ** rng.uniform(-2, 0.3, n)))
+    th = f32(10.0 ** rng.uniform(-3, 0.3, n))
+    eta = f32(rng.uniform(1.05, 2.2, n))
+    inputs = {"P": P, "N": N, "V": V, "base": base, "metal": metal, "rough": rough,
+              "tw": tw, "tc": tc, "ac": ac, "ad": ad, "th": th, "eta": eta}  # fmt: skip
+    body = """
+        MaterialAttributes m = defaultMaterialAttributes();
+        m.baseColor = base; m.metallic = metal; m.roughness = rough; m.ior = eta;
+        m.transmission = tw; m.transmissionColor = tc; m.attenuationColor = ac;
+        m.attenuationDistance = ad; m.thickness = th;
+        result = shadeSurface(m, P, N, V);
+    """
+    table = _random_distribution(rng)
+    dist = _distribution_texture(ctx, table)
+    # the material's IOR feeds F0 (MATERIAL_HAS_IOR) as well as the refraction
+    defines: tuple[str, ...] = ("MATERIAL_HAS_IOR",)
+    if compiled:
+        defines += ("MATERIAL_HAS_TRANSMISSION",)
+    if thin:
+        defines += ("MATERIAL_THIN_WALLED",)
+    if lobes is not None:
+        defines += (f"MATEDIT_LOBES {lobes} //",)
+    try:
+        got = gpu_eval_many(
+            ctx, body, inputs, {"result": "vec3"}, includes=["surface.glsl"], defines=defines,
+            uniform_blocks={"LightsBlock": pack_lights(scene), "IblBlock": block},
+            textures={"uPrefilteredEnv": pref, "uBrdfLut": lut, "uEnvironment": env,
+                      "uEnvDistribution": dist},
+        )["result"]  # fmt: skip
+    finally:
+        for t in (env, pref, lut, dist):
+            t.release()
+    scene[:] = [_f32_light(l) for l in scene]
+    ibl_in = surface.IblInputs(
+        sh=sh, prefiltered=lambda R, lod: np.broadcast_to(pref_c, np.shape(R)), mip_count=5,
+        brdf_lut=lut_v[:2], lut_values=True,
+        environment=lambda d: np.broadcast_to(env_c, np.shape(d)),
+        environment_distribution=table, intensity=1.7,
+        samples=32, sample_offset=(0.25, 0.6), mode=mode,
+    )  # fmt: skip
+
+    def twin(flag=compiled, **v):
+        m = material.MaterialAttributes(
+            baseColor=v["base"], metallic=v["metal"], roughness=v["rough"], ior=v["eta"],
+            transmission=v["tw"], transmissionColor=v["tc"], attenuationColor=v["ac"],
+            attenuationDistance=v["ad"], thickness=v["th"])
+        return surface.shadeSurface(m, v["P"], v["N"], v["V"], scene, ibl_in,
+                                    transmission=flag, thin_walled=thin,
+                                    lobes=surface.LOBES_ALL if lobes is None else lobes)
+
+    return got, inputs, twin
+
+
+MODES = [ibl.IBL_MODE_SPLIT_SUM, ibl.IBL_MODE_REFERENCE, ibl.IBL_MODE_NONE]
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("mode", MODES)
+def test_zero_transmission_is_the_talk(ctx, rng, mode):
+    """Compiled in at weight 0: the GPU image equals the talk's program to 1e-6."""
+    seed = int(rng.integers(1 << 30))
+    with_lobe, inputs, twin = _shade(ctx, np.random.default_rng(seed), mode, True, True)
+    talk, _, _ = _shade(ctx, np.random.default_rng(seed), mode, False, True)
+    err = np.abs(with_lobe - talk)
+    assert np.all(err <= 1e-6 * (1.0 + np.abs(talk))), err.max()
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("thin", [False, True])
+@pytest.mark.parametrize("mode", [ibl.IBL_MODE_SPLIT_SUM, ibl.IBL_MODE_REFERENCE])
+def test_shade_surface_with_transmission_gpu_twin(ctx, rng, mode, thin):
+    got, inputs, twin = _shade(ctx, rng, mode, True, False, thin=thin)
+    ref = twin(**inputs)
+    spread = perturbation_spread(twin, inputs, rng)
+    if mode == ibl.IBL_MODE_REFERENCE:
+        check_monte_carlo(f"shadeSurface+transmission[mode {mode}]", got, ref, spread,
+                          inputs["N"], inputs["V"])
+    else:
+        check(f"shadeSurface+transmission[mode {mode}]", got, ref, rtol=2e-4, atol=1e-5,
+              slack=spread)
+    assert np.abs(ref - twin(False, **inputs)).max() > 1e-2  # the lobe does something
+
+
+@pytest.mark.gl
+def test_transmission_lobe_view_gpu_twin(ctx, rng):
+    got, inputs, twin = _shade(ctx, rng, ibl.IBL_MODE_SPLIT_SUM, True, False, lobes=64)
+    ref = twin(**inputs)
+    check("transmission view", got, ref, rtol=2e-4, atol=1e-5,
+          slack=perturbation_spread(twin, inputs, rng))
+    off = inputs["tw"] == 0.0
+    assert np.all(np.abs(got[off]) <= 1e-6)
+
+
+@pytest.mark.gl
+def test_lobe_functions_gpu_twin(ctx, rng):
+    """The GLSL functions against the twin: the exit ray, Beer-Lambert (the 1 cm slab's e^-1
+    among them) and both BTDFs."""
+    n = 2048
+    N, V = normal_and_view(rng, n)
+    L = f32(rng.normal(size=(n, 3)))
+    L -= (2.0 * np.maximum(np.sum(L * N, -1), 0.0))[:, None] * N  # below the surface
+    L /= np.linalg.norm(L, axis=-1, keepdims=True)
+    a = f32(rng.uniform(0.05, 1.0, n))
+    eta = f32(rng.uniform(1.05, 2.2, n))
+    F0 = f32(np.repeat((((eta - 1) / (eta + 1)) ** 2)[:, None], 3, 1))
+    ac = f32(rng.uniform(0.05, 1, (n, 3)))
+    ac[0] = math.exp(-1.0)
+    d = f32(rng.uniform(0.0, 0.05, n))
+    d[0] = 0.01
+    ad = f32(rng.uniform(0.005, 0.05, n))
+    ad[0] = 0.01
+    got = gpu_eval_many(ctx, """
+        exitRay = transmissionSphereExit(N, transmissionEntry(N, V, eta), eta);
+        absorb = beerLambert(ac, ad, d);
+        solid = refractionBtdfCosine(N, V, L, a, eta, F0);
+        thin = thinWalledBtdfCosine(N, V, L, a, F0);
+        look = transmissionLookupRay(makeTransmissionLobe(1.0, vec3(1.0), vec3(1.0), 0.0, 1.0,
+                                                          eta, 0.0, 1.0, N, V, 1.0), N, a, 1.0);
+    """, {"N": N, "V": V, "L": L, "a": a, "eta": eta, "F0": F0, "ac": ac, "ad": ad, "d": d},
+        {"exitRay": "vec3", "absorb": "vec3", "solid": "vec3", "thin": "vec3", "look": "vec3"},
+        includes=["transmission.glsl"])
+    check("exit ray", got["exitRay"],
+          tr.transmissionSphereExit(N, tr.transmissionEntry(N, V, eta), eta), rtol=5e-3,
+          atol=2e-3)  # two float32 refractions: grazing rays amplify rounding
+    lobe = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 1.0, eta, 0.0, True, N, V,
+                                   1.0)
+    check("lookup ray", got["look"], tr.transmissionLookupRay(lobe, N, a, True), rtol=5e-3,
+          atol=2e-3)
+    check("beer-lambert", got["absorb"], tr.beerLambert(ac, ad, d), rtol=1e-4, atol=1e-6)
+    assert abs(got["absorb"][0, 0] - math.exp(-1.0)) <= 1e-3
+    check("walter btdf", got["solid"], tr.refractionBtdfCosine(N, V, L, a, eta, F0),
+          rtol=2e-3, atol=1e-4)
+    check("thin btdf", got["thin"], tr.thinWalledBtdfCosine(N, V, L, a, F0), rtol=2e-3,
+          atol=1e-4)
+
+
+# --- MaterialX ----------------------------------------------------------------------------------
+
+
+def _cli(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "matedit", *args], capture_output=True,
+                          text=True)
+
+
+def _material(path, values, thin=False):
+    import json
+
+    out = {"id": "out", "kind": "material_output"}
+    if thin:
+        out["settings"] = {"thin_walled": True}
+    path.write_text(json.dumps({
+        "format": "matedit.material", "version": 2, "name": "glass",
+        "nodes": [{"id": "make", "kind": "make_attributes", "values": values}, out],
+        "links": [{"from": ["make", "attributes"], "to": ["out", "attributes"]}]}))
+    return path
+
+
+def _attributes(path):
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+
+    return bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), 4)
+
+
+@pytest.mark.parametrize("values, thin", [
+    ({"transmission": 0.8, "transmissionColor": [0.9, 0.8, 0.7], "roughness": 0.2}, True),
+    ({"transmission": 1.0, "attenuationColor": [0.9, 0.5, 0.1], "attenuationDistance": 0.3,
+      "thickness": 0.5, "ior": 1.45}, False),
+])
+def test_materialx_round_trip(tmp_path, values, thin):
+    """The fields and the thin-walled setting survive export to standard_surface
+    (transmission, transmission_color, transmission_depth, thin_walled) and import, 1e-6."""
+    pytest.importorskip("MaterialX")
+    src = _material(tmp_path / "glass.json", values, thin)
+    out = tmp_path / "glass.mtlx"
+    r = _cli("export", str(src), "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    from tests.test_interop_mtlx import load_with_stdlib
+
+    doc = load_with_stdlib(out)
+    ok, msg = doc.validate()
+    assert ok, msg
+    shader = next(n for n in doc.getNodes() if n.getCategory() == "standard_surface")
+    sets = {i.getName(): i.getValueString() for i in shader.getInputs()}
+    assert float(sets["transmission"]) == pytest.approx(values["transmission"])
+    assert (sets.get("thin_walled") == "true") == thin
+    back = tmp_path / "back.json"
+    r = _cli("import", str(out), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    import json
+
+    settings = next(n for n in json.loads(back.read_text())["nodes"]
+                    if n["kind"] == "material_output").get("settings", {})
+    assert bool(settings.get("thin_walled", False)) == thin
+    a, b = _attributes(src), _attributes(back)
+    for k in ("transmission", "transmissionColor", "attenuationColor", "attenuationDistance",
+              "thickness", "baseColor", "cavity", "roughness", "ior"):
+        np.testing.assert_allclose(b[k], a[k], atol=1e-6, err_msg=k)
+
+
+@pytest.mark.parametrize("base", [1.0, 0.0])
+def test_standard_surface_glass_does_not_import_black(tmp_path, base):
+    """A standard_surface glass (transmission 1) keeps cavity 1 whatever its `base`: the base
+    weight becomes a base-colour multiplier (it scales the diffuse only), and the imported
+    glass in a white furnace returns about all the light."""
+    pytest.importorskip("MaterialX")
+    text = ('<?xml version="1.0"?>\n<materialx version="1.39">\n'
+            '<standard_surface name="glass" type="surfaceshader">'
+            f'<input name="base" type="float" value="{base}" />'
+            '<input name="base_color" type="color3" value="0.8, 0.8, 0.8" />'
+            '<input name="specular_roughness" type="float" value="0.05" />'
+            '<input name="transmission" type="float" value="1" />'
+            '<input name="transmission_color" type="color3" value="0.9, 1, 0.95" />'
+            '</standard_surface>\n'
+            '<surfacematerial name="M" type="material">'
+            '<input name="surfaceshader" type="surfaceshader" nodename="glass" />'
+            '</surfacematerial>\n</materialx>\n')
+    src = tmp_path / "glass.mtlx"
+    src.write_text(text)
+    back = tmp_path / "glass.json"
+    r = _cli("import", str(src), "-o", str(back))
+    assert r.returncode == 0, r.stderr
+    a = _attributes(back)
+    assert np.allclose(a["cavity"], 1.0)
+    assert np.allclose(a["baseColor"], 0.8 * base)
+    assert np.allclose(a["transmission"], 1.0)
+    assert np.allclose(a["transmissionColor"], [0.9, 1.0, 0.95])
+    sh = np.zeros((9, 3))
+    sh[0] = 2.0 * math.sqrt(math.pi)
+    m = material.MaterialAttributes(
+        baseColor=a["baseColor"][0, 0], metallic=float(a["metallic"][0, 0, 0]),
+        roughness=float(a["roughness"][0, 0, 0]), transmission=1.0,
+        transmissionColor=a["transmissionColor"][0, 0], cavity=float(a["cavity"][0, 0, 0]))
+    ibl_in = surface.IblInputs(sh=sh, prefiltered=lambda R, lod: np.ones(np.shape(R)),
+                               brdf_lut=np.array([0.9, 0.03]), lut_values=True,
+                               mode=ibl.IBL_MODE_SPLIT_SUM)
+    out = surface.shadeSurface(m, np.zeros(3), np.array([0.0, 0.0, 1.0]),
+                               np.array([0.0, 0.0, 1.0]), (), ibl_in, transmission=True)
+    assert np.all(out >= 0.85), out
+
+
+# --- the environment seen through: preview and reference against brute force ------------------
+
+
+def smooth_env(d):
+    d = np.asarray(d, np.float64)
+    x, y, z = d[..., 0], d[..., 1], d[..., 2]
+    return np.stack([1.0 + 0.6 * x, 1.0 + 0.4 * z, 0.7 - 0.3 * y + 0.2 * x * z], -1)
+
+
+def _through(V, a, thin, eta=1.5, F0=0.04):
+    """Brute force over the sphere of the transmitted radiance under smooth_env, and the
+    transmitted albedo (env 1)."""
+    L, dw = sphere_grid(1500)
+    f = w_thin_cos(V, L, a, F0) if thin else w_refract_cos(V, L, a, eta, F0)
+    return np.sum(f[..., None] * smooth_env(L), axis=(0, 1)) * dw, np.sum(f) * dw
+
+
+@pytest.mark.parametrize("rough", [0.3, 0.6])
+def test_reference_converges_to_brute_force_thin_walled(rough):
+    """Reference mode's BTDF-sampled transmission (numpy twin, 4096 samples) equals the
+    brute-force integral of the thin wall's BTDF over a smooth environment, within 1 %."""
+    from matedit.shading import lights as _lights
+    from matedit.shading import reference_layered as rl
+
+    mu = 0.7
+    V, N = view(mu), np.array([0.0, 0.0, 1.0])
+    want, _ = _through(V, rough * rough, True)
+    s = _lights.makeShadingContext(np.zeros(3), N, V, np.zeros(3), np.full(3, 0.04), rough)
+    s.transmission = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 0.0, 1.5, 0.0,
+                                             True, N, V, 1.0)
+    s.thin_walled = True
+    got = rl.transmissionEnvironmentIBL(smooth_env, s, rough, 4096, (0.1, 0.7))
+    np.testing.assert_allclose(got, want, rtol=1e-2)
+
+
+@pytest.mark.parametrize("rough", [0.35, 0.6])
+def test_reference_converges_to_brute_force_solid(rough):
+    """The same for a solid: Walter's BTDF over the sphere of directions inside, each looked up
+    along its exit from the sphere (Snell's law at the far side), within 1 %."""
+    from matedit.shading import lights as _lights
+    from matedit.shading import reference_layered as rl
+
+    mu = 0.5
+    V, N = view(mu), np.array([0.0, 0.0, 1.0])
+    L, dw = sphere_grid(1500)
+    f = w_refract_cos(V, L, rough * rough, 1.5, 0.04)
+    # the exit, independently: the chord of a unit sphere from the entry, Snell's law there
+    cos_t = -L[..., 2]
+    n_out = 2.0 * cos_t[..., None] * L + np.array([0.0, 0.0, 1.0])
+    c_in = np.sum(L * n_out, -1)  # cos of the ray inside to the exit's outward normal
+    sin_out = np.clip(1.5 * np.sqrt(np.clip(1 - c_in**2, 0, 1)), 0, 1)
+    tang = L - c_in[..., None] * n_out
+    tang = tang / np.maximum(np.linalg.norm(tang, axis=-1, keepdims=True), 1e-12)
+    exit_ray = np.sqrt(1 - sin_out**2)[..., None] * n_out + sin_out[..., None] * tang
+    want = np.sum(f[..., None] * smooth_env(exit_ray), axis=(0, 1)) * dw
+    s = _lights.makeShadingContext(np.zeros(3), N, V, np.zeros(3), np.full(3, 0.04), rough)
+    s.transmission = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 0.0, 1.5, 0.0,
+                                             False, N, V, 1.0)
+    got = rl.transmissionEnvironmentIBL(smooth_env, s, rough, 4096, (0.1, 0.7))
+    np.testing.assert_allclose(got, want, rtol=1e-2)
+
+
+def _prefiltered_env(R, r):
+    """Karis' prefiltered environment by brute force: N = V = R, the GGX-weighted mean of
+    the radiance with weight NoL (Karis 2013, PrefilterEnvMap, integrated exactly)."""
+    R = np.asarray(R, np.float64).reshape(-1, 3)
+    a = max(r * r, 1e-4)
+    L, _ = sphere_grid(300)
+    out = []
+    for Ri in R:
+        Ri = Ri / np.linalg.norm(Ri)
+        H = Ri + L
+        H = H / np.linalg.norm(H, axis=-1, keepdims=True)
+        nl = np.sum(L * Ri, -1)
+        w = np.where(nl > 0, w_D(np.sum(H * Ri, -1), a) * nl, 0.0)
+        out.append(np.sum(w[..., None] * smooth_env(L), axis=(0, 1)) / np.sum(w))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("rough", [0.3, 0.6])
+def test_preview_thin_slab_against_the_btdf_integral(rough):
+    """The preview's transmitted radiance through a thin-walled rough slab (split sum:
+    (1 - E_R) x the prefiltered environment along -V) against the brute-force integral of the
+    thin wall's BTDF over the environment, normalised to the same albedo: the split sum's
+    lobe-shape approximation (with the dominant direction), within 5 % on this smooth
+    environment (measured 0.8 % at roughness 0.3, 4.2 % at 0.6)."""
+    mu = 0.7
+    V, N = view(mu), np.array([0.0, 0.0, 1.0])
+    AB = split_sum_ab(mu, rough)
+    ibl_in = surface.IblInputs(prefiltered=lambda R, lod: _prefiltered_env(R, lod / 4.0),
+                               mip_count=5, brdf_lut=AB, lut_values=True,
+                               mode=ibl.IBL_MODE_SPLIT_SUM)
+    m = material.MaterialAttributes(metallic=0.0, roughness=rough, transmission=1.0)
+    got = surface.shadeSurface(m, np.zeros(3), N, V, (), ibl_in, transmission=True,
+                               thin_walled=True, lobes=surface.LOBE_TRANSMISSION)
+    radiance, albedo = _through(V, rough * rough, True)
+    want = (1.0 - (0.04 * AB[0] + AB[1])) * radiance / albedo
+    np.testing.assert_allclose(np.ravel(got), want, rtol=5e-2)
