@@ -284,7 +284,6 @@ class InteropActions:
             self.last_message = text
             return False
 
-        from matedit.app.canvas.arrange import arrange_document
         from matedit.interop.mtlx_import import MtlxImportError, import_mtlx
         from matedit.io.atomic import atomic_write_text
         from matedit.io.document import dumps
@@ -293,7 +292,7 @@ class InteropActions:
         try:
             refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
             doc = import_mtlx(src, out, material)
-            arrange_document(doc)  # the importer's own columns, made readable
+            _arrange(doc)  # the importer's own columns, made readable
             if not self.host.actions.maybe_save():
                 return False
             atomic_write_text(out, dumps(doc))
@@ -305,6 +304,25 @@ class InteropActions:
         except Exception as exc:
             return self._fail(title, exc)
         return self.host.actions.open(out, ask=False) and self._done(f"imported {src.name}")
+
+
+def _arrange(doc) -> None:
+    """Arrange every node of `doc` in place (Edit › Arrange over all of it), measured on a
+    canvas of its own that is then dropped: an import is laid out before it is saved."""
+    from matedit.app.canvas import NodeCanvasView
+    from matedit.app.canvas.arrange import arrange
+    from matedit.app.controller import DocumentController
+
+    view = NodeCanvasView(DocumentController(doc))
+    try:
+        scene = view.scene()
+        moved, frames, _left = arrange(scene, list(scene.node_items))
+    finally:
+        view.deleteLater()
+    for nid, pos in moved.items():
+        doc.graph.nodes[nid].position = pos
+    for cid, rect in frames.items():
+        doc.graph.comments[cid].rect = rect
 
 
 def _real(path: Path) -> Path:

@@ -79,6 +79,7 @@ def replaced_by_constant(doc, node_id: str, means: dict[str, Any]):
     mean instead; None when an output it feeds has no mean (a material or a texture)."""
     d = copy.deepcopy(doc)
     from matedit.graph.model import Link, Node
+    from matedit.nodes.kind import Role, kind_for
 
     outs = sorted({lk.src_port for lk in d.graph.links if lk.src == node_id})
     if not outs:
@@ -91,7 +92,7 @@ def replaced_by_constant(doc, node_id: str, means: dict[str, Any]):
         comps = 1 if isinstance(value, float) else len(value)
         if comps not in _TYPES:
             return None
-        d.graph.nodes[cid] = Node(cid, "constant", (0.0, 0.0),
+        d.graph.nodes[cid] = Node(cid, kind_for(Role.CONSTANT), (0.0, 0.0),
                                   {"type": _TYPES[comps], "value": value}, {})
         for lk in list(d.graph.links):
             if (lk.src, lk.src_port) == (node_id, port):
@@ -121,8 +122,8 @@ def _counted_differences(full: int, variants, resolver) -> list[int]:
     import tempfile
     from pathlib import Path
 
-    from matedit.commands.stats import spirv_text
     from matedit.compiler import compile_document, cost
+    from matedit.interop.stats import spirv_text
 
     out = []
     with tempfile.TemporaryDirectory(prefix="matedit-measure-") as tmp:
@@ -176,9 +177,11 @@ def measure_costs(doc, resolver, per_target: dict, size: int = 256, runs: int = 
         d = layer_removed(doc, layer["stack"], layer["id"])
         if d is not None:
             variants.append(("layer", layer["id"], d))
-    skip = {"make_attributes", "material_output", "layer_stack"}
+    from matedit.nodes.kind import Role, role_of
+
+    skip = {Role.MAKE_ATTRIBUTES, Role.MATERIAL_OUTPUT, Role.LAYER_STACK}
     chosen = [r for r in counted["nodes"] if r["instructions"] > 0 and
-              r["kind"] not in skip][:top] if only is None else \
+              role_of(r["kind"]) not in skip][:top] if only is None else \
         [r for r in counted["nodes"] if r["id"] in only]
     for row in chosen:
         d = replaced_by_constant(doc, row["id"], means)

@@ -1,6 +1,6 @@
 """Edit › Arrange: a layered layout of the selection (or of the whole graph), left to right.
 
-A Sugiyama-style layout over networkx: each node's column is its longest path to a node
+A Sugiyama-style layout: each node's column is its longest path to a node
 that nothing downstream of it (inside the arranged set) reads, so outputs sit in the
 rightmost column and a parameter sits just left of its first consumer. A wire that skips
 columns gets a placeholder lane in every column it crosses; the order within a column comes
@@ -19,8 +19,8 @@ functions, and tests/test_sample_layouts.py checks them with `layout_problems`.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from graphlib import TopologicalSorter
 
-import networkx as nx
 from PySide6.QtCore import QRectF
 
 from matedit.app.canvas.placement import free_offset, taken_rects
@@ -71,13 +71,19 @@ def layout_problems(scene, ids: Iterable[str] | None = None) -> list[str]:
     return problems
 
 
-def _columns(graph: nx.DiGraph) -> dict[str, int]:
+def _columns(ids: set[str], links: list[Link]) -> dict[str, int]:
     """Column 0 is the outputs'; every node sits at least one column left of its consumers
-    (a node with neither inputs nor consumers sits in column 1, beside the outputs)."""
+    (a node with neither inputs nor consumers sits in column 1, beside the outputs). The
+    graph is acyclic (validation refuses a cycle), so its order comes from graphlib."""
+    succ: dict[str, set[str]] = {n: set() for n in ids}
+    fed: set[str] = set()
+    for lk in links:
+        succ[lk.src].add(lk.dst)
+        fed.add(lk.dst)
     col: dict[str, int] = {}
-    for n in reversed(list(nx.lexicographical_topological_sort(graph))):
-        succ = list(graph.successors(n))
-        col[n] = 1 + max(col[s] for s in succ) if succ else (0 if graph.in_degree(n) else 1)
+    # consumers first: a sorter over "n depends on its consumers"
+    for n in TopologicalSorter({n: succ[n] for n in sorted(ids)}).static_order():
+        col[n] = 1 + max(col[s] for s in succ[n]) if succ[n] else (0 if n in fed else 1)
     return col
 
 
@@ -118,10 +124,7 @@ def layout(scene, ids: Iterable[str]) -> dict[str, int]:
         r = it.mapRectToScene(it.shape().boundingRect())
         size[nid] = (r.width(), r.height(), r.left() - it.pos().x(), r.top() - it.pos().y())
     links = _inner_links(g, chosen)
-    graph = nx.DiGraph()
-    graph.add_nodes_from(chosen)
-    graph.add_edges_from((lk.src, lk.dst) for lk in links)
-    col = _columns(graph)
+    col = _columns(chosen, links)
     # A chain of placeholders for each wire that skips a column (one per wire source and
     # column: wires from one output share their lane).
     members: dict[int, list[str]] = {}
@@ -329,22 +332,3 @@ def _bounds(rects: list[QRectF]) -> QRectF:
     return r
 
 
-
-def arrange_document(doc) -> list[str]:
-    """Arrange every node of `doc` in place (its positions and comment frames), measured on
-    a canvas scene of its own that is then dropped: how a MaterialX import is laid out
-    before it is saved. The problems the layout could not clear."""
-    from matedit.app.canvas.view import NodeCanvasView
-    from matedit.app.controller import DocumentController
-
-    view = NodeCanvasView(DocumentController(doc))
-    try:
-        scene = view.scene()
-        moved, frames, left = arrange(scene, list(scene.node_items))
-    finally:
-        view.deleteLater()
-    for nid, pos in moved.items():
-        doc.graph.nodes[nid].position = pos
-    for cid, rect in frames.items():
-        doc.graph.comments[cid].rect = rect
-    return left

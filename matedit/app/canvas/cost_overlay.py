@@ -91,7 +91,7 @@ class CostOverlay(QObject):
 
     def _work(self, gen: int, doc) -> None:
         try:
-            from matedit.commands.stats import material_stats
+            from matedit.interop.stats import material_stats
             from matedit.io.document import FileResolver
 
             result: object = material_stats(doc, FileResolver(), [TARGET])[TARGET]
