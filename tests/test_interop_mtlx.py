@@ -148,7 +148,9 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
     finally:
         drawer.release()
     print(path.stem, "checked", checked)
-    assert "base_color" in checked, checked
+    # every sample varies something over the surface (the soap bubble only its film)
+    assert checked, f"{path.stem}: no input is a node graph"
+    assert "base_color" in checked or path.stem == "soap_bubble", checked
 
 
 # --- import ---------------------------------------------------------------------------------
