@@ -170,12 +170,14 @@ class InteropActions:
 
             emax = float(max(1.0, np.max(attrs["emissive"])))
             attrs["emissive"] = attrs["emissive"] / emax
+            lobes = gltf.lobes_of(ir)
             files = gltf.files_for(out, maps_from(attrs, ir.attributes),
-                                   mesh_from_spec(mesh_spec), self._stem(), emax)
+                                   mesh_from_spec(mesh_spec), self._stem(), emax, lobes)
             gltf.write(files)
         except Exception as exc:
             return self._fail(title, exc)
-        return self._done(f"exported {', '.join(p.name for p in files)}")
+        said = "".join(f"; note: {n}" for n in lobes.notes)
+        return self._done(f"exported {', '.join(p.name for p in files)}{said}")
 
     def export_mtlx(self, out: Path | None = None, size: int = 512) -> bool:
         title = "Export MaterialX"

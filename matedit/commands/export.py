@@ -84,11 +84,14 @@ def _gltf(args, out: Path) -> int:
     emax = float(max(1.0, np.max(attrs["emissive"])))
     attrs["emissive"] = attrs["emissive"] / emax
     maps = maps_from(attrs, ir.attributes, "png")
-    files = gltf.files_for(out, maps, mesh, stem_of(doc), emax)
+    lobes = gltf.lobes_of(ir)
+    files = gltf.files_for(out, maps, mesh, stem_of(doc), emax, lobes)
     try:
         gltf.write(files)
     except OSError as exc:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    for note in lobes.notes:
+        report("note", f"{path}: {note}")
     if sys.stderr.isatty():
         print(f"exported {path} to {', '.join(str(p) for p in files)}", file=sys.stderr)
     return 0

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import tempfile
 import urllib.parse
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -42,9 +43,10 @@ class _Blob:
         return len(self.views) - 1
 
 
-def build(maps: list[BakedMap], mesh, name: str, emissive_max: float = 1.0) -> tuple[g.GLTF2,
-                                                                                    bytes]:
-    """The glTF document (without its buffer's uri) and its binary buffer."""
+def build(maps: list[BakedMap], mesh, name: str, emissive_max: float = 1.0,
+          lobes: LobeExport | None = None) -> tuple[g.GLTF2, bytes]:
+    """The glTF document (without its buffer's uri) and its binary buffer; `lobes`: the
+    KHR_materials_* extensions of the lobe fields (`lobe_extensions`)."""
     by = {m.name: m for m in maps}
     blob = _Blob()
     accessors: list[g.Accessor] = []
@@ -109,6 +111,9 @@ def build(maps: list[BakedMap], mesh, name: str, emissive_max: float = 1.0) -> t
             mat.extensions = {"KHR_materials_emissive_strength":
                               {"emissiveStrength": float(emissive_max)}}
             extensions.append("KHR_materials_emissive_strength")
+    if lobes is not None and lobes.extensions:
+        mat.extensions = {**(mat.extensions or {}), **lobes.extensions}
+        extensions += sorted(lobes.extensions)
     doc = g.GLTF2(
         asset=g.Asset(version="2.0", generator="matedit"),
         scene=0, scenes=[g.Scene(nodes=[0])],
@@ -125,9 +130,9 @@ def build(maps: list[BakedMap], mesh, name: str, emissive_max: float = 1.0) -> t
 
 
 def files_for(out: Path, maps: list[BakedMap], mesh, name: str,
-              emissive_max: float = 1.0) -> dict[Path, bytes]:
+              emissive_max: float = 1.0, lobes: LobeExport | None = None) -> dict[Path, bytes]:
     """Output path -> bytes for OUT.glb, or OUT.gltf and OUT.bin."""
-    doc, data = build(maps, mesh, name, emissive_max)
+    doc, data = build(maps, mesh, name, emissive_max, lobes)
     if out.suffix.lower() == ".glb":
         doc.buffers = [g.Buffer(byteLength=len(data))]
         doc.set_binary_blob(data)
@@ -154,3 +159,141 @@ def write(files: dict[Path, bytes]) -> None:
     with staged_outputs(order[0].parent) as stage:
         for p in order:
             stage.write_bytes(p, files[p])
+
+
+# --- the lobes beyond the talk's fields: KHR_materials_* factors ---------------------------
+VARYING = 1e-4  # a field whose values spread wider than this over the bake is "varying"
+
+
+@dataclass(frozen=True)
+class LobeExport:
+    """The KHR_materials_* extensions of a material's lobe fields, and what could not be
+    said exactly (`notes`, one line each, for the command line's `note:` lines)."""
+
+    extensions: dict[str, dict]
+    notes: tuple[str, ...]
+
+
+def _stats(values: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, np.ndarray,
+                                                              np.ndarray]:
+    v = np.asarray(values[name], np.float64).reshape(-1, np.asarray(values[name]).shape[-1])
+    return v.mean(axis=0), v.min(axis=0), v.max(axis=0)
+
+
+def _default(name: str) -> float:
+    from matedit.nodes.material import ATTRIBUTE_FIELDS
+
+    return float(next(f.default for f in ATTRIBUTE_FIELDS if f.name == name))
+
+
+def lobe_extensions(values: dict[str, np.ndarray], written, thin_walled: bool) -> LobeExport:
+    """The lobe fields the material writes (`written`), evaluated over the bake surface
+    (`values`: field -> (..., k)), as glTF extension factors. A field that varies over the
+    surface is exported as its mean, with a note naming its range (no lobe map is baked)."""
+    ext: dict[str, dict] = {}
+    notes: list[str] = []
+    written = set(written)
+
+    seen: dict[str, list[float] | float] = {}
+
+    def factor(name: str) -> list[float] | float:  # noted once however often asked
+        if name in seen:
+            return seen[name]
+        mean, lo, hi = _stats(values, name)
+        if np.max(hi - lo) > VARYING:
+            rng = (f"{float(lo[0]):.4g} .. {float(hi[0]):.4g}" if len(lo) == 1 else
+                   f"({', '.join(f'{x:.3g}' for x in lo)}) .. "
+                   f"({', '.join(f'{x:.3g}' for x in hi)})")
+            notes.append(f"{name} varies over the surface ({rng}); glTF gets its mean "
+                         f"(no {name} map is baked)")
+        out = [round(float(x), 6) for x in mean]
+        seen[name] = out[0] if len(out) == 1 else out
+        return seen[name]
+
+    def has(name: str) -> bool:
+        return name in written and name in values
+
+    if has("ior") and factor("ior") != 1.5:
+        ext["KHR_materials_ior"] = {"ior": max(1.0, float(factor("ior")))}  # type: ignore[arg-type]
+    if has("specularColor"):
+        color = factor("specularColor")
+        if color != [1.0, 1.0, 1.0]:
+            ext["KHR_materials_specular"] = {"specularFactor": 1.0,
+                                             "specularColorFactor": color}
+    if has("coat") and float(factor("coat")) > 0.0:  # type: ignore[arg-type]
+        cc = {"clearcoatFactor": factor("coat")}
+        if has("coatRoughness"):
+            cc["clearcoatRoughnessFactor"] = factor("coatRoughness")
+        ext["KHR_materials_clearcoat"] = cc
+        if has("coatColor") and factor("coatColor") != [1.0, 1.0, 1.0]:
+            notes.append("coatColor (the coat's tint) has no glTF counterpart "
+                         "(KHR_materials_clearcoat is untinted); dropped")
+        if has("coatIor") and factor("coatIor") != 1.5:
+            notes.append("coatIor has no glTF counterpart (KHR_materials_clearcoat is 1.5); "
+                         "dropped")
+        if has("coatNormal"):
+            notes.append("coatNormal is not baked (no clearcoatNormalTexture); the coat "
+                         "takes the geometric normal")
+    if has("sheenColor"):
+        color = factor("sheenColor")
+        if color != [0.0, 0.0, 0.0]:
+            sh = {"sheenColorFactor": color}
+            if has("sheenRoughness"):
+                sh["sheenRoughnessFactor"] = factor("sheenRoughness")
+            ext["KHR_materials_sheen"] = sh
+    if has("anisotropy") and float(factor("anisotropy")) > 0.0:  # type: ignore[arg-type]
+        an: dict = {"anisotropyStrength": factor("anisotropy")}
+        if has("anisotropyDirection"):
+            d = factor("anisotropyDirection")
+            an["anisotropyRotation"] = round(float(np.arctan2(d[1], d[0])), 6)  # type: ignore[index]
+        ext["KHR_materials_anisotropy"] = an
+        notes.append("anisotropy: glTF stretches the roughness by its own rule "
+                     "(alpha_t = mix(alpha, 1, strength^2)), not matedit's (docs/shading.md); "
+                     "the highlight's length differs")
+    if has("transmission") and float(factor("transmission")) > 0.0:  # type: ignore[arg-type]
+        ext["KHR_materials_transmission"] = {"transmissionFactor": factor("transmission")}
+        if has("transmissionColor") and factor("transmissionColor") != [1.0, 1.0, 1.0]:
+            notes.append("transmissionColor: glTF tints transmitted light by the base colour; "
+                         "the separate tint is dropped")
+        if not thin_walled:
+            vol: dict = {"thicknessFactor": factor("thickness") if "thickness" in values
+                         else _default("thickness")}
+            if has("attenuationDistance") and float(factor("attenuationDistance")) > 0.0:  # type: ignore[arg-type]
+                vol["attenuationDistance"] = factor("attenuationDistance")
+                if has("attenuationColor"):
+                    vol["attenuationColor"] = factor("attenuationColor")
+            ext["KHR_materials_volume"] = vol
+    if has("thinFilmThickness"):
+        mean, lo, hi = _stats(values, "thinFilmThickness")
+        if float(hi[0]) > 0.0:
+            # without a thickness texture glTF's film is iridescenceThicknessMaximum thick
+            ir = {"iridescenceFactor": 1.0,
+                  "iridescenceThicknessMaximum": round(float(mean[0]), 3)}
+            if has("thinFilmIor"):
+                ir["iridescenceIor"] = factor("thinFilmIor")
+            if float(hi[0] - lo[0]) > VARYING:
+                notes.append(f"thinFilmThickness varies over the surface ({float(lo[0]):.4g} "
+                             f".. {float(hi[0]):.4g} nm); glTF gets its mean "
+                             f"{float(mean[0]):.4g} nm (no iridescence thickness map)")
+            ext["KHR_materials_iridescence"] = ir
+    if has("subsurface") and float(_stats(values, "subsurface")[2][0]) > 0.0:
+        notes.append("subsurface has no ratified glTF extension; dropped (the base colour "
+                     "keeps the diffuse)")
+    return LobeExport(ext, tuple(notes))
+
+
+LOBE_SIZE = 32  # the bake surface's side for the lobe fields' mean and range
+
+
+def lobes_of(ir) -> LobeExport:
+    """`lobe_extensions` of an optimised IR: its lobe fields evaluated by the CPU twin over
+    a LOBE_SIZE² bake surface (the factors are means, so a small surface is enough)."""
+    from matedit.compiler.lower import THIN_WALLED_DEFINE
+    from matedit.interop.bake import attributes_cpu
+    from matedit.nodes.material import ATTRIBUTE_FIELDS
+
+    lobe_fields = {f.name for f in ATTRIBUTE_FIELDS if f.lobe}
+    if not lobe_fields & set(ir.attributes):
+        return LobeExport({}, ())
+    values = attributes_cpu(ir, LOBE_SIZE)
+    return lobe_extensions(values, ir.attributes, THIN_WALLED_DEFINE in ir.defines)
