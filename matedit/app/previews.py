@@ -25,6 +25,7 @@ from matedit.compiler.lower import CompileError, lower_document
 from matedit.graph import nodes
 from matedit.graph.nodes import Thumbnail
 from matedit.graph.types import PortType
+from matedit.nodes.twin import sphere_surface
 from matedit.shading import thumbnail
 
 SIZE = 48
@@ -33,20 +34,8 @@ BACKGROUND = np.array([0.035, 0.04, 0.05])  # linear; matches the node body once
 
 
 def preview_sphere(size: int = SIZE) -> tuple[SurfaceArrays, np.ndarray]:
-    """A unit sphere seen head-on from +Z, as the mesh preview's UVs lay it out; and the mask
-    of pixels that see it (top row first)."""
-    t = (np.arange(size) + 0.5) / size * 2 - 1
-    x, y = np.meshgrid(t, -t)
-    r2 = x * x + y * y
-    inside = (r2 < 1.0).ravel()
-    z = np.sqrt(np.clip(1 - r2, 0, 1))
-    n = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
-    # the preview UV sphere: u around +Y from +X, v from the south pole up
-    u = (np.arctan2(-n[:, 2], n[:, 0]) / (2 * np.pi)) % 1.0
-    v = 1.0 - np.arccos(np.clip(n[:, 1], -1, 1)) / np.pi
-    view = np.tile([0.0, 0.0, 1.0], (len(n), 1))
-    return SurfaceArrays(np.stack([u, v], axis=1), n.copy(), n, view, 0.0,
-                         grid=(size, size)), inside  # the footprint: filtered edges, bumps
+    """The preview sphere (matedit.nodes.twin.sphere_surface) at the thumbnails' size."""
+    return sphere_surface(size)
 
 
 def shaded(attrs: dict, size: int = SIZE) -> np.ndarray:

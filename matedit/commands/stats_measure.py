@@ -30,12 +30,14 @@ PROBE_SIZE = 48
 
 FRAMES_PER_RUN = 3  # frames a program draws in each round; the fastest is its time
 
+
 def mean_values(doc, resolver) -> dict[str, Any]:
     """'node.port' -> the mean of that top-level output over the visible preview sphere."""
     from matedit.compiler.cpu_eval import evaluate
     from matedit.compiler.lower import lower_document
+    from matedit.nodes.twin import sphere_surface
 
-    surface, inside = _sphere(PROBE_SIZE)
+    surface, inside = sphere_surface(PROBE_SIZE)
     ir = lower_document(doc, resolver)
     probe: dict[str, Any] = {}
     with np.errstate(all="ignore"):
@@ -53,24 +55,6 @@ def mean_values(doc, resolver) -> dict[str, Any]:
         m = np.nanmean(a[inside], axis=0)
         out[key] = float(m) if m.ndim == 0 else [float(x) for x in m]
     return out
-
-
-def _sphere(size: int):
-    """The preview sphere's surface arrays (a unit sphere head-on, matedit.app.previews'
-    layout, rebuilt here so the command stays free of the editor's modules)."""
-    from matedit.nodes.twin import SurfaceArrays
-
-    t = (np.arange(size) + 0.5) / size * 2 - 1
-    x, y = np.meshgrid(t, -t)
-    r2 = x * x + y * y
-    inside = (r2 < 1.0).ravel()
-    z = np.sqrt(np.clip(1 - r2, 0, 1))
-    n = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
-    u = (np.arctan2(-n[:, 2], n[:, 0]) / (2 * np.pi)) % 1.0
-    v = 1.0 - np.arccos(np.clip(n[:, 1], -1, 1)) / np.pi
-    view = np.tile([0.0, 0.0, 1.0], (len(n), 1))
-    return SurfaceArrays(np.stack([u, v], axis=1), n.copy(), n, view, 0.0,
-                         grid=(size, size)), inside
 
 
 _TYPES = {1: "float", 2: "vec2", 3: "vec3", 4: "vec4"}

@@ -40,6 +40,23 @@ class SurfaceArrays:
         return len(self.uv)
 
 
+def sphere_surface(size: int) -> tuple[SurfaceArrays, np.ndarray]:
+    """A unit sphere seen head-on from +Z, as the mesh preview's UVs lay it out; and the mask
+    of pixels that see it (top row first)."""
+    t = (np.arange(size) + 0.5) / size * 2 - 1
+    x, y = np.meshgrid(t, -t)
+    r2 = x * x + y * y
+    inside = (r2 < 1.0).ravel()
+    z = np.sqrt(np.clip(1 - r2, 0, 1))
+    n = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+    # the preview UV sphere: u around +Y from +X, v from the south pole up
+    u = (np.arctan2(-n[:, 2], n[:, 0]) / (2 * np.pi)) % 1.0
+    v = 1.0 - np.arccos(np.clip(n[:, 1], -1, 1)) / np.pi
+    view = np.tile([0.0, 0.0, 1.0], (len(n), 1))
+    return SurfaceArrays(np.stack([u, v], axis=1), n.copy(), n, view, 0.0,
+                         grid=(size, size)), inside  # the footprint: filtered edges, bumps
+
+
 def _col(x: np.ndarray) -> np.ndarray:
     """A per-point float (N,) as a column (N, 1), to scale vectors (N, k) row by row."""
     return x[..., None]
