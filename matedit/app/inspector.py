@@ -39,7 +39,7 @@ from matedit.app.paths import absolute_of, reference_for
 from matedit.graph import nodes
 from matedit.graph.commands import SetLabel, SetSetting, SetValue
 from matedit.graph.model import ChangeEvent, ChangeKind, Node
-from matedit.graph.nodes import MESH_UV, Port, Role, SettingDef, role_of
+from matedit.graph.nodes import MESH_UV, Port, Role, SettingDef, limit_problem, role_of
 from matedit.graph.ports import normalize_channels
 from matedit.graph.types import PortType, coerce_value
 
@@ -51,6 +51,12 @@ def is_colour(name: str, node_kind: str) -> bool:
     n = name.lower()
     return role_of(node_kind) == Role.COLOR_PARAMETER or any(w in n for w in _COLOUR_WORDS)
 
+
+
+def _shown(value) -> str:
+    if isinstance(value, list):
+        return "(" + ", ".join(f"{x:g}" for x in value) + ")"
+    return f"{value:g}"
 
 class InspectorPanel(QScrollArea):
     """Shows and edits one node of the active document."""
@@ -498,6 +504,13 @@ class InspectorPanel(QScrollArea):
         node = self._node()
         if node is None:
             return
+        a = self.controller.analysis
+        spec = a.ports[node.id].input(port) if a and node.id in a.ports else None
+        problem = limit_problem(spec, value) if spec is not None else None
+        if problem is not None:  # clamped, and said: the field shows the bound it took
+            why, value = problem
+            self.message.emit(f"{node.id}: {why}; set to {_shown(value)}")
+            QTimer.singleShot(0, self.refresh_values)
         if node.values.get(port) == value:
             return
         self.controller.push(SetValue(node.id, port, value, text=f"set {node.id}.{port}"),

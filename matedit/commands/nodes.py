@@ -28,6 +28,9 @@ _PORT = {
         "default": {},
         "range": {"type": ["array", "null"], "items": {"type": "number"}, "minItems": 2,
                   "maxItems": 2},
+        # hard bounds, null on an unbounded side (the slider's `range` may be typed past)
+        "limits": {"type": ["array", "null"], "items": {"type": ["number", "null"]},
+                   "minItems": 2, "maxItems": 2},
         "doc": {"type": "string"},
         "required": {"type": "boolean"},
     },
@@ -89,6 +92,7 @@ def _port(p, is_input: bool) -> dict[str, Any]:
     if is_input:
         out["default"] = p.default
         out["range"] = list(p.range) if p.range else None
+        out["limits"] = list(p.limits) if p.limits else None
         out["required"] = bool(p.required)
     return out
 

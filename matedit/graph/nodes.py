@@ -43,6 +43,7 @@ from matedit.nodes.kind import (
     is_value_parameter,
     kind_for,
     kinds_where,
+    limit_problem,
     register,
     role_of,
 )
@@ -68,6 +69,7 @@ __all__ = [
     "LUMA_REC709", "RAMP_STOPS", "REGISTRY", "InputDef", "Mtlx", "MxBuilder", "MxNode", "MxRecipe",
     "NodeDef", "OutputDef", "Port", "PortsRule", "Ref", "Role", "SettingDef", "Thumbnail",
     "attribute_group", "categories", "definition", "get", "is_impure", "is_parameter",
-    "is_value_parameter", "kind_for", "kinds_where", "lobe_input", "lobe_value_is_default",
+    "is_value_parameter", "kind_for", "kinds_where", "limit_problem", "lobe_input",
+    "lobe_value_is_default",
     "port_group", "register", "role_of",
 ]

@@ -163,6 +163,7 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
                                  nid, "function", f))
         try:
             ports[nid] = node_ports(node, resolver, doc)
+            diags.extend(_limit_warnings(node, ports[nid], f))
         except PortError as exc:
             diags.append(error(str(exc), nid, exc.field, f))
         except LookupError as exc:
@@ -355,6 +356,18 @@ def _default_number_problem(default) -> str | None:
             if why:
                 return why
     return None
+
+
+def _limit_warnings(node, ports: NodePorts, f) -> list[Diagnostic]:
+    """A value beyond its port's hard bounds (Port.limits): a warning naming the node and the
+    field; the material still compiles (the editor clamps what an artist types)."""
+    out = []
+    for name, value in sorted(node.values.items()):
+        port = ports.input(name)
+        problem = nodes.limit_problem(port, value) if port is not None else None
+        if problem is not None:
+            out.append(warning(problem[0], node.id, name, f))
+    return out
 
 
 def _check_input_default(n, f) -> list[Diagnostic]:

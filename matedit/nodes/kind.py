@@ -35,6 +35,39 @@ class Port:
     # off, and the lobe's code is compiled out. Moving it off or back to its default is
     # therefore a structural edit (one recompile), any other value edit a uniform.
     lobe: bool = False
+    # Hard bounds (None: unbounded on that side): a value beyond them means nothing to the
+    # shader, which clamps it; the editor clamps it visibly and validation warns. `range` is
+    # only the slider's span and may be typed past.
+    limits: tuple[float | None, float | None] | None = None
+
+
+def limit_problem(port: Port, value: Any) -> tuple[str, Any] | None:
+    """(why, the value clamped into `port.limits`) where a number, or any component of a
+    vector, is beyond them; None where it is within (or the port has none)."""
+    if port.limits is None or isinstance(value, (str, bool)) or value is None:
+        return None
+    lo, hi = port.limits
+    many = isinstance(value, (list, tuple))
+    comps = list(value) if many else [value]
+    if not all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in comps):
+        return None
+    fixed = [float(c) for c in comps]
+    if lo is not None:
+        fixed = [max(c, lo) for c in fixed]
+    if hi is not None:
+        fixed = [min(c, hi) for c in fixed]
+    if fixed == [float(c) for c in comps]:
+        return None
+    bound = ("at least " + _num(lo) if lo is not None else "") + \
+        (" and " if lo is not None and hi is not None else "") + \
+        ("at most " + _num(hi) if hi is not None else "")
+    shown = "(" + ", ".join(_num(c) for c in comps) + ")" if many else _num(comps[0])
+    return f"{port.name} {shown} is out of bounds: it must be {bound}", \
+        (fixed if many else fixed[0])
+
+
+def _num(x: float) -> str:
+    return f"{float(x):g}"
 
 
 # The names the catalogue uses for the two sides (one type).
@@ -353,8 +386,9 @@ _SEED = ("seed", "float", 0.0, "integer seed: another seed, another pattern", (0
 
 
 def _i(name: str, type_: str, default: Any = 0.0, doc: str = "",
-       rng: tuple[float, float] | None = None, required: bool = False) -> Port:
-    return Port(name, type_, default, doc, rng, required)
+       rng: tuple[float, float] | None = None, required: bool = False,
+       limits: tuple[float | None, float | None] | None = None) -> Port:
+    return Port(name, type_, default, doc, rng, required, limits=limits)
 
 
 def _o(name: str, type_: str, doc: str = "", group: str = "") -> Port:

@@ -91,6 +91,19 @@ ATTRIBUTE_FIELDS: tuple[InputDef, ...] = tuple(replace(f, group="Base") for f in
           "distance, metres (scene units), light travels inside to reach attenuationColor; "
           "0: no absorption", (0.0, 2.0), "Transmission"),
 )
+# The fields' hard bounds (Port.limits): weights and roughnesses in [0, 1], indices of
+# refraction from 1, colours, lengths and thicknesses from 0.
+_WEIGHT, _IOR, _POSITIVE = (0.0, 1.0), (1.0, None), (0.0, None)
+FIELD_LIMITS: dict[str, tuple[float | None, float | None]] = {
+    **dict.fromkeys(("metallic", "roughness", "cavity", "opacity", "coat", "coatRoughness",
+                     "sheenRoughness", "anisotropy", "subsurface", "transmission"), _WEIGHT),
+    **dict.fromkeys(("ior", "coatIor", "thinFilmIor"), _IOR),
+    **dict.fromkeys(("baseColor", "emissive", "specularColor", "coatColor", "sheenColor",
+                     "subsurfaceColor", "subsurfaceRadius", "thickness", "transmissionColor",
+                     "attenuationColor", "attenuationDistance", "thinFilmThickness"),
+                    _POSITIVE),
+}
+ATTRIBUTE_FIELDS = tuple(replace(f, limits=FIELD_LIMITS.get(f.name)) for f in ATTRIBUTE_FIELDS)
 ATTRIBUTE_NAMES = tuple(f.name for f in ATTRIBUTE_FIELDS)
 
 

@@ -252,7 +252,8 @@ register(NodeDef(
     "value_noise", "Value Noise", "Procedural",
     "Smooth value noise in [0, 1] over uv, summed over octaves.",
     inputs=(_i("uv", "vec2", MESH_UV), _i("scale", "float", 8.0, "cells per UV unit", (0.0, 64.0)),
-            _i("octaves", "float", 3.0, "detail levels (1-6)", (1.0, 6.0))),
+            _i("octaves", "float", 3.0, "detail levels (1-6)", (1.0, 6.0),
+               limits=(1.0, float(NOISE_MAX_OCTAVES)))),
     outputs=(_o("value", "float"),),
     glsl="node_value_noise", thumbnail=Thumbnail.ALWAYS,
     mtlx=BAKE,
@@ -316,7 +317,8 @@ _fn("cellular_noise_3d", "Cellular Noise 3D", "Noise",
     [_o("f1", "float"), _o("f2", "float"), _o("edge", "float"), _o("cell_id", "float")],
     thumbnail=Thumbnail.ALWAYS,
     numpy=_cellular_noise_3d)
-_OCT = [_i("octaves", "float", 4.0, "detail levels (fractional fades the last in)", (1.0, 8.0)),
+_OCT = [_i("octaves", "float", 4.0, "detail levels (fractional fades the last in)", (1.0, 8.0),
+           limits=(1.0, float(FBM_MAX_OCTAVES))),
         _i("lacunarity", "float", 2.0, "frequency ratio between octaves", (1.0, 4.0)),
         _i("gain", "float", 0.5, "amplitude ratio between octaves", (0.0, 1.0))]
 
@@ -401,6 +403,7 @@ _fn("domain_warp", "Domain Warp", "Noise",
     "Displaces uv by fractal noise, so any pattern fed the result swirls and breaks up.",
     [_i(*_UV), _i("scale", "float", 4.0, "", (0.0, 64.0)),
      _i("strength", "float", 0.1, "displacement in UV units", (0.0, 1.0)),
-     _i("octaves", "float", 3.0, "", (1.0, 8.0)), _i(*_SEED)], [_o("uv", "vec2")],
+     _i("octaves", "float", 3.0, "", (1.0, 8.0), limits=(1.0, float(FBM_MAX_OCTAVES))),
+     _i(*_SEED)], [_o("uv", "vec2")],
     thumbnail=Thumbnail.ALWAYS,
     numpy=_domain_warp)
