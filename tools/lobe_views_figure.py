@@ -20,6 +20,12 @@ TILES = [
     ("velvet", "lit", "Velvet: lit"), ("velvet", "sheen", "sheen only"),
     ("brushed_steel", "lit", "Brushed steel: lit"),
     ("brushed_steel", "anisotropy", "anisotropy direction"),
+    ("skin", "lit", "Skin: lit"), ("skin", "subsurface", "subsurface only"),
+    ("honey", "lit", "Honey: lit"), ("honey", "transmission", "transmission only"),
+    ("soap_bubble", "lit", "Soap bubble: lit"), ("soap_bubble", "transmission",
+                                                 "transmission only"),
+    ("oil_slick_metal", "lit", "Oil slick: lit"), ("oil_slick_metal", "thin-film",
+                                                   "film thickness"),
 ]
 
 
