@@ -509,7 +509,7 @@ COMMAND_CASES = {
 }
 # Commands that write no file: their declaration must say they read nothing to protect, or
 # only documents (validate).
-NO_OUTPUT = {"validate", "nodes", "brdf-lut"}
+NO_OUTPUT = {"validate", "nodes", "brdf-lut", "stats"}  # stats prints, writes nothing
 
 
 def _direct_ok(command, kind, name) -> bool:
