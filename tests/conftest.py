@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import zlib
 
 import pytest
 
@@ -95,3 +96,12 @@ def ctx(gl_ctx):
     _ = gl_ctx.error  # reading it clears any stale error
     yield gl_ctx
     assert gl_ctx.error == "GL_NO_ERROR"
+
+
+@pytest.fixture
+def rng(request):
+    """A random generator seeded by the test's name: stable across runs and processes (str
+    hash is salted per process; crc32 is not). A module may define its own."""
+    import numpy as np
+
+    return np.random.default_rng(zlib.crc32(request.node.name.encode()))

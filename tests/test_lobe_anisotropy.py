@@ -17,7 +17,6 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -48,9 +47,6 @@ ROOT = Path(__file__).resolve().parents[1]
 ANISO = ("MATERIAL_HAS_ANISOTROPY",)
 
 
-@pytest.fixture
-def rng(request):
-    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
 
 
 # --- references from the papers --------------------------------------------------------

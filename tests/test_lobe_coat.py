@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
-import zlib
 
 import numpy as np
 import pytest
@@ -47,9 +46,6 @@ from tests.test_shading_gpu_twin import (
 COAT = ("MATERIAL_HAS_COAT",)
 
 
-@pytest.fixture
-def rng(request):
-    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
 
 
 def _coat_inputs(rng, n):

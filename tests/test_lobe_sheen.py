@@ -9,8 +9,6 @@ matedit.shading.
 
 from __future__ import annotations
 
-import zlib
-
 import numpy as np
 import pytest
 
@@ -32,12 +30,6 @@ from tests.test_shading_gpu_twin import (
     unit01,
     unit_vectors,
 )
-
-
-@pytest.fixture
-def rng(request):
-    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
-
 
 # --- independent references (from the paper, in float64) ---------------------------------
 

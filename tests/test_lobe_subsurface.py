@@ -9,7 +9,6 @@ the sphere of directions; none of them imports the closed forms of matedit.shadi
 from __future__ import annotations
 
 import math
-import zlib
 
 import numpy as np
 import pytest
@@ -34,12 +33,6 @@ from tests.test_shading_gpu_twin import (
     unit01,
     unit_vectors,
 )
-
-
-@pytest.fixture
-def rng(request):
-    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
-
 
 # --- independent references (float64) ------------------------------------------------------
 

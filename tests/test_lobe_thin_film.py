@@ -15,7 +15,6 @@ nothing of matedit.shading.thin_film.
 from __future__ import annotations
 
 import math
-import zlib
 
 import numpy as np
 import pytest
@@ -39,12 +38,6 @@ from tests.test_shading_gpu_twin import (
     roughness,
     unit01,
 )
-
-
-@pytest.fixture
-def rng(request):
-    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
-
 
 # --- the independent spectral reference (float64) -------------------------------------------
 

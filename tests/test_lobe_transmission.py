@@ -10,7 +10,6 @@ sphere of directions; none of them imports matedit.shading.transmission.
 from __future__ import annotations
 
 import math
-import zlib
 
 import numpy as np
 import pytest
@@ -33,12 +32,6 @@ from tests.test_shading_gpu_twin import (
     roughness,
     unit01,
 )
-
-
-@pytest.fixture
-def rng(request):
-    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
-
 
 # --- independent references (float64, from Walter et al. 2007) -----------------------------
 

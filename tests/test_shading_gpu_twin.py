@@ -12,8 +12,6 @@ must be as good as an exact evaluation of slightly different inputs: backward er
 
 from __future__ import annotations
 
-import zlib
-
 import numpy as np
 import pytest
 
@@ -93,10 +91,6 @@ def _report():
         print(f"  {name:32s} {a:10.3e} {r:10.3e}")
 
 
-@pytest.fixture
-def rng(request):
-    # A stable seed per test (str hash is salted per process; crc32 is not).
-    return np.random.default_rng(zlib.crc32(request.node.name.encode()))
 
 
 def check(name, gpu, ref, rtol=1e-4, atol=1e-6, slack=0.0):
