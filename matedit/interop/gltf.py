@@ -210,17 +210,25 @@ def lobe_extensions(values: dict[str, np.ndarray], written, thin_walled: bool) -
         seen[name] = out[0] if len(out) == 1 else out
         return seen[name]
 
+    def scalar(name: str) -> float:
+        v = factor(name)
+        return float(v[0] if isinstance(v, list) else v)
+
+    def vector(name: str) -> list[float]:
+        v = factor(name)
+        return v if isinstance(v, list) else [v]
+
     def has(name: str) -> bool:
         return name in written and name in values
 
     if has("ior") and factor("ior") != 1.5:
-        ext["KHR_materials_ior"] = {"ior": max(1.0, float(factor("ior")))}  # type: ignore[arg-type]
+        ext["KHR_materials_ior"] = {"ior": max(1.0, scalar("ior"))}
     if has("specularColor"):
         color = factor("specularColor")
         if color != [1.0, 1.0, 1.0]:
             ext["KHR_materials_specular"] = {"specularFactor": 1.0,
                                              "specularColorFactor": color}
-    if has("coat") and float(factor("coat")) > 0.0:  # type: ignore[arg-type]
+    if has("coat") and scalar("coat") > 0.0:
         cc = {"clearcoatFactor": factor("coat")}
         if has("coatRoughness"):
             cc["clearcoatRoughnessFactor"] = factor("coatRoughness")
@@ -241,16 +249,16 @@ def lobe_extensions(values: dict[str, np.ndarray], written, thin_walled: bool) -
             if has("sheenRoughness"):
                 sh["sheenRoughnessFactor"] = factor("sheenRoughness")
             ext["KHR_materials_sheen"] = sh
-    if has("anisotropy") and float(factor("anisotropy")) > 0.0:  # type: ignore[arg-type]
+    if has("anisotropy") and scalar("anisotropy") > 0.0:
         an: dict = {"anisotropyStrength": factor("anisotropy")}
         if has("anisotropyDirection"):
-            d = factor("anisotropyDirection")
-            an["anisotropyRotation"] = round(float(np.arctan2(d[1], d[0])), 6)  # type: ignore[index]
+            d = vector("anisotropyDirection")
+            an["anisotropyRotation"] = round(float(np.arctan2(d[1], d[0])), 6)
         ext["KHR_materials_anisotropy"] = an
         notes.append("anisotropy: glTF stretches the roughness by its own rule "
                      "(alpha_t = mix(alpha, 1, strength^2)), not matedit's (docs/shading.md); "
                      "the highlight's length differs")
-    if has("transmission") and float(factor("transmission")) > 0.0:  # type: ignore[arg-type]
+    if has("transmission") and scalar("transmission") > 0.0:
         ext["KHR_materials_transmission"] = {"transmissionFactor": factor("transmission")}
         if has("transmissionColor") and factor("transmissionColor") != [1.0, 1.0, 1.0]:
             notes.append("transmissionColor: glTF tints transmitted light by the base colour; "
@@ -258,7 +266,7 @@ def lobe_extensions(values: dict[str, np.ndarray], written, thin_walled: bool) -
         if not thin_walled:
             vol: dict = {"thicknessFactor": factor("thickness") if "thickness" in values
                          else _default("thickness")}
-            if has("attenuationDistance") and float(factor("attenuationDistance")) > 0.0:  # type: ignore[arg-type]
+            if has("attenuationDistance") and scalar("attenuationDistance") > 0.0:
                 vol["attenuationDistance"] = factor("attenuationDistance")
                 if has("attenuationColor"):
                     vol["attenuationColor"] = factor("attenuationColor")
