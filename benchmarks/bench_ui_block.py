@@ -1,6 +1,7 @@
-"""How long the UI thread is blocked by a structural edit, in the real editor window.
+"""How long the UI thread is blocked, in the real editor window: by a structural edit, during
+reference accumulation, a slider drag, an environment change and a resize.
 
-Run: .venv/bin/python benchmarks/bench_ui_block.py [--edits N] [--json]
+Run: .venv/bin/python benchmarks/bench_ui_block.py [--edits N] [--cases-only] [--json]
 (starts a virtual X server when there is no DISPLAY; prints figures, passes or fails nothing)
 
 Two child processes, each on the sample layered material in MainWindow with compiles off the UI
@@ -16,6 +17,20 @@ before).
   (what the user feels as a freeze: no event, no paint meanwhile).
 - edit -> pixels: from the push to the end of that frame (debounce skipped, as bench_editor.py).
 - UI-thread link (Renderer.set_material in the viewport) and that first frame's paint time.
+
+A third child process (`--child cases`, no warm-up child: its processes would share the 2
+cores with what is measured) times the other cases, each by the same 5 ms ticks, each
+writing its own `ui_block_max_ms`:
+
+- reference: the mode chooser set to Reference, at REFERENCE_SAMPLES samples a pixel, from the
+  choice until the view has converged (or REFERENCE_WINDOW_S); also the time to converge and
+  the number of paints (the viewport draws the accumulation in slices: more paints than frames);
+- slider: a drag of the `amount` parameter, SLIDER_STEPS value edits (merged undo steps, as a
+  field's drag) one every 16 ms, until the frame after the last edit;
+- environment: the environment chooser to Sky, back to Studio and to Sky again (each change
+  through `EnvironmentChoice.choose`, the first may bake; the IBL cache is the user's), until
+  the frame after each;
+- resize: the window between 1600x1000 and 1400x900, RESIZES times, until the frame after each.
 """
 
 from __future__ import annotations
@@ -32,6 +47,11 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 TICK_MS = 5
+REFERENCE_SAMPLES = 512  # 16 frames of 32 samples: converges within the window on llvmpipe
+REFERENCE_WINDOW_S = 60.0
+SLIDER_STEPS = 30
+RESIZES = 6
+CASES = ("reference", "slider", "environment", "resize")
 
 
 def child(warm: bool, edits: int) -> dict:
@@ -177,12 +197,169 @@ def child(warm: bool, edits: int) -> dict:
     return out
 
 
-def measure(warm: bool, edits: int, timeout: float = 600) -> dict:
-    """One child process with a fresh, empty Mesa shader cache (enabled)."""
+class Ticks:
+    """A 5 ms precise timer on the UI thread; `gaps(t0, t1)` are the gaps between ticks from
+    the last tick before t0 to the first after t1 (ms), `longest` the longest of them."""
+
+    def __init__(self) -> None:
+        from PySide6.QtCore import Qt, QTimer
+
+        self.ticks: list[float] = []
+        self.timer = QTimer()
+        self.timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self.timer.setInterval(TICK_MS)
+        self.timer.timeout.connect(lambda: self.ticks.append(time.perf_counter()))
+        self.timer.start()
+
+    def gaps(self, t0: float, t1: float) -> list[float]:
+        before = [t for t in self.ticks if t < t0]
+        inside = [t for t in self.ticks if t0 <= t <= t1]
+        after = [t for t in self.ticks if t > t1][:1]
+        window = (before[-1:] or [t0]) + inside + (after or [t1])
+        return [(b - a) * 1e3 for a, b in zip(window, window[1:])]
+
+    def longest(self, t0: float, t1: float) -> float:
+        return max(self.gaps(t0, t1), default=0.0)
+
+
+def cases_child(only: tuple[str, ...] = CASES) -> dict:
+    """Reference accumulation, slider drag, environment change and resize (module docstring)."""
+    os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
+    sys.path.insert(0, str(HERE))
+    from bench_editor import open_editor, start_display
+
+    display = start_display()
+    from PySide6.QtCore import QEventLoop, QStandardPaths, QTimer
+
+    QStandardPaths.setTestModeEnabled(True)  # keep the real settings and autosaves alone
+    from matedit.app.app import make_application
+
+    app = make_application()
+    from matedit.app.compile_service import MaterialCompiler
+    from matedit.app.compile_worker import CompileWorker
+    from matedit.app.controller import new_merge_id
+    from matedit.graph.commands import SetValue
+
+    MaterialCompiler.asynchronous = True
+    CompileWorker.warm_up = False
+    w, view = open_editor(app)
+    if view.renderer is None:
+        return {"error": f"no renderer: {view.problem}"}
+    panel = w.viewport
+    loop = QEventLoop()
+
+    def spin(ms: int) -> None:
+        QTimer.singleShot(ms, loop.quit)
+        loop.exec()
+
+    def wait_frames(n0: int, until=None, limit_s: float = 60.0) -> float:
+        """Runs the loop until a frame after `n0` is drawn (and `until()` holds); its end."""
+        end = time.perf_counter() + limit_s
+        while view.frames <= n0 or (until is not None and not until()):
+            spin(2)
+            if time.perf_counter() > end:
+                break
+        return time.perf_counter()
+
+    while not view.has_material or view.renderer.has_material is False:  # the first program
+        spin(50)
+    spin(500)
+    ticks = Ticks()
+    out: dict = {"viewport": list(view.renderer.size),
+                 "gl": view.ctx.info.get("GL_RENDERER", "?"), "cases": {}}
+    r = view.renderer
+
+    if "reference" in only:
+        r.set_reference_samples(REFERENCE_SAMPLES)
+        spin(200)
+        paints: list[float] = []
+        view.frameDrawn.connect(lambda: paints.append(view.last_frame_time * 1e3))
+        n0, t0 = view.frames, time.perf_counter()
+        panel.mode_combo.setCurrentText("Reference")
+        t1 = wait_frames(n0, lambda: r.converged, REFERENCE_WINDOW_S)
+        gaps = ticks.gaps(t0, t1)
+        out["cases"]["reference"] = {
+            "ui_block_max_ms": max(gaps, default=0.0), "samples": REFERENCE_SAMPLES,
+            "converged": bool(r.converged), "converge_ms": (t1 - t0) * 1e3,
+            "frames": r.accumulated_frames, "paints": view.frames - n0,
+            "paint_median_ms": statistics.median(paints) if paints else None,
+            "longest_gaps_ms": sorted(gaps)[-5:][::-1],
+            "gaps_over_50_ms": sum(1 for g in gaps if g > 50.0)}
+        panel.mode_combo.setCurrentText("Split-sum")
+        wait_frames(view.frames)
+        spin(200)
+
+    if "slider" in only:
+        node = w.controller.document.graph.nodes["amount"]
+        v0 = float(node.values.get("value", 0.5))
+        merge = new_merge_id()
+        state = {"i": 0}
+        t0 = time.perf_counter()
+
+        def step() -> None:
+            i = state["i"] = state["i"] + 1
+            value = round(v0 + 0.4 * ((i % 10) / 10.0 - 0.2), 4)
+            w.controller.push(SetValue("amount", "value", value, text="bench drag"),
+                              merge_id=merge)
+            if i < SLIDER_STEPS:
+                QTimer.singleShot(16, step)
+
+        step()
+        while state["i"] < SLIDER_STEPS:
+            spin(5)
+        t_last = time.perf_counter()
+        t1 = wait_frames(view.frames)
+        out["cases"]["slider"] = {"ui_block_max_ms": ticks.longest(t0, t1),
+                                  "edits": SLIDER_STEPS, "drag_ms": (t_last - t0) * 1e3}
+        spin(200)
+
+    if "environment" in only:
+        runs = []
+        for spec in ("sky", "studio", "sky"):
+            n0, t0 = view.frames, time.perf_counter()
+            panel.choose_environment(spec)
+            t1 = wait_frames(n0)
+            runs.append({"environment": spec, "block_ms": ticks.longest(t0, t1),
+                         "ms": (t1 - t0) * 1e3})
+            spin(200)
+        out["cases"]["environment"] = {"ui_block_max_ms": max(x["block_ms"] for x in runs),
+                                       "runs": runs}
+        panel.choose_environment("studio")
+        spin(200)
+
+    if "resize" in only:
+        runs = []
+        for i in range(RESIZES):
+            size = (1400, 900) if i % 2 == 0 else (1600, 1000)
+            n0, t0 = view.frames, time.perf_counter()
+            w.resize(*size)
+            t1 = wait_frames(n0)
+            runs.append({"size": list(size), "block_ms": ticks.longest(t0, t1),
+                         "ms": (t1 - t0) * 1e3, "viewport": list(view.renderer.size)})
+            spin(200)
+        out["cases"]["resize"] = {"ui_block_max_ms": max(x["block_ms"] for x in runs),
+                                  "runs": runs}
+
+    ticks.timer.stop()
+    w.actions.ask_save_changes = lambda name: "discard"
+    w.close()
+    app.processEvents()
+    if display is not None:
+        print(json.dumps(out))
+        sys.stdout.flush()
+        display.stop()
+        os._exit(0)
+    return out
+
+
+def measure(warm: bool | None, edits: int, timeout: float = 600) -> dict:
+    """One child process with a fresh, empty Mesa shader cache (enabled); warm None: the
+    cases child."""
     with tempfile.TemporaryDirectory(prefix="matedit-mesa-cache-") as cache:
         env = dict(os.environ, MESA_SHADER_CACHE_DISABLE="false", MESA_SHADER_CACHE_DIR=cache)
-        cmd = [sys.executable, str(Path(__file__).resolve()), "--child",
-               "warm" if warm else "cold", "--edits", str(edits)]
+        kind = "cases" if warm is None else "warm" if warm else "cold"
+        cmd = [sys.executable, str(Path(__file__).resolve()), "--child", kind,
+               "--edits", str(edits)]
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env,
                                   cwd=HERE.parent)
@@ -194,28 +371,38 @@ def measure(warm: bool, edits: int, timeout: float = 600) -> dict:
     return json.loads(lines[-1])
 
 
-def run(edits: int = 8) -> dict:
-    """Both runs (for benchmarks/run_all.py): {"warm": ..., "cold": ...}."""
-    return {"warm": measure(True, edits), "cold": measure(False, edits)}
+def run(edits: int = 8, cases_only: bool = False) -> dict:
+    """Every run (for benchmarks/run_all.py): {"warm": ..., "cold": ..., "cases": ...}."""
+    out = {} if cases_only else {"warm": measure(True, edits), "cold": measure(False, edits)}
+    out["cases"] = measure(None, edits)
+    return out
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--edits", type=int, default=8)
     ap.add_argument("--json", action="store_true")
-    ap.add_argument("--child", choices=("warm", "cold"))
+    ap.add_argument("--cases-only", action="store_true",
+                    help="only reference, slider, environment and resize")
+    ap.add_argument("--only", default=",".join(CASES),
+                    help="with --child cases: comma-separated cases to run")
+    ap.add_argument("--child", choices=("warm", "cold", "cases"))
     args = ap.parse_args(argv)
     if args.child:
-        out = child(args.child == "warm", args.edits)
+        only = tuple(c for c in args.only.split(",") if c in CASES)
+        out = cases_child(only) if args.child == "cases" else child(args.child == "warm",
+                                                                    args.edits)
         print(json.dumps(out))
         return 0 if "error" not in out else 1
-    res = run(args.edits)
+    res = run(args.edits, args.cases_only)
     if args.json:
         print(json.dumps(res))
         return 0
     print(f"UI-thread blocking by a structural edit, sample layered material, {args.edits} edits "
           f"each; Mesa shader cache enabled, fresh temporary MESA_SHADER_CACHE_DIR per run")
     for key, label in (("cold", "no warm-up (before)"), ("warm", "worker warm-up")):
+        if key not in res:
+            continue
         r = res[key]
         if "error" in r:
             print(f"  {label:22s} error: {r['error']}")
@@ -227,6 +414,22 @@ def main(argv=None) -> int:
               f"(plain {r['plain_paint_median_ms']:4.0f}) | compile "
               f"{r['compile_median_ms']:4.1f} ms | viewport {r['viewport'][0]}x"
               f"{r['viewport'][1]}, warmed {r['warmed']}, links/edit {r['links_per_edit']}")
+    c = res["cases"]
+    if "error" in c:
+        print(f"  other cases: error: {c['error']}")
+        return 0
+    print(f"Other cases (no warm-up child), viewport {c['viewport'][0]}x{c['viewport'][1]}:")
+    for name, r in c["cases"].items():
+        extra = ""
+        if name == "reference":
+            extra = (f" | {r['samples']} samples/px {'converged' if r['converged'] else 'NOT'}"
+                     f" in {r['converge_ms']:.0f} ms, {r['frames']} frames, "
+                     f"{r['paints']} paints")
+        elif name == "slider":
+            extra = f" | {r['edits']} edits over {r['drag_ms']:.0f} ms"
+        else:
+            extra = " | " + ", ".join(f"{x['block_ms']:.0f}" for x in r["runs"]) + " ms"
+        print(f"  {name:12s} ui_block max {r['ui_block_max_ms']:6.0f} ms{extra}")
     return 0
 
 

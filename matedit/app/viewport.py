@@ -54,6 +54,11 @@ class ViewportWidget(QOpenGLWidget):
     frameDrawn = Signal()
     statusMessage = Signal(str)
     settingsChanged = Signal(object)  # the new RenderSettings
+    # GL work a paint does for reference accumulation (ms; None: the renderer's default,
+    # matedit.render.slicing.DEFAULT_BUDGET_MS); the next paint is queued behind the events
+    # that came meanwhile
+    slice_budget_ms: float | None = None
+    DISPLAY_INTERVAL_S = 0.25  # reference accumulation shows its progress this often
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -78,6 +83,11 @@ class ViewportWidget(QOpenGLWidget):
         self._fbo = None
         self._fbo_glo = -1
         self.settings = RenderSettings()
+        self._last_paint = 0.0
+        self._slicer = QTimer(self)  # reference accumulation between paints (_advance)
+        self._slicer.setSingleShot(True)
+        self._slicer.setInterval(0)
+        self._slicer.timeout.connect(self._advance)
 
     # --- GL lifecycle ----------------------------------------------------------------------
     def initializeGL(self) -> None:  # noqa: N802 - Qt's name
@@ -103,6 +113,11 @@ class ViewportWidget(QOpenGLWidget):
                 self.renderer = cls(self.ctx, size=size, samples=4)
                 env_done = False
             self._apply_view_state(set_environment=not env_done)
+            # reference accumulation in bands of rows, a paint's worth at a time, so that
+            # the event loop runs between them (matedit.render.slicing)
+            from matedit.render.slicing import DEFAULT_BUDGET_MS
+
+            self.renderer.slice_budget_ms = self.slice_budget_ms or DEFAULT_BUDGET_MS
         except Exception as exc:
             self.renderer = None
             self.problem = f"renderer failed to start: {type(exc).__name__}: {exc}"
@@ -149,9 +164,34 @@ class ViewportWidget(QOpenGLWidget):
             return
         self.frames += 1
         self.last_frame_time = time.perf_counter() - t0
+        self._last_paint = time.perf_counter()
         self.frameDrawn.emit()
-        if self.renderer.needs_redraw:
-            QTimer.singleShot(0, self, self.update)  # reference mode accumulates until converged
+        if self.renderer.needs_redraw:  # reference mode accumulates until converged
+            self._slicer.start()
+
+    def _advance(self) -> None:
+        """Reference accumulation between paints: one budget's worth of bands
+        (Renderer.advance), then the event loop; a paint when a frame is complete, or
+        DISPLAY_INTERVAL_S after the last one (the first frame shows as it is drawn)."""
+        r = self.renderer
+        if r is None or not r.needs_redraw:
+            return
+        frames = r.accumulated_frames
+        self.makeCurrent()
+        try:
+            bands = r.advance()
+        except Exception as exc:  # as paintGL: keep the editor alive, say what went wrong
+            self.problem = f"render failed: {type(exc).__name__}: {exc}"
+            self.renderer = None
+            self.update()
+            return
+        finally:
+            self.doneCurrent()
+        if not bands or r.accumulated_frames != frames or not r.needs_redraw or \
+                time.perf_counter() - self._last_paint >= self.DISPLAY_INTERVAL_S:
+            self.update()
+        else:
+            self._slicer.start()
 
     def _paint_message(self, text: str) -> None:
         p = QPainter(self)

@@ -5,15 +5,26 @@ reference and difference modes, `Accumulator` adds the resolved frames (each wit
 sample set, `r2_offset`) into a float sum; difference mode keeps the split-sum frame beside it.
 The display pass writes exposure, ACES and sRGB, or the difference heat map, into the caller's
 framebuffer (by default an internal sRGB8 image).
+
+`Accumulator.draw` takes whole frames (the CLI, the tests, `render_converged`). The editor's
+viewport uses `Accumulator.draw_sliced` instead: a reference frame (and difference mode's
+split-sum frame) is drawn in bands (`SceneTargets.scissor`: whole rows, or part of a row),
+sized by a `matedit.render.slicing.BandPlanner` to a budget per paint, and added to the sum
+only when its last band is in; until the first frame is complete the partly drawn frame is
+shown.
 """
 
 from __future__ import annotations
+
+import time
+from collections.abc import Callable
 
 import moderngl
 import numpy as np
 
 from matedit.render.deferred import GBuffer
 from matedit.render.fullscreen import FullscreenQuad, render_program, set_uniform
+from matedit.render.slicing import BandPlanner
 from matedit.shading.ibl import IBL_MODE_REFERENCE, IBL_MODE_SPLIT_SUM
 
 HEAT_RANGE = 0.1  # |split sum - reference| shown at full heat, linear HDR
@@ -53,10 +64,14 @@ class SceneTargets:
         self.background = _float_target(ctx, size) if deferred else None
         self.resolved = _float_target(ctx, size)
         self.ctx, self.size = ctx, size
+        # (x, y, width, height) of the band the next scene draws (clears, passes and resolve
+        # scissored to it), None for the whole frame
+        self.scissor: tuple[int, int, int, int] | None = None
 
     def _begin(self, fbo: moderngl.Framebuffer, clear: tuple[float, ...] | None) -> None:
         fbo.use()
         fbo.viewport = (0, 0, *self.size)
+        fbo.scissor = self.scissor  # the current framebuffer's: GL's scissor test follows
         if clear is not None:
             self.ctx.clear(*clear, depth=1.0)
 
@@ -74,6 +89,8 @@ class SceneTargets:
         self._begin(self.msaa, None)
 
     def resolve(self) -> None:
+        """The multisampled target into `resolved` (within the scissor band, if any: the
+        blit follows GL's scissor test, which the last `_begin` set)."""
         self.ctx.copy_framebuffer(self.resolved, self.msaa)
 
     def release(self) -> None:
@@ -95,7 +112,11 @@ class Accumulator:
         self._quad = quad
         self._accumulate = render_program(ctx, "fullscreen.vert", "accumulate.frag")
         self._display = render_program(ctx, "fullscreen.vert", "display.frag")
-        self.frames = 0
+        self._frames = 0
+        # where the next band starts in the frame being drawn in slices: row, and the
+        # column within it when only a part of the row is drawn
+        self.row = self.col = 0
+        self.split_ready = False  # difference mode's split-sum frame is kept (draw_sliced)
         self.drawn = 0  # frames displayed (keys the difference mean read back)
         self._difference: tuple[int, float] | None = None
         self.sum: moderngl.Framebuffer | None = None
@@ -108,7 +129,19 @@ class Accumulator:
         self._size = size
         self.sum = _float_target(self.ctx, size)
         self.split = _float_target(self.ctx, size)
-        self.frames = 0
+        self.frames = 0  # and the sliced frame restarts
+
+    @property
+    def frames(self) -> int:
+        """Reference frames in the sum; set to 0 for a reset (the sliced frame restarts)."""
+        return self._frames
+
+    @frames.setter
+    def frames(self, n: int) -> None:
+        self._frames = int(n)
+        if self._frames == 0:
+            self.row = self.col = 0
+            self.split_ready = False
 
     def draw(self, mode: str, reference_frames: int, scene, resolved: moderngl.Framebuffer,
              target: moderngl.Framebuffer | None, exposure: float) -> None:
@@ -121,11 +154,76 @@ class Accumulator:
             if self.frames < reference_frames:
                 scene(IBL_MODE_REFERENCE, r2_offset(self.frames))
                 self.add(resolved)
+                self.row = self.col = 0  # a sliced frame under way restarts
             if mode == "difference":
                 scene(IBL_MODE_SPLIT_SUM, (0.0, 0.0))
                 self.keep_split_sum(resolved)
+                self.split_ready = True
         self.display(target if target is not None else self.output(), mode, resolved, exposure)
         self.drawn += 1
+
+    def pending(self, mode: str, reference_frames: int) -> bool:
+        """Whether draw_sliced has a band to draw: a split-sum frame to keep (difference) or
+        reference frames to add."""
+        if mode == "splitsum":
+            return False
+        return (mode == "difference" and not self.split_ready) or \
+            self.frames < reference_frames
+
+    def draw_sliced(self, mode: str, reference_frames: int, scene,
+                    resolved: moderngl.Framebuffer, target: moderngl.Framebuffer | None,
+                    exposure: float, planner: BandPlanner,
+                    clock: Callable[[], float] = time.perf_counter) -> int:
+        """One paint of `mode`: split sum a whole frame (as `draw`); reference and difference
+        `advance` by a budget's worth of bands, then the display (until the first frame is
+        complete, of the frame as far as it is drawn). Returns the bands drawn."""
+        if mode == "splitsum":
+            self.draw(mode, reference_frames, lambda m, o: scene(m, o, None), resolved, target,
+                      exposure)
+            return 0
+        bands = self.advance(mode, reference_frames, scene, resolved, planner, clock)
+        out = target if target is not None else self.output()
+        self.display(out, "splitsum" if self.frames == 0 else mode, resolved, exposure)
+        self.drawn += 1
+        return bands
+
+    def advance(self, mode: str, reference_frames: int, scene,
+                resolved: moderngl.Framebuffer, planner: BandPlanner,
+                clock: Callable[[], float] = time.perf_counter) -> int:
+        """Bands of reference or difference mode's next frames until `planner`'s budget is
+        spent (at least one band while any is pending); no display. `scene(ibl_mode, offset,
+        band)` draws and resolves the pixels of `band` (x, y, w, h). A reference frame is
+        added to the sum when its last band is in, so every pixel gets the frames `draw`
+        would give it; difference mode first keeps its split-sum frame, drawn once per
+        accumulation (nothing it shows changes until a reset). Returns the bands drawn."""
+        w, h = self._size
+        spent, bands = 0.0, 0
+        while self.pending(mode, reference_frames):
+            left = planner.budget_ms - spent
+            band = planner.next_band(self.row, self.col, w, h, left)
+            if bands and not planner.fits(band, left):
+                break
+            split_pass = mode == "difference" and not self.split_ready
+            t0 = clock()
+            if split_pass:
+                scene(IBL_MODE_SPLIT_SUM, (0.0, 0.0), band)
+            else:
+                scene(IBL_MODE_REFERENCE, r2_offset(self.frames), band)
+            self.ctx.finish()  # the band's real cost (the driver works asynchronously)
+            ms = (clock() - t0) * 1e3
+            planner.record(band, ms)
+            spent += ms
+            bands += 1
+            x, y, bw, bh = band
+            self.row, self.col = (y + bh, 0) if x + bw >= w else (y, x + bw)
+            if self.row >= h:
+                self.row = 0
+                if split_pass:
+                    self.keep_split_sum(resolved)
+                    self.split_ready = True
+                else:
+                    self.add(resolved)
+        return bands
 
     def add(self, resolved: moderngl.Framebuffer) -> None:
         """Adds a resolved reference frame to the sum."""
@@ -138,7 +236,7 @@ class Accumulator:
         self._accumulate["uFrame"].value = 0
         self._quad.draw(self._accumulate)
         self.ctx.disable(moderngl.BLEND)
-        self.frames += 1
+        self._frames += 1
 
     def keep_split_sum(self, resolved: moderngl.Framebuffer) -> None:
         """Keeps the resolved split-sum frame of difference mode."""

@@ -26,6 +26,7 @@ from matedit.render.mesh import GpuMesh, mesh_from_spec
 from matedit.render.programs import MaterialStatus, ProgramCache
 from matedit.render.scene import ScenePass
 from matedit.render.settings import MODES, PreviewSettings
+from matedit.render.slicing import BandPlanner
 from matedit.shading.ibl import IBL_MODE_REFERENCE
 from matedit.shading.lights import Light
 from matedit.shading.views import check_view, is_attribute_view
@@ -58,6 +59,10 @@ class Renderer(PreviewSettings):
         self.scene = ScenePass(ctx, samples, self._quad, self, prelink=self.deferred)
         self.lighting = self.scene.lighting
         self.accumulator = Accumulator(ctx, self._quad)
+        # reference and difference frames drawn in bands of about this many ms a render()
+        # call (the editor's viewport sets it; None: whole frames, as the CLI draws)
+        self.slice_budget_ms: float | None = None
+        self.planner = BandPlanner()
         self.targets: SceneTargets | None = None
         self.set_mesh("sphere")
         self.resize(*size)
@@ -227,18 +232,42 @@ class Renderer(PreviewSettings):
         """Reference frames averaged so far (converged at `reference_frames`)."""
         return self.accumulator.frames
 
-    def _scene(self, ibl_mode: int, offset=(0.0, 0.0)) -> None:
+    def _scene(self, ibl_mode: int, offset=(0.0, 0.0), band=None) -> None:
+        """The scene into the targets, only the rows of `band` (x, y, w, h) when given."""
         program = self._program
         if ibl_mode == IBL_MODE_REFERENCE and self.is_forward and self._compiled is not None:
             program = self.programs.reference(self._compiled, self.energy_compensation,
                                               fallback=program, view=self.view)
-        self.scene.draw(self, self.targets, self._mesh, program, self.is_forward,
-                        self.material, ibl_mode, offset)
+        self.targets.scissor = band
+        try:
+            self.scene.draw(self, self.targets, self._mesh, program, self.is_forward,
+                            self.material, ibl_mode, offset)
+        finally:
+            self.targets.scissor = None
 
     def render(self, target: moderngl.Framebuffer | None = None) -> None:
-        """Draws one frame into `target` (default: an internal sRGB8 image, see read_image)."""
+        """Draws one frame into `target` (default: an internal sRGB8 image, see read_image).
+        With `slice_budget_ms` set, reference and difference mode draw as much of their next
+        frame as fits that budget (frames.Accumulator.draw_sliced): call again while
+        `needs_redraw`."""
+        if self.slice_budget_ms is not None:
+            self.planner.budget_ms = float(self.slice_budget_ms)
+            self.accumulator.draw_sliced(self.mode, self.reference_frames, self._scene,
+                                         self.targets.resolved, target, self.exposure,
+                                         self.planner)
+            return
         self.accumulator.draw(self.mode, self.reference_frames, self._scene,
                               self.targets.resolved, target, self.exposure)
+
+    def advance(self) -> int:
+        """With `slice_budget_ms` set, reference or difference mode's next bands within that
+        budget, without a display (the next `render` shows them); returns the bands drawn
+        (0 when converged, in split-sum mode or without a budget)."""
+        if self.slice_budget_ms is None or self.mode == "splitsum":
+            return 0
+        self.planner.budget_ms = float(self.slice_budget_ms)
+        return self.accumulator.advance(self.mode, self.reference_frames, self._scene,
+                                        self.targets.resolved, self.planner)
 
     @property
     def difference_mean(self) -> float | None:
@@ -250,11 +279,15 @@ class Renderer(PreviewSettings):
         """Renders until reference/difference mode has converged; returns frames drawn."""
         limit = max_frames if max_frames is not None else self.reference_frames + 1
         frames = 0
-        while True:
-            self.render(target)
-            frames += 1
-            if not self.needs_redraw or frames >= limit:
-                return frames
+        budget, self.slice_budget_ms = self.slice_budget_ms, None  # whole frames here
+        try:
+            while True:
+                self.render(target)
+                frames += 1
+                if not self.needs_redraw or frames >= limit:
+                    return frames
+        finally:
+            self.slice_budget_ms = budget
 
     def set_reference_samples(self, total: int) -> None:
         """Reference mode's samples a pixel: up to 32 a frame, accumulated over frames."""
