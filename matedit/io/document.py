@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import json
 import os
+import stat
+import threading
+from collections import OrderedDict
 from pathlib import Path
 from typing import Any
 
@@ -323,11 +326,37 @@ def save(doc: MaterialDocument, path: str | os.PathLike | None = None) -> Path:
     return Path(target)
 
 
-class FileResolver:
-    """Finds material functions relative to the file that uses them, caching loaded files."""
+# Material functions and layers read by any FileResolver in this process, by real path, with
+# the signature of the file they were read from (device, inode, size, mtime in ns): a compile
+# reads and checks an unchanged file once, and a file written since (a new mtime or size, or
+# another file renamed over it) is read again. Only documents that loaded are kept; nothing
+# in a document is executed, so a cached one is the same data a new read would give.
+_DOCUMENT_CACHE_SIZE = 256
+_documents: OrderedDict[Path, tuple[tuple[int, int, int, int], MaterialDocument]] = \
+    OrderedDict()
+_documents_lock = threading.Lock()  # the editor compiles on a worker thread
 
-    def __init__(self) -> None:
-        self._cache: dict[Path, tuple[float, MaterialDocument]] = {}
+
+def _file_signature(p: Path) -> tuple[int, int, int, int] | None:
+    """(device, inode, size, mtime_ns) of a regular file; None for anything else (read, and
+    refused, as before: never cached)."""
+    st = p.stat()
+    if not stat.S_ISREG(st.st_mode):
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
+def clear_document_cache() -> None:
+    """Forgets every function and layer document read so far (tests; a caller that changes
+    a file without changing its size or mtime)."""
+    with _documents_lock:
+        _documents.clear()
+
+
+class FileResolver:
+    """Finds material functions relative to the file that uses them. Files that loaded are
+    cached for the whole process by path, size and mtime (`_documents`): the document a
+    resolver returns is shared, never to be changed by its caller."""
 
     def path_of(self, ref: str, owner: MaterialDocument | None) -> Path:
         base = Path(owner.path).parent if owner is not None and owner.path else Path.cwd()
@@ -336,17 +365,25 @@ class FileResolver:
     def resolve(self, ref: str, owner: MaterialDocument | None) -> MaterialDocument:
         try:
             p = self.path_of(ref, owner)
-            mtime = p.stat().st_mtime
+            signature = _file_signature(p)
         except (OSError, ValueError):
             raise LookupError(f"{ref}: file not found") from None
-        hit = self._cache.get(p)
-        if hit and hit[0] == mtime:
-            return hit[1]
+        if signature is not None:
+            with _documents_lock:
+                hit = _documents.get(p)
+                if hit is not None and hit[0] == signature:
+                    _documents.move_to_end(p)
+                    return hit[1]
         try:
             doc = load(p)
         except FormatError as exc:
             raise LookupError(f"{ref}: {exc.reason}") from None
         if not doc.is_function:
             raise LookupError(f"{ref} is a material, not a material function")
-        self._cache[p] = (mtime, doc)
+        if signature is not None:
+            with _documents_lock:
+                _documents[p] = (signature, doc)
+                _documents.move_to_end(p)
+                while len(_documents) > _DOCUMENT_CACHE_SIZE:
+                    _documents.popitem(last=False)
         return doc

@@ -79,9 +79,12 @@ def check_document_shape(raw: Any, file: str | None = None) -> None:
     if not isinstance(fmt, str) or fmt not in SCHEMA_FILES:
         raise FormatError(file, f"'format' must be one of {', '.join(sorted(SCHEMA_FILES))}, "
                           f"got {fmt!r}", field="format")
+    validator = _validator(fmt)
+    if validator.is_valid(raw):  # the usual case: no error to rank
+        return
     from jsonschema.exceptions import best_match
 
-    error = best_match(_validator(fmt).iter_errors(raw))
+    error = best_match(validator.iter_errors(raw))
     if error is None:
         return
     path = list(error.absolute_path)
