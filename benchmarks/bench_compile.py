@@ -1,6 +1,10 @@
 """Compile time against graph size, and the GL link time of each sample on this machine.
 
-Run: MESA_SHADER_CACHE_DISABLE=true .venv/bin/python benchmarks/bench_compile.py
+Run: MESA_SHADER_CACHE_DISABLE=true .venv/bin/python benchmarks/bench_compile.py [--samples]
+
+--samples: only `compile_document` of each sample material (no GL), a new FileResolver per
+compile as every CLI command makes one: the first compile (files read and schema-checked)
+and the median of the next ones (matedit.io.document's cache of unchanged files).
 """
 
 from __future__ import annotations
@@ -48,7 +52,30 @@ def link_times() -> list[tuple[str, float, float]]:
     return rows
 
 
+def sample_compile_times(repeat: int = 9) -> list[tuple[str, float, float]]:
+    """(sample, first compile, median of the next `repeat`) in seconds, in one process."""
+    import time
+
+    rows = []
+    for path in sorted((graphs_dir() / "materials").glob("*.json")):
+        doc = load(path)
+        t0 = time.perf_counter()
+        compile_document(doc, FileResolver())
+        first = time.perf_counter() - t0
+        rows.append((path.stem, first,
+                     median_time(lambda d=doc: compile_document(d, FileResolver()),
+                                 repeat=repeat)))
+    return rows
+
+
 def main() -> None:
+    if "--samples" in sys.argv[1:]:
+        print(f"# sample compiles on {machine()}, a new FileResolver per compile")
+        print("\n| sample | first compile (ms) | next compiles (ms, median of 9) |")
+        print("|---|---:|---:|")
+        for name, first, rest in sample_compile_times():
+            print(f"| {name} | {first * 1000:.1f} | {rest * 1000:.1f} |")
+        return
     print(f"# compile benchmark on {machine()}")
     print(f"# MESA_SHADER_CACHE_DISABLE={os.environ.get('MESA_SHADER_CACHE_DISABLE')}")
     print("\n| nodes | graph -> GLSL (ms, median) | growth per decade |")

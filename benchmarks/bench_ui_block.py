@@ -48,7 +48,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 TICK_MS = 5
 REFERENCE_SAMPLES = 512  # 16 frames of 32 samples: converges within the window on llvmpipe
-REFERENCE_WINDOW_S = 60.0
+REFERENCE_WINDOW_S = 120.0
 SLIDER_STEPS = 30
 RESIZES = 6
 CASES = ("reference", "slider", "environment", "resize")
@@ -197,6 +197,11 @@ def child(warm: bool, edits: int) -> dict:
     return out
 
 
+def _quantile(values: list[float], q: float) -> float:
+    v = sorted(values)
+    return v[min(len(v) - 1, int(q * (len(v) - 1)))] if v else 0.0
+
+
 class Ticks:
     """A 5 ms precise timer on the UI thread; `gaps(t0, t1)` are the gaps between ticks from
     the last tick before t0 to the first after t1 (ms), `longest` the longest of them."""
@@ -284,6 +289,8 @@ def cases_child(only: tuple[str, ...] = CASES) -> dict:
             "frames": r.accumulated_frames, "paints": view.frames - n0,
             "paint_median_ms": statistics.median(paints) if paints else None,
             "longest_gaps_ms": sorted(gaps)[-5:][::-1],
+            "gap_p50_ms": _quantile(gaps, 0.5), "gap_p90_ms": _quantile(gaps, 0.9),
+            "gap_p99_ms": _quantile(gaps, 0.99),
             "gaps_over_50_ms": sum(1 for g in gaps if g > 50.0)}
         panel.mode_combo.setCurrentText("Split-sum")
         wait_frames(view.frames)
@@ -424,7 +431,9 @@ def main(argv=None) -> int:
         if name == "reference":
             extra = (f" | {r['samples']} samples/px {'converged' if r['converged'] else 'NOT'}"
                      f" in {r['converge_ms']:.0f} ms, {r['frames']} frames, "
-                     f"{r['paints']} paints")
+                     f"{r['paints']} paints; tick gaps p50 {r['gap_p50_ms']:.0f}, p90 "
+                     f"{r['gap_p90_ms']:.0f}, p99 {r['gap_p99_ms']:.0f} ms, "
+                     f"{r['gaps_over_50_ms']} over 50 ms")
         elif name == "slider":
             extra = f" | {r['edits']} edits over {r['drag_ms']:.0f} ms"
         else:

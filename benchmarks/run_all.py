@@ -665,7 +665,8 @@ def startup_section(rep: Report, st: dict, goals: list) -> None:
 
 
 def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
-    rep.add("## 6b. Structural edit in the editor: UI-thread blocking")
+    rep.add("## 6b. The editor's UI thread: structural edits, reference mode, drag, "
+            "environment, resize")
     rep.add()
     rep.add("benchmarks/bench_ui_block.py: the real MainWindow under Xvfb on the sample layered "
             "material, compiles off the UI thread (as `matedit edit`), each structural edit "
@@ -699,6 +700,34 @@ def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
                       f"{w['ui_block_max_ms']:.0f} ms (plain frame "
                       f"{w['plain_paint_median_ms']:.0f} ms)",
                       verdict(w["ui_block_max_ms"] <= GOALS["ui_block_ms"])])
+    c = ub.get("cases", {})
+    if "error" in c:
+        rep.add(f"Other cases: error: {c['error']}")
+        rep.add()
+    elif c.get("cases"):
+        rep.add(f"The other cases (benchmarks/bench_ui_block.py `--child cases`, no warm-up "
+                f"child), viewport {c['viewport'][0]}×{c['viewport'][1]} px: reference "
+                "accumulation from the mode chooser until converged, a slider drag, "
+                "environment changes, window resizes.")
+        rep.add()
+        rows = []
+        for name, r in c["cases"].items():
+            if name == "reference":
+                what = (f"{r['samples']} samples a pixel, {r['frames']} frames in "
+                        f"{r['converge_ms'] / 1e3:.1f} s"
+                        + ("" if r["converged"] else " (not converged)")
+                        + f", {r['paints']} paints; tick gaps p50 {r.get('gap_p50_ms', 0):.0f}"
+                        f", p90 {r.get('gap_p90_ms', 0):.0f} ms, {r['gaps_over_50_ms']} over "
+                        "50 ms")
+            elif name == "slider":
+                what = f"{r['edits']} value edits over {r['drag_ms']:.0f} ms"
+            else:
+                what = "each: " + ", ".join(f"{x['block_ms']:.0f}" for x in r["runs"]) + " ms"
+            rows.append([name, f"**{r['ui_block_max_ms']:.0f}**", what])
+            goals.append([f"UI thread blocked: {name}", f"≤ {GOALS['ui_block_ms']:.0f} ms",
+                          f"{r['ui_block_max_ms']:.0f} ms",
+                          verdict(r["ui_block_max_ms"] <= GOALS["ui_block_ms"])])
+        rep.table(["case", "UI block max (ms)", "what"], "lrl", rows)
 
 
 def results_json(results: dict, uiblock: dict, meta: dict) -> dict:
@@ -739,6 +768,11 @@ def results_json(results: dict, uiblock: dict, meta: dict) -> dict:
         if "ui_block_max_ms" in r:
             out["ui_block_max_ms" + suffix] = r["ui_block_max_ms"]
             out["editor_structural_edit_ms" + suffix] = r["latency_median_ms"]
+    for name, r in uiblock.get("cases", {}).get("cases", {}).items():
+        out[f"ui_block_{name}_max_ms"] = r["ui_block_max_ms"]
+    ref = uiblock.get("cases", {}).get("cases", {}).get("reference", {})
+    if ref.get("converged"):
+        out["reference_converge_ms"] = ref["converge_ms"]
     return out
 
 

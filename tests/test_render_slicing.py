@@ -269,3 +269,19 @@ def test_banded_reference_frames_equal_whole_frames(ctx, deferred, mode):
         np.testing.assert_allclose(banded, whole, rtol=0, atol=1e-5 * scale)
     finally:
         r.release()
+
+
+def test_cells_not_measured_are_costed_at_the_dearest_pixel_seen_after_the_first_band():
+    """The first frame: a cell not drawn yet may be on the mesh; it is costed at the most a
+    pixel has cost so far (not counting the first band, the driver's compile), so the first
+    frame's bands err on the small side."""
+    p = BandPlanner(budget_ms=10.0)
+    p.next_band(0, 0, W, H)
+    p.record((0, 0, W, STRIP), 900.0)  # the compile: not a pixel's cost
+    assert p.peak is None
+    p.record((0, STRIP, CELL, STRIP), 4.0)  # a mesh cell: 4 ms
+    p.record((CELL, STRIP, CELL, STRIP), 0.5)  # a background cell
+    assert p.latest == pytest.approx(0.5 / (CELL * STRIP))
+    assert p.predict((2 * CELL, STRIP, CELL, STRIP)) == pytest.approx(4.0)  # the peak
+    assert p.next_band(STRIP, 2 * CELL, W, H) == (2 * CELL, STRIP, 2 * CELL, STRIP)
+    assert p.predict((CELL, STRIP, CELL, STRIP)) == pytest.approx(0.5)  # measured: its own

@@ -8,8 +8,10 @@ converged image has had the same samples as a frame drawn whole.
 
 `BandPlanner` sizes the bands from the time bands took (measured with the GPU finished). It
 remembers the cost of a pixel in every cell (cells on the mesh cost many times what
-background cells do, and the next frame's cells cost what this frame's did), and uses the
-latest band's cost for cells not measured yet; a band over cells measured before scales
+background cells do, and the next frame's cells cost what this frame's did), and costs
+cells not measured yet at the dearest pixel measured so far (the first band's aside: the
+driver compiles the program at its first draw), so that the first frame's bands err on the
+small side; a band over cells measured before scales
 their costs, as they were relative to each other, to what it took. No GL or Qt here: the
 accumulator (matedit.render.frames) draws, the viewport asks for the next paint.
 
@@ -40,7 +42,9 @@ class BandPlanner:
     """Sizes the next band to fit what is left of a paint's budget (the module docstring).
 
     `cost[s, c]` is the ms a pixel of cell c of strip s took when last drawn (NaN: not
-    yet); `latest` the ms a pixel of the last band took (None before any band). A slow band
+    yet); `latest` the ms a pixel of the last band took (None before any band), `peak` the
+    most a pixel took in a band after the first (what a cell not measured yet is costed at,
+    `latest` until then). A slow band
     (the driver compiling a program at its first draw) is forgotten when its cells are
     drawn again.
     """
@@ -48,6 +52,7 @@ class BandPlanner:
     budget_ms: float = DEFAULT_BUDGET_MS
     latest: float | None = None
     last_pixels: int = 0
+    peak: float | None = None  # the dearest pixel of a band after the first
     cost: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     _size: tuple[int, int] = (0, 0)
 
@@ -70,7 +75,8 @@ class BandPlanner:
 
     def _rates(self, s: slice, c: slice) -> np.ndarray:
         r = self.cost[s, c]
-        return np.where(np.isnan(r), self.latest or 0.0, r)
+        unknown = self.peak if self.peak is not None else (self.latest or 0.0)
+        return np.where(np.isnan(r), unknown, r)
 
     def _pixels_cost(self, band: Band) -> float:
         s, c, px = self._cells(band)
@@ -136,6 +142,8 @@ class BandPlanner:
             return
         ms = max(0.0, float(ms))
         s, c, _ = self._cells(band)
+        if self.latest is not None:
+            self.peak = max(self.peak or 0.0, ms / pixels)
         self.latest, self.last_pixels = ms / pixels, pixels
         if self._known(band):
             # cells measured before keep their costs relative to each other (a band across
@@ -148,5 +156,5 @@ class BandPlanner:
 
     def forget(self) -> None:
         """Costs change: measure again from one strip."""
-        self.latest, self.last_pixels = None, 0
+        self.latest, self.last_pixels, self.peak = None, 0, None
         self._size, self.cost = (0, 0), np.zeros((0, 0))
