@@ -285,3 +285,23 @@ def test_cells_not_measured_are_costed_at_the_dearest_pixel_seen_after_the_first
     assert p.predict((2 * CELL, STRIP, CELL, STRIP)) == pytest.approx(4.0)  # the peak
     assert p.next_band(STRIP, 2 * CELL, W, H) == (2 * CELL, STRIP, 2 * CELL, STRIP)
     assert p.predict((CELL, STRIP, CELL, STRIP)) == pytest.approx(0.5)  # measured: its own
+
+
+def test_a_split_sum_frame_between_slices_restarts_the_frame_under_way(ctx):
+    """Split-sum mode draws whole frames into the target the sliced reference frame is
+    being drawn in: back in reference mode the frame starts again, never mixing the two."""
+    r = Renderer(ctx, (2 * CELL, 2 * STRIP), samples=4, environment="studio",
+                 bake_settings=SMALL)
+    try:
+        r.set_material(_material())
+        r.reference_samples, r.reference_frames = 4, 2
+        r.slice_budget_ms = 1e-3
+        r.mode = "reference"
+        r.render()
+        r.render()
+        assert (r.accumulator.row, r.accumulator.col) != (0, 0) and r.accumulated_frames == 0
+        r.mode = "splitsum"
+        r.render()
+        assert (r.accumulator.row, r.accumulator.col) == (0, 0)
+    finally:
+        r.release()

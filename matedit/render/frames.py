@@ -150,6 +150,7 @@ class Accumulator:
         new frame added until `reference_frames` are; difference both."""
         if mode == "splitsum":
             scene(IBL_MODE_SPLIT_SUM, (0.0, 0.0))
+            self.row = self.col = 0  # a sliced frame under way is overwritten: restart it
         else:
             if self.frames < reference_frames:
                 scene(IBL_MODE_REFERENCE, r2_offset(self.frames))
