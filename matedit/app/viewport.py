@@ -187,7 +187,9 @@ class ViewportWidget(QOpenGLWidget):
             return
         finally:
             self.doneCurrent()
-        if not bands or r.accumulated_frames != frames or not r.needs_redraw or \
+        if not r.needs_redraw:  # converged: shown (and said) before anyone asks
+            self.repaint()
+        elif not bands or r.accumulated_frames != frames or \
                 time.perf_counter() - self._last_paint >= self.DISPLAY_INTERVAL_S:
             self.update()
         else:
