@@ -141,3 +141,19 @@ def test_a_link_resolves_to_its_target_as_before(sample, reads, tmp_path):
     reads["read"].clear()
     b = FileResolver().resolve("../layers/rust_link.json", load(sample))
     assert a is b and reads["read"] == [f"{SAMPLE}.json"]  # only the material, by load()
+
+
+def test_a_file_rewritten_at_once_with_the_same_size_is_read_again(sample, reads):
+    """mtimes are stamped coarsely: a file modified in the last two seconds is not cached, so
+    a rewrite of the same size within one tick of the clock is still seen."""
+    doc = load(sample)
+    rust = _wear_file(sample)
+    text = rust.read_text(encoding="utf-8")
+    rust.write_text(text, encoding="utf-8")  # modified now
+    compile_document(doc, FileResolver())
+    reads["read"].clear()
+    st = rust.stat()
+    rust.write_text(text, encoding="utf-8")
+    os.utime(rust, ns=(st.st_atime_ns, st.st_mtime_ns))  # the same size and mtime
+    compile_document(doc, FileResolver())
+    assert reads["read"] == ["rust.json"]

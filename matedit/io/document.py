@@ -13,6 +13,7 @@ import json
 import os
 import stat
 import threading
+import time
 from collections import OrderedDict
 from pathlib import Path
 from typing import Any
@@ -329,9 +330,14 @@ def save(doc: MaterialDocument, path: str | os.PathLike | None = None) -> Path:
 # Material functions and layers read by any FileResolver in this process, by real path, with
 # the signature of the file they were read from (device, inode, size, mtime in ns): a compile
 # reads and checks an unchanged file once, and a file written since (a new mtime or size, or
-# another file renamed over it) is read again. Only documents that loaded are kept; nothing
+# another file renamed over it) is read again, and so is one modified in the last two seconds
+# (_RACY_NS). Only documents that loaded are kept; nothing
 # in a document is executed, so a cached one is the same data a new read would give.
 _DOCUMENT_CACHE_SIZE = 256
+# A file modified this recently (ns) is read again next time, not cached: file systems stamp
+# mtimes coarsely (a few ms; FAT, 2 s), and a rewrite of the same size within one tick would
+# otherwise look unchanged
+_RACY_NS = 2_000_000_000
 _documents: OrderedDict[Path, tuple[tuple[int, int, int, int], MaterialDocument]] = \
     OrderedDict()
 _documents_lock = threading.Lock()  # the editor compiles on a worker thread
@@ -358,6 +364,11 @@ class FileResolver:
     cached for the whole process by path, size and mtime (`_documents`): the document a
     resolver returns is shared, never to be changed by its caller."""
 
+    def __init__(self) -> None:
+        # files modified too recently for the shared cache, kept for this resolver's life
+        # (one compile, or the editor's: the signature still decides)
+        self._recent: dict[Path, tuple[tuple[int, int, int, int], MaterialDocument]] = {}
+
     def path_of(self, ref: str, owner: MaterialDocument | None) -> Path:
         base = Path(owner.path).parent if owner is not None and owner.path else Path.cwd()
         return Path(os.path.realpath(base / ref))
@@ -369,6 +380,9 @@ class FileResolver:
         except (OSError, ValueError):
             raise LookupError(f"{ref}: file not found") from None
         if signature is not None:
+            recent = self._recent.get(p)
+            if recent is not None and recent[0] == signature:
+                return recent[1]
             with _documents_lock:
                 hit = _documents.get(p)
                 if hit is not None and hit[0] == signature:
@@ -380,7 +394,9 @@ class FileResolver:
             raise LookupError(f"{ref}: {exc.reason}") from None
         if not doc.is_function:
             raise LookupError(f"{ref} is a material, not a material function")
-        if signature is not None:
+        if signature is not None and time.time_ns() - signature[3] < _RACY_NS:
+            self._recent[p] = (signature, doc)
+        elif signature is not None:
             with _documents_lock:
                 _documents[p] = (signature, doc)
                 _documents.move_to_end(p)
