@@ -83,8 +83,9 @@ def _twin_coat(V, kind, radius, length, rough, tilt=0.0):
 ANISOTROPY = 0.9  # the anisotropic rows: T along X (the tube's axis), B along Y
 
 
-def _twin_aniso(V, kind, radius, length, rough, tilt=0.0):
-    """The anisotropic lobe (issue 23) at ANISOTROPY, stretched along X, on N = +Z."""
+def _twin_aniso(V, kind, radius, length, rough, tilt=0.0, axis_deg=0.0):
+    """The anisotropic lobe (issue 23) at ANISOTROPY, stretched along X, on N = +Z; a tube's
+    axis `axis_deg` degrees from X in the surface's plane."""
     n = len(V)
     N = np.tile([0.0, 0.0, 1.0], (n, 1))
     s = lights.makeShadingContext(np.zeros((n, 3)), N, V, np.zeros((n, 3)), np.ones((n, 3)),
@@ -93,10 +94,22 @@ def _twin_aniso(V, kind, radius, length, rough, tilt=0.0):
                                              np.tile([1.0, 0, 0], (n, 1)),
                                              np.tile([0.0, 1, 0], (n, 1)), N)
     pos = (D * math.sin(tilt), 0.0, D * math.cos(tilt))
-    light = lights.Light(kind, position=pos, direction=(1.0, 0.0, 0.0),
+    ang = math.radians(axis_deg)
+    light = lights.Light(kind, position=pos, direction=(math.cos(ang), math.sin(ang), 0.0),
                          intensity=1.0, influence_radius=1e4, source_radius=radius,
                          source_length=length)
     return lights.evaluateLight(s, light)[:, 0]
+
+
+def _rotated(rho, axis_deg: float):
+    """The albedo of the lobe turned by -axis_deg about N: a tube along X then sees the lobe
+    as a tube `axis_deg` from the stretch would (capsule_true_energy's capsule lies along X)."""
+    ca, sa = math.cos(math.radians(axis_deg)), math.sin(math.radians(axis_deg))
+
+    def turned(u):
+        return rho(np.stack([ca * u[..., 0] - sa * u[..., 1], sa * u[..., 0] + ca * u[..., 1],
+                             u[..., 2]], -1))
+    return turned
 
 
 def aniso_albedo(rough: float, an: float, nmu: int = 65, nc: int = 17, ny: int = 256,
@@ -142,26 +155,36 @@ def aniso_albedo(rough: float, an: float, nmu: int = 65, nc: int = 17, ny: int =
     return rho
 
 
-def table_aniso(quick: bool) -> tuple[list, list]:
-    """Rendered / true for the anisotropic lobe: spheres straight above and tubes along X,
-    both integrated over the tube view grid (the lobe is not axisymmetric)."""
+AXIS_DEGREES = (45.0, 90.0)  # the extra tubes: across the stretch (90) and between
+
+
+def table_aniso(quick: bool, spec=None) -> tuple[list, list, list, list]:
+    """Rendered / true for the anisotropic lobe: spheres straight above and 45 degrees off
+    (towards +X, along the stretch), tubes along X (the stretch) and, in the last list,
+    tubes at AXIS_DEGREES from it; all integrated over the tube view grid (the lobe is not
+    axisymmetric)."""
+    spec = spec or _twin_aniso
     V, w = tube_view_grid(400, 400) if quick else tube_view_grid(800, 800)
     rhos = {r: aniso_albedo(r, ANISOTROPY) for r in ROUGHNESS}
-    spheres, tubes = [], []
-    for rd in SPHERE_RD:
-        row = []
-        for rough in ROUGHNESS:
-            true = sphere_true_energy_tilted(rd * D, D, 0.0, rough, rho=rhos[rough])
-            row.append(float(np.sum(_twin_aniso(V, "sphere", rd * D, 0.0, rough) * w)) / true)
-        spheres.append((rd, row))
-    for length in TUBE_LENGTHS:
-        row = []
-        for rough in ROUGHNESS:
-            true = capsule_true_energy(TUBE_RADIUS, length, D, rough, rho=rhos[rough])
-            row.append(float(np.sum(_twin_aniso(V, "tube", TUBE_RADIUS, length, rough) * w))
-                       / true)
-        tubes.append((length, row))
-    return spheres, tubes
+    spheres, tilted, tubes, turned = [], [], [], []
+    for rows, tilt in ((spheres, 0.0), (tilted, TILT)):
+        for rd in SPHERE_RD:
+            row = []
+            for rough in ROUGHNESS:
+                true = sphere_true_energy_tilted(rd * D, D, tilt, rough, rho=rhos[rough])
+                row.append(float(np.sum(spec(V, "sphere", rd * D, 0.0, rough, tilt) * w))
+                           / true)
+            rows.append((rd, row))
+    for deg, rows in ((0.0, tubes),) + tuple((d, turned) for d in AXIS_DEGREES):
+        for length in TUBE_LENGTHS:
+            row = []
+            for rough in ROUGHNESS:
+                true = capsule_true_energy(TUBE_RADIUS, length, D, rough,
+                                           rho=_rotated(rhos[rough], deg))
+                row.append(float(np.sum(spec(V, "tube", TUBE_RADIUS, length, rough,
+                                             axis_deg=deg) * w)) / true)
+            rows.append((f"{length} m, {deg:g}°" if deg else length, row))
+    return spheres, tilted, tubes, turned
 
 
 def _gpu(ctx):
@@ -178,6 +201,31 @@ def _gpu(ctx):
                                         "radius": f(radius), "len": f(length),
                                         "rough": f(rough)}, {"spec": "float"},
                             includes=["lights.glsl"])
+        return out["spec"].astype(np.float64)
+    return spec
+
+
+def _gpu_aniso(ctx):
+    """The GLSL of _twin_aniso (lights.glsl with MATERIAL_HAS_ANISOTROPY)."""
+    from gpu_eval import gpu_eval_many
+    from test_shading_light_energy import BODY
+
+    def spec(V, kind, radius, length, rough, tilt=0.0, axis_deg=0.0):
+        n = len(V)
+        f = lambda x: np.full(n, x, np.float32)  # noqa: E731
+        ang = math.radians(axis_deg)
+        body = BODY.replace("vec3(0.0, 0.0, dist)",
+                            f"dist * vec3({math.sin(tilt):.9f}, 0.0, {math.cos(tilt):.9f})")
+        axis = f"vec3({math.cos(ang):.9f}, {math.sin(ang):.9f}, 0.0)"
+        body = body.replace("light.direction = vec3(1.0, 0.0, 0.0);",
+                            f"light.direction = {axis};")
+        x, y, z = "vec3(1.0, 0.0, 0.0)", "vec3(0.0, 1.0, 0.0)", "vec3(0.0, 0.0, 1.0)"
+        body = body.replace("    spec = ", f"    s.aniso = makeAnisotropicLobe(s.a, {ANISOTROPY}, "
+                            f"{x}, {x}, {y}, {z});\n    spec = ")
+        out = gpu_eval_many(ctx, body, {"V": V.astype(np.float32), "kind": f({"sphere": 2,
+                                        "tube": 3}[kind]), "dist": f(D), "radius": f(radius),
+                                        "len": f(length), "rough": f(rough)}, {"spec": "float"},
+                            includes=["lights.glsl"], defines=("MATERIAL_HAS_ANISOTROPY",))
         return out["spec"].astype(np.float64)
     return spec
 
@@ -220,7 +268,8 @@ def markdown(title: str, spheres, tilted, tubes) -> str:
     for rd, row in tilted:
         lines.append(f"| sphere r/d {rd}, 45° | " + " | ".join(f"{x:.2f}" for x in row) + " |")
     for length, row in tubes:
-        lines.append(f"| tube {length} m | " + " | ".join(f"{x:.2f}" for x in row) + " |")
+        name = f"tube {length}" if isinstance(length, str) else f"tube {length} m"
+        lines.append(f"| {name} | " + " | ".join(f"{x:.2f}" for x in row) + " |")
     return "\n".join(lines)
 
 
@@ -312,7 +361,10 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--gpu", action="store_true", help="evaluate the GLSL (llvmpipe: slower)")
+    ap.add_argument("--only", choices=("all", "base", "coat", "sheen", "aniso"), default="all",
+                    help="one table (base: the talk's lobe, both divisors); --gpu: base, aniso")
     args = ap.parse_args()
+    want = lambda part: args.only in ("all", part)  # noqa: E731
     ctx = None
     if args.gpu:
         from matedit.render.context import headless_context
@@ -320,7 +372,7 @@ def main() -> int:
         ctx = headless_context()
     saved = brdf.AREA_WIDEN_DIVISOR
     try:
-        for c in (3.0, saved):
+        for c in (3.0, saved) if want("base") else ():
             if ctx is not None and c != saved:
                 continue  # the GLSL is compiled with its own default
             brdf.AREA_WIDEN_DIVISOR = c
@@ -333,7 +385,7 @@ def main() -> int:
             print()
             print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
-        if ctx is None:
+        if ctx is None and want("coat"):
             # the clear coat's lobe: its own representative point and widening (its alpha)
             t0 = time.perf_counter()
             spheres, tilted, tubes = table(_twin_coat, args.quick)
@@ -343,21 +395,24 @@ def main() -> int:
             print()
             print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
+        if ctx is None and want("sheen"):
             t0 = time.perf_counter()
             print(sheen_markdown(sheen_table(args.quick)))
             print(f"[{time.perf_counter() - t0:.1f} s]")
             print()
-        if ctx is None:
-            # the anisotropic lobe: representative point along the bent reflection, widening
-            # per alpha (anisotropy.glsl); its own albedo for the true energy
+        if want("aniso"):
+            # the anisotropic lobe: representative points closest to R in the lobe's metric,
+            # widening per alpha (anisotropy.glsl); its own albedo for the true energy
             t0 = time.perf_counter()
-            spheres, tubes = table_aniso(args.quick)
-            print(markdown(f"anisotropic lobe (anisotropy {ANISOTROPY}, stretched along the "
-                           f"tube's axis X): rendered / true specular energy, a' = a + r / "
-                           f"({saved:g} d), roughness in the columns, numpy twin",
-                           spheres, [], tubes))
+            spec = _gpu_aniso(ctx) if ctx is not None else None
+            spheres, tilted, tubes, turned = table_aniso(args.quick, spec)
+            print(markdown(f"anisotropic lobe (anisotropy {ANISOTROPY}, stretched along X): "
+                           f"rendered / true specular energy, a' = a + r / ({saved:g} d), "
+                           f"roughness in the columns, {'GLSL' if ctx else 'numpy twin'}",
+                           spheres, tilted, tubes + turned))
             print()
-            print(goal(spheres, [], tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
+            print(goal(spheres, tilted, tubes + turned)
+                  + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
     finally:
         brdf.AREA_WIDEN_DIVISOR = saved
