@@ -28,11 +28,14 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 from light_energy_ref import (  # noqa: E402
+    aniso_albedo,
+    brdf_albedo,
     capsule_true_energy,
     exitance_axisymmetric,
     sphere_true_energy,
     sphere_true_energy_tilted,
     tube_view_grid,
+    turned_albedo,
 )
 
 import matedit.shading.anisotropy as anisotropy  # noqa: E402
@@ -101,60 +104,6 @@ def _twin_aniso(V, kind, radius, length, rough, tilt=0.0, axis_deg=0.0):
     return lights.evaluateLight(s, light)[:, 0]
 
 
-def _rotated(rho, axis_deg: float):
-    """The albedo of the lobe turned by -axis_deg about N: a tube along X then sees the lobe
-    as a tube `axis_deg` from the stretch would (capsule_true_energy's capsule lies along X)."""
-    ca, sa = math.cos(math.radians(axis_deg)), math.sin(math.radians(axis_deg))
-
-    def turned(u):
-        return rho(np.stack([ca * u[..., 0] - sa * u[..., 1], sa * u[..., 0] + ca * u[..., 1],
-                             u[..., 2]], -1))
-    return turned
-
-
-def aniso_albedo(rough: float, an: float, nmu: int = 65, nc: int = 17, ny: int = 256,
-                 npsi: int = 64):
-    """rho(l) of the anisotropic lobe for analytic lights (k = (sqrt(alpha_o) + 1)^2 / 8 per
-    direction, Heitz 2014's projected alpha; F = 1), written here from the papers: midpoint
-    quadrature over stretched unit-GGX slopes (Heitz 2014 sec. 5.3), tabulated over cos(theta)
-    and |cos(phi)| of the direction from X and interpolated bilinearly."""
-    a = rough * rough
-    at, ab = min(a * (1 + an), 1.0), max(a * (1 - an), min(a, 1e-3))
-    y = (np.arange(ny) + 0.5) / ny
-    t = np.sqrt(y / (1 - y))
-    psi = (np.arange(npsi) + 0.5) / npsi * 2 * math.pi
-    hx, hy = t[:, None] * at * np.cos(psi), t[:, None] * ab * np.sin(psi)
-    inv = 1 / np.sqrt(hx * hx + hy * hy + 1)
-    hx, hy, hz = hx * inv, hy * inv, inv
-
-    def g1(x, y_, z):
-        s2 = np.maximum(x * x + y_ * y_, 1e-300)
-        alpha_o = np.sqrt((x * x * at * at + y_ * y_ * ab * ab) / s2)
-        k = (np.sqrt(alpha_o) + 1) ** 2 / 8
-        return z / (z * (1 - k) + k)
-    mus, cs = np.linspace(1e-3, 1, nmu), np.linspace(0, 1, nc)
-    tab = np.zeros((nmu, nc))
-    for i, mu in enumerate(mus):
-        for j, c in enumerate(cs):
-            st = math.sqrt(1 - mu * mu)
-            v = (st * c, st * math.sqrt(1 - c * c), mu)
-            vh = v[0] * hx + v[1] * hy + v[2] * hz
-            lx, ly, lz = 2 * vh * hx - v[0], 2 * vh * hy - v[1], 2 * vh * hz - v[2]
-            ok = (lz > 0) & (vh > 0)
-            w = g1(lx, ly, np.where(ok, lz, 1.0)) * g1(v[0], v[1], mu) * vh / (hz * mu)
-            tab[i, j] = np.where(ok, w, 0.0).mean()
-
-    def rho(u):
-        z = np.clip(u[..., 2], mus[0], 1.0)
-        c = np.clip(np.abs(u[..., 0]) / np.sqrt(np.maximum(1 - u[..., 2] ** 2, 1e-12)), 0, 1)
-        p, q = (z - mus[0]) / (mus[1] - mus[0]), c * (nc - 1)
-        i0, j0 = np.minimum(p.astype(int), nmu - 2), np.minimum(q.astype(int), nc - 2)
-        fp, fq = p - i0, q - j0
-        return ((1 - fp) * ((1 - fq) * tab[i0, j0] + fq * tab[i0, j0 + 1])
-                + fp * ((1 - fq) * tab[i0 + 1, j0] + fq * tab[i0 + 1, j0 + 1]))
-    return rho
-
-
 AXIS_DEGREES = (45.0, 90.0)  # the extra tubes: across the stretch (90) and between
 
 
@@ -180,7 +129,7 @@ def table_aniso(quick: bool, spec=None) -> tuple[list, list, list, list]:
             row = []
             for rough in ROUGHNESS:
                 true = capsule_true_energy(TUBE_RADIUS, length, D, rough,
-                                           rho=_rotated(rhos[rough], deg))
+                                           rho=turned_albedo(rhos[rough], deg))
                 row.append(float(np.sum(spec(V, "tube", TUBE_RADIUS, length, rough,
                                              axis_deg=deg) * w)) / true)
             rows.append((f"{length} m, {deg:g}°" if deg else length, row))
@@ -348,12 +297,39 @@ def sheen_table(quick: bool) -> list:
     return rows
 
 
-def sheen_markdown(rows) -> str:
+def sheen_albedo(rough: float):
+    """rho(l) of the white sheen lobe (matedit.shading.sheen.sheenBRDF, the lobe under test)
+    by light_energy_ref.brdf_albedo: the tubes' true energy is capsule_true_energy of it
+    (the swapped integrals; the lobe is reciprocal, as the test checks)."""
+    N = np.array([0.0, 0.0, 1.0])
+    alpha = sheen.sheenAlpha(rough)
+    return brdf_albedo(lambda V, L: sheen.sheenBRDF(N, V, L, alpha))
+
+
+def sheen_tube_table(quick: bool) -> list:
+    """Tubes along X straight above: rendered (over the tube view grid) / the capsule's true
+    sheen exitance."""
+    V, w = tube_view_grid(200, 200) if quick else tube_view_grid(400, 400)
+    rhos = {r: sheen_albedo(r) for r in SHEEN_ROUGHNESS}
+    rows = []
+    for length in TUBE_LENGTHS:
+        row = []
+        for rough in SHEEN_ROUGHNESS:
+            true = capsule_true_energy(TUBE_RADIUS, length, D, rough, rho=rhos[rough])
+            e = float(np.sum(_twin_sheen(V, "tube", TUBE_RADIUS, length, rough) * w))
+            row.append(e / true)
+        rows.append((length, row))
+    return rows
+
+
+def sheen_markdown(rows, tubes=()) -> str:
     head = "| light | " + " | ".join(f"sheen rough {r}" for r in SHEEN_ROUGHNESS) + " |"
-    lines = ["**sheen lobe: rendered / brute-force sheen energy, sphere light straight above, "
-             "numpy twin**", "", head, "|---|" + "---|" * len(SHEEN_ROUGHNESS)]
+    lines = ["**sheen lobe: rendered / brute-force sheen energy, light straight above (tubes "
+             "along X), numpy twin**", "", head, "|---|" + "---|" * len(SHEEN_ROUGHNESS)]
     for rd, row in rows:
         lines.append(f"| sphere r/d {rd} | " + " | ".join(f"{x:.3f}" for x in row) + " |")
+    for length, row in tubes:
+        lines.append(f"| tube {length} m | " + " | ".join(f"{x:.3f}" for x in row) + " |")
     return "\n".join(lines)
 
 
@@ -397,7 +373,7 @@ def main() -> int:
             print()
         if ctx is None and want("sheen"):
             t0 = time.perf_counter()
-            print(sheen_markdown(sheen_table(args.quick)))
+            print(sheen_markdown(sheen_table(args.quick), sheen_tube_table(args.quick)))
             print(f"[{time.perf_counter() - t0:.1f} s]")
             print()
         if want("aniso"):
