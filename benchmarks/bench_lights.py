@@ -1,6 +1,6 @@
 """Measured specular energy of the area lights: rendered / true (not a test).
 
-    .venv/bin/python benchmarks/bench_lights.py [--quick] [--gpu]
+    .venv/bin/python benchmarks/bench_lights.py [--quick] [--gpu] [--only PART]
 
 Geometry (tests/light_energy_ref.py): a white metal (F0 = 1) with N = +Z, the light straight
 above at d = 2 m (one sphere table with the light 45 degrees off the normal), intensity 1;
@@ -12,7 +12,11 @@ the representative-point lights, evaluated by matedit.shading (the numpy twin th
 to the GLSL at 1e-4; `--gpu` evaluates the GLSL itself), for the widening divisor of
 a' = a + r / (c d): c = 3 (docs/shading.md's reading, before) and c = 2 (the default now).
 The tests (tests/test_shading_light_energy.py) check a subset on the GPU.
-The sheen lobe's sphere lights are measured against its own brute force (sheen_table).
+The sheen lobe's sphere lights are measured against its own brute force (sheen_table), its
+tubes against the capsule's solid angle over the lobe's albedo (sheen_tube_table). The
+anisotropic lobe (table_aniso) against its own albedo, spheres overhead and 45 degrees off,
+tubes along, across and at 45 degrees to the stretch. `--only base|coat|sheen|aniso` prints
+one part (the aniso table takes minutes); with `--gpu`, base and aniso evaluate the GLSL.
 """
 
 from __future__ import annotations
