@@ -140,7 +140,8 @@ vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, ve
 }
 
 // The bent reflection vector (Filament's anisotropic IBL lookup; benchmarks/bench_aniso_ibl.py
-// compares the split sum's taps below with it; the area lights use the metric points above):
+// compares the split sum's taps below with it; the area lights use the metric points of
+// lights.glsl, anisotropicSphereRepresentativePoint):
 // the "anisotropic normal" is V with its component across the stretch (along B) removed,
 // the normal a lobe infinitely long along T would reflect V about; N is bent towards it by
 // the anisotropy. An approximation: it moves the lookup along the stretch, it does not
