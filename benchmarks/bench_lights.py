@@ -1,6 +1,6 @@
 """Measured specular energy of the area lights: rendered / true (not a test).
 
-    .venv/bin/python benchmarks/bench_lights.py [--quick] [--gpu]
+    .venv/bin/python benchmarks/bench_lights.py [--quick] [--gpu] [--only PART]
 
 Geometry (tests/light_energy_ref.py): a white metal (F0 = 1) with N = +Z, the light straight
 above at d = 2 m (one sphere table with the light 45 degrees off the normal), intensity 1;
@@ -12,7 +12,11 @@ the representative-point lights, evaluated by matedit.shading (the numpy twin th
 to the GLSL at 1e-4; `--gpu` evaluates the GLSL itself), for the widening divisor of
 a' = a + r / (c d): c = 3 (docs/shading.md's reading, before) and c = 2 (the default now).
 The tests (tests/test_shading_light_energy.py) check a subset on the GPU.
-The sheen lobe's sphere lights are measured against its own brute force (sheen_table).
+The sheen lobe's sphere lights are measured against its own brute force (sheen_table), its
+tubes against the capsule's solid angle over the lobe's albedo (sheen_tube_table). The
+anisotropic lobe (table_aniso) against its own albedo, spheres overhead and 45 degrees off,
+tubes along, across and at 45 degrees to the stretch. `--only base|coat|sheen|aniso` prints
+one part (the aniso table takes minutes); with `--gpu`, base and aniso evaluate the GLSL.
 """
 
 from __future__ import annotations
@@ -28,11 +32,14 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 from light_energy_ref import (  # noqa: E402
+    aniso_albedo,
+    brdf_albedo,
     capsule_true_energy,
     exitance_axisymmetric,
     sphere_true_energy,
     sphere_true_energy_tilted,
     tube_view_grid,
+    turned_albedo,
 )
 
 import matedit.shading.anisotropy as anisotropy  # noqa: E402
@@ -83,8 +90,9 @@ def _twin_coat(V, kind, radius, length, rough, tilt=0.0):
 ANISOTROPY = 0.9  # the anisotropic rows: T along X (the tube's axis), B along Y
 
 
-def _twin_aniso(V, kind, radius, length, rough, tilt=0.0):
-    """The anisotropic lobe (issue 23) at ANISOTROPY, stretched along X, on N = +Z."""
+def _twin_aniso(V, kind, radius, length, rough, tilt=0.0, axis_deg=0.0):
+    """The anisotropic lobe (issue 23) at ANISOTROPY, stretched along X, on N = +Z; a tube's
+    axis `axis_deg` degrees from X in the surface's plane."""
     n = len(V)
     N = np.tile([0.0, 0.0, 1.0], (n, 1))
     s = lights.makeShadingContext(np.zeros((n, 3)), N, V, np.zeros((n, 3)), np.ones((n, 3)),
@@ -93,75 +101,43 @@ def _twin_aniso(V, kind, radius, length, rough, tilt=0.0):
                                              np.tile([1.0, 0, 0], (n, 1)),
                                              np.tile([0.0, 1, 0], (n, 1)), N)
     pos = (D * math.sin(tilt), 0.0, D * math.cos(tilt))
-    light = lights.Light(kind, position=pos, direction=(1.0, 0.0, 0.0),
+    ang = math.radians(axis_deg)
+    light = lights.Light(kind, position=pos, direction=(math.cos(ang), math.sin(ang), 0.0),
                          intensity=1.0, influence_radius=1e4, source_radius=radius,
                          source_length=length)
     return lights.evaluateLight(s, light)[:, 0]
 
 
-def aniso_albedo(rough: float, an: float, nmu: int = 65, nc: int = 17, ny: int = 256,
-                 npsi: int = 64):
-    """rho(l) of the anisotropic lobe for analytic lights (k = (sqrt(alpha_o) + 1)^2 / 8 per
-    direction, Heitz 2014's projected alpha; F = 1), written here from the papers: midpoint
-    quadrature over stretched unit-GGX slopes (Heitz 2014 sec. 5.3), tabulated over cos(theta)
-    and |cos(phi)| of the direction from X and interpolated bilinearly."""
-    a = rough * rough
-    at, ab = min(a * (1 + an), 1.0), max(a * (1 - an), min(a, 1e-3))
-    y = (np.arange(ny) + 0.5) / ny
-    t = np.sqrt(y / (1 - y))
-    psi = (np.arange(npsi) + 0.5) / npsi * 2 * math.pi
-    hx, hy = t[:, None] * at * np.cos(psi), t[:, None] * ab * np.sin(psi)
-    inv = 1 / np.sqrt(hx * hx + hy * hy + 1)
-    hx, hy, hz = hx * inv, hy * inv, inv
-
-    def g1(x, y_, z):
-        s2 = np.maximum(x * x + y_ * y_, 1e-300)
-        alpha_o = np.sqrt((x * x * at * at + y_ * y_ * ab * ab) / s2)
-        k = (np.sqrt(alpha_o) + 1) ** 2 / 8
-        return z / (z * (1 - k) + k)
-    mus, cs = np.linspace(1e-3, 1, nmu), np.linspace(0, 1, nc)
-    tab = np.zeros((nmu, nc))
-    for i, mu in enumerate(mus):
-        for j, c in enumerate(cs):
-            st = math.sqrt(1 - mu * mu)
-            v = (st * c, st * math.sqrt(1 - c * c), mu)
-            vh = v[0] * hx + v[1] * hy + v[2] * hz
-            lx, ly, lz = 2 * vh * hx - v[0], 2 * vh * hy - v[1], 2 * vh * hz - v[2]
-            ok = (lz > 0) & (vh > 0)
-            w = g1(lx, ly, np.where(ok, lz, 1.0)) * g1(v[0], v[1], mu) * vh / (hz * mu)
-            tab[i, j] = np.where(ok, w, 0.0).mean()
-
-    def rho(u):
-        z = np.clip(u[..., 2], mus[0], 1.0)
-        c = np.clip(np.abs(u[..., 0]) / np.sqrt(np.maximum(1 - u[..., 2] ** 2, 1e-12)), 0, 1)
-        p, q = (z - mus[0]) / (mus[1] - mus[0]), c * (nc - 1)
-        i0, j0 = np.minimum(p.astype(int), nmu - 2), np.minimum(q.astype(int), nc - 2)
-        fp, fq = p - i0, q - j0
-        return ((1 - fp) * ((1 - fq) * tab[i0, j0] + fq * tab[i0, j0 + 1])
-                + fp * ((1 - fq) * tab[i0 + 1, j0] + fq * tab[i0 + 1, j0 + 1]))
-    return rho
+AXIS_DEGREES = (45.0, 90.0)  # the extra tubes: across the stretch (90) and between
 
 
-def table_aniso(quick: bool) -> tuple[list, list]:
-    """Rendered / true for the anisotropic lobe: spheres straight above and tubes along X,
-    both integrated over the tube view grid (the lobe is not axisymmetric)."""
+def table_aniso(quick: bool, spec=None) -> tuple[list, list, list, list]:
+    """Rendered / true for the anisotropic lobe: spheres straight above and 45 degrees off
+    (towards +X, along the stretch), tubes along X (the stretch) and, in the last list,
+    tubes at AXIS_DEGREES from it; all integrated over the tube view grid (the lobe is not
+    axisymmetric)."""
+    spec = spec or _twin_aniso
     V, w = tube_view_grid(400, 400) if quick else tube_view_grid(800, 800)
     rhos = {r: aniso_albedo(r, ANISOTROPY) for r in ROUGHNESS}
-    spheres, tubes = [], []
-    for rd in SPHERE_RD:
-        row = []
-        for rough in ROUGHNESS:
-            true = sphere_true_energy_tilted(rd * D, D, 0.0, rough, rho=rhos[rough])
-            row.append(float(np.sum(_twin_aniso(V, "sphere", rd * D, 0.0, rough) * w)) / true)
-        spheres.append((rd, row))
-    for length in TUBE_LENGTHS:
-        row = []
-        for rough in ROUGHNESS:
-            true = capsule_true_energy(TUBE_RADIUS, length, D, rough, rho=rhos[rough])
-            row.append(float(np.sum(_twin_aniso(V, "tube", TUBE_RADIUS, length, rough) * w))
-                       / true)
-        tubes.append((length, row))
-    return spheres, tubes
+    spheres, tilted, tubes, turned = [], [], [], []
+    for rows, tilt in ((spheres, 0.0), (tilted, TILT)):
+        for rd in SPHERE_RD:
+            row = []
+            for rough in ROUGHNESS:
+                true = sphere_true_energy_tilted(rd * D, D, tilt, rough, rho=rhos[rough])
+                row.append(float(np.sum(spec(V, "sphere", rd * D, 0.0, rough, tilt) * w))
+                           / true)
+            rows.append((rd, row))
+    for deg, rows in ((0.0, tubes),) + tuple((d, turned) for d in AXIS_DEGREES):
+        for length in TUBE_LENGTHS:
+            row = []
+            for rough in ROUGHNESS:
+                true = capsule_true_energy(TUBE_RADIUS, length, D, rough,
+                                           rho=turned_albedo(rhos[rough], deg))
+                row.append(float(np.sum(spec(V, "tube", TUBE_RADIUS, length, rough,
+                                             axis_deg=deg) * w)) / true)
+            rows.append((f"{length} m, {deg:g}°" if deg else length, row))
+    return spheres, tilted, tubes, turned
 
 
 def _gpu(ctx):
@@ -178,6 +154,31 @@ def _gpu(ctx):
                                         "radius": f(radius), "len": f(length),
                                         "rough": f(rough)}, {"spec": "float"},
                             includes=["lights.glsl"])
+        return out["spec"].astype(np.float64)
+    return spec
+
+
+def _gpu_aniso(ctx):
+    """The GLSL of _twin_aniso (lights.glsl with MATERIAL_HAS_ANISOTROPY)."""
+    from gpu_eval import gpu_eval_many
+    from test_shading_light_energy import BODY
+
+    def spec(V, kind, radius, length, rough, tilt=0.0, axis_deg=0.0):
+        n = len(V)
+        f = lambda x: np.full(n, x, np.float32)  # noqa: E731
+        ang = math.radians(axis_deg)
+        body = BODY.replace("vec3(0.0, 0.0, dist)",
+                            f"dist * vec3({math.sin(tilt):.9f}, 0.0, {math.cos(tilt):.9f})")
+        axis = f"vec3({math.cos(ang):.9f}, {math.sin(ang):.9f}, 0.0)"
+        body = body.replace("light.direction = vec3(1.0, 0.0, 0.0);",
+                            f"light.direction = {axis};")
+        x, y, z = "vec3(1.0, 0.0, 0.0)", "vec3(0.0, 1.0, 0.0)", "vec3(0.0, 0.0, 1.0)"
+        body = body.replace("    spec = ", f"    s.aniso = makeAnisotropicLobe(s.a, {ANISOTROPY}, "
+                            f"{x}, {x}, {y}, {z});\n    spec = ")
+        out = gpu_eval_many(ctx, body, {"V": V.astype(np.float32), "kind": f({"sphere": 2,
+                                        "tube": 3}[kind]), "dist": f(D), "radius": f(radius),
+                                        "len": f(length), "rough": f(rough)}, {"spec": "float"},
+                            includes=["lights.glsl"], defines=("MATERIAL_HAS_ANISOTROPY",))
         return out["spec"].astype(np.float64)
     return spec
 
@@ -220,7 +221,8 @@ def markdown(title: str, spheres, tilted, tubes) -> str:
     for rd, row in tilted:
         lines.append(f"| sphere r/d {rd}, 45° | " + " | ".join(f"{x:.2f}" for x in row) + " |")
     for length, row in tubes:
-        lines.append(f"| tube {length} m | " + " | ".join(f"{x:.2f}" for x in row) + " |")
+        name = f"tube {length}" if isinstance(length, str) else f"tube {length} m"
+        lines.append(f"| {name} | " + " | ".join(f"{x:.2f}" for x in row) + " |")
     return "\n".join(lines)
 
 
@@ -299,12 +301,39 @@ def sheen_table(quick: bool) -> list:
     return rows
 
 
-def sheen_markdown(rows) -> str:
+def sheen_albedo(rough: float):
+    """rho(l) of the white sheen lobe (matedit.shading.sheen.sheenBRDF, the lobe under test)
+    by light_energy_ref.brdf_albedo: the tubes' true energy is capsule_true_energy of it
+    (the swapped integrals; the lobe is reciprocal, as the test checks)."""
+    N = np.array([0.0, 0.0, 1.0])
+    alpha = sheen.sheenAlpha(rough)
+    return brdf_albedo(lambda V, L: sheen.sheenBRDF(N, V, L, alpha))
+
+
+def sheen_tube_table(quick: bool) -> list:
+    """Tubes along X straight above: rendered (over the tube view grid) / the capsule's true
+    sheen exitance."""
+    V, w = tube_view_grid(200, 200) if quick else tube_view_grid(400, 400)
+    rhos = {r: sheen_albedo(r) for r in SHEEN_ROUGHNESS}
+    rows = []
+    for length in TUBE_LENGTHS:
+        row = []
+        for rough in SHEEN_ROUGHNESS:
+            true = capsule_true_energy(TUBE_RADIUS, length, D, rough, rho=rhos[rough])
+            e = float(np.sum(_twin_sheen(V, "tube", TUBE_RADIUS, length, rough) * w))
+            row.append(e / true)
+        rows.append((length, row))
+    return rows
+
+
+def sheen_markdown(rows, tubes=()) -> str:
     head = "| light | " + " | ".join(f"sheen rough {r}" for r in SHEEN_ROUGHNESS) + " |"
-    lines = ["**sheen lobe: rendered / brute-force sheen energy, sphere light straight above, "
-             "numpy twin**", "", head, "|---|" + "---|" * len(SHEEN_ROUGHNESS)]
+    lines = ["**sheen lobe: rendered / brute-force sheen energy, light straight above (tubes "
+             "along X), numpy twin**", "", head, "|---|" + "---|" * len(SHEEN_ROUGHNESS)]
     for rd, row in rows:
         lines.append(f"| sphere r/d {rd} | " + " | ".join(f"{x:.3f}" for x in row) + " |")
+    for length, row in tubes:
+        lines.append(f"| tube {length} m | " + " | ".join(f"{x:.3f}" for x in row) + " |")
     return "\n".join(lines)
 
 
@@ -312,7 +341,10 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--gpu", action="store_true", help="evaluate the GLSL (llvmpipe: slower)")
+    ap.add_argument("--only", choices=("all", "base", "coat", "sheen", "aniso"), default="all",
+                    help="one table (base: the talk's lobe, both divisors); --gpu: base, aniso")
     args = ap.parse_args()
+    want = lambda part: args.only in ("all", part)  # noqa: E731
     ctx = None
     if args.gpu:
         from matedit.render.context import headless_context
@@ -320,7 +352,7 @@ def main() -> int:
         ctx = headless_context()
     saved = brdf.AREA_WIDEN_DIVISOR
     try:
-        for c in (3.0, saved):
+        for c in (3.0, saved) if want("base") else ():
             if ctx is not None and c != saved:
                 continue  # the GLSL is compiled with its own default
             brdf.AREA_WIDEN_DIVISOR = c
@@ -333,7 +365,7 @@ def main() -> int:
             print()
             print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
-        if ctx is None:
+        if ctx is None and want("coat"):
             # the clear coat's lobe: its own representative point and widening (its alpha)
             t0 = time.perf_counter()
             spheres, tilted, tubes = table(_twin_coat, args.quick)
@@ -343,21 +375,24 @@ def main() -> int:
             print()
             print(goal(spheres, tilted, tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
+        if ctx is None and want("sheen"):
             t0 = time.perf_counter()
-            print(sheen_markdown(sheen_table(args.quick)))
+            print(sheen_markdown(sheen_table(args.quick), sheen_tube_table(args.quick)))
             print(f"[{time.perf_counter() - t0:.1f} s]")
             print()
-        if ctx is None:
-            # the anisotropic lobe: representative point along the bent reflection, widening
-            # per alpha (anisotropy.glsl); its own albedo for the true energy
+        if want("aniso"):
+            # the anisotropic lobe: representative points closest to R in the lobe's metric,
+            # widening per alpha (anisotropy.glsl); its own albedo for the true energy
             t0 = time.perf_counter()
-            spheres, tubes = table_aniso(args.quick)
-            print(markdown(f"anisotropic lobe (anisotropy {ANISOTROPY}, stretched along the "
-                           f"tube's axis X): rendered / true specular energy, a' = a + r / "
-                           f"({saved:g} d), roughness in the columns, numpy twin",
-                           spheres, [], tubes))
+            spec = _gpu_aniso(ctx) if ctx is not None else None
+            spheres, tilted, tubes, turned = table_aniso(args.quick, spec)
+            print(markdown(f"anisotropic lobe (anisotropy {ANISOTROPY}, stretched along X): "
+                           f"rendered / true specular energy, a' = a + r / ({saved:g} d), "
+                           f"roughness in the columns, {'GLSL' if ctx else 'numpy twin'}",
+                           spheres, tilted, tubes + turned))
             print()
-            print(goal(spheres, [], tubes) + f"  [{time.perf_counter() - t0:.1f} s]")
+            print(goal(spheres, tilted, tubes + turned)
+                  + f"  [{time.perf_counter() - t0:.1f} s]")
             print()
     finally:
         brdf.AREA_WIDEN_DIVISOR = saved

@@ -139,8 +139,9 @@ vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, ve
     return D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * F_Schlick(F0, VoH) * NoL;
 }
 
-// The bent reflection vector of the area lights' representative point (the split sum reads
-// the taps below instead):
+// The bent reflection vector (Filament's anisotropic IBL lookup; benchmarks/bench_aniso_ibl.py
+// compares the split sum's taps below with it; the area lights use the metric points of
+// lights.glsl, anisotropicSphereRepresentativePoint):
 // the "anisotropic normal" is V with its component across the stretch (along B) removed,
 // the normal a lobe infinitely long along T would reflect V about; N is bent towards it by
 // the anisotropy. An approximation: it moves the lookup along the stretch, it does not
@@ -237,25 +238,134 @@ vec2 anisotropicEnvironmentBRDF(highp sampler3D lut, float NoV, float roughness,
     return mix(d0, d1, c - m0);
 }
 
-// Energy kept by a sphere light's widened anisotropic highlight: each alpha is widened by
-// the source as the isotropic one is, a' = saturate(a + r / (DIVISOR d)), and the peak of
-// D, 1 / (pi at ab), is renormalised by (at ab) / (at' ab'); at = ab gives (a / a')^2.
-float anisotropicSphereNormalization(float at, float ab, float sourceRadius, float d) {
-    // Karis 2013, "Real Shading in Unreal Engine 4", eq 10, 14, applied per axis
-    float widen = sourceRadius / (MATEDIT_AREA_WIDEN_DIVISOR * max(d, 1e-8));
-    return (at * ab) / (saturate(at + widen) * saturate(ab + widen));
+// --- Sphere and tube lights (benchmarks/LIGHTS_ENERGY.md, "The anisotropic lobe") ---------
+// The representative point is the point of the light that brings H closest to N in the
+// lobe's own metric, (T.H / at)^2 + (B.H / ab)^2, not in angle: a lobe 19 times narrower
+// across than along loses most of its highlight when the point is off by a fraction of ab
+// across, and costs almost nothing when it is off along. The light is read in the gnomonic
+// projection about the direction Ln of its centre (X / (X.Ln) - Ln, the plane tangent to
+// the unit sphere of directions at Ln): there the sphere is an exact disc of radius
+// r / sqrt(d^2 - r^2) and the segment an exact segment, and offsets of L there move H by
+// half as much along the same axes (e1 ~ T, e2 ~ B), so the metric is diag(1/at^2, 1/ab^2)
+// up to a common scale. The mirror reflection R (where H = N) is the target; the bent
+// reflection below is kept for the split sum's benchmark, not for the lights.
+
+// The light's tangent-plane frame at Ln: e1 the lobe's T projected, e2 = Ln x e1; where T
+// lies along Ln (a grazing light along the stretch), B projected gives the frame instead.
+void anisotropicLightFrame(AnisotropicLobe l, vec3 Ln, out vec3 e1, out vec3 e2) {
+    // matedit anisotropic representative point (docs/shading.md, Anisotropy)
+    vec3 t = l.T - Ln * dot(l.T, Ln);
+    float tt = dot(t, t);
+    if (tt < 1e-12) {
+        vec3 b = l.B - Ln * dot(l.B, Ln);
+        e2 = b * inversesqrt(max(dot(b, b), 1e-30));
+        e1 = cross(e2, Ln);
+        return;
+    }
+    e1 = t * inversesqrt(tt);
+    e2 = cross(Ln, e1);
 }
 
-// Energy kept by a line's highlight: the line widens the lobe along its own direction only,
-// so the alpha widened is the lobe's alpha projected on the tube's axis (projectedAlpha);
-// a' = saturate(a_axis + 0.5 l / (DIVISOR d)), energy a_axis / a'. At at = ab: a / a'.
-float anisotropicLineNormalization(AnisotropicLobe l, vec3 N, vec3 axis, float sourceLength,
-                                   float d) {
-    // Karis 2013, "Real Shading in Unreal Engine 4", eq 20 (form a / a'), of the projected alpha
+// The point of the disc |p| <= rho (gnomonic plane, frame e1 e2) closest to o in the metric
+// q p1^2 + p2^2, q = (ab / at)^2: o itself inside; outside, the boundary point p = rho u with
+// q (o1 - rho u1) = mu u1, o2 - rho u2 = mu u2 (Lagrange), u1 = q o1 / (mu + q rho), u2 =
+// o2 / (mu + rho), |u| = 1. The root mu of G(mu) = |(q o1, o2) / (mu + (q, 1) rho)|^-1 = 1 is
+// found by Newton on G, which is exactly linear at q = 1 and nearly so elsewhere, from the
+// lower bound |(q o1, o2)| - rho: ANISOTROPY_LIGHT_NEWTON_STEPS steps give the exact
+// minimiser's energy to 1 % (benchmarks/LIGHTS_ENERGY.md).
+const int ANISOTROPY_LIGHT_NEWTON_STEPS = 2;
+
+vec2 anisotropicDiscPoint(vec2 o, float rho, float q) {
+    // matedit anisotropic representative point (docs/shading.md, Anisotropy): closest point
+    // of a disc in an elliptic metric, as the closest point of an ellipse (Lagrange), Newton
+    if (dot(o, o) <= rho * rho) return o;
+    float A = q * o.x;
+    float C = o.y;
+    float mu = max(sqrt(A * A + C * C) - rho, 0.0);
+    for (int i = 0; i < ANISOTROPY_LIGHT_NEWTON_STEPS; i++) {
+        float da = mu + q * rho;
+        float dc = mu + rho;
+        float S = max(A * A / (da * da) + C * C / (dc * dc), 1e-30);
+        float dG = (A * A / (da * da * da) + C * C / (dc * dc * dc)) / (S * sqrt(S));
+        mu = max(mu + (1.0 - inversesqrt(S)) / max(dG, 1e-30), 0.0);
+    }
+    vec2 u = vec2(A / (mu + q * rho), C / (mu + rho));
+    float uu = dot(u, u);
+    return uu > 0.0 ? u * (rho * inversesqrt(uu)) : vec2(0.0);
+}
+
+// The representative points themselves are in lights.glsl (after the talk's, their
+// fallback): anisotropicSphereRepresentativePoint, anisotropicTubeRepresentativePoint.
+
+// The light's widening along T and B in H space. A disc of radius w (in H, the talk's
+// r / (DIVISOR d)) seen by V: L moving in the plane of V and L moves H by half as much, L
+// moving across that plane by 1 / (2 V.H), so the disc is an ellipse in H, w in the plane
+// and w / V.H across it (45 degrees between N and the light: 1.41 w across). Its support
+// along T and B: sqrt(w^2 (X.e_in)^2 + (w / V.H)^2 (X.e_perp)^2), e_perp the tangent
+// direction across the plane (its share of V x L on T and B). V along L, or a plane of V
+// and L along the surface: w on both axes. The narrow alpha is as small as this difference.
+void anisotropicWidening(AnisotropicLobe l, vec3 V, vec3 L, float widen, out float wT,
+                         out float wB) {
+    // matedit anisotropic widening (docs/shading.md, Anisotropy): the Jacobian of H = (V + L)
+    // / |V + L| (Walter et al. 2007, eq 14's 1 / (4 V.H) is its determinant) on Karis 2013's
+    // widening, eq 14
+    vec3 h = V + L;
+    float c = max(dot(V, h) * inversesqrt(max(dot(h, h), 1e-30)), 1e-4);
+    vec3 e = cross(V, L);
+    float pT = dot(e, l.T);
+    float pB = dot(e, l.B);
+    float pp = pT * pT + pB * pB;
+    float cT2 = 0.0;
+    float cB2 = 0.0;
+    float noPlane = 1.0;
+    if (pp >= 1e-12) {
+        cT2 = pT * pT / pp;
+        cB2 = pB * pB / pp;
+        noPlane = 0.0;
+    }
+    float ic2 = 1.0 / (c * c);
+    wT = widen * sqrt(cB2 + cT2 * ic2 + noPlane);
+    wB = widen * sqrt(cT2 + cB2 * ic2 + noPlane);
+}
+
+// Energy kept by a sphere light's widened anisotropic highlight: each alpha is widened by
+// the disc's support along its axis (anisotropicWidening of the talk's w = r / (DIVISOR d)),
+// a' = saturate(a + w_axis), and the peak of D, 1 / (pi at ab), is renormalised by
+// (at ab) / (at' ab'). The form is Steiner's for the lobe's ellipse grown by the disc: its
+// area pi at ab grows by (perimeter) w + pi w^2, the perimeter of a flat ellipse ~ pi (at + ab).
+float anisotropicSphereNormalization(AnisotropicLobe l, vec3 V, vec3 L, float sourceRadius,
+                                     float d) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 10, 14, applied per axis
+    float wT, wB;
+    anisotropicWidening(l, V, L, sourceRadius / (MATEDIT_AREA_WIDEN_DIVISOR * max(d, 1e-8)),
+                        wT, wB);
+    return (l.at * l.ab) / (saturate(l.at + wT) * saturate(l.ab + wB));
+}
+
+// Energy kept by a tube's highlight: the lobe's ellipse grown by the capsule, a segment of
+// half-length wl = 0.5 l / (DIVISOR d) and a disc of w = r / (DIVISOR dp) widened as the
+// sphere's (Steiner again: the segment adds 2 wl times the grown ellipse's width across it,
+// 2 (a_across + w_across), a_across the projected alpha across the axis). Normalised as the
+// sphere: (at ab) / (at' ab' + wl' (a_across + w_across)), wl' = min(wl, 1 - a_axis): the
+// talk's clamp of the line's widened alpha at 1. Along a principal axis without the disc
+// this is the talk's a / a' of the projected alpha along the axis.
+float anisotropicTubeNormalization(AnisotropicLobe l, vec3 N, vec3 V, vec3 L, vec3 axis,
+                                   float sourceLength, float d, float sourceRadius, float dp) {
+    // Karis 2013, "Real Shading in Unreal Engine 4", eq 10, 14, 20, of the lobe's extents
+    // along and across the axis (Heitz 2014 eq 80's projected alpha)
     vec3 NxA = cross(N, axis);
+    vec3 across = NxA;
+    vec3 NxC = cross(N, across);
     float aAxis = projectedAlpha(l.at, l.ab, dot(l.T, axis), dot(NxA, NxA));
-    float widen = 0.5 * sourceLength / (MATEDIT_AREA_WIDEN_DIVISOR * max(d, 1e-8));
-    return aAxis / saturate(aAxis + widen);
+    float aAcross = projectedAlpha(l.at, l.ab, dot(l.T, across), dot(NxC, NxC));
+    float wT, wB;
+    anisotropicWidening(l, V, L, sourceRadius / (MATEDIT_AREA_WIDEN_DIVISOR * max(dp, 1e-8)),
+                        wT, wB);
+    float wAcross = projectedAlpha(wT, wB, dot(l.T, across), dot(NxC, NxC));
+    float wl = min(0.5 * sourceLength / (MATEDIT_AREA_WIDEN_DIVISOR * max(d, 1e-8)),
+                   max(1.0 - aAxis, 0.0));
+    return (l.at * l.ab)
+           / (saturate(l.at + wT) * saturate(l.ab + wB) + wl * (aAcross + wAcross));
 }
 
 // Anisotropic GGX half vector for a uniform point Xi, in the lobe's frame (T, B, N): a
@@ -273,15 +383,10 @@ vec3 importanceSampleGGXAnisotropic(vec2 Xi, float at, float ab, vec3 N, vec3 T,
 // Solid-angle density of L under anisotropic GGX half-vector sampling: D(H) NoH / (4 VoH).
 float ggxAnisotropicDirectionPdf(AnisotropicLobe l, vec3 N, vec3 V, vec3 L) {
     // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38: p(l) = p(h) / (4 VoH)
-    vec3 h = L + V;
-    float hh = dot(h, h);
-    if (hh < 1e-12) return 0.0;
-    vec3 H = h * inversesqrt(hh);
-    float VoH = dot(V, H);
-    if (VoH <= 0.0) return 0.0;
-    float NoH = saturate(dot(N, H));
-    vec3 NxH = cross(N, H);
-    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), dot(NxH, NxH), l.at, l.ab);
+    vec3 H;
+    float VoH, NoH, oneMinusNoH2;
+    if (!reflectionHalfVector(N, V, L, H, VoH, NoH, oneMinusNoH2)) return 0.0;
+    float D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), oneMinusNoH2, l.at, l.ab);
     return D * NoH / (4.0 * VoH);
 }
 

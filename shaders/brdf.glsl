@@ -35,19 +35,36 @@ float D_GGX(float NoH, float a, float oneMinusNoH2) {
     return a2 / (PI * d * d);
 }
 
+// The half vector of a reflection density: H = normalize(L + V), V.H, N.H (saturated) and
+// |N x H|^2, shared by the isotropic and anisotropic GGX densities (anisotropy.glsl); false
+// where L + V vanishes or V.H <= 0 (no density there: GGX sampling cannot reach L).
+bool reflectionHalfVector(vec3 N, vec3 V, vec3 L, out vec3 H, out float VoH, out float NoH,
+                          out float oneMinusNoH2) {
+    // Walter et al. 2007, "Microfacet Models for Refraction", eq 13 (h_r) and 14
+    vec3 h = L + V;
+    float hh = dot(h, h);
+    H = vec3(0.0);
+    VoH = 0.0;
+    NoH = 0.0;
+    oneMinusNoH2 = 0.0;
+    if (hh < 1e-12) return false;
+    H = h * inversesqrt(hh);
+    VoH = dot(V, H);
+    if (VoH <= 0.0) return false;
+    NoH = saturate(dot(N, H));
+    vec3 NxH = cross(N, H);
+    oneMinusNoH2 = dot(NxH, NxH);
+    return true;
+}
+
 // Solid-angle density of L under GGX half-vector sampling around N with alpha a,
 // D NoH / (4 VoH); 0 where L + V vanishes or V.H <= 0 (the reference mode's estimators).
 float ggxReflectionPdf(vec3 N, vec3 V, vec3 L, float a) {
     // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38
-    vec3 h = L + V;
-    float hh = dot(h, h);
-    if (hh < 1e-12) return 0.0;
-    vec3 H = h * inversesqrt(hh);
-    float VoH = dot(V, H);
-    if (VoH <= 0.0) return 0.0;
-    float NoH = saturate(dot(N, H));
-    vec3 NxH = cross(N, H);
-    return D_GGX(NoH, a, dot(NxH, NxH)) * NoH / (4.0 * VoH);
+    vec3 H;
+    float VoH, NoH, oneMinusNoH2;
+    if (!reflectionHalfVector(N, V, L, H, VoH, NoH, oneMinusNoH2)) return 0.0;
+    return D_GGX(NoH, a, oneMinusNoH2) * NoH / (4.0 * VoH);
 }
 
 // Schlick's k for analytic lights: Disney's remapping of roughness.

@@ -231,6 +231,27 @@ vec3 directionalLight(ShadingContext s, Light light) {
     return radiance * light.color * light.intensity;
 }
 
+#if defined(MATERIAL_HAS_ANISOTROPY)
+// The sphere light's representative direction (unnormalised, from P) for the anisotropic
+// lobe: the disc point closest to the mirror direction R in the lobe's metric. Where R
+// points away from the light (R.Ln <= 0) the talk's closest point to the ray is kept.
+vec3 anisotropicSphereRepresentativePoint(AnisotropicLobe l, vec3 Lc, vec3 R,
+                                          float sourceRadius) {
+    // matedit anisotropic representative point (docs/shading.md, Anisotropy), of Karis 2013,
+    // "Real Shading in Unreal Engine 4", eq 11 (the point of the light closest to R)
+    float d = length(Lc);
+    vec3 Ln = Lc / max(d, 1e-8);
+    float RoL = dot(R, Ln);
+    if (RoL <= 1e-8) return sphereRepresentativePoint(Lc, R, sourceRadius);
+    vec3 e1, e2;
+    anisotropicLightFrame(l, Ln, e1, e2);
+    vec3 o = R / RoL - Ln;
+    float rho = sourceRadius * inversesqrt(max(d * d - sourceRadius * sourceRadius, 1e-16));
+    vec2 p = anisotropicDiscPoint(vec2(dot(o, e1), dot(o, e2)), rho, sq(l.ab / l.at));
+    return Ln + p.x * e1 + p.y * e2;
+}
+#endif
+
 vec3 sphereLight(ShadingContext s, Light light) {
     // Karis 2013, "Real Shading in Unreal Engine 4", sphere lights: representative point
     vec3 Lc = light.position - s.P;
@@ -242,13 +263,19 @@ vec3 sphereLight(ShadingContext s, Light light) {
     // Specular: the point of the sphere closest to the reflection ray, energy renormalised.
     vec3 R = reflect(-s.V, s.N);
 #if defined(MATERIAL_HAS_ANISOTROPY)
-    R = anisotropicReflection(s.aniso, s.N, s.V);  // bent reflection, anisotropy.glsl
-#endif
-    vec3 L = normalize(sphereRepresentativePoint(Lc, R, light.sourceRadius));
-#if defined(MATERIAL_HAS_ANISOTROPY)
-    vec3 specular = specularTowards(s, L)
-                  * anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.sourceRadius, d);
+    // the point closest to R in the lobe's metric (anisotropy 0: the talk's, bit for bit)
+    vec3 specular;
+    if (s.aniso.anisotropy > 0.0) {
+        vec3 La = normalize(anisotropicSphereRepresentativePoint(s.aniso, Lc, R,
+                                                                 light.sourceRadius));
+        specular = specularTowards(s, La)
+                 * anisotropicSphereNormalization(s.aniso, s.V, La, light.sourceRadius, d);
+    } else {
+        vec3 L = normalize(sphereRepresentativePoint(Lc, R, light.sourceRadius));
+        specular = specularTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d);
+    }
 #else
+    vec3 L = normalize(sphereRepresentativePoint(Lc, R, light.sourceRadius));
     vec3 specular = specularTowards(s, L) * sphereNormalization(s.a, light.sourceRadius, d);
 #endif
 #if defined(MATERIAL_HAS_SHEEN_COLOR)
@@ -304,6 +331,37 @@ vec3 tubeRepresentativePoint(vec3 L0, vec3 L1, vec3 R) {
     return L0 + saturate(t) * Ld;
 }
 
+#if defined(MATERIAL_HAS_ANISOTROPY)
+// The tube's point on its segment L0 L1 (from P) for the anisotropic lobe: the segment's
+// gnomonic image (about its centre's direction) is a segment g0 g1; its point closest to the
+// mirror direction's image o in the lobe's metric is a clamped quadratic minimum, s; the
+// segment parameter of that direction is t = s z0 / (s z0 + (1 - s) z1) (z = L.Ln: the
+// gnomonic image is projective in t). Where R points away, the talk's closest point to the ray.
+vec3 anisotropicTubeRepresentativePoint(AnisotropicLobe l, vec3 L0, vec3 L1, vec3 R) {
+    // matedit anisotropic representative point (docs/shading.md, Anisotropy), of Karis 2013,
+    // "Real Shading in Unreal Engine 4", eq 19 (the point of the segment closest to R)
+    vec3 Lc = 0.5 * (L0 + L1);
+    vec3 Ln = Lc / max(length(Lc), 1e-8);
+    float z0 = dot(L0, Ln);
+    float z1 = dot(L1, Ln);
+    float RoL = dot(R, Ln);
+    if (RoL <= 1e-8 || z0 <= 1e-8 || z1 <= 1e-8) return tubeRepresentativePoint(L0, L1, R);
+    vec3 e1, e2;
+    anisotropicLightFrame(l, Ln, e1, e2);
+    vec3 g0 = L0 / z0;
+    vec3 dl = L1 / z1 - g0;
+    vec3 og = R / RoL - g0;
+    float q = sq(l.ab / l.at);
+    float dl1 = dot(dl, e1);
+    float dl2 = dot(dl, e2);
+    float num = q * dot(og, e1) * dl1 + dot(og, e2) * dl2;
+    float den = q * dl1 * dl1 + dl2 * dl2;
+    float s = saturate(num / max(den, 1e-30));
+    float t = s * z0 / max(s * z0 + (1.0 - s) * z1, 1e-30);
+    return L0 + t * (L1 - L0);
+}
+#endif
+
 vec3 tubeLight(ShadingContext s, Light light) {
     // Karis 2013, "Real Shading in Unreal Engine 4", tube lights: eq 16 diffuse, eq 19 specular
     vec3 Lc = light.position - s.P;
@@ -322,16 +380,28 @@ vec3 tubeLight(ShadingContext s, Light light) {
     // falloff is the inverse square to that point (the tube's limit is the sphere light).
     vec3 R = reflect(-s.V, s.N);
 #if defined(MATERIAL_HAS_ANISOTROPY)
-    R = anisotropicReflection(s.aniso, s.N, s.V);  // bent reflection, anisotropy.glsl
-#endif
+    // the points closest to R in the lobe's metric (anisotropy 0: the talk's, bit for bit)
+    vec3 Lp;
+    float dp;
+    vec3 L;
+    float energy;
+    if (s.aniso.anisotropy > 0.0) {
+        Lp = anisotropicTubeRepresentativePoint(s.aniso, L0, L1, R);
+        dp = length(Lp);
+        L = normalize(anisotropicSphereRepresentativePoint(s.aniso, Lp, R, light.sourceRadius));
+        energy = anisotropicTubeNormalization(s.aniso, s.N, s.V, L, light.direction,
+                                              light.sourceLength, d, light.sourceRadius, dp);
+    } else {
+        Lp = tubeRepresentativePoint(L0, L1, R);
+        dp = length(Lp);
+        L = normalize(sphereRepresentativePoint(Lp, R, light.sourceRadius));
+        energy = lineNormalization(s.a, light.sourceLength, d)
+               * sphereNormalization(s.a, light.sourceRadius, dp);
+    }
+#else
     vec3 Lp = tubeRepresentativePoint(L0, L1, R);
     float dp = length(Lp);
     vec3 L = normalize(sphereRepresentativePoint(Lp, R, light.sourceRadius));
-#if defined(MATERIAL_HAS_ANISOTROPY)
-    float energy = anisotropicLineNormalization(s.aniso, s.N, light.direction,
-                                                light.sourceLength, d)
-                 * anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.sourceRadius, dp);
-#else
     float energy = lineNormalization(s.a, light.sourceLength, d)
                  * sphereNormalization(s.a, light.sourceRadius, dp);
 #endif

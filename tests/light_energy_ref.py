@@ -149,3 +149,82 @@ def sphere_true_energy_tilted(radius: float, d: float, tilt: float, roughness: f
     u = np.stack([x, s * np.sin(P), z], -1)
     zc = np.clip(z, 0.0, 1.0)
     return float(le * np.sum(np.where(z > 0, albedo(u) * zc, 0.0)) * w)
+
+
+def brdf_albedo(brdf, n_mu: int = 129, n_cos: int = 192, n_phi: int = 96):
+    """rho(u) = integral of f(v, u) N.v dv over the hemisphere of v (N = +Z) of an isotropic
+    BRDF `brdf(V (n, 3), L (n, 3)) -> (n,)` (the lobe under test, passed in), by a midpoint
+    grid uniform in solid angle (cos theta_v, phi_v), tabulated over u's cos theta at n_mu
+    nodes and interpolated linearly. With a reciprocal f, rho(l) is the directional albedo
+    for incidence l, so the exitance under a light of radiance Le is Le * integral over the
+    light of rho(l) N.l dl (the swapped integrals of this module's docstring)."""
+    c = (np.arange(n_cos) + 0.5) / n_cos
+    phi = (np.arange(n_phi) + 0.5) / n_phi * 2 * math.pi
+    C, P = np.meshgrid(c, phi, indexing="ij")
+    S = np.sqrt(1 - C * C)
+    V = np.stack([S * np.cos(P), S * np.sin(P), C], -1).reshape(-1, 3)
+    d_omega = 2 * math.pi / V.shape[0]
+    mus = np.linspace(0.0, 1.0, n_mu)
+    tab = np.empty(n_mu)
+    for i, mu in enumerate(mus):
+        s = math.sqrt(max(1 - mu * mu, 0.0))
+        L = np.broadcast_to(np.array([s, 0.0, max(mu, 1e-6)]), V.shape)
+        tab[i] = float(np.sum(np.asarray(brdf(V, L), np.float64) * V[:, 2]) * d_omega)
+
+    def rho(u):
+        return np.interp(np.clip(u[..., 2], 0.0, 1.0), mus, tab)
+    return rho
+
+
+def aniso_albedo(rough: float, an: float, nmu: int = 65, nc: int = 17, ny: int = 256,
+                 npsi: int = 64):
+    """rho(l) of the anisotropic lobe for analytic lights (k = (sqrt(alpha_o) + 1)^2 / 8 per
+    direction, Heitz 2014's projected alpha; F = 1), written here from the papers: midpoint
+    quadrature over stretched unit-GGX slopes (Heitz 2014 sec. 5.3), tabulated over cos(theta)
+    and |cos(phi)| of the direction from X and interpolated bilinearly."""
+    a = rough * rough
+    at, ab = min(a * (1 + an), 1.0), max(a * (1 - an), min(a, 1e-3))
+    y = (np.arange(ny) + 0.5) / ny
+    t = np.sqrt(y / (1 - y))
+    psi = (np.arange(npsi) + 0.5) / npsi * 2 * math.pi
+    hx, hy = t[:, None] * at * np.cos(psi), t[:, None] * ab * np.sin(psi)
+    inv = 1 / np.sqrt(hx * hx + hy * hy + 1)
+    hx, hy, hz = hx * inv, hy * inv, inv
+
+    def g1(x, y_, z):
+        s2 = np.maximum(x * x + y_ * y_, 1e-300)
+        alpha_o = np.sqrt((x * x * at * at + y_ * y_ * ab * ab) / s2)
+        k = (np.sqrt(alpha_o) + 1) ** 2 / 8
+        return z / (z * (1 - k) + k)
+    mus, cs = np.linspace(1e-3, 1, nmu), np.linspace(0, 1, nc)
+    tab = np.zeros((nmu, nc))
+    for i, mu in enumerate(mus):
+        for j, c in enumerate(cs):
+            st = math.sqrt(1 - mu * mu)
+            v = (st * c, st * math.sqrt(1 - c * c), mu)
+            vh = v[0] * hx + v[1] * hy + v[2] * hz
+            lx, ly, lz = 2 * vh * hx - v[0], 2 * vh * hy - v[1], 2 * vh * hz - v[2]
+            ok = (lz > 0) & (vh > 0)
+            w = g1(lx, ly, np.where(ok, lz, 1.0)) * g1(v[0], v[1], mu) * vh / (hz * mu)
+            tab[i, j] = np.where(ok, w, 0.0).mean()
+
+    def rho(u):
+        z = np.clip(u[..., 2], mus[0], 1.0)
+        c = np.clip(np.abs(u[..., 0]) / np.sqrt(np.maximum(1 - u[..., 2] ** 2, 1e-12)), 0, 1)
+        p, q = (z - mus[0]) / (mus[1] - mus[0]), c * (nc - 1)
+        i0, j0 = np.minimum(p.astype(int), nmu - 2), np.minimum(q.astype(int), nc - 2)
+        fp, fq = p - i0, q - j0
+        return ((1 - fp) * ((1 - fq) * tab[i0, j0] + fq * tab[i0, j0 + 1])
+                + fp * ((1 - fq) * tab[i0 + 1, j0] + fq * tab[i0 + 1, j0 + 1]))
+    return rho
+
+
+def turned_albedo(rho, axis_deg: float):
+    """The albedo of the lobe turned by -axis_deg about N: a tube along X then sees the lobe
+    as a tube `axis_deg` from the stretch would (capsule_true_energy's capsule lies along X)."""
+    ca, sa = math.cos(math.radians(axis_deg)), math.sin(math.radians(axis_deg))
+
+    def turned(u):
+        return rho(np.stack([ca * u[..., 0] - sa * u[..., 1], sa * u[..., 0] + ca * u[..., 1],
+                             u[..., 2]], -1))
+    return turned

@@ -222,13 +222,18 @@ def test_lobe_terms_gpu_equal_twin(ctx, rng):
         terms = vec4(D_GGXAnisotropic(saturate(dot(N, h)), dot(l.T, h), dot(l.B, h), dot(NxH, NxH),
                                      l.at, l.ab),
                      projectedAlpha(l.at, l.ab, dot(l.T, V), dot(NxV, NxV)),
-                     anisotropicSphereNormalization(l.at, l.ab, 0.3 * an, 1.0 + rough),
-                     anisotropicLineNormalization(l, N, L, 2.0 * an, 1.0 + rough));
+                     anisotropicSphereNormalization(l, V, L, 0.3 * an, 1.0 + rough),
+                     anisotropicTubeNormalization(l, N, V, L, dir, 2.0 * an, 1.0 + rough,
+                                                  0.1 * an, 1.5 - rough));
+        vec3 Lc = (2.0 + rough) * normalize(L + 0.3 * N);
+        repS = normalize(anisotropicSphereRepresentativePoint(l, Lc, reflect(-V, N), 0.4 * an));
+        repT = anisotropicTubeRepresentativePoint(l, Lc - an * B, Lc + an * B, reflect(-V, N));
         refl = anisotropicReflection(l, N, V);
         spec = anisotropicSpecularTowards(l, N, V, NoV, F0, L);
         ibl = anisotropicBrdfCosineIBL(l, N, V, F0, L);
     """
     out = gpu_eval_many(ctx, body, s, {"lobe": "vec4", "lobeB": "vec4", "terms": "vec4",
+                                       "repS": "vec3", "repT": "vec3",
                                        "refl": "vec3", "spec": "vec3", "ibl": "vec3"},
                         includes=["lights.glsl"], defines=ANISO)  # fmt: skip
 
@@ -249,14 +254,33 @@ def test_lobe_terms_gpu_equal_twin(ctx, rng):
                                         lo.at, lo.ab),
             anisotropy.projectedAlpha(lo.at, lo.ab, np.sum(lo.T * V, 1),
                                       np.sum(np.cross(N, V) ** 2, 1)),
-            anisotropy.anisotropicSphereNormalization(lo.at, lo.ab, 0.3 * v["an"],
+            anisotropy.anisotropicSphereNormalization(lo, V, L, 0.3 * v["an"],
                                                       1.0 + v["rough"]),
-            anisotropy.anisotropicLineNormalization(lo, N, L, 2.0 * v["an"], 1.0 + v["rough"]),
+            anisotropy.anisotropicTubeNormalization(lo, N, V, L, v["dir"], 2.0 * v["an"],
+                                                    1.0 + v["rough"], 0.1 * v["an"],
+                                                    1.5 - v["rough"]),
         ], 1)  # fmt: skip
 
     # D of a narrow lobe (ab ~ 1e-3) is ill-conditioned in H: the module doc's slack.
     check("anisotropic terms", out["terms"], terms(**s), rtol=1e-4, atol=1e-6,
           slack=perturbation_spread(terms, s, rng))  # fmt: skip
+
+    def reps(**v):
+        lo = _np_lobe(v)
+        N, V, L, B, an = v["N"], v["V"], v["L"], v["B"], v["an"][:, None]
+        w = L + 0.3 * N
+        Lc = (2.0 + v["rough"][:, None]) * w / np.linalg.norm(w, axis=1, keepdims=True)
+        R = 2.0 * np.sum(N * V, 1, keepdims=True) * N - V
+        p = lights.anisotropicSphereRepresentativePoint(lo, Lc, R, 0.4 * v["an"])
+        return np.concatenate([p / np.linalg.norm(p, axis=1, keepdims=True),
+                               lights.anisotropicTubeRepresentativePoint(
+                                   lo, Lc - an * B, Lc + an * B, R)], 1)
+
+    # the metric points: a Newton solve and a clamped quadratic, ill-conditioned where the
+    # lobe is narrow (q = (ab / at)^2 ~ 1e-6): the perturbation slack
+    check_most("anisotropic representative points",
+               np.concatenate([out["repS"], out["repT"]], 1), reps(**s), rtol=1e-4, atol=1e-5,
+               slack=perturbation_spread(reps, s, rng))  # fmt: skip
 
     def refl(**v):
         return anisotropy.anisotropicReflection(_np_lobe(v), v["N"], v["V"])

@@ -276,8 +276,11 @@ def test_bad_obj_is_a_clear_error(fresh, tmp_path):
 # Frosted glass 0.205 (docs/shading.md, Transmission): the rough solid's single lookup along
 # the exit ray against reference mode's sampled refraction through the sphere, largest at
 # the silhouette, where the exit bends the rays most.
+# Velvet 0.113 (fabric weave 0.044 is under the common bound): the sheen's split sum reads one
+# lookup around N at roughness 1 for the wide Charlie lobe (docs/shading.md, Sheen; at the
+# sheen roughness, before: 0.224 and 0.074).
 SPLIT_SUM_MEASURED = {"brushed_gold": 0.223, "brushed_steel": 0.179, "oil_slick_metal": 0.110,
-                      "frosted_glass": 0.205}
+                      "frosted_glass": 0.205, "velvet": 0.113}
 
 
 def test_split_sum_and_reference_agree_on_samples(fresh):
@@ -288,11 +291,6 @@ def test_split_sum_and_reference_agree_on_samples(fresh):
     try:
         for path in MATERIALS:
             cm = compile_document(fmt.load(path), FileResolver())
-            if "sheenColor" in cm.ir.attributes:
-                # The sheen's split sum (one lookup around N) is 7 .. 29 % off its own
-                # integral by design (docs/shading.md, Sheen; velvet 0.22, fabric 0.074); it
-                # is judged against brute-force integrals in tests/test_lobe_sheen.py.
-                continue
             fresh.set_material(cm)
             fresh.mode = "splitsum"
             fresh.render()

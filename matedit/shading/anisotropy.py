@@ -1,6 +1,7 @@
 """Twin of ``anisotropy.glsl``: anisotropic GGX, its projected-roughness Schlick-Smith
-visibility, the bent reflection vector (area lights), the split sum's taps, the area lights'
-widening and the sampling.
+visibility, the bent reflection vector, the split sum's taps, the area lights' metric
+representative points (their frame and disc point; the points are in lights.py) and widening,
+and the sampling.
 
 Same names, same arithmetic, float64; vectorised over leading axes (pixels). The
 convention (see the GLSL header): the lobe's T is the direction the highlight stretches
@@ -13,7 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from matedit.shading.brdf import F_Schlick, F_SchlickExact, k_Analytic, k_IBL
+from matedit.shading.brdf import (
+    F_Schlick,
+    F_SchlickExact,
+    k_Analytic,
+    k_IBL,
+    reflectionHalfVector,
+)
 from matedit.shading.common import PI, cross, dot, f64, reflect, saturate
 
 ANISOTROPY_MIN_ALPHA = 1e-3
@@ -134,8 +141,8 @@ def anisotropicSpecularTowards(l: AnisotropicLobe, N, V, NoV, F0, L) -> np.ndarr
 
 
 def anisotropicReflection(l: AnisotropicLobe, N, V) -> np.ndarray:
-    """The area lights' representative-point direction. Revie 2011 / McAuley 2015 (Filament's
-    anisotropic IBL): reflect V about
+    """The bent reflection (benchmarks/bench_aniso_ibl.py's comparison; not the lights').
+    Revie 2011 / McAuley 2015 (Filament's anisotropic IBL): reflect V about
     normalize(mix(N, (B x V) x B, anisotropy))."""
     N, V = f64(N), f64(V)
     n_a = cross(cross(l.B, V), l.B)
@@ -150,19 +157,92 @@ def anisotropicReflection(l: AnisotropicLobe, N, V) -> np.ndarray:
     return reflect(-V, bent)
 
 
-def anisotropicSphereNormalization(at, ab, sourceRadius, d) -> np.ndarray:
-    """Karis 2013 eq 10, 14 per axis: (at ab) / (at' ab'), a' = saturate(a + r / (2 d))."""
-    at, ab = f64(at), f64(ab)
-    widen = f64(sourceRadius) / (_widen_divisor() * np.maximum(f64(d), 1e-8))
-    return (at * ab) / (saturate(at + widen) * saturate(ab + widen))
+ANISOTROPY_LIGHT_NEWTON_STEPS = 2
 
 
-def anisotropicLineNormalization(l: AnisotropicLobe, N, axis, sourceLength, d) -> np.ndarray:
-    """Karis 2013 eq 20 (a / a') of the lobe's alpha projected on the tube's axis."""
-    axis = np.broadcast_to(f64(axis), np.broadcast_shapes(np.shape(axis), f64(N).shape))
-    aAxis = projectedAlpha(l.at, l.ab, dot(l.T, axis), _onemx2(f64(N), axis))
-    widen = 0.5 * f64(sourceLength) / (_widen_divisor() * np.maximum(f64(d), 1e-8))
-    return aAxis / saturate(aAxis + widen)
+def anisotropicLightFrame(l: AnisotropicLobe, Ln) -> tuple[np.ndarray, np.ndarray]:
+    """The light's tangent-plane frame at Ln: e1 the lobe's T projected, e2 = Ln x e1; where T
+    lies along Ln, B projected gives e2 and e1 = e2 x Ln."""
+    Ln = f64(Ln)
+    t = l.T - Ln * dot(l.T, Ln)[..., None]
+    tt = dot(t, t)
+    b = l.B - Ln * dot(l.B, Ln)[..., None]
+    e2b = b / np.sqrt(np.maximum(dot(b, b), 1e-30))[..., None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e1 = t / np.sqrt(tt)[..., None]
+    e2 = cross(Ln, e1)
+    degenerate = (tt < 1e-12)[..., None]
+    e1 = np.where(degenerate, cross(e2b, Ln), e1)
+    e2 = np.where(degenerate, e2b, e2)
+    return e1, e2
+
+
+def anisotropicDiscPoint(o1, o2, rho, q) -> tuple[np.ndarray, np.ndarray]:
+    """The point of the disc |p| <= rho closest to (o1, o2) in the metric q p1^2 + p2^2:
+    (o1, o2) inside; outside, the Lagrange point rho u, u = (q o1 / (mu + q rho), o2 / (mu +
+    rho)) normalised, mu by ANISOTROPY_LIGHT_NEWTON_STEPS Newton steps on G(mu) = 1 / |u|
+    = 1 from |(q o1, o2)| - rho (see the GLSL)."""
+    o1, o2, rho, q = f64(o1), f64(o2), f64(rho), f64(q)
+    A, C = q * o1, o2
+    mu = np.maximum(np.sqrt(A * A + C * C) - rho, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(ANISOTROPY_LIGHT_NEWTON_STEPS):
+            da, dc = mu + q * rho, mu + rho
+            S = np.maximum(A * A / (da * da) + C * C / (dc * dc), 1e-30)
+            dG = (A * A / (da * da * da) + C * C / (dc * dc * dc)) / (S * np.sqrt(S))
+            mu = np.maximum(mu + (1.0 - 1.0 / np.sqrt(S)) / np.maximum(dG, 1e-30), 0.0)
+        u1, u2 = A / (mu + q * rho), C / (mu + rho)
+        uu = u1 * u1 + u2 * u2
+        scale = np.where(uu > 0.0, rho / np.sqrt(uu), 0.0)
+    inside = o1 * o1 + o2 * o2 <= rho * rho
+    return np.where(inside, o1, u1 * scale), np.where(inside, o2, u2 * scale)
+
+
+def anisotropicWidening(l: AnisotropicLobe, V, L, widen) -> tuple[np.ndarray, np.ndarray]:
+    """The light's widening along T and B in H: w in the plane of V and L, w / (V.H) across it
+    (dH = dL / (2 V.H) across, dL / 2 in the plane): the support of that ellipse along each
+    axis, sqrt(w^2 (X.e_in)^2 + (w / V.H)^2 (X.e_perp)^2), e_perp the tangent direction across
+    the plane. V along L (no plane) or a plane along the surface: w on both axes."""
+    V, L, w = f64(V), f64(L), f64(widen)
+    h = V + L
+    c = np.maximum(dot(V, h) / np.sqrt(np.maximum(dot(h, h), 1e-30)), 1e-4)
+    e = cross(V, L)
+    pT, pB = dot(e, l.T), dot(e, l.B)
+    pp = pT * pT + pB * pB
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cT2, cB2 = pT * pT / pp, pB * pB / pp
+    flat = pp < 1e-12
+    cT2, cB2 = np.where(flat, 0.0, cT2), np.where(flat, 0.0, cB2)
+    ic2 = 1.0 / (c * c)
+    return w * np.sqrt(cB2 + cT2 * ic2 + np.where(flat, 1.0, 0.0)), \
+        w * np.sqrt(cT2 + cB2 * ic2 + np.where(flat, 1.0, 0.0))
+
+
+def anisotropicSphereNormalization(l: AnisotropicLobe, V, L, sourceRadius, d) -> np.ndarray:
+    """(at ab) / (at' ab'): each alpha widened by the disc's support along its axis in H
+    (anisotropicWidening of w = r / (2 d)), a' = saturate(a + w_axis)."""
+    wT, wB = anisotropicWidening(
+        l, V, L, f64(sourceRadius) / (_widen_divisor() * np.maximum(f64(d), 1e-8)))
+    return (l.at * l.ab) / (saturate(l.at + wT) * saturate(l.ab + wB))
+
+
+def anisotropicTubeNormalization(l: AnisotropicLobe, N, V, L, axis, sourceLength, d,
+                                 sourceRadius, dp) -> np.ndarray:
+    """(at ab) / (at' ab' + wl' (a_across + w_across)): the lobe's ellipse grown by the
+    capsule (Steiner), wl' = min(0.5 l / (2 d), 1 - a_axis), w = r / (2 dp) widened as the
+    sphere's (anisotropicWidening)."""
+    N = f64(N)
+    axis = np.broadcast_to(f64(axis), np.broadcast_shapes(np.shape(axis), N.shape))
+    across = cross(N, axis)
+    aAxis = projectedAlpha(l.at, l.ab, dot(l.T, axis), _onemx2(N, axis))
+    aAcross = projectedAlpha(l.at, l.ab, dot(l.T, across), _onemx2(N, across))
+    wT, wB = anisotropicWidening(
+        l, V, L, f64(sourceRadius) / (_widen_divisor() * np.maximum(f64(dp), 1e-8)))
+    wAcross = projectedAlpha(wT, wB, dot(l.T, across), _onemx2(N, across))
+    wl = np.minimum(0.5 * f64(sourceLength) / (_widen_divisor() * np.maximum(f64(d), 1e-8)),
+                    np.maximum(1.0 - aAxis, 0.0))
+    return (l.at * l.ab) / (saturate(l.at + wT) * saturate(l.ab + wB)
+                            + wl * (aAcross + wAcross))
 
 
 def importanceSampleGGXAnisotropic(Xi, at, ab, N, T, B) -> np.ndarray:
@@ -176,17 +256,13 @@ def importanceSampleGGXAnisotropic(Xi, at, ab, N, T, B) -> np.ndarray:
 
 
 def ggxAnisotropicDirectionPdf(l: AnisotropicLobe, N, V, L) -> np.ndarray:
-    """Walter et al. 2007 eq 14, 38: D(h) NoH / (4 VoH); 0 where H is undefined or VoH <= 0."""
-    N, V = f64(N), f64(V)
-    h = f64(L) + V
-    hh = dot(h, h)
+    """Walter et al. 2007 eq 14, 38: D(h) NoH / (4 VoH); 0 where H is undefined or VoH <= 0
+    (the half vector shared with brdf.ggxReflectionPdf: reflectionHalfVector)."""
+    H, VoH, NoH, oneMinusNoH2, valid = reflectionHalfVector(N, V, L)
     with np.errstate(divide="ignore", invalid="ignore"):
-        H = h / np.sqrt(np.maximum(hh, 1e-30))[..., None]
-        VoH = dot(V, H)
-        NoH = saturate(dot(N, H))
-        D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), _onemx2(N, H), l.at, l.ab)
+        D = D_GGXAnisotropic(NoH, dot(l.T, H), dot(l.B, H), oneMinusNoH2, l.at, l.ab)
         pdf = D * NoH / (4.0 * VoH)
-    return np.where((hh >= 1e-12) & (VoH > 0.0), pdf, 0.0)
+    return np.where(valid, pdf, 0.0)
 
 
 def ggxAnisotropicSampleDirection(l: AnisotropicLobe, N, V, Xi) -> np.ndarray:

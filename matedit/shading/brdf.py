@@ -25,6 +25,29 @@ def D_GGX(NoH, a, oneMinusNoH2=None) -> np.ndarray:
     return a2 / (PI * d * d)
 
 
+def reflectionHalfVector(N, V, L):
+    """(H, VoH, NoH, |N x H|^2, valid) of a reflection density (Walter et al. 2007 eq 13,
+    14); valid where |L + V|^2 >= 1e-12 and V.H > 0. Shared by the isotropic and the
+    anisotropic GGX densities."""
+    N, V = f64(N), f64(V)
+    h = f64(L) + V
+    hh = (h * h).sum(-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        H = h / np.sqrt(np.maximum(hh, 1e-30))[..., None]
+    VoH = (V * H).sum(-1)
+    NoH = np.clip((N * H).sum(-1), 0.0, 1.0)
+    NxH = np.cross(N, H)
+    return H, VoH, NoH, (NxH * NxH).sum(-1), (hh >= 1e-12) & (VoH > 0.0)
+
+
+def ggxReflectionPdf(N, V, L, a) -> np.ndarray:
+    """Walter et al. 2007 eq 14, 38: D NoH / (4 VoH); 0 where H is undefined or VoH <= 0."""
+    _, VoH, NoH, oneMinusNoH2, valid = reflectionHalfVector(N, V, L)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pdf = D_GGX(NoH, a, oneMinusNoH2) * NoH / (4.0 * VoH)
+    return np.where(valid, pdf, 0.0)
+
+
 def k_Analytic(roughness) -> np.ndarray:
     r = f64(roughness) + 1.0
     return r * r * 0.125

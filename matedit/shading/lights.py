@@ -200,14 +200,13 @@ def sphereLight(s: ShadingContext, light: Light) -> np.ndarray:
     NoLc = saturate(dot(s.N, Lc / np.maximum(d, 1e-8)[..., None]))
     diffuse = diffuseTowards(s, dot(s.N, Lc / np.maximum(d, 1e-8)[..., None]))
     R = reflect(-s.V, s.N)
-    if s.aniso is not None:
-        R = _aniso.anisotropicReflection(s.aniso, s.N, s.V)
     L = normalize(sphereRepresentativePoint(Lc, R, light.source_radius))
-    norm = sphereNormalization(s.a, light.source_radius, d)
-    if s.aniso is not None:
-        norm = _aniso.anisotropicSphereNormalization(s.aniso.at, s.aniso.ab,
-                                                     light.source_radius, d)
-    specular = specularTowards(s, L) * norm[..., None]
+    specular = specularTowards(s, L) * sphereNormalization(s.a, light.source_radius, d)[..., None]
+    if s.aniso is not None:  # the point closest to R in the lobe's metric where anisotropy > 0
+        La = normalize(anisotropicSphereRepresentativePoint(s.aniso, Lc, R, light.source_radius))
+        lit = specularTowards(s, La) * _aniso.anisotropicSphereNormalization(
+            s.aniso, s.V, La, light.source_radius, d)[..., None]
+        specular = np.where((f64(s.aniso.anisotropy) > 0.0)[..., None], lit, specular)
     if s.sheenColor is not None:  # towards the centre, like the diffuse
         diffuse = sheenLayer(s, diffuse + specular, Lc / np.maximum(d, 1e-8)[..., None], NoLc)
         specular = 0.0
@@ -246,6 +245,47 @@ def tubeRepresentativePoint(L0, L1, R) -> np.ndarray:
     return L0 + saturate(t)[..., None] * Ld
 
 
+def anisotropicSphereRepresentativePoint(l, Lc, R, sourceRadius) -> np.ndarray:
+    """The disc point closest to the mirror direction R in the lobe's metric, in the gnomonic
+    plane about the light's direction (unnormalised); the talk's point where R.Ln <= 0."""
+    Lc, R = f64(Lc), f64(R)
+    d = length(Lc)
+    Ln = Lc / np.maximum(d, 1e-8)[..., None]
+    RoL = dot(R, Ln)
+    e1, e2 = _aniso.anisotropicLightFrame(l, Ln)
+    o = R / np.where(RoL > 1e-8, RoL, 1.0)[..., None] - Ln
+    r = f64(sourceRadius)
+    rho = r / np.sqrt(np.maximum(d * d - r * r, 1e-16))
+    p1, p2 = _aniso.anisotropicDiscPoint(dot(o, e1), dot(o, e2), rho, sq(l.ab / l.at))
+    point = Ln + p1[..., None] * e1 + p2[..., None] * e2
+    return np.where((RoL <= 1e-8)[..., None], sphereRepresentativePoint(Lc, R, sourceRadius),
+                    point)
+
+
+def anisotropicTubeRepresentativePoint(l, L0, L1, R) -> np.ndarray:
+    """The segment's point whose direction is closest to R in the lobe's metric (gnomonic
+    image about the centre's direction, clamped quadratic, projective parameter); the talk's
+    where R or an end points away."""
+    L0, L1, R = f64(L0), f64(L1), f64(R)
+    Lc = 0.5 * (L0 + L1)
+    Ln = Lc / np.maximum(length(Lc), 1e-8)[..., None]
+    z0, z1, RoL = dot(L0, Ln), dot(L1, Ln), dot(R, Ln)
+    bad = (RoL <= 1e-8) | (z0 <= 1e-8) | (z1 <= 1e-8)
+    safe = lambda z: np.where(bad, 1.0, z)[..., None]  # noqa: E731
+    e1, e2 = _aniso.anisotropicLightFrame(l, Ln)
+    g0 = L0 / safe(z0)
+    dl = L1 / safe(z1) - g0
+    og = R / safe(RoL) - g0
+    q = sq(l.ab / l.at)
+    dl1, dl2 = dot(dl, e1), dot(dl, e2)
+    num = q * dot(og, e1) * dl1 + dot(og, e2) * dl2
+    den = q * dl1 * dl1 + dl2 * dl2
+    sg = saturate(num / np.maximum(den, 1e-30))
+    t = sg * z0 / np.maximum(sg * z0 + (1.0 - sg) * z1, 1e-30)
+    return np.where(bad[..., None], tubeRepresentativePoint(L0, L1, R),
+                    L0 + t[..., None] * (L1 - L0))
+
+
 def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
     Lc = f64(light.position) - s.P
     d = length(Lc)
@@ -257,19 +297,23 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
         diffuse = diffuse + subsurfaceCosine(s.subsurface, tubeCosine(s.N, L0, L1)) * (
             2.0 / tubeDenominator(L0, L1))[..., None]
     R = reflect(-s.V, s.N)
-    if s.aniso is not None:
-        R = _aniso.anisotropicReflection(s.aniso, s.N, s.V)
     Lp = tubeRepresentativePoint(L0, L1, R)
     dp = length(Lp)
     L = normalize(sphereRepresentativePoint(Lp, R, light.source_radius))
     energy = lineNormalization(s.a, light.source_length, d) * sphereNormalization(
         s.a, light.source_radius, dp
     )
-    if s.aniso is not None:
-        energy = _aniso.anisotropicLineNormalization(
-            s.aniso, s.N, light.direction, light.source_length, d
-        ) * _aniso.anisotropicSphereNormalization(s.aniso.at, s.aniso.ab, light.source_radius, dp)
     specular = specularTowards(s, L) * (energy / (dp * dp + LIGHT_FALLOFF_EPS**2))[..., None]
+    if s.aniso is not None:  # the points closest to R in the lobe's metric (anisotropy > 0)
+        Lpa = anisotropicTubeRepresentativePoint(s.aniso, L0, L1, R)
+        dpa = length(Lpa)
+        La = normalize(anisotropicSphereRepresentativePoint(s.aniso, Lpa, R,
+                                                            light.source_radius))
+        energy_a = _aniso.anisotropicTubeNormalization(
+            s.aniso, s.N, s.V, La, light.direction, light.source_length, d,
+            light.source_radius, dpa)
+        lit = specularTowards(s, La) * (energy_a / (dpa * dpa + LIGHT_FALLOFF_EPS**2))[..., None]
+        specular = np.where((f64(s.aniso.anisotropy) > 0.0)[..., None], lit, specular)
     if s.sheenColor is not None:  # towards the centre times the segment's irradiance
         diffuse = sheenLayer(s, diffuse + specular, Lc / np.maximum(d, 1e-8)[..., None],
                              tubeIrradiance(s.N, L0, L1))

@@ -10,8 +10,8 @@ import numpy as np
 
 from matedit.shading import anisotropy as _aniso
 from matedit.shading import coat
-from matedit.shading.brdf import D_GGX
-from matedit.shading.common import PI, dot, f64, length, saturate, sq
+from matedit.shading.brdf import ggxReflectionPdf
+from matedit.shading.common import PI, dot, f64, length, sq
 from matedit.shading.ibl import rotatedHammersley
 from matedit.shading.lights import (
     Light,
@@ -40,15 +40,7 @@ def brdfCosine(s: ShadingContext, L) -> np.ndarray:
 def ggxDirectionPdf(s: ShadingContext, L) -> np.ndarray:
     if s.aniso is not None:
         return _aniso.ggxAnisotropicDirectionPdf(s.aniso, s.N, s.V, L)
-    h = f64(L) + s.V
-    hh = dot(h, h)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        H = h / np.sqrt(np.maximum(hh, 1e-30))[..., None]
-        VoH = dot(s.V, H)
-        NoH = saturate(dot(s.N, H))
-        NxH = np.cross(s.N, H)
-        pdf = D_GGX(NoH, s.a, dot(NxH, NxH)) * NoH / (4.0 * VoH)
-    return np.where((hh >= 1e-12) & (VoH > 0.0), pdf, 0.0)
+    return ggxReflectionPdf(s.N, s.V, L, s.a)
 
 
 def ggxSampleDirection(s: ShadingContext, Xi) -> np.ndarray:

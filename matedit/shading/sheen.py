@@ -158,15 +158,20 @@ def sheenLayerCosine(s, base, L) -> np.ndarray:
     return sheenLayer(s, base, L, saturate(dot(s.N, L)))
 
 
+SHEEN_IBL_LOOKUP_ROUGHNESS = 1.0  # sheen_shading.glsl: the widest mip, around N
+
+
 def sheenImageBasedLighting(s, ibl) -> np.ndarray:
-    """Split sum (prefiltered at the sheen roughness around N; reference mode integrates the
-    sheen in reference_layered);
+    """Split sum (prefiltered at SHEEN_IBL_LOOKUP_ROUGHNESS = 1 around N, see the GLSL;
+    reference mode integrates the sheen in reference_layered);
     `ibl` is matedit.shading.surface.IblInputs."""
     if ibl.mode == IBL_MODE_NONE:
         return np.zeros(np.broadcast_shapes(s.N.shape, s.V.shape))
     NoV = saturate(dot(s.N, s.V))
     if callable(ibl.prefiltered):  # around N (sheen_shading.glsl)
-        pref = prefilteredRadiance(ibl.prefiltered, s.N, s.sheenRoughness, ibl.mip_count)
+        pref = prefilteredRadiance(ibl.prefiltered, s.N,
+                                   np.full(np.shape(NoV), SHEEN_IBL_LOOKUP_ROUGHNESS),
+                                   ibl.mip_count)
     else:
         pref = f64(ibl.prefiltered)
     dfg = sheenDFG(s.sheenLut, NoV, s.sheenRoughness)
