@@ -266,8 +266,10 @@ vec3 transmissionEnvironmentIBL(samplerCube env, ShadingContext s, float roughne
         float NoL = dot(s.N, L);
         if (NoL >= 0.0) continue;
         float G = smithG1GGX(NoV, a) * smithG1GGX(NoL, a);
-        sum += (1.0 - F_Schlick(s.F0, VoH)) * (G * VoH / (NoV * NoH))
-             * textureLod(env, dir, 0.0).rgb;
+        // the base's Fresnel (or the film's) and the layers over it, as the lights'
+        // transmissionTowards (lights.glsl)
+        sum += (1.0 - specularFresnel(s, VoH)) * transmissionLayers(s, L)
+             * (G * VoH / (NoV * NoH)) * textureLod(env, dir, 0.0).rgb;
     }
     return sum * l.tint * (l.weight / float(sampleCount));
 }

@@ -27,7 +27,7 @@ from matedit.shading.ibl import (
     referenceGgxSample,
     rotatedHammersley,
 )
-from matedit.shading.lights import ShadingContext
+from matedit.shading.lights import ShadingContext, transmissionLayers
 from matedit.shading.sampling import importanceSampleCosine, importanceSampleGGX
 
 # the GLSL's order; the subsurface lobe's front (cosine about N) and back (about -N) samplings
@@ -220,6 +220,8 @@ def transmissionEnvironmentIBL(env, s: ShadingContext, roughness, sampleCount: i
         G = _trans.smithG1GGX(NoV, a) * _trans.smithG1GGX(NoL, a)
         with np.errstate(invalid="ignore", divide="ignore"):
             w = np.where(ok, G * VoH / (NoV * NoH), 0.0)
-        f = (1.0 - F_Schlick(s.F0, np.where(ok, VoH, 1.0))) * w[..., None]
+        # the base's Fresnel (or the film's) and the layers over it (lights.transmissionTowards)
+        F = _film.filmOrFresnel(s.film, s.F0, np.where(ok, VoH, 1.0), F_Schlick)
+        f = (1.0 - F) * transmissionLayers(s, L) * w[..., None]
         total = total + np.where(ok[..., None], f * f64(env(direction)), 0.0)
     return total * f64(t.tint) * (f64(t.weight) / sampleCount)[..., None]
