@@ -215,7 +215,7 @@ def split_sum_ab(NoV, r):
     return np.array([A, B])
 
 
-def _white_furnace(rough, thin, mu):
+def _white_furnace(rough, thin, mu, compensated=False):
     """The preview's output in a white furnace (environment 1 everywhere), no lights."""
     sh = np.zeros((9, 3))
     sh[0] = 2.0 * math.sqrt(math.pi)  # L00 of a constant radiance 1
@@ -229,16 +229,20 @@ def _white_furnace(rough, thin, mu):
     m = material.MaterialAttributes(baseColor=np.array([1.0, 1.0, 1.0]), metallic=0.0,
                                     roughness=rough, transmission=1.0)
     return surface.shadeSurface(m, np.zeros(3), N, V, (), ibl_in, transmission=True,
-                                thin_walled=thin)
+                                thin_walled=thin, energy_compensation=compensated)
 
 
+@pytest.mark.parametrize("compensated", [False, True])
 @pytest.mark.parametrize("rough", [0.1, 0.5, 0.9])
 @pytest.mark.parametrize("thin", [False, True])
-def test_furnace_preview(rough, thin):
+def test_furnace_preview(rough, thin, compensated):
     """The preview's glass (transmission 1, IOR 1.5) in a white furnace: reflected +
-    transmitted in [0.95, 1 + 2e-3]: the transmission takes what the reflection leaves."""
+    transmitted in [0.95, 1 + 2e-3]: the transmission takes what the reflection leaves, the
+    compensated reflection too under energy compensation (which raises the reflection by
+    (1 + F0 (1 / (A + B) - 1)); before the transmission took it into account the furnace
+    returned up to 1 + that excess)."""
     for mu in (0.95, 0.5, 0.2):
-        out = _white_furnace(rough, thin, mu)
+        out = _white_furnace(rough, thin, mu, compensated)
         assert np.all(out <= 1.0 + 2e-3) and np.all(out >= 0.95), (mu, out)
 
 
@@ -272,7 +276,8 @@ def _lut_texture(ctx, lut):
     return tex
 
 
-def _shade(ctx, rng, mode, compiled, zero, thin=False, n=1024, lobes=None, layers=()):
+def _shade(ctx, rng, mode, compiled, zero, thin=False, n=1024, lobes=None, layers=(),
+           compensated=False):
     """GPU shadeSurface (with or without MATERIAL_HAS_TRANSMISSION) and the inputs/twin;
     `layers` adds any of "coat", "sheen", "film" over the base (random weights)."""
     scene = _all_kinds(rng, 16)
@@ -330,6 +335,8 @@ def _shade(ctx, rng, mode, compiled, zero, thin=False, n=1024, lobes=None, layer
         defines += ("MATERIAL_THIN_WALLED",)
     if lobes is not None:
         defines += (f"MATEDIT_LOBES {lobes} //",)
+    if compensated:
+        defines += ("MATEDIT_ENERGY_COMPENSATION",)
     defines += tuple({"coat": "MATERIAL_HAS_COAT", "sheen": "MATERIAL_HAS_SHEEN_COLOR",
                       "film": "MATERIAL_HAS_THIN_FILM_THICKNESS"}[k] for k in layers)
     try:
@@ -366,7 +373,8 @@ def _shade(ctx, rng, mode, compiled, zero, thin=False, n=1024, lobes=None, layer
                                     transmission=flag, thin_walled=thin,
                                     lobes=surface.LOBES_ALL if lobes is None else lobes,
                                     coat="coat" in layers, sheen="sheen" in layers,
-                                    thin_film="film" in layers)
+                                    thin_film="film" in layers,
+                                    energy_compensation=compensated)
 
     return got, inputs, twin
 
@@ -430,6 +438,18 @@ def test_transmission_under_layers_gpu_twin(ctx, rng, mode, thin, layers):
     plain, _, _ = _shade(ctx, np.random.default_rng(seed), mode, True, False, thin=thin,
                          lobes=64)
     assert np.abs(view - plain).max() > 1e-2, name
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("thin", [False, True])
+def test_transmission_energy_compensation_gpu_twin(ctx, rng, thin):
+    """Under MATEDIT_ENERGY_COMPENSATION (with a film, where the split sum's transmission
+    takes what the film's compensated reflection leaves): GPU = twin, split sum, 2e-4
+    relative + 1e-5 with the inputs' float32 spread."""
+    got, inputs, twin = _shade(ctx, rng, ibl.IBL_MODE_SPLIT_SUM, True, False, thin=thin,
+                               layers=("film",), compensated=True)
+    check(f"transmission+compensation[thin {thin}]", got, twin(**inputs), rtol=2e-4,
+          atol=1e-5, slack=perturbation_spread(twin, inputs, rng))
 
 
 @pytest.mark.gl
