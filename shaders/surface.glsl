@@ -284,8 +284,8 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                                     uIbl.sampleOffset.xy) * uIbl.params.y;
 #if defined(MATERIAL_HAS_TRANSMISSION)
         // the transmitted part by sampling the BTDF (reference_layered.glsl)
-        ibl += transmissionEnvironmentIBL(uEnvironment, s, roughness, count,
-                                          uIbl.sampleOffset.xy) * uIbl.params.y;
+        ibl += transmissionEnvironmentIBL(uEnvironment, uEnvDistribution, s, roughness,
+                                          count, uIbl.sampleOffset.xy) * uIbl.params.y;
 #endif
     }
 #endif

@@ -623,6 +623,18 @@ def smooth_env(d):
     return np.stack([1.0 + 0.6 * x, 1.0 + 0.4 * z, 0.7 - 0.3 * y + 0.2 * x * z], -1)
 
 
+def _table_of(env, h=32, w=64):
+    """The environment's sampling table (matedit.ibl.importance) from its luminance at the
+    equirect texels' centres."""
+    from matedit.ibl.importance import build_distribution, luminance
+    from matedit.shading.env_sampling import equirectDirection
+
+    u = (np.arange(w) + 0.5) / w
+    v = (np.arange(h) + 0.5) / h
+    uv = np.stack(np.meshgrid(u, v, indexing="xy"), -1)
+    return build_distribution(luminance(env(equirectDirection(uv)))).table
+
+
 def _through(V, a, thin, eta=1.5, F0=0.04):
     """Brute force over the sphere of the transmitted radiance under smooth_env, and the
     transmitted albedo (env 1)."""
@@ -645,7 +657,8 @@ def test_reference_converges_to_brute_force_thin_walled(rough):
     s.transmission = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 0.0, 1.5, 0.0,
                                              True, N, V, 1.0)
     s.thin_walled = True
-    got = rl.transmissionEnvironmentIBL(smooth_env, s, rough, 4096, (0.1, 0.7))
+    got = rl.transmissionEnvironmentIBL(smooth_env, _table_of(smooth_env), s, rough, 4096,
+                                        (0.1, 0.7))
     np.testing.assert_allclose(got, want, rtol=1e-2)
 
 
@@ -672,7 +685,8 @@ def test_reference_converges_to_brute_force_solid(rough):
     s = _lights.makeShadingContext(np.zeros(3), N, V, np.zeros(3), np.full(3, 0.04), rough)
     s.transmission = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 0.0, 1.5, 0.0,
                                              False, N, V, 1.0)
-    got = rl.transmissionEnvironmentIBL(smooth_env, s, rough, 4096, (0.1, 0.7))
+    got = rl.transmissionEnvironmentIBL(smooth_env, _table_of(smooth_env), s, rough, 4096,
+                                        (0.1, 0.7))
     np.testing.assert_allclose(got, want, rtol=1e-2)
 
 
@@ -877,3 +891,41 @@ def test_furnace_thin_film_and_transmission(rough, case):
     got = np.ravel(surface.shadeSurface(m, np.zeros(3), N, V, (), ref, **kw))
     assert np.all(got <= 1.0 + 2e-3), got
     np.testing.assert_allclose(got, R + T, rtol=1e-2)
+
+
+# --- reference mode's MIS for thin walls ------------------------------------------------------
+
+_SUN = np.array([-0.5, 0.2, -0.85]) / np.linalg.norm([-0.5, 0.2, -0.85])
+
+
+def sun_env(d):
+    """A sky of 0.5 .. 0.6 and a sun of peak 300 (angular radius about 0.08 rad) behind the
+    wall, off the view ray -V."""
+    d = np.asarray(d, np.float64)
+    g = 300.0 * np.exp((d @ _SUN - 1.0) / 0.003)
+    return np.stack([0.5 + g, 0.5 + 0.9 * g, 0.6 + 0.7 * g], -1)
+
+
+@pytest.mark.parametrize("rough", [0.3, 0.6])
+def test_reference_thin_wall_mis_converges_with_a_sun_behind(rough):
+    """A thin wall (IOR 1.5) with a small bright sun behind it: reference mode's estimator
+    (BTDF samples and environment samples, balance heuristic) against the brute-force
+    integral of the thin wall's BTDF over the sphere: within 8 % at 64 samples and 3 % at
+    256 (measured 4.8 % / 6.5 % and 2.2 % / 0.5 % at roughness 0.3 / 0.6, of the largest
+    channel; the BTDF's samples alone measured 58 % / 43 % at 64 samples)."""
+    from matedit.shading import lights as _lights
+    from matedit.shading import reference_layered as rl
+
+    mu = 0.7
+    V, N = view(mu), np.array([0.0, 0.0, 1.0])
+    L, dw = sphere_grid(1500)
+    want = np.sum(w_thin_cos(V, L, rough * rough, 0.04)[..., None] * sun_env(L),
+                  axis=(0, 1)) * dw
+    s = _lights.makeShadingContext(np.zeros(3), N, V, np.zeros(3), np.full(3, 0.04), rough)
+    s.transmission = tr.makeTransmissionLobe(1.0, [1, 1, 1], [1, 1, 1], 0.0, 0.0, 1.5, 0.0,
+                                             True, N, V, 1.0)
+    s.thin_walled = True
+    table = _table_of(sun_env)
+    for count, tol in ((64, 0.08), (256, 0.03)):
+        got = rl.transmissionEnvironmentIBL(sun_env, table, s, rough, count, (0.1, 0.7))
+        assert np.abs(got - want).max() <= tol * want.max(), (count, got, want)

@@ -292,7 +292,8 @@ def shadeSurface(
             ibl.sample_offset) * ibl.intensity
         if s.transmission is not None:  # by sampling the BTDF (reference_layered.glsl)
             indirect = indirect + _layered.transmissionEnvironmentIBL(
-                ibl.environment, s, roughness, max(int(ibl.samples), 1),
+                ibl.environment, ibl.environment_distribution, s, roughness,
+                max(int(ibl.samples), 1),
                 ibl.sample_offset) * ibl.intensity
     else:
         indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,
