@@ -430,15 +430,40 @@ vec3 tubeLight(ShadingContext s, Light light) {
 }
 
 #if defined(MATERIAL_HAS_TRANSMISSION)
-// f |NoL| of the transmission lobe towards L (below the surface), thin-walled or solid.
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+float sheenBaseScale(ShadingContext s, float NoL);  // sheen_shading.glsl
+#endif
+
+// What the transmitted light keeps of the layers over the base towards L (below the
+// surface): the sheen's albedo scaling and the coat's transmittance, as the base's
+// reflection has them, the light's cosine taken mirrored (-N.L): it crosses the layers once
+// where it enters the part (behind) and once where it leaves towards the eye.
+vec3 transmissionLayers(ShadingContext s, vec3 L) {
+    // glTF KHR_materials_sheen albedo scaling (sheen_shading.glsl, sheenBaseScale); the coat's
+    // (1 - Fc(V)) (1 - Fc(L)) coatColor (coat.glsl, coatTransmittance)
+    vec3 k = vec3(1.0);
+#if defined(MATERIAL_HAS_SHEEN_COLOR)
+    k *= sheenBaseScale(s, -dot(s.N, L));
+#endif
+#if defined(MATERIAL_HAS_COAT)
+    k *= coatTransmittance(s.coat, -dot(s.coat.N, L));
+#endif
+    return k;
+}
+
+// f |NoL| of the transmission lobe towards L (below the surface), thin-walled or solid,
+// its Fresnel the base specular's (Schlick's, or the thin film's: 1 - F is what it lets
+// through), through the layers over the base.
 vec3 transmissionTowards(ShadingContext s, vec3 L) {
     // Walter et al. 2007 (transmission.glsl): the solid's BTDF, or the thin wall's
+    float VoH;
 #if defined(MATERIAL_THIN_WALLED)
-    vec3 f = thinWalledBtdfCosine(s.N, s.V, L, s.a, s.F0);
+    float f = thinWalledBtdfCosineNoFresnel(s.N, s.V, L, s.a, VoH);
 #else
-    vec3 f = refractionBtdfCosine(s.N, s.V, L, s.a, s.transmission.eta, s.F0);
+    float f = refractionBtdfCosineNoFresnel(s.N, s.V, L, s.a, s.transmission.eta, VoH);
 #endif
-    return f * s.transmission.tint * s.transmission.weight;
+    return (1.0 - specularFresnel(s, VoH)) * f * s.transmission.tint * s.transmission.weight
+         * transmissionLayers(s, L);
 }
 
 // Radiance transmitted towards V from a light behind the surface: each type as its

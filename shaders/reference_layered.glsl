@@ -234,16 +234,40 @@ vec3 layeredEnvironmentIBL(samplerCube env, sampler2D dist, LayeredReference r,
 }
 
 #if defined(MATERIAL_HAS_TRANSMISSION)
-// The transmitted radiance under the unfiltered environment `env`, by sampling the BTDF:
-// a GGX microfacet normal m (density D |N.m|), then the view ray refracted through m (solid;
-// the environment looked up along its exit from the sphere, transmission.glsl) or reflected
-// about m and mirrored through the tangent plane (thin-walled, exactly the lobe the lights
-// use). The reflection is the layered estimator's; this one takes the transmitted part.
-vec3 transmissionEnvironmentIBL(samplerCube env, ShadingContext s, float roughness,
-                                uint sampleCount, vec2 offset) {
+#if defined(MATERIAL_THIN_WALLED)
+// Solid-angle density of L (below the surface) under the thin wall's BTDF sampling: the
+// GGX normal m = normalize(V + L'), L' = L mirrored through the tangent plane, drawn by
+// D (N.m), the reflection's Jacobian 1 / (4 V.m).
+float thinWalledBtdfPdf(vec3 N, vec3 V, vec3 L, float a) {
+    // Walter et al. 2007, "Microfacet Models for Refraction", eq 14 and 38, of the mirror
+    vec3 Lm = L - 2.0 * dot(N, L) * N;
+    vec3 h = V + Lm;
+    float hh = dot(h, h);
+    if (dot(N, L) >= 0.0 || hh < 1e-12) return 0.0;
+    vec3 m = h * inversesqrt(hh);
+    float VoM = dot(V, m);
+    float NoM = dot(N, m);
+    if (VoM <= 0.0 || NoM <= 0.0) return 0.0;
+    vec3 NxM = cross(N, m);
+    return D_GGX(NoM, a, dot(NxM, NxM)) * NoM / (4.0 * VoM);
+}
+#endif
+
+// The transmitted radiance under the unfiltered environment `env` (distribution `dist`), by
+// sampling the BTDF: a GGX microfacet normal m (density D |N.m|), then the view ray refracted
+// through m (solid; the environment looked up along its exit from the sphere,
+// transmission.glsl) or reflected about m and mirrored through the tangent plane
+// (thin-walled, exactly the lobe the lights use). Thin walls add one environment sample a
+// step, combined with the BTDF's by the balance heuristic (the direction seen is the
+// direction inside); a solid's seen direction is its exit from the sphere, which has no
+// closed-form inverse, so it samples the BTDF alone. The reflection is the layered
+// estimator's; this one takes the transmitted part.
+vec3 transmissionEnvironmentIBL(samplerCube env, sampler2D dist, ShadingContext s,
+                                float roughness, uint sampleCount, vec2 offset) {
     // Walter et al. 2007, "Microfacet Models for Refraction through Rough Surfaces", eq 35-41:
     // with m drawn by D |N.m| the weight f |N.L| / p is (1 - F) G |V.m| / (|N.V| |N.m|), for
-    // the refraction (the Jacobian of eq 17 cancels) and the mirrored reflection alike
+    // the refraction (the Jacobian of eq 17 cancels) and the mirrored reflection alike;
+    // Veach 1997, ch. 9, the balance heuristic
     TransmissionLobe l = s.transmission;
     float NoV = dot(s.N, s.V);
     if (NoV <= 0.0 || l.weight <= 0.0) return vec3(0.0);
@@ -251,6 +275,18 @@ vec3 transmissionEnvironmentIBL(samplerCube env, ShadingContext s, float roughne
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < sampleCount; i++) {
         vec2 Xi = rotatedHammersley(i, sampleCount, fract(offset + vec2(0.5, 0.25)));
+#if defined(MATERIAL_THIN_WALLED)
+        // the environment's sample (MIS): f |N.L| of the BTDF at the reference's alpha
+        float pe;
+        vec3 Le = sampleEnvironmentDirection(dist, environmentSamplePoint(Xi), pe);
+        if (pe > 0.0 && dot(s.N, Le) < 0.0) {
+            float VoHe;
+            float fe = thinWalledBtdfCosineNoFresnel(s.N, s.V, Le, a, VoHe);
+            sum += (1.0 - specularFresnel(s, VoHe)) * transmissionLayers(s, Le)
+                 * (fe / (pe + thinWalledBtdfPdf(s.N, s.V, Le, a)))
+                 * textureLod(env, Le, 0.0).rgb;
+        }
+#endif
         vec3 H = importanceSampleGGX(Xi, a, s.N);
         float VoH = dot(s.V, H);
         float NoH = dot(s.N, H);
@@ -266,7 +302,17 @@ vec3 transmissionEnvironmentIBL(samplerCube env, ShadingContext s, float roughne
         float NoL = dot(s.N, L);
         if (NoL >= 0.0) continue;
         float G = smithG1GGX(NoV, a) * smithG1GGX(NoL, a);
-        sum += (1.0 - F_Schlick(s.F0, VoH)) * (G * VoH / (NoV * NoH))
+        float w = G * VoH / (NoV * NoH);
+#if defined(MATERIAL_THIN_WALLED)
+        // the balance heuristic's share of the BTDF's sample, p_b / (p_b + p_e); all of it
+        // where the environment cannot draw L (p_e = 0)
+        float pb = thinWalledBtdfPdf(s.N, s.V, L, a);
+        float peL = environmentPdf(dist, L);
+        if (peL > 0.0) w *= pb / (pb + peL);
+#endif
+        // the base's Fresnel (or the film's) and the layers over it, as the lights'
+        // transmissionTowards (lights.glsl)
+        sum += (1.0 - specularFresnel(s, VoH)) * transmissionLayers(s, L) * w
              * textureLod(env, dir, 0.0).rgb;
     }
     return sum * l.tint * (l.weight / float(sampleCount));

@@ -210,7 +210,8 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
 #endif
 #if defined(MATERIAL_HAS_TRANSMISSION)
     // Specular transmission (transmission.glsl): the diffuse keeps 1 - transmission; the
-    // transmitted part takes what the specular reflection leaves, 1 - (F0 A + B).
+    // transmitted part takes what the specular reflection leaves, 1 - (F0 A + B), with the
+    // film's reflectance at N.V in place of F0 where there is one (as imageBasedLighting).
 #if defined(MATERIAL_THIN_WALLED)
     const float thinWalled = 1.0;
 #else
@@ -221,7 +222,11 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                                           m.thickness, m.ior, m.metallic, thinWalled, N, V,
                                           lobeOn(LOBE_TRANSMISSION));
     vec2 transmissionAB = environmentBRDF(uBrdfLut, saturate(dot(N, V)), roughness);
-    vec3 transmissionReflected = saturate(F0 * transmissionAB.x + transmissionAB.y);
+    vec3 transmissionF0 = F0;
+#if defined(MATERIAL_HAS_THIN_FILM_THICKNESS)
+    if (s.film.thickness > 0.0) transmissionF0 = thinFilmFresnel(s.film, saturate(dot(N, V)));
+#endif
+    vec3 transmissionReflected = saturate(transmissionF0 * transmissionAB.x + transmissionAB.y);
     s.diffuseColor *= 1.0 - saturate(m.transmission);
     diffuseColor *= 1.0 - saturate(m.transmission);
 #if defined(MATERIAL_HAS_SUBSURFACE)
@@ -238,6 +243,10 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
     diffuseColor *= diffuseScale;
 #if defined(MATERIAL_HAS_SUBSURFACE)
     s.subsurface.color *= diffuseScale;  // a diffuse lobe too
+#endif
+#if defined(MATERIAL_HAS_TRANSMISSION)
+    // the split sum's transmission takes what the compensated reflection leaves
+    transmissionReflected = saturate(transmissionReflected * s.specularScale);
 #endif
 #endif
 #if MATEDIT_LOBES != 127
@@ -275,8 +284,8 @@ vec3 shadeSurface(MaterialAttributes m, vec3 P, vec3 N, vec3 V, vec3 Ng, vec3 T,
                                     uIbl.sampleOffset.xy) * uIbl.params.y;
 #if defined(MATERIAL_HAS_TRANSMISSION)
         // the transmitted part by sampling the BTDF (reference_layered.glsl)
-        ibl += transmissionEnvironmentIBL(uEnvironment, s, roughness, count,
-                                          uIbl.sampleOffset.xy) * uIbl.params.y;
+        ibl += transmissionEnvironmentIBL(uEnvironment, uEnvDistribution, s, roughness,
+                                          count, uIbl.sampleOffset.xy) * uIbl.params.y;
 #endif
     }
 #endif

@@ -116,45 +116,68 @@ float smithG1GGX(float NoX, float a) {
     return 2.0 * c / max(c + sqrt(a * a + (1.0 - a * a) * c * c), 1e-12);
 }
 
-// f |NoL| of the solid's BTDF for a light below the surface (NoL < 0), V above it: the rough
-// interface outside (index 1, V) | inside (index eta, L).
-vec3 refractionBtdfCosine(vec3 N, vec3 V, vec3 L, float a, float eta, vec3 F0) {
+// f |NoL| / (1 - F) of the solid's BTDF for a light below the surface (NoL < 0), V above it:
+// the rough interface outside (index 1, V) | inside (index eta, L). `VoH` receives the V.h
+// its Fresnel is taken at (the caller's Schlick or thin-film Fresnel).
+float refractionBtdfCosineNoFresnel(vec3 N, vec3 V, vec3 L, float a, float eta, out float VoH) {
     // Walter et al. 2007, "Microfacet Models for Refraction through Rough Surfaces", eq 21
     // with GGX D (eq 33), separable Smith G (eq 23, 34) and the half vector of eq 16,
     // h = -(V + eta L). The eta^2 of eq 21 is kept: the integral over L of f |NoL| is the
     // interface's transmittance (the radiance's eta^2 in and out of the part cancel).
+    VoH = 0.0;
     float NoV = dot(N, V);
     float NoL = dot(N, L);
-    if (NoL >= 0.0 || NoV <= 0.0) return vec3(0.0);
+    if (NoL >= 0.0 || NoV <= 0.0) return 0.0;
     vec3 h = -(V + eta * L);
     float hh = dot(h, h);
-    if (hh < 1e-12) return vec3(0.0);
+    if (hh < 1e-12) return 0.0;
     vec3 H = h * inversesqrt(hh);
     if (dot(N, H) < 0.0) H = -H;
-    float VoH = dot(V, H);
+    float vh = dot(V, H);
     float LoH = dot(L, H);
-    if (VoH <= 0.0 || LoH >= 0.0) return vec3(0.0);
-    float den = VoH + eta * LoH;
-    float D = D_GGX(saturate(dot(N, H)), a);
+    if (vh <= 0.0 || LoH >= 0.0) return 0.0;
+    VoH = vh;
+    float den = vh + eta * LoH;
+    vec3 NxH = cross(N, H);  // 1 - NoH^2 without cancellation (narrow lobes, brdf.glsl)
+    float D = D_GGX(saturate(dot(N, H)), a, dot(NxH, NxH));
     float G = smithG1GGX(NoV, a) * smithG1GGX(NoL, a);
-    return (1.0 - F_Schlick(F0, VoH))
-         * (VoH * -LoH * eta * eta * G * D / (NoV * max(den * den, 1e-12)));
+    return vh * -LoH * eta * eta * G * D / (NoV * max(den * den, 1e-12));
 }
 
-// f |NoL| of the thin wall's BTDF for a light below the surface: the reflection lobe (GGX,
-// Smith G) of L mirrored through the tangent plane, weighted by 1 - F.
-vec3 thinWalledBtdfCosine(vec3 N, vec3 V, vec3 L, float a, vec3 F0) {
+// f |NoL| of the solid's BTDF with Schlick's Fresnel of F0: (1 - F(V.h)) times the above.
+vec3 refractionBtdfCosine(vec3 N, vec3 V, vec3 L, float a, float eta, vec3 F0) {
+    // Walter et al. 2007, eq 21 (refractionBtdfCosineNoFresnel), Schlick's F
+    float VoH;
+    float f = refractionBtdfCosineNoFresnel(N, V, L, a, eta, VoH);
+    return (1.0 - F_Schlick(F0, VoH)) * f;
+}
+
+// f |NoL| / (1 - F) of the thin wall's BTDF for a light below the surface: the reflection
+// lobe (GGX, Smith G) of L mirrored through the tangent plane. `VoH` receives the V.h of its
+// Fresnel.
+float thinWalledBtdfCosineNoFresnel(vec3 N, vec3 V, vec3 L, float a, out float VoH) {
     // matedit's thin-walled model (docs/shading.md, Transmission): the microfacet lobe of
     // Walter et al. 2007 eq 20 about the mirrored direction: a thin slab of two equal
     // rough faces, its spread taken as one face's
+    VoH = 0.0;
     float NoV = dot(N, V);
     float NoL = dot(N, L);
-    if (NoL >= 0.0 || NoV <= 0.0) return vec3(0.0);
+    if (NoL >= 0.0 || NoV <= 0.0) return 0.0;
     vec3 Lm = L - 2.0 * NoL * N;
     vec3 H = normalize(V + Lm);
-    float D = D_GGX(saturate(dot(N, H)), a);
+    VoH = saturate(dot(V, H));
+    vec3 NxH = cross(N, H);  // 1 - NoH^2 without cancellation (narrow lobes, brdf.glsl)
+    float D = D_GGX(saturate(dot(N, H)), a, dot(NxH, NxH));
     float G = smithG1GGX(NoV, a) * smithG1GGX(NoL, a);
-    return (1.0 - F_Schlick(F0, saturate(dot(V, H)))) * (D * G / (4.0 * NoV));
+    return D * G / (4.0 * NoV);
+}
+
+// f |NoL| of the thin wall's BTDF with Schlick's Fresnel of F0, weighted by 1 - F.
+vec3 thinWalledBtdfCosine(vec3 N, vec3 V, vec3 L, float a, vec3 F0) {
+    // matedit's thin-walled model (thinWalledBtdfCosineNoFresnel), Schlick's F
+    float VoH;
+    float f = thinWalledBtdfCosineNoFresnel(N, V, L, a, VoH);
+    return (1.0 - F_Schlick(F0, VoH)) * f;
 }
 
 // The transmitted radiance under the prefiltered environment (split sum): what the

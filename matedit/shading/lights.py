@@ -12,13 +12,13 @@ from matedit.shading import brdf as _brdf
 from matedit.shading import coat
 from matedit.shading.brdf import D_GGX, F_Schlick, V_SchlickSmith, diffuseLobe, k_Analytic
 from matedit.shading.common import dot, f64, length, normalize, reflect, saturate, sq
-from matedit.shading.sheen import sheenLayer
+from matedit.shading.sheen import sheenBaseScale, sheenLayer
 from matedit.shading.subsurface import SubsurfaceLobe, subsurfaceCosine
 from matedit.shading.thin_film import ThinFilm, filmOrFresnel, thinFilmFresnel
 from matedit.shading.transmission import (
     TransmissionLobe,
-    refractionBtdfCosine,
-    thinWalledBtdfCosine,
+    refractionBtdfCosineNoFresnel,
+    thinWalledBtdfCosineNoFresnel,
 )
 
 LIGHT_TYPE_POINT = 0
@@ -333,14 +333,28 @@ def tubeLight(s: ShadingContext, light: Light) -> np.ndarray:
     return (diffuse + specular) * _scale(light, window)
 
 
+def transmissionLayers(s: ShadingContext, L) -> np.ndarray:
+    """Twin of lights.glsl's: the sheen's albedo scaling and the coat's transmittance at the
+    light's mirrored cosine -N.L (1 where the material has neither)."""
+    k: np.ndarray = np.ones(np.broadcast_shapes(s.N.shape, np.shape(L)))
+    if s.sheenColor is not None:
+        k = k * sheenBaseScale(s, -dot(s.N, L))[..., None]
+    if s.coat is not None:
+        k = k * coat.coatTransmittance(s.coat, -dot(s.coat.N, L))
+    return k
+
+
 def transmissionTowards(s: ShadingContext, L) -> np.ndarray:
+    """Twin of lights.glsl's: the BTDF with the base's (or the film's) Fresnel, through the
+    layers over the base."""
     t = s.transmission
     assert t is not None
     if s.thin_walled:
-        f = thinWalledBtdfCosine(s.N, s.V, L, s.a, s.F0)
+        f, VoH = thinWalledBtdfCosineNoFresnel(s.N, s.V, L, s.a)
     else:
-        f = refractionBtdfCosine(s.N, s.V, L, s.a, t.eta, s.F0)
-    return f * f64(t.tint) * f64(t.weight)[..., None]
+        f, VoH = refractionBtdfCosineNoFresnel(s.N, s.V, L, s.a, t.eta)
+    return ((1.0 - filmOrFresnel(s.film, s.F0, VoH, F_Schlick)) * f[..., None] * f64(t.tint)
+            * f64(t.weight)[..., None] * transmissionLayers(s, L))
 
 
 def transmissionLight(s: ShadingContext, light: Light) -> np.ndarray:

@@ -15,7 +15,7 @@ from matedit.shading import sheen as _sheen
 from matedit.shading import subsurface as _sss
 from matedit.shading import thin_film as _film
 from matedit.shading import transmission as _trans
-from matedit.shading.brdf import F_Schlick, F_SchlickExact
+from matedit.shading.brdf import D_GGX, F_Schlick, F_SchlickExact
 from matedit.shading.common import INV_PI, dot, f64, saturate
 from matedit.shading.env_sampling import environmentPdf, sampleEnvironmentDirection
 from matedit.shading.ibl import (
@@ -27,7 +27,7 @@ from matedit.shading.ibl import (
     referenceGgxSample,
     rotatedHammersley,
 )
-from matedit.shading.lights import ShadingContext
+from matedit.shading.lights import ShadingContext, transmissionLayers
 from matedit.shading.sampling import importanceSampleCosine, importanceSampleGGX
 
 # the GLSL's order; the subsurface lobe's front (cosine about N) and back (about -N) samplings
@@ -191,11 +191,26 @@ def layeredEnvironmentIBL(env, dist, r: LayeredReference, sampleCount: int,
     return total / sampleCount
 
 
-def transmissionEnvironmentIBL(env, s: ShadingContext, roughness, sampleCount: int,
+def thinWalledBtdfPdf(N, V, L, a) -> np.ndarray:
+    """Twin of reference_layered.glsl's: D (N.m) / (4 V.m) of m = normalize(V + L mirrored)."""
+    N, V, L = f64(N), f64(V), f64(L)
+    NoL = dot(N, L)
+    h = V + (L - 2.0 * NoL[..., None] * N)
+    hh = dot(h, h)
+    m = h / np.sqrt(np.maximum(hh, 1e-30))[..., None]
+    VoM, NoM = dot(V, m), dot(N, m)
+    NxM = np.cross(N, m)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        p = D_GGX(NoM, a, dot(NxM, NxM)) * NoM / (4.0 * VoM)
+    return np.where((NoL < 0.0) & (hh >= 1e-12) & (VoM > 0.0) & (NoM > 0.0), p, 0.0)
+
+
+def transmissionEnvironmentIBL(env, dist, s: ShadingContext, roughness, sampleCount: int,
                                offset) -> np.ndarray:
     """Twin of reference_layered.glsl's: the transmitted radiance by sampling the BTDF (a GGX
     normal, refracted through it and out of the sphere, or reflected and mirrored for a thin
-    wall), weight (1 - F) G V.m / (N.V N.m)."""
+    wall), weight (1 - F) G V.m / (N.V N.m); thin walls add an environment sample a step
+    (`dist`, the environment's sampling table), balance heuristic."""
     t = s.transmission
     assert t is not None
     N, V = f64(s.N), f64(s.V)
@@ -204,8 +219,18 @@ def transmissionEnvironmentIBL(env, s: ShadingContext, roughness, sampleCount: i
     shape = np.broadcast_shapes(N.shape, V.shape)
     total = np.zeros(shape)
     offset = np.mod(f64(offset) + np.array([0.5, 0.25]), 1.0)
+    alive = (NoV > 0.0)[..., None]
     for i in range(sampleCount):
         Xi = np.broadcast_to(rotatedHammersley(i, sampleCount, offset), shape[:-1] + (2,))
+        if s.thin_walled:  # the environment's sample (MIS)
+            Le, pe = sampleEnvironmentDirection(dist, environmentSamplePoint(Xi))
+            fe, VoHe = _trans.thinWalledBtdfCosineNoFresnel(N, V, Le, a)
+            ok_e = (pe > 0.0) & (dot(N, Le) < 0.0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                we = np.where(ok_e, fe / (pe + thinWalledBtdfPdf(N, V, Le, a)), 0.0)
+            Fe = _film.filmOrFresnel(s.film, s.F0, VoHe, F_Schlick)
+            contrib = (1.0 - Fe) * transmissionLayers(s, Le) * we[..., None] * f64(env(Le))
+            total = total + np.where((ok_e[..., None] & alive), np.nan_to_num(contrib), 0.0)
         H = importanceSampleGGX(Xi, a, N)
         VoH, NoH = dot(V, H), dot(N, H)
         if s.thin_walled:
@@ -220,6 +245,12 @@ def transmissionEnvironmentIBL(env, s: ShadingContext, roughness, sampleCount: i
         G = _trans.smithG1GGX(NoV, a) * _trans.smithG1GGX(NoL, a)
         with np.errstate(invalid="ignore", divide="ignore"):
             w = np.where(ok, G * VoH / (NoV * NoH), 0.0)
-        f = (1.0 - F_Schlick(s.F0, np.where(ok, VoH, 1.0))) * w[..., None]
+            if s.thin_walled:  # the balance heuristic's share, p_b / (p_b + p_e)
+                pb = thinWalledBtdfPdf(N, V, L, a)
+                peL = environmentPdf(dist, L)
+                w = np.where(ok, np.where(peL > 0.0, w * pb / (pb + peL), w), 0.0)
+        # the base's Fresnel (or the film's) and the layers over it (lights.transmissionTowards)
+        F = _film.filmOrFresnel(s.film, s.F0, np.where(ok, VoH, 1.0), F_Schlick)
+        f = (1.0 - F) * transmissionLayers(s, L) * w[..., None]
         total = total + np.where(ok[..., None], f * f64(env(direction)), 0.0)
     return total * f64(t.tint) * (f64(t.weight) / sampleCount)[..., None]

@@ -251,7 +251,12 @@ def shadeSurface(
         NoV = saturate(dot(f64(N), f64(V)))
         AB = f64(ibl.brdf_lut) if ibl.lut_values else environmentBRDF(ibl.brdf_lut, NoV,
                                                                       roughness)
-        reflected = saturate(f64(F0) * AB[..., 0:1] + AB[..., 1:2])
+        # the film's reflectance at N.V in place of F0 where there is one (surface.glsl)
+        tF0 = f64(F0)
+        if s.film is not None:
+            tF0 = np.where((f64(s.film.thickness) > 0.0)[..., None],
+                           _film.thinFilmFresnel(s.film, NoV), tF0)
+        reflected = saturate(tF0 * AB[..., 0:1] + AB[..., 1:2])
         keep = (1.0 - saturate(m.transmission))[..., None]
         s.diffuseColor = s.diffuseColor * keep
         diffuseColor = s.diffuseColor
@@ -266,6 +271,8 @@ def shadeSurface(
         diffuseColor = s.diffuseColor
         if s.subsurface is not None:
             s.subsurface.color = s.subsurface.color * diffuse_scale
+        if reflected is not None:  # what the compensated reflection leaves (surface.glsl)
+            reflected = saturate(reflected * f64(s.specularScale))
     if lobes != LOBES_ALL:
         s.diffuseColor = s.diffuseColor * lobeOn(lobes, LOBE_DIFFUSE)
         diffuseColor = s.diffuseColor
@@ -285,7 +292,8 @@ def shadeSurface(
             ibl.sample_offset) * ibl.intensity
         if s.transmission is not None:  # by sampling the BTDF (reference_layered.glsl)
             indirect = indirect + _layered.transmissionEnvironmentIBL(
-                ibl.environment, s, roughness, max(int(ibl.samples), 1),
+                ibl.environment, ibl.environment_distribution, s, roughness,
+                max(int(ibl.samples), 1),
                 ibl.sample_offset) * ibl.intensity
     else:
         indirect = imageBasedLighting(N, V, diffuseColor, F0, roughness, ibl, s.specularScale,

@@ -86,8 +86,9 @@ def smithG1GGX(NoX, a) -> np.ndarray:
     return 2.0 * c / np.maximum(c + np.sqrt(a * a + (1.0 - a * a) * c * c), 1e-12)
 
 
-def refractionBtdfCosine(N, V, L, a, eta, F0) -> np.ndarray:
-    """f |NoL| of Walter et al. 2007 eq 21 (GGX, separable Smith G), light below (NoL < 0)."""
+def refractionBtdfCosineNoFresnel(N, V, L, a, eta) -> tuple[np.ndarray, np.ndarray]:
+    """f |NoL| / (1 - F) of Walter et al. 2007 eq 21 (GGX, separable Smith G), light below
+    (NoL < 0), and the V.h its Fresnel takes (0 where the BTDF is 0)."""
     N, V, L, eta = f64(N), f64(V), f64(L), f64(eta)
     NoV, NoL = dot(N, V), dot(N, L)
     h = -(V + eta[..., None] * L)
@@ -96,28 +97,41 @@ def refractionBtdfCosine(N, V, L, a, eta, F0) -> np.ndarray:
     H = np.where((dot(N, H) < 0.0)[..., None], -H, H)
     VoH, LoH = dot(V, H), dot(L, H)
     den = VoH + eta * LoH
-    D = D_GGX(saturate(dot(N, H)), a)
+    NxH = np.cross(N, H)
+    D = D_GGX(saturate(dot(N, H)), a, dot(NxH, NxH))
     G = smithG1GGX(NoV, a) * smithG1GGX(NoL, a)
     with np.errstate(divide="ignore", invalid="ignore"):
         f = VoH * -LoH * eta * eta * G * D / (NoV * np.maximum(den * den, 1e-12))
     ok = (NoL < 0.0) & (NoV > 0.0) & (hh >= 1e-12) & (VoH > 0.0) & (LoH < 0.0)
-    return np.where(ok[..., None], (1.0 - F_Schlick(F0, VoH)) * np.where(ok, f, 0.0)[..., None],
-                    0.0)
+    return np.where(ok, f, 0.0), np.where(ok, VoH, 0.0)
 
 
-def thinWalledBtdfCosine(N, V, L, a, F0) -> np.ndarray:
-    """f |NoL| of the reflection lobe of L mirrored through the tangent plane, times 1 - F."""
+def refractionBtdfCosine(N, V, L, a, eta, F0) -> np.ndarray:
+    """f |NoL| of Walter et al. 2007 eq 21 (GGX, separable Smith G), light below (NoL < 0)."""
+    f, VoH = refractionBtdfCosineNoFresnel(N, V, L, a, eta)
+    return (1.0 - F_Schlick(F0, VoH)) * f[..., None]
+
+
+def thinWalledBtdfCosineNoFresnel(N, V, L, a) -> tuple[np.ndarray, np.ndarray]:
+    """f |NoL| / (1 - F) of the reflection lobe of L mirrored through the tangent plane, and
+    the V.h of its Fresnel (0 where the BTDF is 0)."""
     N, V, L = f64(N), f64(V), f64(L)
     NoV, NoL = dot(N, V), dot(N, L)
     Lm = L - 2.0 * NoL[..., None] * N
     H = normalize(V + Lm)
-    D = D_GGX(saturate(dot(N, H)), a)
+    NxH = np.cross(N, H)
+    D = D_GGX(saturate(dot(N, H)), a, dot(NxH, NxH))
     G = smithG1GGX(NoV, a) * smithG1GGX(NoL, a)
     with np.errstate(divide="ignore", invalid="ignore"):
         f = D * G / (4.0 * NoV)
     ok = (NoL < 0.0) & (NoV > 0.0)
-    return np.where(ok[..., None], (1.0 - F_Schlick(F0, saturate(dot(V, H))))
-                    * np.where(ok, f, 0.0)[..., None], 0.0)
+    return np.where(ok, f, 0.0), np.where(ok, saturate(dot(V, H)), 0.0)
+
+
+def thinWalledBtdfCosine(N, V, L, a, F0) -> np.ndarray:
+    """f |NoL| of the reflection lobe of L mirrored through the tangent plane, times 1 - F."""
+    f, VoH = thinWalledBtdfCosineNoFresnel(N, V, L, a)
+    return (1.0 - F_Schlick(F0, VoH)) * f[..., None]
 
 
 def transmissionRadiance(lobe: TransmissionLobe, prefiltered, reflectedAlbedo) -> np.ndarray:
