@@ -14,6 +14,7 @@ from matedit.cli_support import UsageError, report
 from matedit.interop.stats import (
     ALL_TARGETS,
     ATTRIBUTION,
+    COUNTING,
     SCHEMA_VERSION,
     TARGETS,
     ToolError,
@@ -72,6 +73,7 @@ def build_report(path: Path, targets: list[str], measure: dict | None = None) ->
                          f"{path}: {exc}") from None
     out: dict[str, Any] = {"format": "matedit.stats", "version": SCHEMA_VERSION,
                            "source": path.name, "attribution": ATTRIBUTION,
+                           "counting": COUNTING,
                            "targets": per_target, "permutations": perms}
     if measure is not None:
         from matedit.commands.stats_measure import measure_costs
@@ -97,13 +99,17 @@ def run(args) -> int:
 
 
 def text_report(rep: dict, top: int = 10) -> str:
-    lines = [f"{rep['source']}"]
+    lines = [f"{rep['source']}", "counting: dynamic (loops by their trip counts with the "
+             "current values; static: each instruction once)"]
     for t, f in rep["targets"].items():
-        lines.append(f"\n{t}: {f['instructions']} instructions ({f['alu']} ALU, "
+        lines.append(f"\n{t}: {f['instructions']} dynamic instructions ({f['alu']} ALU, "
                      f"{f['texture']} texture, {f['memory']} memory, {f['control']} control), "
                      f"{f['samples']} samples, {f['samplers']} samplers, "
                      f"{f['uniform_bytes']} uniform bytes, {f['varyings']} varyings  "
                      f"[{f['module']}]")
+        lines.append(f"  static: {f['static']['instructions']} instructions in the module, "
+                     f"{f['static']['samples']} samples; {f['loops']['count']} loops, "
+                     f"{f['loops']['counted_once']} counted once (no known bound)")
         rows = [r for r in f["nodes"] if r["instructions"] > 0][:top]
         for r in rows:
             lines.append(f"  {r['id']:<24} {r['kind']:<22} {r['instructions']:>8.1f} instr "
