@@ -340,6 +340,26 @@ def test_measure_json_validates(tmp_path):
     assert rep["measure"]["rows"]
 
 
+def test_budget_flags_warn_and_set_the_status(tmp_path):
+    """Over a budget: the report, then one `warning:` line per budget passed, status 3; within
+    it, status 0 and no warning."""
+    path = graphs_dir() / "materials" / "worn_painted_steel.json"
+    r = _cli(str(path), "--json", "--target", "essl300")
+    assert r.returncode == 0, r.stderr
+    n = json.loads(r.stdout)["targets"]["essl300"]["samplers"]
+    assert n >= 2
+    r = _cli(str(path), "--target", "essl300", "--budget-samplers", str(n - 1))
+    assert r.returncode == 3, r.stderr
+    assert "essl300:" in r.stdout  # the report is printed all the same
+    (line,) = r.stderr.strip().splitlines()
+    assert line == (f"warning: worn_painted_steel.json: {n} texture samplers on essl300: over "
+                    f"the budget of {n - 1}")
+    r = _cli(str(path), "--target", "essl300", "--budget-samplers", str(n))
+    assert r.returncode == 0 and r.stderr == ""
+    r = _cli(str(path), "--target", "glsl450", "--budget-instructions", "100")
+    assert r.returncode == 3 and "over the budget of 100" in r.stderr
+
+
 @pytest.mark.parametrize("args,needle", [
     (["missing.json"], "missing.json"),
     (["{bad}", "--size", "2"], "--size"),

@@ -15,13 +15,17 @@ from matedit.interop.stats import (
     ALL_TARGETS,
     ATTRIBUTION,
     COUNTING,
+    DEFAULT_BUDGET,
     SCHEMA_VERSION,
     TARGETS,
     ToolError,
     material_stats,
+    over_budget,
     permutations,
 )
 from matedit.io.inputs import declare_inputs
+
+OVER_BUDGET = 3  # the exit status of a material over a --budget-* budget (docs/cli.md)
 
 __all__ = ["TARGETS", "build_report", "material_stats", "register", "run", "text_report"]
 
@@ -44,6 +48,11 @@ def register(sub) -> None:
                    help="--measure: render N x N pixels (default 256)")
     p.add_argument("--runs", type=int, default=9, metavar="K",
                    help="--measure: timed repetitions per variant (default 9)")
+    p.add_argument("--budget-samplers", type=int, default=None, metavar="N",
+                   help="warn and exit 3 above N texture samplers on essl300 (WebGL2 "
+                   f"guarantees {DEFAULT_BUDGET['samplers']})")
+    p.add_argument("--budget-instructions", type=int, default=None, metavar="N",
+                   help="warn and exit 3 above N dynamic glsl450 instructions")
     declare_inputs(p, file="document")
     p.set_defaults(run=run)
 
@@ -89,13 +98,21 @@ def run(args) -> int:
         raise UsageError(f"--size {args.size}: expected 8 to 4096")
     if args.runs < 3 or args.runs > 101:
         raise UsageError(f"--runs {args.runs}: expected 3 to 101")
+    for flag, v in (("--budget-samplers", args.budget_samplers),
+                    ("--budget-instructions", args.budget_instructions)):
+        if v is not None and v < 0:
+            raise UsageError(f"{flag} {v}: expected 0 or more")
     measure = {"size": args.size, "runs": args.runs} if args.measure else None
     rep = build_report(path, targets, measure)
     if args.json:
         sys.stdout.write(json.dumps(rep, indent=2, sort_keys=True) + "\n")
     else:
         sys.stdout.write(text_report(rep))
-    return 0
+    sys.stdout.flush()
+    over = over_budget(rep["targets"], args.budget_samplers, args.budget_instructions)
+    for text in over:
+        report("warning", f"{path.name}: {text}")
+    return OVER_BUDGET if over else 0
 
 
 def text_report(rep: dict, top: int = 10) -> str:

@@ -401,3 +401,32 @@ def permutations(doc, resolver) -> dict[str, Any]:
 
 
 # --- the command ------------------------------------------------------------------------------
+
+
+# --- budgets ----------------------------------------------------------------------------------
+# WebGL2 (OpenGL ES 3.0) guarantees 16 texture units in the fragment stage
+# (MAX_TEXTURE_IMAGE_UNITS); the instruction budget is a rule of thumb for a real-time
+# material on mid-range hardware (dynamic glsl450 instructions, the shading included).
+DEFAULT_BUDGET = {"samplers": 16, "instructions": 20000}
+BUDGET_SAMPLER_TARGET = "essl300"
+BUDGET_INSTRUCTION_TARGET = "glsl450"
+
+
+def over_budget(per_target: dict[str, Any], samplers: int | None = None,
+                instructions: int | None = None) -> list[str]:
+    """One sentence for each budget the material passes: more samplers than `samplers` on
+    essl300 (glsl450's count where essl300 was not computed), more dynamic instructions than
+    `instructions` on glsl450. None: that budget is not checked."""
+    out = []
+    if samplers is not None:
+        t = BUDGET_SAMPLER_TARGET if BUDGET_SAMPLER_TARGET in per_target else "glsl450"
+        n = per_target.get(t, {}).get("samplers")
+        if n is not None and n > samplers:
+            out.append(f"{n} texture samplers on {t}: over the budget of {samplers}"
+                       + (" (what WebGL2 guarantees)" if samplers == 16 else ""))
+    if instructions is not None:
+        n = per_target.get(BUDGET_INSTRUCTION_TARGET, {}).get("instructions")
+        if n is not None and n > instructions:
+            out.append(f"{n} instructions on {BUDGET_INSTRUCTION_TARGET} (dynamic): over the "
+                       f"budget of {instructions}")
+    return out
