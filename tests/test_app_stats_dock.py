@@ -70,11 +70,13 @@ def test_stats_dock_shows_every_target_and_the_permutations(qtbot, expected):
     for i in range(lp.list.count()):
         row = lp.list.itemWidget(lp.list.item(i))
         lay = layers[row.layer_id]
-        text = row.cost.text()
-        instr, share = text.split(" · ")
-        assert float(instr) == pytest.approx(lay["instructions"], abs=0.5), text
-        assert float(share.rstrip(" %")) == pytest.approx(
-            100 * lay["instructions"] / g["instructions"], abs=0.5)
+        share = float(row.cost.text().rstrip(" %"))
+        assert share == pytest.approx(100 * lay["instructions"] / g["instructions"], abs=0.5)
+        tip = row.cost.toolTip()
+        instr, pct = float(tip.split(" instructions")[0]), tip.split(": ")[1].split(" %")[0]
+        assert instr == pytest.approx(lay["instructions"], abs=0.05), tip
+        assert float(pct) == pytest.approx(100 * lay["instructions"] / g["instructions"],
+                                           abs=0.05)
 
     # a structural edit: the dock and the column follow it, off the UI thread
     before = panel.report

@@ -138,12 +138,15 @@ class _LayerRow(QWidget):
         self.name.setStyleSheet("background: transparent; font-weight: bold;")
         self.name.setToolTip(f"{layer.function}\nEdit to rename")
         self.name.editingFinished.connect(lambda: panel.rename(layer.id, self.name.text()))
-        top.addWidget(self.eye)
-        top.addWidget(self.name, 1)
-        self.cost = QLabel("")  # the cost column (LayersPanel.set_costs)
+        # the cost column (LayersPanel.set_costs), next to the eye: a narrow dock scrolls the
+        # row's right-hand side out of view
+        self.cost = QLabel("")
         self.cost.setObjectName("layerCost")
         self.cost.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+        self.cost.setMinimumWidth(self.cost.fontMetrics().horizontalAdvance("100 %") + 2)
+        top.addWidget(self.eye)
         top.addWidget(self.cost)
+        top.addWidget(self.name, 1)
         self.blend = QComboBox()
         if is_base:
             self.blend.addItem("base")
@@ -400,7 +403,7 @@ class LayersPanel(QWidget):
             if not isinstance(row, _LayerRow):
                 continue
             c = costs.get(row.layer_id)
-            row.cost.setText("" if c is None else f"{c[0]:.0f} · {100 * c[1]:.0f} %")
+            row.cost.setText("" if c is None else f"{100 * c[1]:.0f} %")
             row.cost.setToolTip("" if c is None else
                                 f"{c[0]:.1f} instructions (glsl450, dynamic, the layer's "
                                 f"nodes and its blend): {100 * c[1]:.1f} % of the material's")
