@@ -43,7 +43,7 @@ def main() -> int:
     if not os.environ.get("MATEDIT_SHOTS_CHILD"):
         return reexec_under_xvfb()
     sys.path.insert(0, str(ROOT))
-    from PySide6.QtCore import QBuffer, QByteArray, QIODevice
+    from PySide6.QtCore import QBuffer, QByteArray, QIODevice, Qt
 
     from matedit.app.app import make_application
     from matedit.app.main_window import MainWindow
@@ -98,8 +98,8 @@ def main() -> int:
     canvas.select_nodes([stack.node_id])
     w.layers.select_layer(stack.layers[-1].id)
     pump(0.5)
-    save(w.layers_dock, "layers-panel.png")
-    save(w.inspector_dock, "inspector.png")
+    save(w.panels.layers_dock, "layers-panel.png")
+    save(w.panels.inspector_dock, "inspector.png")
 
     # 3. A material function opened in its own tab, with breadcrumbs back.
     fn = w.tabs.open_function(graphs / "functions" / "edge_wear.json")
@@ -124,23 +124,23 @@ def main() -> int:
     pump(0.3)
 
     # 5. Viewport modes: split sum, converged reference, difference heat map.
-    save(w.viewport_dock, "viewport-splitsum.png")
+    save(w.panels.viewport_dock, "viewport-splitsum.png")
     for label, name in (("Reference", "viewport-reference.png"),
                         ("Difference", "viewport-difference.png")):
         w.viewport.mode_combo.setCurrentText(label)
         wait(lambda: view.renderer.converged, timeout=300, what=f"{label} to converge")
         pump(0.5)
-        save(w.viewport_dock, name)
+        save(w.panels.viewport_dock, name)
     w.viewport.mode_combo.setCurrentText("Split-sum")
     pump(0.5)
 
     # 6. Lights & Environment, with the sky environment and a tube light added.
-    w.lights_dock.raise_()
+    w.panels.lights_dock.raise_()
     w.lights.add_light("tube")
     w.viewport.choose_environment("sky")
     pump(1.0)
-    save(w.lights_dock, "lights.png")
-    save(w.viewport_dock, "viewport-sky.png")
+    save(w.panels.lights_dock, "lights.png")
+    save(w.panels.viewport_dock, "viewport-sky.png")
 
     # 7. Export dialog.
     from matedit.app.export_dialog import ExportDialog
@@ -163,7 +163,7 @@ def main() -> int:
     assert w.compiler.set_preview(PreviewTarget(noise, port)), (noise, port)
     wait(lambda: w.compiler.current is not before, what="the node preview to compile")
     pump(1.5)
-    save(w.viewport_dock, "viewport-node-preview.png")
+    save(w.panels.viewport_dock, "viewport-node-preview.png")
     w.compiler.set_preview(None)
     pump(1.0)
 
@@ -183,13 +183,28 @@ def main() -> int:
     save(ref, "shortcuts.png")
     ref.close()
 
-    # 11. A broken link: the Diagnostics panel names the node.
+    # 11. View > Cost Overlay and View > Stats: nodes tinted by their instructions, the Layers
+    # panel's cost column, the per-target totals (computed off the UI thread).
+    w.tabs.canvas_actions["cost_overlay"].trigger()
+    w.stats.dock.show()
+    w.stats.dock.raise_()
+    wait(lambda: canvas.cost_overlay.report is not None and w.stats.panel.report is not None,
+         timeout=300.0, what="the cost figures")
+    w.resizeDocks([w.stats.dock], [330], Qt.Orientation.Vertical)
+    w.panels.inspector_dock.raise_()
+    canvas.frame_all()
+    pump(1.0)
+    save(w, "cost-overlay.png")
+    w.tabs.canvas_actions["cost_overlay"].trigger()
+    w.stats.dock.close()
+
+    # 12. A broken link: the Diagnostics panel names the node.
     from matedit.graph.commands import Disconnect
 
     link = next(l for l in w.controller.document.graph.links if l.dst == "out")
     w.controller.push(Disconnect(link))
     pump(1.0)
-    w.diagnostics_dock.raise_()
+    w.panels.diagnostics_dock.raise_()
     pump(0.3)
     save(w, "diagnostics.png")
 

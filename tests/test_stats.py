@@ -130,10 +130,14 @@ def test_totals_match_an_independent_count_of_the_binary(name, tmp_path, reports
     for target, cm in compiled.items():
         n, samples = _binary_counts(_optimised(cm.fragment_text, tmp_path,
                                                stats.TARGETS[target].vulkan))
-        assert rep[target]["instructions"] == n, target
-        assert rep[target]["samples"] == samples, target
+        st = rep[target]["static"]
+        assert st["instructions"] == n, target
+        assert st["samples"] == samples, target
+        assert st["alu"] + st["texture"] + st["memory"] + st["control"] == n
+        # dynamic counts see each loop as often as it runs: never fewer than the module's
+        assert rep[target]["instructions"] >= n
         assert rep[target]["alu"] + rep[target]["texture"] + rep[target]["memory"] + \
-            rep[target]["control"] == n
+            rep[target]["control"] == rep[target]["instructions"]
 
 
 def _noise_material(noise_branches: int = 1, octaves: float = 4.0,
@@ -194,16 +198,29 @@ def test_duplicated_noise_branch_doubles_its_cost():
     assert pair == pytest.approx(2 * single, rel=0.20)  # the issue's 20 %
 
 
+OCTAVE_RATIO = (3.0, 4.0)  # the counted 8-octave / 2-octave ratio of the fBm node
+
+
 def test_fbm_octaves_counted_and_measured():
-    """Counted: the fBm loop runs to NODE_FBM_MAX_OCTAVES (8) with an early exit, so its
-    instructions do not depend on the octave count: the counted ratio is exactly 1. Measured:
-    8 octaves evaluate four times the gradient noises of 2, on top of a fixed cost of the
-    nodes (the loop's set-up and exit, the sums); on llvmpipe at 128 x 128 the measured ratio
-    of four fBm nodes' subtree read 1.7, 3.6 and 5.7 in three tries on a shared machine, so
-    the test asks for at least 1.3: more, clearly, not how much more."""
-    c2 = _row(_glsl450(_noise_material(octaves=2.0)), "n0")["instructions"]
-    c8 = _row(_glsl450(_noise_material(octaves=8.0)), "n0")["instructions"]
-    assert c8 == c2
+    """Counted: the fBm loop runs to NODE_FBM_MAX_OCTAVES (8) with an early exit on the
+    node's octave count; dynamic counting runs it with the node's value, so the node costs a
+    fixed part (scale, seed, the loop's set-up and exit, the normalisation) plus one loop body
+    per octave. Independent of how the counter works, the figure must then be linear in the
+    octave count: c(8) - c(2) = 6 (c(2) - c(1)), to 1 %. With a body of about 230
+    instructions and a fixed part of about 30, 8 octaves count 3.8 times 2 (read: 1875.5 /
+    492.0 = 3.81); the test asks for 3 to 4. Statically (each instruction once) the counts are the
+    same. Measured: 8 octaves evaluate four times the gradient noises of 2, on top of the
+    fixed cost; on llvmpipe at 128 x 128 the measured ratio of four fBm nodes' subtree read
+    1.7, 3.6 and 5.7 in three tries on a shared machine, so the test asks for at least 1.3:
+    more, clearly, not how much more."""
+    reps = {o: _glsl450(_noise_material(octaves=o)) for o in (1.0, 2.0, 8.0)}
+    c1, c2, c8 = (_row(reps[o], "n0")["instructions"] for o in (1.0, 2.0, 8.0))
+    assert c8 - c2 == pytest.approx(6 * (c2 - c1), rel=0.01), (c1, c2, c8)
+    assert OCTAVE_RATIO[0] <= c8 / c2 <= OCTAVE_RATIO[1], (c2, c8, c8 / c2)
+    assert reps[8.0]["static"]["instructions"] == reps[2.0]["static"]["instructions"]
+    # the material's total grows by the same instructions as the node
+    assert reps[8.0]["instructions"] - reps[2.0]["instructions"] == pytest.approx(
+        c8 - c2, rel=0.05)
     from matedit.commands.stats_measure import measure_costs
 
     def measured(octaves: float) -> float:
@@ -323,6 +340,26 @@ def test_measure_json_validates(tmp_path):
     assert rep["measure"]["rows"]
 
 
+def test_budget_flags_warn_and_set_the_status(tmp_path):
+    """Over a budget: the report, then one `warning:` line per budget passed, status 3; within
+    it, status 0 and no warning."""
+    path = graphs_dir() / "materials" / "worn_painted_steel.json"
+    r = _cli(str(path), "--json", "--target", "essl300")
+    assert r.returncode == 0, r.stderr
+    n = json.loads(r.stdout)["targets"]["essl300"]["samplers"]
+    assert n >= 2
+    r = _cli(str(path), "--target", "essl300", "--budget-samplers", str(n - 1))
+    assert r.returncode == 3, r.stderr
+    assert "essl300:" in r.stdout  # the report is printed all the same
+    (line,) = r.stderr.strip().splitlines()
+    assert line == (f"warning: worn_painted_steel.json: {n} texture samplers on essl300: over "
+                    f"the budget of {n - 1}")
+    r = _cli(str(path), "--target", "essl300", "--budget-samplers", str(n))
+    assert r.returncode == 0 and r.stderr == ""
+    r = _cli(str(path), "--target", "glsl450", "--budget-instructions", "100")
+    assert r.returncode == 3 and "over the budget of 100" in r.stderr
+
+
 @pytest.mark.parametrize("args,needle", [
     (["missing.json"], "missing.json"),
     (["{bad}", "--size", "2"], "--size"),
@@ -367,6 +404,91 @@ _HAND = """
 OpReturn
 OpFunctionEnd
 """
+
+
+# --- trip counts on a module written by hand --------------------------------------------------
+_LOOP = """
+%float = OpTypeFloat 32
+%int = OpTypeInt 32 1
+%bool = OpTypeBool
+%i0 = OpConstant %int 0
+%i1 = OpConstant %int 1
+%i8 = OpConstant %int 8
+%f0 = OpConstant %float 0
+%f1 = OpConstant %float 1
+OpMemberName %Block 0 "u_n_octaves"
+%Block = OpTypeStruct %float
+%pBlock = OpTypePointer Uniform %Block
+%pf = OpTypePointer Uniform %float
+%ub = OpVariable %pBlock Uniform
+%main = OpFunction %void None %f
+%entry = OpLabel
+%ac = OpAccessChain %pf %ub %i0
+%oct = OpLoad %float %ac
+OpBranch %head
+%head = OpLabel
+%k = OpPhi %int %i0 %entry %k1 %cont
+%lt = OpSLessThan %bool %k %i8
+OpLoopMerge %merge %cont None
+OpBranchConditional %lt %body %merge
+%body = OpLabel
+%kf = OpConvertSToF %float %k
+%rest = OpFSub %float %oct %kf
+%stop = OpFOrdLessThanEqual %bool %rest %f0
+OpSelectionMerge %go None
+OpBranchConditional %stop %brk %go
+%brk = OpLabel
+OpBranch %merge
+%go = OpLabel
+%w1 = OpFMul %float %rest %rest
+%w2 = OpFAdd %float %w1 %f1
+%w3 = OpExtInst %float %x %y
+OpBranch %cont
+%cont = OpLabel
+%k1 = OpIAdd %int %k %i1
+OpBranch %head
+%merge = OpLabel
+OpReturn
+OpFunctionEnd
+"""
+
+
+@pytest.mark.parametrize("octaves,expected", [
+    # entry: AccessChain, Load, Branch (3); per header run: SLessThan, BranchConditional (2);
+    # per body run: ConvertSToF, FSub, FOrdLessThanEqual, BranchConditional (4); per full
+    # octave: FMul, FAdd, ExtInst, Branch (go) + IAdd, Branch (cont) (6); a break: Branch (1);
+    # the merge: Return (1). n octaves (1 <= n < 8): n + 1 header runs, n + 1 body runs, n
+    # full octaves, one break.
+    (1.0, 3 + 2 * 2 + 4 * 2 + 6 * 1 + 1 + 1),
+    (3.0, 3 + 2 * 4 + 4 * 4 + 6 * 3 + 1 + 1),
+    # 8 and more: the bound ends it; 9 header runs, 8 bodies, no break
+    (8.0, 3 + 2 * 9 + 4 * 8 + 6 * 8 + 1),
+    (20.0, 3 + 2 * 9 + 4 * 8 + 6 * 8 + 1),
+])
+def test_loop_trip_counts_on_a_hand_written_module(octaves, expected):
+    from matedit.compiler import cost, trips
+
+    m = cost.parse(_LOOP)
+    t = trips.weights(m.body, m.globals, {"u_n_octaves": octaves})
+    assert cost.count(m, t.weights).figures.instructions == expected
+    assert cost.count(m).figures.instructions == 3 + 2 + 4 + 1 + 6 + 1  # static: each once
+
+
+def test_a_loop_on_an_unknown_value_counts_at_its_bound_and_without_one_once():
+    from matedit.compiler import cost, trips
+
+    m = cost.parse(_LOOP)
+    # the octave count unknown (not given): the break is unknown, the bound of 8 ends it
+    t = trips.weights(m.body, m.globals, {})
+    assert cost.count(m, t.weights).figures.instructions == \
+        3 + 2 * 9 + 4 * 8 + 6 * 8 + 1 * 8 + 1
+    # no bound either (the comparison against a loaded value): counted once
+    unbounded = _LOOP.replace("%lt = OpSLessThan %bool %k %i8",
+                              "%lt = OpFOrdLessThan %bool %oct %f1")
+    m = cost.parse(unbounded)
+    t = trips.weights(m.body, m.globals, {})
+    assert cost.count(m, t.weights).figures.instructions == cost.count(m).figures.instructions
+    assert [n for _, n in t.loops] == [None]
 
 
 def test_attribution_rule_on_a_hand_written_module():

@@ -138,7 +138,14 @@ class _LayerRow(QWidget):
         self.name.setStyleSheet("background: transparent; font-weight: bold;")
         self.name.setToolTip(f"{layer.function}\nEdit to rename")
         self.name.editingFinished.connect(lambda: panel.rename(layer.id, self.name.text()))
+        # the cost column (LayersPanel.set_costs), next to the eye: a narrow dock scrolls the
+        # row's right-hand side out of view
+        self.cost = QLabel("")
+        self.cost.setObjectName("layerCost")
+        self.cost.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+        self.cost.setMinimumWidth(self.cost.fontMetrics().horizontalAdvance("100 %") + 2)
         top.addWidget(self.eye)
+        top.addWidget(self.cost)
         top.addWidget(self.name, 1)
         self.blend = QComboBox()
         if is_base:
@@ -281,6 +288,7 @@ class LayersPanel(QWidget):
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
         self.controller = controller
+        self.costs: dict[str, tuple[float, float]] = {}  # layer id -> (instructions, share)
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.setSpacing(4)
@@ -380,6 +388,25 @@ class LayersPanel(QWidget):
             self.list.setItemWidget(item, row)
             if layer.id == selected:
                 item.setSelected(True)
+        self._show_costs()
+
+    def set_costs(self, costs: dict[str, tuple[float, float]]) -> None:
+        """Each layer's (instructions, share of the material's) in its row's cost column
+        (matedit.app.stats_dock: computed off the UI thread); kept across rebuilds."""
+        self.costs = dict(costs)
+        self._show_costs()
+
+    def _show_costs(self) -> None:
+        costs = self.costs
+        for i in range(self.list.count()):
+            row = self.list.itemWidget(self.list.item(i))
+            if not isinstance(row, _LayerRow):
+                continue
+            c = costs.get(row.layer_id)
+            row.cost.setText("" if c is None else f"{100 * c[1]:.0f} %")
+            row.cost.setToolTip("" if c is None else
+                                f"{c[0]:.1f} instructions (glsl450, dynamic, the layer's "
+                                f"nodes and its blend): {100 * c[1]:.1f} % of the material's")
 
     def refresh_values(self) -> None:
         s = self.stack

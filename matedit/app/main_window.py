@@ -31,6 +31,7 @@ from matedit.app.layout import WindowLayout
 from matedit.app.menus import Menus, install_menus
 from matedit.app.node_preview import PreviewTarget
 from matedit.app.problems import ProblemsModel
+from matedit.app.stats_dock import install_stats
 from matedit.resources import graphs_dir
 
 SAMPLE = "materials/rusty_painted_metal.json"
@@ -61,7 +62,9 @@ class MainWindow(QMainWindow):
         self.library, self.lights, self.environment = p.library, p.lights, p.environment
         self.code, self.diagnostics = p.code, p.diagnostics
         self.problems = ProblemsModel(self.compiler, self.viewport, self)
-        self.menus: Menus = install_menus(self, self, p.docks())  # canvas commands from the table
+        self.stats = install_stats(self, self.controller, self.layers, self.problems,
+                                   self.tabs.material.canvas.cost_overlay, p.history_dock)
+        self.menus: Menus = install_menus(self, self, [*p.docks(), self.stats.dock])
         self._build_status()
         self._connect()
         # File › New Instance, the Parameters dock, the Library's instances

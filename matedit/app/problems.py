@@ -40,6 +40,7 @@ class ProblemsModel(QObject):
         self.compiler = compiler
         self.compile: list[Problem] = []
         self.gl: list[Problem] = []
+        self.budget: list[Problem] = []  # the cost budget's warnings (matedit.app.stats_dock)
         self.status = ""
         self.view = view
         compiler.compiled.connect(self._compiled)
@@ -55,7 +56,7 @@ class ProblemsModel(QObject):
 
     def _document_changed(self) -> None:
         """Another document: the previous one's compiler and driver reports are not its."""
-        self.compile, self.gl, self.status = [], [], ""
+        self.compile, self.gl, self.budget, self.status = [], [], [], ""
         self.changed.emit()
 
     def _shows_material(self) -> bool:
@@ -89,8 +90,13 @@ class ProblemsModel(QObject):
         out = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "graph")
                for d in (analysis.diagnostics if analysis is not None else [])]
         if is_material:
-            out += self.compile + self.gl
+            out += self.compile + self.gl + self.budget
         return unique(out)
+
+    def set_budget(self, problems: list[Problem]) -> None:
+        if problems != self.budget:
+            self.budget = list(problems)
+            self.changed.emit()
 
     @property
     def material_fails(self) -> bool:

@@ -14,13 +14,18 @@ from matedit.cli_support import UsageError, report
 from matedit.interop.stats import (
     ALL_TARGETS,
     ATTRIBUTION,
+    COUNTING,
+    DEFAULT_BUDGET,
     SCHEMA_VERSION,
     TARGETS,
     ToolError,
     material_stats,
+    over_budget,
     permutations,
 )
 from matedit.io.inputs import declare_inputs
+
+OVER_BUDGET = 3  # the exit status of a material over a --budget-* budget (docs/cli.md)
 
 __all__ = ["TARGETS", "build_report", "material_stats", "register", "run", "text_report"]
 
@@ -43,6 +48,11 @@ def register(sub) -> None:
                    help="--measure: render N x N pixels (default 256)")
     p.add_argument("--runs", type=int, default=9, metavar="K",
                    help="--measure: timed repetitions per variant (default 9)")
+    p.add_argument("--budget-samplers", type=int, default=None, metavar="N",
+                   help="warn and exit 3 above N texture samplers on essl300 (WebGL2 "
+                   f"guarantees {DEFAULT_BUDGET['samplers']})")
+    p.add_argument("--budget-instructions", type=int, default=None, metavar="N",
+                   help="warn and exit 3 above N dynamic glsl450 instructions")
     declare_inputs(p, file="document")
     p.set_defaults(run=run)
 
@@ -72,6 +82,7 @@ def build_report(path: Path, targets: list[str], measure: dict | None = None) ->
                          f"{path}: {exc}") from None
     out: dict[str, Any] = {"format": "matedit.stats", "version": SCHEMA_VERSION,
                            "source": path.name, "attribution": ATTRIBUTION,
+                           "counting": COUNTING,
                            "targets": per_target, "permutations": perms}
     if measure is not None:
         from matedit.commands.stats_measure import measure_costs
@@ -87,23 +98,35 @@ def run(args) -> int:
         raise UsageError(f"--size {args.size}: expected 8 to 4096")
     if args.runs < 3 or args.runs > 101:
         raise UsageError(f"--runs {args.runs}: expected 3 to 101")
+    for flag, v in (("--budget-samplers", args.budget_samplers),
+                    ("--budget-instructions", args.budget_instructions)):
+        if v is not None and v < 0:
+            raise UsageError(f"{flag} {v}: expected 0 or more")
     measure = {"size": args.size, "runs": args.runs} if args.measure else None
     rep = build_report(path, targets, measure)
     if args.json:
         sys.stdout.write(json.dumps(rep, indent=2, sort_keys=True) + "\n")
     else:
         sys.stdout.write(text_report(rep))
-    return 0
+    sys.stdout.flush()
+    over = over_budget(rep["targets"], args.budget_samplers, args.budget_instructions)
+    for text in over:
+        report("warning", f"{path.name}: {text}")
+    return OVER_BUDGET if over else 0
 
 
 def text_report(rep: dict, top: int = 10) -> str:
-    lines = [f"{rep['source']}"]
+    lines = [f"{rep['source']}", "counting: dynamic (loops by their trip counts with the "
+             "current values; static: each instruction once)"]
     for t, f in rep["targets"].items():
-        lines.append(f"\n{t}: {f['instructions']} instructions ({f['alu']} ALU, "
+        lines.append(f"\n{t}: {f['instructions']} dynamic instructions ({f['alu']} ALU, "
                      f"{f['texture']} texture, {f['memory']} memory, {f['control']} control), "
                      f"{f['samples']} samples, {f['samplers']} samplers, "
                      f"{f['uniform_bytes']} uniform bytes, {f['varyings']} varyings  "
                      f"[{f['module']}]")
+        lines.append(f"  static: {f['static']['instructions']} instructions in the module, "
+                     f"{f['static']['samples']} samples; {f['loops']['count']} loops, "
+                     f"{f['loops']['counted_once']} counted once (no known bound)")
         rows = [r for r in f["nodes"] if r["instructions"] > 0][:top]
         for r in rows:
             lines.append(f"  {r['id']:<24} {r['kind']:<22} {r['instructions']:>8.1f} instr "

@@ -108,15 +108,16 @@ def _counted_differences(full: int, variants, resolver) -> list[int]:
     import tempfile
     from pathlib import Path
 
-    from matedit.compiler import compile_document, cost
-    from matedit.interop.stats import spirv_text
+    from matedit.compiler import compile_document, cost, trips
+    from matedit.interop.stats import spirv_text, uniform_values
 
     out = []
     with tempfile.TemporaryDirectory(prefix="matedit-measure-") as tmp:
         for _, _, d in variants:
             cm = compile_document(d, resolver, "glsl450")
             m = cost.parse(spirv_text(cm.fragment_text, "glsl450", False, Path(tmp)))
-            out.append(full - cost.count(m).figures.instructions)
+            w = trips.weights(m.body, m.globals, uniform_values(cm, d)).weights
+            out.append(full - cost.count(m, w).figures.instructions)
     return out
 
 

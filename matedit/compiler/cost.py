@@ -14,7 +14,9 @@ here. Two things are read:
   "unattributed" key. Lines are matedit's encoded `#line` numbers (source * 100000 + line,
   `matedit.glsl.include`), so a line says which file it is in.
 
-Each instruction is counted once, so owners' figures sum to the module's. Code that
+Both take optional `weights` (`matedit.compiler.trips`): how many times each instruction runs,
+so a loop counts once per iteration (dynamic counts); without them each instruction counts
+once (static). Owners' figures sum to the module's either way. Code that
 spirv-opt shares between nodes (a common subexpression, a hoisted load) keeps the location
 of the copy it kept; `attribute` splits it evenly between that owner and the others that use
 its value without being fed by it (the caller says which uses are inputs). Code folded to a
@@ -62,10 +64,10 @@ class Figures:
     def instructions(self) -> int:
         return self.alu + self.texture + self.memory + self.control
 
-    def add(self, cls: str, sample: bool) -> None:
-        setattr(self, cls, getattr(self, cls) + 1)
+    def add(self, cls: str, sample: bool, n: int = 1) -> None:
+        setattr(self, cls, getattr(self, cls) + n)
         if sample:
-            self.samples += 1
+            self.samples += n
 
     def as_dict(self) -> dict[str, int]:
         return {"instructions": self.instructions, "alu": self.alu, "texture": self.texture,
@@ -83,6 +85,7 @@ class Module:
     debug_sets: set[str] = field(default_factory=set)  # ids of NonSemantic imports
     inlined: dict[str, tuple[int, str | None]] = field(default_factory=dict)  # DebugInlinedAt
     ext: dict[str, str] = field(default_factory=dict)  # OpExtInst result id -> its instruction
+    globals: list[tuple[str | None, str, list[str]]] = field(default_factory=list)  # the rest
 
 
 def parse(text: str) -> Module:
@@ -102,6 +105,7 @@ def parse(text: str) -> Module:
             if op == "OpFunctionEnd":
                 in_function = False
             continue
+        m.globals.append((rid, op, args))
         if op == "OpExtInstImport" and args and args[0].startswith('"NonSemantic.'):
             m.debug_sets.add(rid or "")
         elif op == "OpConstant" and rid and len(args) >= 2:
@@ -154,17 +158,19 @@ class Totals:
     outputs: int
 
 
-def count(m: Module) -> Totals:
+def count(m: Module, weights: list[int] | None = None) -> Totals:
+    """The module's figures; with `weights` (`trips.weights`), each instruction counts as many
+    times as it runs."""
     fig = Figures()
     loaded: set[str] = set()
     stored: set[str] = set()
-    for _, op, args in m.body:
+    for i, (_, op, args) in enumerate(m.body):
         if _is_debug(m, op, args):
             continue
         c = _classify(op)
         if c is None:
             continue
-        fig.add(*c)
+        fig.add(*c, 1 if weights is None else weights[i])
         if op == "OpLoad" and len(args) >= 2:
             loaded.add(args[1])
         elif op in ("OpAccessChain", "OpInBoundsAccessChain") and len(args) >= 2:
@@ -197,9 +203,11 @@ class Owned:
     cls: tuple[str, bool] | None
     rid: str | None
     uses: list[str]
+    runs: int = 1  # how many times it runs (`trips.weights`)
 
 
-def owned(m: Module, owner: Callable[[list[int]], str | None]) -> list[Owned]:
+def owned(m: Module, owner: Callable[[list[int]], str | None],
+          weights: list[int] | None = None) -> list[Owned]:
     """Every instruction that computes or passes a value, with `owner(chain)`. The current
     line and scope carry across block boundaries within a function (spirv-opt leaves the
     first instructions of a merge block, phis and loads, without a scope of their own)."""
@@ -207,7 +215,7 @@ def owned(m: Module, owner: Callable[[list[int]], str | None]) -> list[Owned]:
     line: int | None = None
     scope_inlined: str | None = None
     cache: dict[tuple[int | None, str | None], str | None] = {}
-    for rid, op, args in m.body:
+    for i, (rid, op, args) in enumerate(m.body):
         if op == "OpFunction":
             line, scope_inlined = None, None
             continue
@@ -227,19 +235,22 @@ def owned(m: Module, owner: Callable[[list[int]], str | None]) -> list[Owned]:
         key = (line, scope_inlined)
         if key not in cache:
             cache[key] = owner(chain_of(m, line, scope_inlined))
-        out.append(Owned(cache[key], c, rid, [a for a in args if a.startswith("%")]))
+        out.append(Owned(cache[key], c, rid, [a for a in args if a.startswith("%")],
+                         1 if weights is None else weights[i]))
     return out
 
 
 def attribute(m: Module, owner: Callable[[list[int]], str | None],
-              shared: Callable[[str, str], bool] | None = None) -> dict[str | None, dict]:
+              shared: Callable[[str, str], bool] | None = None,
+              weights: list[int] | None = None) -> dict[str | None, dict]:
     """Each executed instruction's figures (floats) under its owner. With `shared`, an
     instruction owned by a node whose value another owner also uses, where `shared(own,
     other)` says that use is not the other's own input (spirv-opt merged two copies of the
     same code), is split evenly between its owner and those others, with the instructions
     of the owner that compute it. The split moves instructions between owners, never adds
-    or drops one: the total is the module's."""
-    ins = owned(m, owner)
+    or drops one: the total is the module's. With `weights`, each instruction counts as many
+    times as it runs."""
+    ins = owned(m, owner, weights)
     n = len(ins)
     sharers: list[frozenset[str]] = [frozenset()] * n
     if shared is not None:
@@ -271,7 +282,7 @@ def attribute(m: Module, owner: Callable[[list[int]], str | None],
         if x.cls is None:
             continue
         owners: list[str | None] = [x.key, *sorted(sharers[i])]
-        w = 1.0 / len(owners)
+        w = x.runs / len(owners)
         cls, sample = x.cls
         for k in owners:
             f = out.setdefault(k, {"alu": 0.0, "texture": 0.0, "memory": 0.0,

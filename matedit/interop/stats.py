@@ -35,6 +35,13 @@ ATTRIBUTION = (
     "folded constants and dead nodes have no instructions and cost 0; code no "
     "node owns (shading model, lights, entry point) is the 'shading' row. The debug module "
     "is attributed and its shares are scaled to the release module's total.")
+COUNTING = (
+    "dynamic: each instruction counts as many times as it runs with the material's current "
+    "values (matedit.compiler.trips): a loop whose exit is known from constants and the "
+    "material's values (a node's octave count) counts once per run of its header, one whose "
+    "exit needs a run-time value counts at its constant bound, one with neither counts once; "
+    "a branch on a known value counts its one side, on an unknown one both. 'static' counts "
+    "each instruction of the module once.")
 
 
 # --- tools ----------------------------------------------------------------------------------
@@ -198,13 +205,36 @@ class _Share:
         self.samples += f["samples"]
 
 
+def uniform_values(cm, doc) -> dict[str, Any]:
+    """The current value of each of the compiled material's scalar uniforms, by name, from the
+    document (what `trips` evaluates loop exits with)."""
+    from matedit.graph.types import PortType, coerce_value
+
+    out: dict[str, Any] = {}
+    for u in cm.ir.uniforms:
+        node = doc.graph.nodes.get(u.node)
+        value = node.values.get(u.port, u.default) if node is not None else u.default
+        try:
+            v = coerce_value(PortType(u.type.value), value)
+        except (ValueError, TypeError):
+            continue
+        if isinstance(v, (int, float)):
+            out[u.name] = v
+    return out
+
+
 def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
     """The figures of one GLSL target's compile (`release`, `debug`: disassembled modules)."""
-    from matedit.compiler import cost
+    from matedit.compiler import cost, trips
     from matedit.compiler.schedule import std140_layout
 
-    totals = cost.count(cost.parse(release))
+    values = uniform_values(cm, doc)
+    rel = cost.parse(release)
+    rel_trips = trips.weights(rel.body, rel.globals, values)
+    static = cost.count(rel)
+    totals = cost.count(rel, rel_trips.weights)
     mod = cost.parse(debug)
+    dbg_weights = trips.weights(mod.body, mod.globals, values).weights
     owner, _lines = _owner_fn(cm)
     main_ops = cm.ir.main.ops
     deps = _depends(main_ops)
@@ -216,7 +246,7 @@ def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
         ka, kb = root(a), root(b)
         return ka != kb and ka not in deps[kb]
 
-    shares = cost.attribute(mod, owner, shared)
+    shares = cost.attribute(mod, owner, shared, dbg_weights)
     attributed = sum(cost.instructions(f) for f in shares.values())
     total = totals.figures.instructions
     scale = total / attributed if attributed else 1.0
@@ -286,6 +316,9 @@ def target_figures(cm, doc, release: str, debug: str) -> dict[str, Any]:
         "varyings": totals.inputs,
         "outputs": totals.outputs,
         "uniform_bytes": ubytes,
+        "static": static.figures.as_dict(),
+        "loops": {"count": len({h for h, _ in rel_trips.loops}),
+                  "counted_once": len({h for h, n in rel_trips.loops if n is None})},
         "attributed_instructions": int(round(attributed)),
         "scale": round(scale, 4),
         "shading": row(shading),
@@ -355,15 +388,45 @@ def permutations(doc, resolver) -> dict[str, Any]:
             for s, v in zip(sw, combo):
                 d.graph.nodes[s["node"]].settings["value"] = v
             cm = compile_all(d, resolver, ["glsl450"])["glsl450"]
-            from matedit.compiler import cost
+            from matedit.compiler import cost, trips
 
-            t = cost.count(cost.parse(spirv_text(cm.fragment_text, "glsl450", False,
-                                                 Path(tmp))))
+            m = cost.parse(spirv_text(cm.fragment_text, "glsl450", False, Path(tmp)))
+            t = cost.count(m, trips.weights(m.body, m.globals, uniform_values(cm, d)).weights)
             variants.append({"values": {s["name"]: v for s, v in zip(sw, combo)},
                              "instructions": t.figures.instructions,
+                             "static_instructions": cost.count(m).figures.instructions,
                              "samples": t.figures.samples,
                              "current": all(s["value"] == v for s, v in zip(sw, combo))})
     return {"switches": sw, "count": 2 ** n, "variants": variants}
 
 
 # --- the command ------------------------------------------------------------------------------
+
+
+# --- budgets ----------------------------------------------------------------------------------
+# WebGL2 (OpenGL ES 3.0) guarantees 16 texture units in the fragment stage
+# (MAX_TEXTURE_IMAGE_UNITS); the instruction budget is a rule of thumb for a real-time
+# material on mid-range hardware (dynamic glsl450 instructions, the shading included).
+DEFAULT_BUDGET = {"samplers": 16, "instructions": 20000}
+BUDGET_SAMPLER_TARGET = "essl300"
+BUDGET_INSTRUCTION_TARGET = "glsl450"
+
+
+def over_budget(per_target: dict[str, Any], samplers: int | None = None,
+                instructions: int | None = None) -> list[str]:
+    """One sentence for each budget the material passes: more samplers than `samplers` on
+    essl300 (glsl450's count where essl300 was not computed), more dynamic instructions than
+    `instructions` on glsl450. None: that budget is not checked."""
+    out = []
+    if samplers is not None:
+        t = BUDGET_SAMPLER_TARGET if BUDGET_SAMPLER_TARGET in per_target else "glsl450"
+        n = per_target.get(t, {}).get("samplers")
+        if n is not None and n > samplers:
+            out.append(f"{n} texture samplers on {t}: over the budget of {samplers}"
+                       + (" (what WebGL2 guarantees)" if samplers == 16 else ""))
+    if instructions is not None:
+        n = per_target.get(BUDGET_INSTRUCTION_TARGET, {}).get("instructions")
+        if n is not None and n > instructions:
+            out.append(f"{n} instructions on {BUDGET_INSTRUCTION_TARGET} (dynamic): over the "
+                       f"budget of {instructions}")
+    return out

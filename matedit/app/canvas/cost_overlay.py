@@ -40,6 +40,7 @@ class CostOverlay(QObject):
     (node id -> (tint, text)), `failed` a one-line reason."""
 
     ready = Signal(dict)
+    computed = Signal(object)  # the report itself (one target's figures), after `ready`
     failed = Signal(str)
     _done = Signal(int, object)  # from the worker thread: generation, report or exception
 
@@ -89,12 +90,16 @@ class CostOverlay(QObject):
         threading.Thread(target=self._work, args=(gen, work), daemon=True,
                          name="matedit-cost-overlay").start()
 
+    def compute(self, doc) -> dict:
+        """The report, on the worker thread: glsl450's figures (`StatsService` adds more)."""
+        from matedit.interop.stats import material_stats
+        from matedit.io.document import FileResolver
+
+        return material_stats(doc, FileResolver(), [TARGET])[TARGET]
+
     def _work(self, gen: int, doc) -> None:
         try:
-            from matedit.interop.stats import material_stats
-            from matedit.io.document import FileResolver
-
-            result: object = material_stats(doc, FileResolver(), [TARGET])[TARGET]
+            result: object = self.compute(doc)
         except Exception as exc:  # a graph that does not compile, a missing tool
             result = exc
         self._done.emit(gen, result)
@@ -113,3 +118,4 @@ class CostOverlay(QObject):
         assert isinstance(result, dict)
         self.report = result
         self.ready.emit(node_costs(result))
+        self.computed.emit(result)
