@@ -40,6 +40,7 @@ class ProblemsModel(QObject):
         self.compiler = compiler
         self.compile: list[Problem] = []
         self.gl: list[Problem] = []
+        self.imported: list[Problem] = []  # the open material's import warnings
         self.status = ""
         self.view = view
         compiler.compiled.connect(self._compiled)
@@ -54,8 +55,16 @@ class ProblemsModel(QObject):
         self.changed.emit()
 
     def _document_changed(self) -> None:
-        """Another document: the previous one's compiler and driver reports are not its."""
-        self.compile, self.gl, self.status = [], [], ""
+        """Another document: the previous one's compiler, driver and import reports are not
+        its."""
+        self.compile, self.gl, self.imported, self.status = [], [], [], ""
+        self.changed.emit()
+
+    def set_import_warnings(self, messages: list[str]) -> None:
+        """What the import that made the open material did not represent exactly (File ›
+        Import MaterialX's `warning:` lines): Diagnostics lists them until another document
+        is opened."""
+        self.imported = [Problem("warning", m, "", "", "import") for m in messages]
         self.changed.emit()
 
     def _shows_material(self) -> bool:
@@ -89,7 +98,7 @@ class ProblemsModel(QObject):
         out = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "graph")
                for d in (analysis.diagnostics if analysis is not None else [])]
         if is_material:
-            out += self.compile + self.gl
+            out += self.compile + self.gl + self.imported
         return unique(out)
 
     @property
