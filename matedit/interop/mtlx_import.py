@@ -8,6 +8,12 @@ the stdlib nodes that matedit.interop.mtlx_map maps from our catalogue, read bac
 other node is an error naming it, never a silent drop. Every error is collected, so one run
 names every unsupported node.
 
+Nothing is dropped silently: every input the surface, a converted node or the
+surfacematerial sets (not at its definition's default) that is not read exactly (dropped,
+approximated, clamped) is a warning line naming the file, material, input, value and node
+(`_Importer.warnings`, handed to the caller's `warnings` list). The base weight multiplies
+the base colour and is never cavity on its own (BASE_WEIGHT).
+
 The file is untrusted: it is read bounded (`read_bounded`), without XIncludes; MaterialX
 names become matedit node ids and parameter names only through the identifier rule
 (`mangle`, then `valid_id` / `identifier_problem`); numbers must be finite; image file names
