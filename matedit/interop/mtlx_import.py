@@ -428,6 +428,7 @@ class _Importer:
         except ValueError as exc:
             self.err(str(exc))
             return None
+        self.value_attributes(gin)
         name = gin.getName()
         if identifier_problem(name):
             name = mangle(name)
