@@ -755,8 +755,11 @@ class _Importer:
         table = dict(SURFACES[cat])
         if cat in BASE_WEIGHT:
             base, specular = BASE_WEIGHT[cat]
-            if self.cavity_reading(shader, cat):
+            if self.cavity_reading(shader, cat):  # read after the roughness, as gltf_pbr's
+                table = {k: v for k, v in table.items() if k not in ("normal", "emissive",
+                                                                     "opacity")}
                 table["cavity"] = (base, None, 1.0)
+                table.update({k: SURFACES[cat][k] for k in ("normal", "emissive", "opacity")})
                 self.mapped.add(specular)
             else:  # the base weight multiplies the base colour, exactly
                 inp, _, factor = table["baseColor"]
