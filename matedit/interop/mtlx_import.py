@@ -926,12 +926,14 @@ class _Importer:
                      "approximated where it is lower")
             elif r[0] < SHEEN_MIN_ROUGHNESS:
                 note(sheen, f"is clamped to {SHEEN_MIN_ROUGHNESS:g} by our sheen; approximated")
-        if cat == "open_pbr_surface" and shader.getInput("thin_film_thickness") is not None:
+        if cat == "open_pbr_surface" and (shader.getInput("thin_film_thickness") is not None
+                                          or shader.getInput("thin_film_weight") is not None):
             w = self.constant(shader, "thin_film_weight")
             if w is None or w[0] not in (0.0, 1.0):
                 note("thin_film_weight", "scales the film's thickness (ours has no film "
                      "weight); approximated")
-        if cat == "gltf_pbr" and shader.getInput("iridescence_thickness") is not None:
+        if cat == "gltf_pbr" and (shader.getInput("iridescence_thickness") is not None
+                                  or shader.getInput("iridescence") is not None):
             w = self.constant(shader, "iridescence")
             if w is None or w[0] not in (0.0, 1.0):
                 note("iridescence", "scales the film's thickness (ours has no film weight); "
