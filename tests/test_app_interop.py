@@ -212,3 +212,29 @@ def test_editor_import_proposes_a_new_name_and_never_replaces_the_open_document(
     assert w.menus.interop.import_mtlx(src), w.menus.interop.last_message
     assert w.controller.document.path == tmp_path / "tile_3.json"
     assert mine.read_bytes() == before
+
+
+def test_editor_import_lists_the_warnings_and_puts_them_in_diagnostics(qtbot, tmp_path):
+    """The same `warning:` lines as `matedit import`: shown in a message and in Diagnostics
+    while the imported material is open, gone when another document is opened."""
+    from pathlib import Path
+
+    from matedit.interop.mtlx_import import import_mtlx
+
+    src = Path(__file__).parent / "data" / "mtlx" / "ss_coated_copper.mtlx"
+    expect: list[str] = []
+    import_mtlx(src, tmp_path / "ref.json", None, expect)
+    assert len(expect) == 5
+    w = make_window(qtbot, SAMPLE)
+    ia = w.menus.interop
+    assert ia.import_mtlx(src, tmp_path / "copper.json"), ia.last_message
+    assert ia.import_report is not None and ia.import_report.isVisible()
+    assert all(m in ia.import_report.text() for m in expect)
+    rows = [p for p in w.diagnostics.problems if p.source == "import"]
+    assert [p.message for p in rows] == expect and all(p.severity == "warning" for p in rows)
+    texts = [w.diagnostics.topLevelItem(i).text(3)
+             for i in range(w.diagnostics.topLevelItemCount())]
+    assert all(m in texts for m in expect)
+    ia.import_report.close()
+    assert w.actions.open(SAMPLE, ask=False)
+    assert not [p for p in w.diagnostics.problems if p.source == "import"]

@@ -23,6 +23,7 @@ from matedit.app import file_dialogs
 if TYPE_CHECKING:
     from matedit.app.controller import DocumentController
     from matedit.app.document_actions import DocumentActions
+    from matedit.app.problems import ProblemsModel
 
 FOLDER_KEY = "interop/folder"
 
@@ -61,6 +62,7 @@ class InteropHost(Protocol):
 
     controller: DocumentController
     actions: DocumentActions
+    problems: ProblemsModel
 
     def status(self, text: str) -> None: ...
 
@@ -73,6 +75,7 @@ class InteropActions:
         self.window = window  # the dialogs' parent
         self.host = host
         self.last_message = ""
+        self.import_report: QMessageBox | None = None  # the last import's warnings, shown
         w = window
         self.act_gltf = QAction("Export &glTF…", w)
         self.act_gltf.triggered.connect(lambda: self.export_gltf())
@@ -291,9 +294,10 @@ class InteropActions:
         from matedit.io.document import dumps
         from matedit.io.inputs import refuse_overwrite
 
+        warnings: list[str] = []
         try:
             refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
-            doc = import_mtlx(src, out, material)
+            doc = import_mtlx(src, out, material, warnings)
             _arrange(doc)  # the importer's own columns, made readable
             if not self.host.actions.maybe_save():
                 return False
@@ -305,7 +309,31 @@ class InteropActions:
             return False
         except Exception as exc:
             return self._fail(title, exc)
-        return self.host.actions.open(out, ask=False) and self._done(f"imported {src.name}")
+        if not self.host.actions.open(out, ask=False):
+            return False
+        return self._import_warnings(src, warnings) and self._done(f"imported {src.name}")
+
+    def _import_warnings(self, src: Path, warnings: list[str]) -> bool:
+        """The import's `warning:` lines, the same as the command line's: in Diagnostics
+        (until another document is opened) and, where there are any, a message listing
+        them."""
+        self.host.problems.set_import_warnings(warnings)
+        if self.import_report is not None:
+            self.import_report.close()
+            self.import_report = None
+        if warnings:
+            shown = "\n".join(warnings[:20])
+            more = f"\n… and {len(warnings) - 20} more (see Diagnostics)" \
+                if len(warnings) > 20 else ""
+            box = QMessageBox(QMessageBox.Icon.Warning, "Import MaterialX",
+                              f"Imported {src.name}. {len(warnings)} of what it sets "
+                              f"{'is' if len(warnings) == 1 else 'are'} not represented "
+                              f"exactly (also listed in Diagnostics):\n\n{shown}{more}",
+                              QMessageBox.StandardButton.Ok, self.window)
+            box.setModal(False)  # the material is open behind it
+            box.show()
+            self.import_report = box
+        return True
 
 
 def _arrange(doc) -> None:

@@ -41,6 +41,7 @@ class ProblemsModel(QObject):
         self.compile: list[Problem] = []
         self.gl: list[Problem] = []
         self.budget: list[Problem] = []  # the cost budget's warnings (matedit.app.stats_dock)
+        self.imported: list[Problem] = []  # the open material's import warnings
         self.status = ""
         self.view = view
         compiler.compiled.connect(self._compiled)
@@ -55,8 +56,16 @@ class ProblemsModel(QObject):
         self.changed.emit()
 
     def _document_changed(self) -> None:
-        """Another document: the previous one's compiler and driver reports are not its."""
-        self.compile, self.gl, self.budget, self.status = [], [], [], ""
+        """Another document: the previous one's compiler, driver, budget and import reports
+        are not its."""
+        self.compile, self.gl, self.budget, self.imported, self.status = [], [], [], [], ""
+        self.changed.emit()
+
+    def set_import_warnings(self, messages: list[str]) -> None:
+        """What the import that made the open material did not represent exactly (File ›
+        Import MaterialX's `warning:` lines): Diagnostics lists them until another document
+        is opened."""
+        self.imported = [Problem("warning", m, "", "", "import") for m in messages]
         self.changed.emit()
 
     def _shows_material(self) -> bool:
@@ -90,7 +99,7 @@ class ProblemsModel(QObject):
         out = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "graph")
                for d in (analysis.diagnostics if analysis is not None else [])]
         if is_material:
-            out += self.compile + self.gl + self.budget
+            out += self.compile + self.gl + self.budget + self.imported
         return unique(out)
 
     def set_budget(self, problems: list[Problem]) -> None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from matedit.cli_support import UsageError
+from matedit.cli_support import UsageError, report
 from matedit.io.inputs import declare_inputs
 
 MAX_SIZE = 8192
@@ -39,12 +39,18 @@ def parse_size(text: str) -> int:
 
 
 def load_material(path: Path):
-    from matedit.io.document import FormatError, load
+    """The material `path` holds, or the effective material of the instance it holds (named
+    after the instance: its file's stem and its name), as compile and render read them; an
+    instance's warnings are `warning:` lines."""
+    from matedit.io.document import FormatError
+    from matedit.io.instance import InstanceError, load_effective
 
     try:
-        doc = load(path)
-    except FormatError as exc:
+        doc, notes = load_effective(path)
+    except (FormatError, InstanceError) as exc:
         raise UsageError(str(exc)) from None
+    for note in notes:
+        report("warning", note.format())
     if doc.is_function:
         raise UsageError(f"{path}: is a material function; use a material that calls it")
     return doc

@@ -11,6 +11,10 @@ names (exit 2).
 
 Every unsupported node or input is an `error:` line naming it (exit 2); nothing is written
 then (with -o DIR: nothing at all, every material is read before the first file is written).
+Nothing is dropped silently: every input, node or attribute the file sets that the import
+does not represent exactly (dropped, approximated, clamped) is a `warning:` line naming the
+file, material, node, input and value; `--strict` makes each an `error:` line instead (exit
+2, nothing written).
 No output may replace the MaterialX document or an image a material reads. See
 matedit.interop.mtlx_import for what is read."""
 
@@ -39,6 +43,9 @@ def register(sub) -> None:
     p.add_argument("--overwrite", action="store_true",
                    help="with -o DIR: replace DIR/NAME.json files that exist already "
                    "(without it they are an error and nothing is written)")
+    p.add_argument("--strict", action="store_true",
+                   help="treat every warning (an input, node or attribute not represented "
+                   "exactly) as an error: exit 2 and write nothing")
     declare_inputs(p, file="mtlx")
     p.set_defaults(run=run)
 
@@ -80,16 +87,21 @@ def run(args) -> int:
             refuse_overwrite([out], command_inputs(args))
         except OverwriteError as exc:
             raise UsageError(str(exc)) from None
+    warnings: list[str] = []
     try:
         if to_folder and args.material is None:
-            docs = import_all(path, out)
+            docs = import_all(path, out, warnings)
         else:
             target = out
             if to_folder:
                 target = output_paths([args.material], out)[args.material]
-            docs = {target: import_mtlx(path, target, args.material)}
+            docs = {target: import_mtlx(path, target, args.material, warnings)}
     except MtlxImportError as exc:
         raise _fail(exc) from None
+    if warnings and args.strict:
+        raise _fail(MtlxImportError([f"{w} (--strict)" for w in warnings])) from None
+    for w in warnings:
+        report("warning", w)
     try:  # the MaterialX document, and every image an imported material reads
         refuse_overwrite(list(docs), command_inputs(args, written=docs.values()))
         if to_folder:  # every material, or none

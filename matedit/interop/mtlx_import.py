@@ -8,6 +8,12 @@ the stdlib nodes that matedit.interop.mtlx_map maps from our catalogue, read bac
 other node is an error naming it, never a silent drop. Every error is collected, so one run
 names every unsupported node.
 
+Nothing is dropped silently: every input the surface, a converted node or the
+surfacematerial sets (not at its definition's default) that is not read exactly (dropped,
+approximated, clamped) is a warning line naming the file, material, input, value and node
+(`_Importer.warnings`, handed to the caller's `warnings` list). The base weight multiplies
+the base colour and is never cavity on its own (BASE_WEIGHT).
+
 The file is untrusted: it is read bounded (`read_bounded`), without XIncludes; MaterialX
 names become matedit node ids and parameter names only through the identifier rule
 (`mangle`, then `valid_id` / `identifier_problem`); numbers must be finite; image file names
@@ -27,7 +33,7 @@ from matedit.graph.names import identifier_problem, mangle
 from matedit.graph.nodes import THIN_WALLED, Role, definition, kind_for
 from matedit.graph.numbers import gpu_number_problem
 from matedit.interop import mtlx_map
-from matedit.interop.mtlx_colorspace import from_materialx
+from matedit.interop.mtlx_colorspace import WORKING, from_materialx
 from matedit.io.atomic import read_bounded
 
 MAX_MTLX_BYTES = 16 << 20
@@ -37,12 +43,12 @@ MAX_NODES = 20000
 SURFACES: dict[str, dict[str, tuple[str, str | None, float]]] = {
     "standard_surface": {
         "baseColor": ("base_color", None, 1.0), "metallic": ("metalness", None, 1.0),
-        "roughness": ("specular_roughness", None, 1.0), "cavity": ("base", None, 1.0),
+        "roughness": ("specular_roughness", None, 1.0),
         "normal": ("normal", None, 1.0), "emissive": ("emission_color", "emission", 1.0),
         "opacity": ("opacity", None, 1.0)},
     "open_pbr_surface": {
         "baseColor": ("base_color", None, 1.0), "metallic": ("base_metalness", None, 1.0),
-        "roughness": ("specular_roughness", None, 1.0), "cavity": ("base_weight", None, 1.0),
+        "roughness": ("specular_roughness", None, 1.0),
         "normal": ("geometry_normal", None, 1.0),
         # emission_luminance is in nits; 1000 nits is our emissive 1.0
         "emissive": ("emission_color", "emission_luminance", 1e-3),
@@ -97,20 +103,47 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         "coatRoughness": ("clearcoat_roughness", None), "coatNormal": ("clearcoat_normal", None),
         "sheenColor": ("sheen_color", None), "sheenRoughness": ("sheen_roughness", None),
         "anisotropy": ("anisotropy_strength", None),
-        "anisotropyDirection": ("anisotropy_rotation", None)},
+        "anisotropyDirection": ("anisotropy_rotation", None),
+        # KHR_materials_specular, _transmission, _volume and _iridescence, as ours (the
+        # iridescence thickness in nm, times its weight; thickness 0: thin-walled, below)
+        "specularColor": ("specular_color", None), "transmission": ("transmission", None),
+        "attenuationColor": ("attenuation_color", None),
+        "attenuationDistance": ("attenuation_distance", None),
+        "thinFilmThickness": ("iridescence_thickness", "iridescence"),
+        "thinFilmIor": ("iridescence_ior", None)},
     "UsdPreviewSurface": {
         "ior": ("ior", None), "coat": ("clearcoat", None),
         "coatRoughness": ("clearcoatRoughness", None)},
 }
 # Transmission, read apart from LOBES (docs/materialx.md, Transmission): category ->
-# (weight, colour, depth, thin-walled flag, the base weight). The colour is a surface tint
-# at depth 0 and the absorption colour reached at `depth` otherwise (both surfaces' rule).
-TRANSMISSION: dict[str, tuple[str, str, str, str, str]] = {
+# (weight, colour, depth, thin-walled flag). The colour is a surface tint at depth 0 and the
+# absorption colour reached at `depth` otherwise (both surfaces' rule).
+TRANSMISSION: dict[str, tuple[str, str, str, str]] = {
     "standard_surface": ("transmission", "transmission_color", "transmission_depth",
-                         "thin_walled", "base"),
+                         "thin_walled"),
     "open_pbr_surface": ("transmission_weight", "transmission_color", "transmission_depth",
-                         "geometry_thin_walled", "base_weight"),
+                         "geometry_thin_walled"),
 }
+# The base weight and the specular weight: category -> (base, specular). The base weight
+# scales the diffuse and (through base_color) the metal's reflectivity, both surfaces' own
+# graphs: it multiplies our baseColor, exactly, and is never cavity. The specular weight
+# scales the dielectric reflection; we have no counterpart (F90 stays 1), except where both
+# weights come from one source: that darkens the surface's lighting, our cavity (what our
+# export writes), exactly where the surface has no coat, sheen, subsurface or transmission.
+BASE_WEIGHT: dict[str, tuple[str, str]] = {
+    "standard_surface": ("base", "specular"),
+    "open_pbr_surface": ("base_weight", "specular_weight"),
+}
+# The lobes base and specular do not darken, where cavity does (the reading above warns).
+_OTHER_LOBES: dict[str, tuple[str, ...]] = {
+    "standard_surface": ("coat", "sheen", "subsurface", "transmission"),
+    "open_pbr_surface": ("coat_weight", "fuzz_weight", "subsurface_weight",
+                         "transmission_weight"),
+}
+# Surface inputs that take a colour for a scalar of ours: the first channel is read.
+_FIRST_CHANNEL = {("standard_surface", "opacity")}
+# Where our sheen clamps its roughness (docs/shading.md, Sheen).
+SHEEN_MIN_ROUGHNESS = 0.3
 
 # Rotations of the anisotropy direction from the tangent: standard_surface's in turns (0..1),
 # glTF's in radians.
@@ -127,6 +160,63 @@ DIRECT: dict[str, tuple[str, dict[str, str]]] = mtlx_map.direct()
 _kind = mtlx_map.kind_mapped_to
 _WIDTH = {"float": 1, "integer": 1, "vector2": 2, "vector3": 3, "color3": 3, "vector4": 4,
           "color4": 4}
+
+
+# The inputs each converted node category reads (DIRECT's read their ports); any other
+# input a file sets on one is a warning (`_Importer.unread`).
+_READS: dict[str, set[str]] = {
+    "extract": {"in", "index"}, "separate2": {"in"}, "separate3": {"in"},
+    "separate4": {"in"}, "combine2": {"in1", "in2"}, "combine3": {"in1", "in2", "in3"},
+    "combine4": {"in1", "in2", "in3", "in4"}, "convert": {"in"}, "texcoord": {"index"},
+    "position": {"space"}, "normal": {"space"}, "rotate2d": {"in", "amount"},
+    "viewdirection": set(), "time": set(), "constant": {"value"}, "dot": {"in"},
+    "image": {"file", "uaddressmode", "vaddressmode", "filtertype", "texcoord"},
+    "normalmap": {"in", "scale", "normal", "tangent", "bitangent"},
+}
+
+
+def connected(inp) -> bool:
+    return bool(inp.getNodeName() or inp.getNodeGraphString() or inp.getInterfaceName()
+                or inp.getOutputString())
+
+
+def value_text(inp) -> str:
+    """An input's value as a warning shows it: a number, a tuple (0.96, 0.64, 0.54), a
+    quoted string, or where it is connected from."""
+    if inp.getNodeGraphString():
+        return f"(from nodegraph {inp.getNodeGraphString()} output {inp.getOutputString()})"
+    if inp.getNodeName():
+        return f"(from node {inp.getNodeName()})"
+    if inp.getInterfaceName():
+        return f"(from interface input {inp.getInterfaceName()})"
+    text = inp.getValueString()
+    if inp.getType() in _WIDTH or inp.getType() == "boolean":
+        try:
+            vals = [float(x) for x in text.split(",")]
+        except ValueError:
+            return repr(text[:60])
+        shown = [f"{v:.6g}" for v in vals]
+        return shown[0] if len(shown) == 1 else f"({', '.join(shown)})"
+    return repr(text[:60])
+
+
+def is_default(inp, nodedef) -> bool:
+    """Whether `inp` is a constant equal to its node definition's default (setting it changes
+    nothing, so not reading it loses nothing)."""
+    if connected(inp) or nodedef is None:
+        return False
+    d = nodedef.getActiveInput(inp.getName())
+    if d is None or d.getDefaultGeomPropString():
+        return False
+    a, b = inp.getValueString().strip(), d.getValueString().strip()
+    if a == b:
+        return True
+    try:
+        va = [float(x) for x in a.split(",")]
+        vb = [float(x) for x in b.split(",")]
+    except ValueError:
+        return a.lower() == b.lower()
+    return len(va) == len(vb) and all(x == y for x, y in zip(va, vb))
 
 
 class MtlxImportError(ValueError):
@@ -172,12 +262,16 @@ def _computed(vals: list[float], where: str) -> list[float]:
 
 
 class _Importer:
-    def __init__(self, source: Path, out: Path, doc, lib) -> None:
+    def __init__(self, source: Path, out: Path, doc, lib, material: str = "") -> None:
         self.source = source
         self.out = out
         self.mxdoc = doc
         self.lib = lib
+        self.material = material
         self.errors: list[str] = []
+        self.warnings: list[str] = []
+        self.mapped: set[str] = set()  # the surface's inputs read exactly
+        self.noted: set[str] = set()  # the surface's inputs already warned about
         self.mat = MaterialDocument(kind=DocumentKind.MATERIAL, path=out)
         self.ids: set[str] = set()
         self.done: dict[tuple[str, str], Src] = {}
@@ -189,6 +283,28 @@ class _Importer:
         msg = f"{self.source.name}: {what}"
         if msg not in self.errors:
             self.errors.append(msg)
+
+    def warn(self, what: str) -> None:
+        """A `warning:` line: something of the file not represented exactly."""
+        where = f"material {self.material}: " if self.material else ""
+        msg = f"{self.source.name}: {where}{what}"
+        if msg not in self.warnings:
+            self.warnings.append(msg)
+
+    def warn_input(self, node, inp, why: str) -> None:
+        """The warning naming input `inp` of `node`, its value and why (ends in `; dropped`
+        or `; approximated`)."""
+        self.warn(f"{inp.getName()} {value_text(inp)} of {node.getCategory()} "
+                  f"{self.name_of(node)} {why}")
+
+    def unread(self, node, read) -> None:
+        """Warn about every input `node` sets (not at its definition's default) that the
+        conversion did not read (`read`: the names it did)."""
+        nd = node.getNodeDef()
+        for inp in node.getInputs():
+            if inp.getName() in read or is_default(inp, nd):
+                continue
+            self.warn_input(node, inp, "is not supported; dropped")
 
     def new_id(self, hint: str) -> str:
         base = mangle(hint, 56)
@@ -272,7 +388,19 @@ class _Importer:
         if len(vals) != width:
             self.err(f"{where}: expected {width} numbers, got {len(vals)}")
             return None
+        self.value_attributes(inp)
         return Src(value=vals, width=width)
+
+    def value_attributes(self, inp) -> None:
+        """A constant's colour space and unit, which MaterialX applies and we do not."""
+        node = inp.getParent()
+        space = inp.getActiveColorSpace() if inp.getType() in ("color3", "color4") else ""
+        if space and space != WORKING:
+            self.warn_input(node, inp, f"is in colour space {space!r}, read as {WORKING} "
+                            "without conversion; approximated")
+        if inp.getUnit():
+            self.warn_input(node, inp, f"has unit {inp.getUnit()!r}, not converted; "
+                            "approximated")
 
     def output_el(self, out, depth: int) -> Src | None:
         graph = out.getParent()
@@ -300,6 +428,7 @@ class _Importer:
         except ValueError as exc:
             self.err(str(exc))
             return None
+        self.value_attributes(gin)
         name = gin.getName()
         if identifier_problem(name):
             name = mangle(name)
@@ -348,6 +477,14 @@ class _Importer:
         return src
 
     def convert(self, node, output: str, depth: int) -> Src | None:
+        src = self._convert(node, output, depth)
+        cat = node.getCategory()
+        read = set(DIRECT[cat][1]) if cat in DIRECT else _READS.get(cat)
+        if read is not None:  # (an unsupported node is an error already)
+            self.unread(node, read)
+        return src
+
+    def _convert(self, node, output: str, depth: int) -> Src | None:
         cat = node.getCategory()
         name = node.getName()
         t = node.getType()
@@ -554,6 +691,7 @@ class _Importer:
     def surface_input(self, shader, name: str) -> Src | None:
         inp = shader.getInput(name)
         if inp is not None:
+            self.mapped.add(name)
             return self.input_el(inp, 0, f"node {self.name_of(shader)}: input {name}")
         nd = shader.getNodeDef()
         d = nd.getActiveInput(name) if nd is not None else None
@@ -565,24 +703,67 @@ class _Importer:
         except ValueError:
             return None
 
-    def transmits(self, shader, cat: str) -> bool:
-        """Whether the file sets the surface's transmission weight (connected, or above 0)."""
-        names = TRANSMISSION.get(cat)
-        if names is None or shader.getInput(names[0]) is None:
+    def _set_or_zero(self, shader, name: str) -> bool:
+        """Whether the surface sets `name` to something other than a constant 0."""
+        inp = shader.getInput(name)
+        if inp is None:
             return False
-        src = self.surface_input(shader, names[0])
-        return src is not None and (src.node is not None or src.value[0] > 0.0)
+        if connected(inp):
+            return True
+        try:
+            return any(v != 0.0 for v in _floats(inp.getValueString() or "0", name))
+        except ValueError:
+            return True
+
+    def _upstream(self, inp) -> tuple:
+        """What a connected input reads, through a nodegraph output to its node: two inputs
+        from different outputs of one node output read the same thing."""
+        if inp.getNodeGraphString():
+            ng = self.mxdoc.getNodeGraph(inp.getNodeGraphString())
+            o = ng.getOutput(inp.getOutputString()) if ng is not None else None
+            if o is not None:
+                return (ng.getName(), o.getNodeName(), o.getOutputString(),
+                        o.getInterfaceName())
+        return (inp.getNodeGraphString(), inp.getNodeName(), inp.getOutputString(),
+                inp.getInterfaceName())
+
+    def _grey(self, inp) -> bool:
+        """Whether a connected colour input is a float made a colour (a convert node from a
+        float: every channel the same), as our export writes a scalar into one."""
+        graph, node, _out, _iface = self._upstream(inp)
+        scope = self.mxdoc.getNodeGraph(graph) if graph else self.mxdoc
+        up = scope.getNode(node) if scope is not None and node else None
+        src = up.getInput("in") if up is not None and up.getCategory() == "convert" else None
+        return src is not None and src.getType() == "float"
+
+    def cavity_reading(self, shader, cat: str) -> bool:
+        """Whether the base and specular weights (BASE_WEIGHT) are one source: together they
+        darken the diffuse, the metal and the dielectric reflection, our cavity (what our
+        export writes; docs/materialx.md, The base weight). A base weight alone never is.
+        Exact on a surface with no other lobe; `approximations` warns otherwise."""
+        if cat not in BASE_WEIGHT:
+            return False
+        b, sp = (shader.getInput(n) for n in BASE_WEIGHT[cat])
+        if b is None or sp is None:
+            return False
+        if connected(b) or connected(sp):
+            return connected(b) and connected(sp) and self._upstream(b) == self._upstream(sp)
+        return b.getValueString().strip() == sp.getValueString().strip()
 
     def build(self, shader) -> MaterialDocument:
         cat = shader.getCategory()
         table = dict(SURFACES[cat])
-        if self.transmits(shader, cat):
-            # The base weight scales the diffuse only: our cavity (all lighting) would darken
-            # the transmission too (a glass of base 0 would import black). It becomes a
-            # base-colour multiplier instead.
-            inp, _, factor = table["baseColor"]
-            table["baseColor"] = (inp, TRANSMISSION[cat][4], factor)
-            del table["cavity"]
+        if cat in BASE_WEIGHT:
+            base, specular = BASE_WEIGHT[cat]
+            if self.cavity_reading(shader, cat):  # read after the roughness, as gltf_pbr's
+                table = {k: v for k, v in table.items() if k not in ("normal", "emissive",
+                                                                     "opacity")}
+                table["cavity"] = (base, None, 1.0)
+                table.update({k: SURFACES[cat][k] for k in ("normal", "emissive", "opacity")})
+                self.mapped.add(specular)
+            else:  # the base weight multiplies the base colour, exactly
+                inp, _, factor = table["baseColor"]
+                table["baseColor"] = (inp, base, factor)
         make = self.add("make", kind_for(Role.MAKE_ATTRIBUTES))
         out = self.add("out", kind_for(Role.MATERIAL_OUTPUT))
         self.mat.graph.nodes[out].position = (260.0, 0.0)
@@ -592,11 +773,19 @@ class _Importer:
             if attr == "normal":
                 self.normal(shader, inp, cat in WORLD_NORMAL, make)
                 continue
+            if attr == "opacity" and cat == "gltf_pbr" and not self.gltf_alpha(shader):
+                continue
             src = self.surface_input(shader, inp)
             if src is None:
                 continue
             if src.width == 3 and attr in ("metallic", "roughness", "cavity", "opacity", "coat",
                                            "coatRoughness", "coatIor"):
+                el = shader.getInput(inp)
+                if el is not None and (len(set(src.value)) > 1 if src.node is None
+                                       else not self._grey(el)):
+                    self.noted.add(inp)
+                    self.warn_input(shader, el, f"is a colour; our {attr} is a scalar, its first "
+                                    "channel is read; approximated")
                 if src.node is None:
                     src = Src(value=src.value[:1], width=1)
                 else:
@@ -632,14 +821,135 @@ class _Importer:
         self.lobes(shader, cat, make)
         if cat in TRANSMISSION:
             self.transmission(shader, cat, make, out)
+        if cat == "gltf_pbr":
+            self.gltf_volume(shader, make, out)
+        self.approximations(shader, cat)
+        nd = shader.getNodeDef()
+        for el in shader.getInputs():  # the rule: nothing the file sets is dropped silently
+            name = el.getName()
+            if name in self.mapped or name in self.noted or is_default(el, nd):
+                continue
+            self.warn_input(shader, el, "is not supported; dropped")
         return self.mat
+
+    def gltf_volume(self, shader, make: str, out: str) -> None:
+        """KHR_materials_volume's thickness: 0 (its default) is a thin-walled part, our
+        Material Output's thin_walled where the material transmits; above 0 our thickness."""
+        t = self.constant(shader, "thickness")
+        if t is not None and t[0] <= 0.0:
+            if shader.getInput("thickness") is not None:
+                self.mapped.add("thickness")
+            if self._set_or_zero(shader, "transmission"):
+                self.mat.graph.nodes[out].settings[THIN_WALLED] = True
+            return
+        src = self.surface_input(shader, "thickness")
+        if src is not None:
+            self.connect(src, make, "thickness")
+
+    def gltf_alpha(self, shader) -> bool:
+        """Whether gltf_pbr's alpha is read (our opacity): under alpha_mode 0 (OPAQUE, the
+        default) glTF ignores it, so it is not; MASK's cutoff is not ours (read as blending)."""
+        mode_in = shader.getInput("alpha_mode")
+        mode = mode_in.getValueString().strip() if mode_in is not None else "0"
+        if mode_in is not None and connected(mode_in):
+            mode = "?"
+        if mode_in is not None:
+            self.mapped.add("alpha_mode")
+        alpha = shader.getInput("alpha")
+        if mode == "2":
+            return True
+        if mode == "1":
+            self.noted.add("alpha_mode")
+            self.warn_input(shader, mode_in, "(MASK) is read as blending by alpha: the "
+                            "alpha_cutoff test is not supported; approximated")
+            self.mapped.add("alpha_cutoff")
+            return True
+        if mode not in ("0", ""):
+            self.noted.add("alpha_mode")
+            self.warn_input(shader, mode_in, "is not supported (0, 1 or 2 as a constant); "
+                            "alpha is dropped")
+        if alpha is not None and not is_default(alpha, shader.getNodeDef()):
+            self.noted.add("alpha")
+            self.warn_input(shader, alpha, "has no effect under alpha_mode 0 (OPAQUE); "
+                            "dropped")
+        self.mapped.add("alpha_cutoff")  # read by MASK only
+        return False
+
+    def constant(self, shader, name: str) -> list[float] | None:
+        """The surface's constant value of `name` (set, else its default); None where it is
+        connected or not a number list."""
+        inp = shader.getInput(name)
+        if inp is not None and connected(inp):
+            return None
+        nd = shader.getNodeDef()
+        el = inp if inp is not None else (nd.getActiveInput(name) if nd is not None else None)
+        if el is None:
+            return None
+        try:
+            return [float(x) for x in el.getValueString().split(",")]
+        except ValueError:
+            return None
+
+    def approximations(self, shader, cat: str) -> None:
+        """Warnings for inputs read, but not exactly (`noted`, so they warn once)."""
+        def note(name: str, why: str) -> None:
+            el = shader.getInput(name)
+            if el is not None and name not in self.noted:
+                self.noted.add(name)
+                self.warn_input(shader, el, why)
+
+        if cat in BASE_WEIGHT and self.cavity_reading(shader, cat):
+            base = BASE_WEIGHT[cat][0]
+            others = [n for n in _OTHER_LOBES[cat] if self._set_or_zero(shader, n)]
+            if others and self.constant(shader, base) != [1.0]:
+                note(base, f"is, with {BASE_WEIGHT[cat][1]} from the same source, read as "
+                     f"our cavity, which darkens the {', '.join(others)} lobe too; "
+                     "approximated")
+        elif cat in BASE_WEIGHT:
+            specular = BASE_WEIGHT[cat][1]
+            if self.constant(shader, specular) != [1.0]:
+                note(specular, "is not supported (we have no specular weight); dropped")
+        if cat == "gltf_pbr" and self.constant(shader, "specular") != [1.0]:
+            note("specular", "is not supported (we have no specular weight); dropped")
+        metal = {"standard_surface": "metalness", "open_pbr_surface": "base_metalness"}.get(cat)
+        if metal is not None and self.constant(shader, metal) != [0.0]:
+            tint = self.constant(shader, "specular_color")
+            if tint != [1.0, 1.0, 1.0]:
+                note("specular_color", f"tints the dielectric's F0 only: the metal's edge "
+                     f"colour it also is in {cat} is not supported; approximated")
+        sheen = {"standard_surface": "sheen_roughness", "open_pbr_surface": "fuzz_roughness",
+                 "gltf_pbr": "sheen_roughness"}.get(cat)
+        if sheen is not None and shader.getInput(sheen) is not None:
+            r = self.constant(shader, sheen)
+            if r is None:
+                note(sheen, f"is clamped to at least {SHEEN_MIN_ROUGHNESS:g} by our sheen; "
+                     "approximated where it is lower")
+            elif r[0] < SHEEN_MIN_ROUGHNESS:
+                note(sheen, f"is clamped to {SHEEN_MIN_ROUGHNESS:g} by our sheen; approximated")
+        if cat == "open_pbr_surface" and (shader.getInput("thin_film_thickness") is not None
+                                          or shader.getInput("thin_film_weight") is not None):
+            w = self.constant(shader, "thin_film_weight")
+            if w is None or w[0] not in (0.0, 1.0):
+                note("thin_film_weight", "scales the film's thickness (ours has no film "
+                     "weight); approximated")
+        if cat == "gltf_pbr" and (shader.getInput("iridescence_thickness") is not None
+                                  or shader.getInput("iridescence") is not None):
+            w = self.constant(shader, "iridescence")
+            if w is None or w[0] not in (0.0, 1.0):
+                note("iridescence", "scales the film's thickness (ours has no film weight); "
+                     "approximated")
+        if cat in ("gltf_pbr", "UsdPreviewSurface") and self.constant(shader, "occlusion") \
+                != [1.0]:
+            note("occlusion", "is read as our cavity, which darkens direct light too (this "
+                 "surface's occlusion darkens indirect light only); approximated")
 
     def transmission(self, shader, cat: str, make: str, out: str) -> None:
         """The transmission inputs (TRANSMISSION): weight, tint or absorption colour by the
         depth, and the thin-walled flag (the Material Output's setting)."""
-        weight, color, depth, thin, _ = TRANSMISSION[cat]
+        weight, color, depth, thin = TRANSMISSION[cat]
         flag = shader.getInput(thin)
         if flag is not None:
+            self.mapped.add(thin)
             if flag.getConnectedNode() is not None or flag.getNodeGraphString():
                 self.err(f"node {self.name_of(shader)}: input {thin}: only a constant is "
                          "supported (our thin_walled is the material output's setting)")
@@ -715,6 +1025,7 @@ class _Importer:
         inp = shader.getInput(name)
         if inp is None:
             return
+        self.mapped.add(name)
         if not world:
             src = self.surface_input(shader, name)
             if src is not None:
@@ -732,6 +1043,7 @@ class _Importer:
                      "supported only from a normalmap node (a tangent-space normal map)")
             return
         where = f"node {self.name_of(up)}"
+        self.unread(up, _READS["normalmap"])
         for extra in ("normal", "tangent", "bitangent"):
             if up.getInput(extra) is not None:
                 self.err(f"{where}: a normalmap with its own {extra} input is not supported")
@@ -840,10 +1152,13 @@ def output_paths(names: list[str], folder: Path) -> dict[str, Path]:
     return out
 
 
-def import_mtlx(path: Path, out: Path, material: str | None = None) -> MaterialDocument:
+def import_mtlx(path: Path, out: Path, material: str | None = None,
+                warnings: list[str] | None = None) -> MaterialDocument:
     """The material of `path` (the one named `material`; without a name the document must
     hold exactly one, else SeveralMaterials) as a matedit document to be saved at `out`;
-    raises MtlxImportError with every problem found."""
+    raises MtlxImportError with every problem found. Appends to `warnings` one line for each
+    input, node or attribute of the file not represented exactly (the rule: nothing is
+    dropped silently; docs/materialx.md)."""
     path, out = Path(path), Path(out)
     doc, lib = _load_mtlx(path)
     materials = _materials(doc)
@@ -859,12 +1174,14 @@ def import_mtlx(path: Path, out: Path, material: str | None = None) -> MaterialD
         raise SeveralMaterials(path, [m.getName() for m in materials])
     else:
         mat = materials[0]
-    return _import_material(path, out, doc, lib, mat)
+    return _import_material(path, out, doc, lib, mat, warnings)
 
 
-def import_all(path: Path, folder: Path) -> dict[Path, MaterialDocument]:
+def import_all(path: Path, folder: Path,
+               warnings: list[str] | None = None) -> dict[Path, MaterialDocument]:
     """Every material of `path`, each as FOLDER/STEM.json (`output_paths`) -> document;
-    raises MtlxImportError with every problem of every material (then nothing is returned)."""
+    raises MtlxImportError with every problem of every material (then nothing is returned).
+    `warnings` as import_mtlx's, for every material."""
     path = Path(path)
     doc, lib = _load_mtlx(path)
     materials = _materials(doc)
@@ -876,7 +1193,7 @@ def import_all(path: Path, folder: Path) -> dict[Path, MaterialDocument]:
     for mat in materials:
         try:
             out[paths[mat.getName()]] = _import_material(path, paths[mat.getName()], doc, lib,
-                                                         mat)
+                                                         mat, warnings)
         except MtlxImportError as exc:
             errors += exc.messages
     if errors:
@@ -884,7 +1201,8 @@ def import_all(path: Path, folder: Path) -> dict[Path, MaterialDocument]:
     return out
 
 
-def _import_material(path: Path, out: Path, doc, lib, mat) -> MaterialDocument:
+def _import_material(path: Path, out: Path, doc, lib, mat,
+                     warnings: list[str] | None = None) -> MaterialDocument:
     sin = mat.getInput("surfaceshader")
     shader = None
     if sin is not None and sin.getNodeName():
@@ -896,7 +1214,12 @@ def _import_material(path: Path, out: Path, doc, lib, mat) -> MaterialDocument:
         raise MtlxImportError([f"{path}: node {shader.getName()}: unsupported surface "
                                f"{shader.getCategory()!r} (expected "
                                f"{', '.join(SURFACES)})"])
-    imp = _Importer(path, out, doc, lib)
+    imp = _Importer(path, out, doc, lib, mat.getName())
+    for other in mat.getInputs():  # displacement, a back surface, a volume: not ours
+        if other.getName() != "surfaceshader" and (connected(other) or
+                                                   other.getValueString()):
+            imp.warn(f"{other.getName()} {value_text(other)} of surfacematerial "
+                     f"{mat.getName()} is not supported; dropped")
     try:
         result = imp.build(shader)
     except RecursionError:
@@ -904,6 +1227,8 @@ def _import_material(path: Path, out: Path, doc, lib, mat) -> MaterialDocument:
                                "import"]) from None
     if imp.errors:
         raise MtlxImportError(imp.errors)
+    if warnings is not None:
+        warnings += imp.warnings
     name = mat.getName()
     result.name = name if not identifier_problem(mangle(name)) else "imported"
     result.description = f"Imported from {path.name}"
