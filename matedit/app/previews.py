@@ -69,6 +69,44 @@ def to_image(value, inside: np.ndarray | None = None, size: int = SIZE) -> QImag
     return img.copy()  # own the pixels
 
 
+def kind_thumbnail(kind: str, size: int = SIZE) -> QImage | None:
+    """A node kind alone, at its defaults: its first float, vector or MaterialAttributes
+    output on the preview sphere, as the canvas shows it (the Node Reference's picture).
+    None for kinds that need a wire, a function or a texture to make a value."""
+    from matedit.graph.model import DocumentKind, MaterialDocument, Node
+    from matedit.io.document import FileResolver
+
+    d = nodes.get(kind)
+    if d is None or kind == "material_output":
+        return None
+    doc = MaterialDocument(kind=DocumentKind.MATERIAL, name="reference")
+    doc.graph.nodes["n"] = Node("n", kind, (0.0, 0.0), {s.name: s.default for s in d.settings})
+    doc.graph.nodes["out"] = Node("out", "material_output")
+    surface, inside = preview_sphere(size)
+    probe: dict = {}
+    try:
+        ir = lower_document(doc, FileResolver())
+        with np.errstate(all="ignore"):
+            evaluate(ir, surface, textures={}, probe=probe)
+    except (CompileError, LookupError, ValueError, KeyError, TypeError, FloatingPointError):
+        return None
+    n = size * size
+    for o in d.outputs:
+        value = probe.get(f"n.{o.name}")
+        if value is None:
+            continue
+        if not isinstance(value, dict):
+            a = np.asarray(value, dtype=np.float64)
+            if a.ndim == 0 or (a.ndim == 1 and len(a) in (2, 3, 4)):  # a constant
+                a = np.broadcast_to(a, (n,) + a.shape)
+            if a.shape[0] != n or a.ndim > 2 or (a.ndim == 2 and a.shape[1] > 4):
+                return None  # not a picture (a matrix, a struct of arrays)
+            value = a
+        with np.errstate(all="ignore"):
+            return to_image(value, inside, size)
+    return None
+
+
 class TextureCache:
     """Texture images for the CPU evaluator, as the viewport samples them: float RGBA, row 0
     at v = 0; 8-bit colour files flagged sRGB decoded to linear. Kept small (thumbnails need

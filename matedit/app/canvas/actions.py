@@ -90,7 +90,8 @@ TABLE: tuple[CanvasCommand, ...] = (
                   "after spirv-opt -O); the figures are in its tooltip",
                   checked=lambda v: v.cost_overlay.active),
     CanvasCommand("node_docs", "&Node Reference", lambda v: v.request_docs(), ("F1",),
-                  tip="Documentation of the selected node kind", enabled=_one_node_selected),
+                  tip="Browse and search every node kind: ports, defaults, ranges and a "
+                      "thumbnail (the selected node's kind first)"),
 )
 
 EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", None,

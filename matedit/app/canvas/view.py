@@ -228,12 +228,12 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         return self.start_rename(ids[0]) if len(ids) == 1 else None
 
     def request_docs(self) -> bool:
-        """Asks for the selected node kind's documentation (`docsRequested`)."""
+        """Opens the node reference (`docsRequested`) at the selected node's kind, or where it
+        was when no single node is selected (an empty kind)."""
         ids = self.selected_ids()
-        node = self.controller.document.graph.nodes.get(ids[0]) if ids else None
-        if node is not None:
-            self.docsRequested.emit(node.kind)
-        return node is not None
+        node = self.controller.document.graph.nodes.get(ids[0]) if len(ids) == 1 else None
+        self.docsRequested.emit(node.kind if node is not None else "")
+        return True
 
     # --- edits -------------------------------------------------------------------------------
     def delete_selection(self) -> bool:
