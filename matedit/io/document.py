@@ -175,8 +175,10 @@ def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocumen
         _expect(isinstance(values, dict), file, "values must be an object", nid, "values")
         label = n.get("label", "")
         _expect(isinstance(label, str), file, "label must be a string", nid, "label")
+        muted = n.get("muted", False)
+        _expect(isinstance(muted, bool), file, "muted must be true or false", nid, "muted")
         doc.graph.nodes[nid] = Node(nid, kind, (float(pos[0]), float(pos[1])), settings,
-                                    values, label, _unknown(n, NODE_FIELDS))
+                                    values, label, _unknown(n, NODE_FIELDS), muted)
 
     links = raw.get("links", [])
     _expect(isinstance(links, list), file, "'links' must be a list", field="links")
@@ -222,7 +224,7 @@ def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocumen
 
 TOP_FIELDS = frozenset({"format", "version", "name", "description", "preview", "nodes",
                         "links", "comments"})
-NODE_FIELDS = frozenset({"id", "kind", "position", "settings", "values", "label"})
+NODE_FIELDS = frozenset({"id", "kind", "position", "settings", "values", "label", "muted"})
 LINK_FIELDS = frozenset({"from", "to"})
 COMMENT_FIELDS = frozenset({"id", "text", "rect", "color"})
 
@@ -251,6 +253,8 @@ def to_dict(doc: MaterialDocument) -> dict:
             entry["values"] = n.values
         if n.label:
             entry["label"] = n.label
+        if n.muted:
+            entry["muted"] = True
         out["nodes"].append(entry)
     if g.comments:
         out["comments"] = [

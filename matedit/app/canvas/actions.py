@@ -75,6 +75,9 @@ TABLE: tuple[CanvasCommand, ...] = (
                   tip="Frame the selected nodes in a comment", enabled=_has_nodes_selected),
     CanvasCommand("rename", "&Rename Node", lambda v: v.rename_selected(), ("F2",),
                   tip="Rename the selected node", enabled=_one_node_selected),
+    CanvasCommand("bypass", "&Bypass", lambda v: v.toggle_bypass(), ("B",),
+                  tip="Bypass the selected nodes (their first input of each output's type "
+                      "passes through), or make them work again", enabled=_has_nodes_selected),
     CanvasCommand("arrange", "Arran&ge", lambda v: v.arrange_selection(), ("L",),
                   tip="Lay out the selected nodes (everything when fewer than two are "
                       "selected) in columns, outputs on the right"),
@@ -94,11 +97,11 @@ TABLE: tuple[CanvasCommand, ...] = (
                       "thumbnail (the selected node's kind first)"),
 )
 
-EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", None,
-             "arrange", "add_node")
+EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", "bypass",
+             None, "arrange", "add_node")
 VIEW_MENU = ("frame_all", "frame_selection", "minimap", "cost_overlay")
-CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename", "arrange",
-                "frame_all")
+CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename", "bypass",
+                "arrange", "frame_all")
 
 
 def key_text(command: CanvasCommand) -> str:

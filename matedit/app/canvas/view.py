@@ -50,6 +50,7 @@ from matedit.graph.commands import (
     PutComment,
     RemoveNode,
     SetLabel,
+    SetMuted,
 )
 from matedit.graph.model import Comment, Link, MaterialDocument, Node
 from matedit.graph.types import PortType
@@ -290,6 +291,26 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         payload = clipboard.copy_payload(self.controller.document, node_ids)
         clip = clipboard.from_mime(clipboard.to_mime(payload))
         return self._paste_doc(clip, (40.0, 40.0), "duplicate") if clip else []
+
+    def toggle_bypass(self) -> list[str]:
+        """Edit › Bypass (B): the selected nodes that can be bypassed stop working (their first
+        input of each output's type passes through), or, when all of them already are, work
+        again; one undo step. The ids changed."""
+        graph = self.controller.document.graph
+        ids = [nid for nid in self.selected_ids()
+               if nid in graph.nodes and nodes.can_bypass(graph.nodes[nid].kind)]
+        if not ids:
+            self.message.emit("Nothing to bypass: sources and outputs have no input to pass "
+                              "through")
+            return []
+        mute = not all(graph.nodes[nid].muted for nid in ids)
+        verb = "bypass" if mute else "restore"
+        text = f"{verb} {len(ids)} node{'s' if len(ids) != 1 else ''}"
+        if not self.controller.push(SetMuted(tuple(ids), mute, text=text)):
+            return []
+        self.message.emit(("Bypassed " if mute else "Restored ") +
+                          f"{len(ids)} node{'s' if len(ids) != 1 else ''}")
+        return ids
 
     def arrange_selection(self) -> list[str]:
         """Edit › Arrange: the selected nodes (every node when fewer than two are selected)
