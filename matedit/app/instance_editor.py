@@ -418,7 +418,10 @@ def attach_instances(material_items: list[QTreeWidgetItem], files: list[Path],
     while pending and progress:  # parents first, whatever the file order
         progress = False
         for f, doc in list(pending):
-            parent_item = by_path.get(str(doc.parent_path().resolve()))
+            try:
+                parent_item = by_path.get(str(doc.parent_path().resolve()))
+            except ValueError:  # a library name that leads nowhere
+                parent_item = None
             if parent_item is None:
                 continue
             it = QTreeWidgetItem(parent_item, [doc.name or f.stem])

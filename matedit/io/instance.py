@@ -39,6 +39,7 @@ from matedit.graph.model import MaterialDocument
 from matedit.graph.names import identifier_problem
 from matedit.graph.nodes import REGISTRY
 from matedit.graph.numbers import describe_number, gpu_number_problem, gpu_numbers_problem
+from matedit.io import library
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import (
     FormatError,
@@ -46,6 +47,7 @@ from matedit.io.document import (
     parse_json_text,
     read_document_text,
     rebase_references,
+    reference_from,
 )
 from matedit.io.jsontext import JSONTextError, parse_json
 from matedit.io.migrations import CURRENT_VERSION
@@ -83,6 +85,8 @@ class InstanceDocument:
     extra: dict[str, Any] = field(default_factory=dict)  # unknown fields, kept on save
 
     def parent_path(self) -> Path:
+        if library.is_library_ref(self.parent):
+            return library.library_path(self.parent)  # ValueError out of the library
         base = Path(self.path).parent if self.path else Path.cwd()
         return base / self.parent
 
@@ -275,10 +279,15 @@ def rebase(doc: InstanceDocument, new_path: Path, parameters: dict[str, Paramete
     """Rewrites the parent, texture overrides and preview files for a file at `new_path`."""
     old_dir = Path(doc.path).parent if doc.path else Path.cwd()
     new_dir = Path(new_path).parent
+    if not library.is_library_ref(doc.parent) and not Path(doc.parent).is_absolute():
+        parent = reference_from(Path(os.path.realpath(old_dir / doc.parent)),
+                                Path(os.path.realpath(new_dir)))
+        # In the same folder only a parent in the library changes (to its library name).
+        if library.is_library_ref(parent) or \
+                os.path.realpath(old_dir) != os.path.realpath(new_dir):
+            doc.parent = parent
     if os.path.realpath(old_dir) == os.path.realpath(new_dir):
         return
-    if not Path(doc.parent).is_absolute():
-        doc.parent = _relative(old_dir / doc.parent, new_dir)
     for name, value in doc.parameters.items():
         known = (parameters or {}).get(name)
         is_tex = (known.type == "texture") if known else doc.parent_parameters.get(name) == \
@@ -405,8 +414,11 @@ def resolve(inst: InstanceDocument) -> ResolvedInstance:
     chain: list[Path] = [_real(inst.path) if inst.path else Path("<unsaved instance>")]
     current = inst
     while True:
-        ppath = current.parent_path()
         here = str(current.path) if current.path else "<instance>"
+        try:
+            ppath = current.parent_path()
+        except ValueError as exc:
+            raise InstanceError(here, f"parent {current.parent}: {exc}") from None
         if len(chain) > MAX_CHAIN:
             raise InstanceError(here, f"the parent chain is more than {MAX_CHAIN} deep")
         real = _real(ppath)
