@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from graphs_util import EDITOR_SAMPLE
 from PySide6.QtCore import Qt
 from test_app_support import app_env, make_window  # noqa: F401 - fixture
 
 from matedit.graph import nodes
+
+pytestmark = pytest.mark.usefixtures("app_env")
 
 
 def _pixels(img) -> np.ndarray:
@@ -18,7 +21,7 @@ def _pixels(img) -> np.ndarray:
         img.height(), img.width(), 3)
 
 
-def test_every_kind_gets_a_thumbnail_or_none_and_they_show_what_the_node_makes(app_env):  # noqa: F811
+def test_every_kind_gets_a_thumbnail_or_none_and_they_show_what_the_node_makes():
     from matedit.app.previews import kind_thumbnail
 
     made = {k: kind_thumbnail(k, 48) for k in nodes.REGISTRY}  # none may raise

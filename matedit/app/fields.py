@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, Signal
@@ -34,6 +35,9 @@ from PySide6.QtWidgets import (
 from matedit.app import file_dialogs
 from matedit.app.controller import new_merge_id
 from matedit.app.theme import icon
+
+if TYPE_CHECKING:
+    from matedit.app.hdr_picker import HdrColorDialog
 
 SLIDER_STEPS = 1000
 SPIN_LIMIT = 1e12  # a typed 1e9 stays 1e9 (float32 uniforms hold it)
@@ -241,7 +245,7 @@ def split_hdr(rgb: list[float]) -> tuple[list[float], float]:
 
 
 class ColorField(QWidget):
-    """A swatch (opens QColorDialog, in sRGB; stored linear) and an intensity multiplier, so
+    """A swatch (opens the float HDR picker; stored linear) and an intensity multiplier, so
     HDR colours (components above 1) stay editable."""
 
     edited = Signal(object, object)
@@ -269,7 +273,7 @@ class ColorField(QWidget):
         self._base: list[float] = []  # the first value is split afresh
         self.set_value(value)
         self.dialog_factory = QColorDialog.getColor  # replaced: a modal dialog (tests)
-        self.live_dialog: QColorDialog | None = None
+        self.live_dialog: HdrColorDialog | None = None
 
     def value(self) -> list[float]:
         k = float(self.intensity.value())
@@ -316,10 +320,10 @@ class ColorField(QWidget):
         v = self.value()
         self.swatch.setToolTip("linear RGB " + ", ".join(f"{c:.3f}" for c in v))
 
-    def pick(self) -> QColorDialog | None:
-        """A colour picker that stays open beside the canvas and edits live (one undo step
-        for the whole pick); the intensity field beside it makes the colour HDR. A replaced
-        `dialog_factory` (the stock modal dialog) is the fallback."""
+    def pick(self) -> HdrColorDialog | None:
+        """A float, HDR colour picker (matedit.app.hdr_picker) that stays open beside the
+        canvas and edits live (one undo step for the whole pick). A replaced
+        `dialog_factory` (a modal dialog returning a QColor) is used instead where set."""
         r, g, b = (int(round(linear_to_srgb(c) * 255)) for c in self._base)
         if self.dialog_factory is QColorDialog.getColor:
             return self._pick_live(QColor(r, g, b))
@@ -332,31 +336,21 @@ class ColorField(QWidget):
         self._paint()
         self.edited.emit(self.value(), None)
 
-    def _pick_live(self, start: QColor) -> QColorDialog:
+    def _pick_live(self, _start: QColor) -> HdrColorDialog:
+        from matedit.app.hdr_picker import HdrColorDialog
+
         if self.live_dialog is not None:
             self.live_dialog.raise_()
             return self.live_dialog
-        dlg = QColorDialog(start, self)
-        dlg.setWindowTitle("Colour (× intensity for HDR)")
-        dlg.setModal(False)
+        dlg = HdrColorDialog(self.value(), self, (list(self._base),
+                                                  float(self.intensity.value())))
         merge = new_merge_id()
-        before = self.value()
 
-        def changed(c: QColor) -> None:
-            if not c.isValid():
-                return
-            self._base = [round(srgb_to_linear(x), 6) for x in (c.redF(), c.greenF(),
-                                                                 c.blueF())]
-            self._unmute()
-            self._paint()
+        def changed(v: list[float]) -> None:  # Cancel comes back here too, in the same step
+            self.set_value(v)
             self.edited.emit(self.value(), merge)
 
-        def cancelled() -> None:  # back to the colour before the pick, in the same step
-            self.set_value(before)
-            self.edited.emit(self.value(), merge)
-
-        dlg.currentColorChanged.connect(changed)
-        dlg.rejected.connect(cancelled)
+        dlg.colorChanged.connect(changed)
         dlg.finished.connect(lambda _r: setattr(self, "live_dialog", None))
         dlg.show()
         self.live_dialog = dlg
