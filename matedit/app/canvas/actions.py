@@ -75,6 +75,13 @@ TABLE: tuple[CanvasCommand, ...] = (
                   tip="Frame the selected nodes in a comment", enabled=_has_nodes_selected),
     CanvasCommand("rename", "&Rename Node", lambda v: v.rename_selected(), ("F2",),
                   tip="Rename the selected node", enabled=_one_node_selected),
+    CanvasCommand("collapse", "Collapse to &Function…", lambda v: v.collapse_selection(),
+                  ("Ctrl+G",), tip="Move the selected nodes into a new material function "
+                  "file; the cut wires become its inputs and outputs, and a call takes their "
+                  "place", enabled=_has_nodes_selected),
+    CanvasCommand("expand", "E&xpand Function", lambda v: v.expand_selected_call(),
+                  ("Ctrl+Shift+G",), tip="Put the selected function call's nodes in its place",
+                  enabled=_one_node_selected),
     CanvasCommand("bypass", "&Bypass", lambda v: v.toggle_bypass(), ("B",),
                   tip="Bypass the selected nodes (their first input of each output's type "
                       "passes through), or make them work again", enabled=_has_nodes_selected),
@@ -98,10 +105,10 @@ TABLE: tuple[CanvasCommand, ...] = (
 )
 
 EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", "bypass",
-             None, "arrange", "add_node")
+             None, "collapse", "expand", None, "arrange", "add_node")
 VIEW_MENU = ("frame_all", "frame_selection", "minimap", "cost_overlay")
 CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename", "bypass",
-                "arrange", "frame_all")
+                "collapse", "expand", "arrange", "frame_all")
 
 
 def key_text(command: CanvasCommand) -> str:

@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from matedit.app.canvas import arrange, clipboard, placement
+from matedit.app.canvas import arrange, clipboard, functions, placement
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.actions import CONTEXT_MENU, CanvasActions
 from matedit.app.canvas.comment_item import CommentItem
@@ -106,6 +106,9 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self.setStyleSheet("QGraphicsView { background: #1b1e24; border: none; }")
         self.setAcceptDrops(True)
         self.run_menu = lambda menu, at: menu.exec(at)  # tests read the menu instead
+        # where Collapse to Function writes the new function (a save dialog; tests answer)
+        self.ask_function_path = lambda suggestion: functions.ask_function_path(self,
+                                                                                suggestion)
 
         self.node_palette = NodePalette(self)
         self.node_palette.chosen.connect(self._palette_chosen)
@@ -291,6 +294,14 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         payload = clipboard.copy_payload(self.controller.document, node_ids)
         clip = clipboard.from_mime(clipboard.to_mime(payload))
         return self._paste_doc(clip, (40.0, 40.0), "duplicate") if clip else []
+
+    def collapse_selection(self) -> str:
+        """Edit › Collapse to Function (matedit.app.canvas.functions); the call's id."""
+        return functions.collapse_selection(self)
+
+    def expand_selected_call(self) -> list[str]:
+        """Edit › Expand Function: the selected call's nodes inline; the new ids."""
+        return functions.expand_call(self)
 
     def toggle_bypass(self) -> list[str]:
         """Edit › Bypass (B): the selected nodes that can be bypassed stop working (their first
