@@ -122,8 +122,8 @@ def collapse(doc: MaterialDocument, analysis: Analysis, node_ids: list[str], fun
     commands: list[Command] = [RemoveNode(nid) for nid in sorted(inside)]
     commands.append(AddNode(Node(call, "function_call", centre, {"function": function_ref})))
     wired: set[Link] = set()
-    for (src, port), port_name in inputs.items():
-        wired.add(Link(src, port, call, port_name))
+    for (src_id, port), port_name in inputs.items():
+        wired.add(Link(src_id, port, call, port_name))
     for l in cut_out:
         wired.add(Link(call, outputs[(l.src, l.src_port)], l.dst, l.dst_port))
     commands += [Connect(l) for l in sorted(wired)]
