@@ -9,13 +9,12 @@ inspector turns their signals into commands.
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, Signal
-from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap, QValidator
+from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap
 from PySide6.QtWidgets import (
     QAbstractScrollArea,
     QApplication,
@@ -34,13 +33,19 @@ from PySide6.QtWidgets import (
 
 from matedit.app import file_dialogs
 from matedit.app.controller import new_merge_id
+from matedit.app.spinbox import (  # noqa: F401 - the field kit's names, used from here too
+    SPIN_LIMIT,
+    NumberSpin,
+    linear_to_srgb,
+    split_hdr,
+    srgb_to_linear,
+)
 from matedit.app.theme import icon
 
 if TYPE_CHECKING:
     from matedit.app.hdr_picker import HdrColorDialog
 
 SLIDER_STEPS = 1000
-SPIN_LIMIT = 1e12  # a typed 1e9 stays 1e9 (float32 uniforms hold it)
 IMAGE_FILTER = "Images (*.png *.jpg *.jpeg *.tga *.tif *.tiff *.exr *.hdr *.bmp);;All files (*)"
 
 
@@ -64,40 +69,6 @@ def guard_wheel(widget: QWidget) -> QWidget:
     widget.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
     widget.installEventFilter(WheelGuard(widget))
     return widget
-
-
-# What a number field reads as a number while it is typed: a sign, digits with one decimal
-# separator ('.' or the locale's ','), and an exponent (1e9, 2.5E-3).
-_NUMBER = re.compile(r"[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?")
-_PARTIAL = re.compile(r"[+-]?(\d*([.,]\d*)?)([eE][+-]?\d*)?")
-
-
-class NumberSpin(QDoubleSpinBox):
-    """A spin box that reads what artists type: `1e9`, `2,5` as well as `2.5`, and shows a
-    large value in full (digits, not a cut-off "100000.000")."""
-
-    def validate(self, text: str, pos: int):  # noqa: D102 - Qt's
-        t = text.strip()
-        if _NUMBER.fullmatch(t):
-            return QValidator.State.Acceptable, text, pos
-        if _PARTIAL.fullmatch(t):
-            return QValidator.State.Intermediate, text, pos
-        return QValidator.State.Invalid, text, pos
-
-    def valueFromText(self, text: str) -> float:  # noqa: N802 - Qt's name
-        try:
-            v = float(text.strip().replace(",", "."))
-        except ValueError:
-            return self.value()
-        return min(max(v, self.minimum()), self.maximum()) if math.isfinite(v) else self.value()
-
-    def textFromValue(self, value: float) -> str:  # noqa: N802 - Qt's name
-        if abs(value) >= 1e4:  # no decimals past ten thousand: the digits fit the field
-            return f"{value:.0f}"
-        return f"{value:.{self.decimals()}f}"
-
-    def fixup(self, text: str) -> str:
-        return text.strip().replace(",", ".")
 
 
 def _spin(decimals: int = 3) -> QDoubleSpinBox:
@@ -226,22 +197,6 @@ class VectorField(QWidget):
 
     def _typed(self, _v: float) -> None:
         self.edited.emit(self.value(), None)
-
-
-def linear_to_srgb(c: float) -> float:
-    c = max(0.0, min(1.0, c))
-    return 12.92 * c if c <= 0.0031308 else 1.055 * c ** (1 / 2.4) - 0.055
-
-
-def srgb_to_linear(c: float) -> float:
-    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
-
-
-def split_hdr(rgb: list[float]) -> tuple[list[float], float]:
-    """An HDR linear colour as (colour with components <= 1, intensity >= 1)."""
-    peak = max(rgb) if rgb else 0.0
-    k = peak if peak > 1.0 else 1.0
-    return [c / k for c in rgb], k
 
 
 class ColorField(QWidget):

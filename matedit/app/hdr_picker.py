@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from matedit.app.fields import SPIN_LIMIT, NumberSpin, linear_to_srgb, split_hdr, srgb_to_linear
+from matedit.app.spinbox import SPIN_LIMIT, NumberSpin, linear_to_srgb, split_hdr, srgb_to_linear
 
 HEX_LEN = 7  # "#rrggbb"
 

@@ -38,6 +38,7 @@ from matedit.graph.commands import (
     Connect,
     Disconnect,
     Macro,
+    MoveNodes,
     SetSetting,
     SetValue,
 )
@@ -47,6 +48,11 @@ from matedit.graph.nodes import Role, kind_for, role_of
 from matedit.graph.ports import COLOR_LAYER_BLENDS, LAYER_BLENDS
 from matedit.io.document import FormatError, load
 from matedit.resources import graphs_dir
+
+# The base layer "Create layer stack" makes of what the output showed: one
+# MaterialAttributes input, passed through.
+GRAPH_LAYER = graphs_dir() / "layers" / "graph_input.json"
+STACK_SHIFT = 300.0  # how far the output moves right for the new stack
 
 LAYER_MIME = "application/x-matedit-layer"  # absolute path of a layer file (from the library)
 ROW_MIME = "application/x-matedit-layer-row"  # id of a layer being reordered
@@ -506,22 +512,39 @@ class LayersPanel(QWidget):
         return None
 
     def create_stack(self, first_layer: Path | None = None) -> str | None:
-        """Adds a layer stack node (with a first layer) wired into the material output."""
-        graph = self.controller.document.graph
+        """Adds a layer stack node wired into the material output. What the output was
+        wired to is adopted as the base layer (the "From the graph" layer, whose input it
+        feeds), so the material looks as it did; `first_layer` goes on top of it. The id of
+        `first_layer`'s entry (or of the base, without one)."""
+        doc = self.controller.document
+        graph = doc.graph
+        out = next((n for n in sorted(graph.nodes.values(), key=lambda n: n.id)
+                    if role_of(n.kind) == Role.MATERIAL_OUTPUT), None)
+        fed = graph.incoming(out.id, "attributes") if out is not None else None
         entries = []
         lid = None
+        if fed is not None:  # adopt the graph the output shows as the base layer
+            lid = "graph"
+            entries.append(Layer(lid, reference_for(doc, GRAPH_LAYER), "From the graph",
+                                 "alpha").to_json())
         if first_layer is not None:
             fn = load(first_layer)
             lid = "".join(c for c in first_layer.stem.split("_")[0] if c.isalnum()) or "layer"
             lid = (lid if lid[0].isalpha() else "l" + lid) + "1"
-            entries.append(Layer(lid, reference_for(self.controller.document, first_layer),
+            lid = lid if lid != "graph" else "graph2"
+            entries.append(Layer(lid, reference_for(doc, first_layer),
                                  fn.name or first_layer.stem).to_json())
-        out = next((n for n in sorted(graph.nodes.values(), key=lambda n: n.id)
-                    if role_of(n.kind) == Role.MATERIAL_OUTPUT), None)
-        pos = (out.position[0] - 260, out.position[1]) if out else (0.0, 0.0)
         sid = graph.new_id("stack")
-        cmds = [AddNode(Node(sid, kind_for(Role.LAYER_STACK), pos, {"layers": entries}))]
-        if out is not None and graph.incoming(out.id, "attributes") is None:
+        # The stack takes the output's place and the output moves right, so the stack sits
+        # between what fed the output and the output, on neither.
+        pos = out.position if out is not None else (0.0, 0.0)
+        cmds: list = [AddNode(Node(sid, kind_for(Role.LAYER_STACK), pos, {"layers": entries}))]
+        if out is not None:
+            cmds.append(MoveNodes({out.id: (out.position[0] + STACK_SHIFT, out.position[1])}))
+        if fed is not None:
+            cmds += [Disconnect(fed),
+                     Connect(Link(fed.src, fed.src_port, sid, f"{entries[0]['id']}_attributes"))]
+        if out is not None:
             cmds.append(Connect(Link(sid, "attributes", out.id, "attributes")))
         if not self.controller.push(Macro(cmds, text="add layer stack")):
             return None

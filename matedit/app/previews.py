@@ -23,7 +23,7 @@ from matedit.compiler.cpu_eval import evaluate
 from matedit.compiler.cpu_nodes import SurfaceArrays
 from matedit.compiler.lower import CompileError, lower_document
 from matedit.graph import nodes
-from matedit.graph.nodes import Thumbnail
+from matedit.graph.nodes import Role, Thumbnail
 from matedit.graph.types import PortType
 from matedit.nodes.twin import sphere_surface
 from matedit.shading import thumbnail
@@ -77,11 +77,11 @@ def kind_thumbnail(kind: str, size: int = SIZE) -> QImage | None:
     from matedit.io.document import FileResolver
 
     d = nodes.get(kind)
-    if d is None or kind == "material_output":
+    if d is None or d.role == Role.MATERIAL_OUTPUT:
         return None
     doc = MaterialDocument(kind=DocumentKind.MATERIAL, name="reference")
     doc.graph.nodes["n"] = Node("n", kind, (0.0, 0.0), {s.name: s.default for s in d.settings})
-    doc.graph.nodes["out"] = Node("out", "material_output")
+    doc.graph.nodes["out"] = Node("out", nodes.kind_for(Role.MATERIAL_OUTPUT))
     surface, inside = preview_sphere(size)
     probe: dict = {}
     try:

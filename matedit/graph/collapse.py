@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 from matedit.graph.commands import AddNode, Command, Connect, RemoveNode, SetValue
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node
-from matedit.graph.nodes import Role, is_value_parameter, role_of
+from matedit.graph.nodes import Role, is_value_parameter, kind_for, role_of
 from matedit.graph.validate import Analysis
 
 # What a collapse leaves in the material: what artists set or what ends the graph.
@@ -96,7 +96,7 @@ def collapse(doc: MaterialDocument, analysis: Analysis, node_ids: list[str], fun
                 settings["default"] = 0.0
             elif t.startswith("vec"):
                 settings["default"] = [0.0] * int(t[-1])
-            fn.graph.nodes[nid] = Node(nid, "function_input",
+            fn.graph.nodes[nid] = Node(nid, kind_for(Role.FUNCTION_INPUT),
                                        (left, top + 110.0 * (len(inputs) - 1)), settings)
         fn.graph.links.add(Link(input_node[inputs[key]], "value", l.dst, l.dst_port))
     outputs: dict[tuple[str, str], str] = {}  # inside (node, port) -> function output name
@@ -112,7 +112,7 @@ def collapse(doc: MaterialDocument, analysis: Analysis, node_ids: list[str], fun
         port_name = _unique(l.src_port, out_names)
         outputs[key] = port_name
         nid = _unique(f"out_{port_name}", ids)
-        fn.graph.nodes[nid] = Node(nid, "function_output",
+        fn.graph.nodes[nid] = Node(nid, kind_for(Role.FUNCTION_OUTPUT),
                                    (right, top + 110.0 * (len(outputs) - 1)),
                                    {"name": port_name, "type": t, "order": len(outputs) - 1})
         fn.graph.links.add(Link(l.src, l.src_port, nid, "value"))
@@ -120,7 +120,8 @@ def collapse(doc: MaterialDocument, analysis: Analysis, node_ids: list[str], fun
     call = g.new_id("call")
     centre = (sum(xs) / len(xs), sum(ys) / len(ys))
     commands: list[Command] = [RemoveNode(nid) for nid in sorted(inside)]
-    commands.append(AddNode(Node(call, "function_call", centre, {"function": function_ref})))
+    commands.append(AddNode(Node(call, kind_for(Role.FUNCTION_CALL), centre,
+                                 {"function": function_ref})))
     wired: set[Link] = set()
     for (src_id, port), port_name in inputs.items():
         wired.add(Link(src_id, port, call, port_name))
