@@ -123,11 +123,20 @@ def wire_report(cmd) -> str:
 class _LayerRow(QWidget):
     """Eye, name, blend and opacity of one layer."""
 
+    def contextMenuEvent(self, ev) -> None:  # noqa: N802 - Qt's
+        s = self.panel.stack
+        menu = QMenu(self)
+        solo = s is not None and s.is_solo(self.layer_id)
+        act = menu.addAction("Show every layer" if solo else "Solo (alone over the base)")
+        act.triggered.connect(lambda _=False: self.panel.solo(self.layer_id))
+        self.panel.run_menu(menu, ev.globalPos())
+
     def __init__(self, panel: LayersPanel, layer: Layer, is_base: bool, opacity: float,
                  parked: list[dict] | None = None):
         super().__init__()
         self.setObjectName("layerRow")
         self.layer_id = layer.id
+        self.panel = panel
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 3, 4, 3)
         lay.setSpacing(2)
@@ -137,8 +146,9 @@ class _LayerRow(QWidget):
         self.eye.setCheckable(True)
         self.eye.setChecked(layer.visible)
         self.eye.setIcon(icon("eye" if layer.visible else "eye-off"))
-        self.eye.setToolTip("Show or hide this layer")
-        self.eye.toggled.connect(lambda on: panel.set_visible(layer.id, on))
+        self.eye.setToolTip("Show or hide this layer (Alt+click: this layer alone over the "
+                            "base, again: every layer)")
+        self.eye.clicked.connect(lambda on: panel.eye_clicked(layer.id, on))
         self.name = QLineEdit(layer.name or layer.id)
         self.name.setFrame(False)
         self.name.setStyleSheet("background: transparent; font-weight: bold;")
@@ -287,6 +297,7 @@ class LayersPanel(QWidget):
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
         self.controller = controller
+        self.run_menu = lambda menu, at: menu.exec(at)  # tests read the menu instead
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.setSpacing(4)
@@ -432,6 +443,26 @@ class LayersPanel(QWidget):
     # --- edits -----------------------------------------------------------------------------
     def set_visible(self, layer_id: str, on: bool) -> None:
         self._push(lambda s: s.set(layer_id, visible=bool(on)))
+
+    def eye_clicked(self, layer_id: str, on: bool) -> None:
+        """The eye: show or hide; with Alt, solo (`solo`)."""
+        from PySide6.QtWidgets import QApplication
+
+        if QApplication.keyboardModifiers() & Qt.KeyboardModifier.AltModifier:
+            self.solo(layer_id)
+        else:
+            self.set_visible(layer_id, on)
+
+    def solo(self, layer_id: str) -> bool:
+        """This layer alone over the base; on a solo layer, every layer shown again."""
+        s = self.stack
+        was = s.is_solo(layer_id) if s is not None else False
+        if not self._push(lambda st: st.solo(layer_id)):
+            return False
+        self.message.emit("Every layer shown" if was else
+                          f"Solo: {layer_id} over the base (Alt+click its eye again to show "
+                          "every layer)")
+        return True
 
     def set_blend(self, layer_id: str, blend: str | None) -> None:
         if not isinstance(blend, str) or not blend:  # a separator row
