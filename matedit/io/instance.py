@@ -101,6 +101,9 @@ class ParameterInfo:
     kind: str
     default: Any  # the material's own value
     settings: dict[str, Any]  # presentation: group, order, ui_min, ui_max, tooltip, ...
+    # Where the value goes: a parameter node's `value`; for a layer's input, the layer
+    # stack's port (`LAYER_VISIBLE` for a layer's visibility switch)
+    port: str = "value"
 
     @property
     def group(self) -> str:
@@ -340,8 +343,12 @@ def save_instance(doc: InstanceDocument, path: str | os.PathLike | None = None,
 
 # --- parameters of a material ---------------------------------------------------------------
 
-def material_parameters(doc: MaterialDocument) -> dict[str, ParameterInfo]:
-    """The parameters a material exposes (the top graph's parameter and switch nodes)."""
+def material_parameters(doc: MaterialDocument, layers: bool = False,
+                        resolver=None) -> dict[str, ParameterInfo]:
+    """The parameters a material exposes (the top graph's parameter and switch nodes). With
+    `layers`, also every layer's unwired inputs on each layer stack (named as the stack's
+    port, `<layer>_<input>`, grouped by layer name) and a visibility switch per layer above
+    the base (`<layer>_visible`), as an instance sees them."""
     out: dict[str, ParameterInfo] = {}
     for nid in sorted(doc.graph.nodes):
         n = doc.graph.nodes[nid]
@@ -360,6 +367,56 @@ def material_parameters(doc: MaterialDocument) -> dict[str, ParameterInfo]:
         else:
             default = n.values.get("value", d.values[0].default if d.values else 0.0)
         out[name] = ParameterInfo(name, t, nid, n.kind, copy.deepcopy(default), settings)
+    if layers:
+        for name, p in _layer_parameters(doc, resolver).items():
+            out.setdefault(name, p)  # a parameter node of the same name wins
+    return out
+
+
+LAYER_VISIBLE = "@visible"  # a layer's visibility switch: no port, the layer's entry
+LAYER_ORDER = 10_000  # layer parameters' `order`, past any a parameter node sets
+_LAYER_TYPES = {"float": "scalar", "vec3": "color", "vec4": "vector"}
+
+
+def _layer_parameters(doc: MaterialDocument, resolver) -> dict[str, ParameterInfo]:
+    from matedit.graph.nodes import Role, role_of
+    from matedit.graph.ports import layer_entries, node_ports
+    from matedit.io.document import FileResolver
+
+    resolver = resolver if resolver is not None else FileResolver()
+    out: dict[str, ParameterInfo] = {}
+    wired = {(l.dst, l.dst_port) for l in doc.graph.links}
+    for nid in sorted(doc.graph.nodes):
+        n = doc.graph.nodes[nid]
+        if role_of(n.kind) != Role.LAYER_STACK:
+            continue
+        try:
+            ports = {p.name: p for p in node_ports(n, resolver, doc).inputs}
+        except (LookupError, ValueError, OSError):
+            continue  # the material's own validation reports it
+        for index, e in enumerate(layer_entries(n)):
+            lid, title = e["id"], str(e.get("name") or e["id"])
+            prefix = f"{lid}_"
+            # after the material's own parameters, in a group and among groups; top layer
+            # last, as the stack reads from the base up
+            order = LAYER_ORDER + 100 * index
+            for pname, port in ports.items():
+                t = _LAYER_TYPES.get(str(port.type))
+                if not pname.startswith(prefix) or t is None or (nid, pname) in wired \
+                        or pname.endswith("_mask"):
+                    continue
+                settings: dict[str, Any] = {"group": title, "order": order + 1 + len(out),
+                                            "tooltip": port.doc or ""}
+                if port.range:
+                    settings["ui_min"], settings["ui_max"] = port.range
+                value = n.values.get(pname, port.default)
+                out[pname] = ParameterInfo(pname, t, nid, n.kind, copy.deepcopy(value),
+                                           settings, pname)
+            if index > 0:
+                out[f"{lid}_visible"] = ParameterInfo(
+                    f"{lid}_visible", "switch", nid, n.kind, bool(e.get("visible", True)),
+                    {"group": title, "order": order,
+                     "tooltip": f"Show the {title} layer"}, f"{LAYER_VISIBLE}:{lid}")
     return out
 
 
@@ -452,7 +509,7 @@ def resolve(inst: InstanceDocument) -> ResolvedInstance:
 
 def _apply(inst: InstanceDocument, chain_docs: list[InstanceDocument], chain: list[Path],
            material: MaterialDocument) -> ResolvedInstance:
-    params = material_parameters(material)
+    params = material_parameters(material, layers=True)
     values = {n: copy.deepcopy(p.default) for n, p in params.items()}
     problems: list[Problem] = []
     anchor = Path(inst.path) if inst.path else Path.cwd() / "instance.json"
@@ -493,6 +550,15 @@ def _apply(inst: InstanceDocument, chain_docs: list[InstanceDocument], chain: li
     for name, p in params.items():
         n = doc.graph.nodes[p.node]
         v = values[name]
+        if p.port.startswith(LAYER_VISIBLE):  # a layer shown or hidden
+            lid = p.port.split(":", 1)[1]
+            for e in n.settings.get("layers", []):
+                if isinstance(e, dict) and e.get("id") == lid:
+                    e["visible"] = bool(v)
+            continue
+        if p.port != "value":  # a layer's input, on its stack
+            n.values[p.port] = copy.deepcopy(v)
+            continue
         if p.type == "texture":
             if name not in texture_dirs:
                 v = n.settings.get("path", "")  # the material's own, rebased above
