@@ -99,6 +99,38 @@ def test_create_layer_stack_button_in_a_new_material_adds_a_stack(qtbot):
     assert any(n.kind == "layer_stack" for n in w.controller.document.graph.nodes.values())
 
 
+def test_create_layer_stack_adopts_what_the_output_showed_as_its_base(qtbot, tmp_path):
+    from graphs_util import simple_material
+
+    from matedit.compiler.cpu_eval import evaluate
+    from matedit.compiler.lower import lower_document
+    from matedit.io.document import save
+    from matedit.nodes.twin import sphere_surface
+
+    save(simple_material(), tmp_path / "m.json")
+    w = make_window(qtbot, tmp_path / "m.json")
+    doc = w.controller.document
+    surface, _ = sphere_surface(16)
+    want = evaluate(lower_document(doc, w.controller.resolver), surface)
+    before = doc.graph.snapshot()
+    out_x = doc.graph.nodes["out"].position[0]
+    w.layers.create_button.click()
+    settle(qtbot, w)
+    stack = next(n for n in doc.graph.nodes.values() if n.kind == "layer_stack")
+    entries = stack.settings["layers"]
+    assert [e["name"] for e in entries] == ["From the graph"]
+    assert entries[0]["function"] == "library:layers/graph_input.json"  # outside the library
+    assert doc.graph.incoming("out", "attributes").src == stack.id
+    assert doc.graph.incoming(stack.id, "graph_attributes").src == "make"
+    assert doc.graph.nodes["out"].position[0] > out_x  # made room: the stack sits between
+    got = evaluate(lower_document(doc, w.controller.resolver), surface)
+    for f in ("baseColor", "roughness", "metallic"):  # the material looks as it did
+        np.testing.assert_array_equal(got[f], want[f], err_msg=f)
+    assert w.layers.stack is not None and len(w.layers.stack.layers) == 1
+    w.controller.undo_stack.undo()  # one step
+    assert doc.graph.snapshot() == before
+
+
 # --- 3 and 4. thumbnails show what the node outputs -------------------------------------------
 
 def _pixels(img) -> np.ndarray:

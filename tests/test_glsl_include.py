@@ -79,3 +79,32 @@ def test_map_log_leaves_code_quoted_in_messages_alone():
     asm = Assembly(text="", sources=["x.glsl", "y.glsl"])
     log = "1:100007(3): error: cannot convert vec3(1) to 0:2 here\n"
     assert asm.map_log(log) == "y.glsl:7(3): error: cannot convert vec3(1) to 0:2 here\n"
+
+
+def _expected(text: str, src: int) -> list[str]:
+    """What splicing a file without includes writes, written out: its `#line` then its lines."""
+    return [f"#line {src * 100_000 + 1} {src}", *text.splitlines()]
+
+
+def test_files_are_parsed_once_per_version_and_edits_or_removals_are_seen(tmp_path):
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    first = "float one() { return 1.0; }\n\n"  # a blank last line is kept
+    (lib / "a.glsl").write_text(first)
+    (lib / "b.glsl").write_text('\n#include "a.glsl"\n\nfloat two() { return 2.0; }\n')
+    asm = assemble("void main() {}", includes=["b.glsl"], roots=[lib])
+    lines = asm.text.splitlines()
+    # b: its #line, a blank line, then a spliced whole (a's #line and lines), back to line 3.
+    assert lines == ["#version 330 core", "#line 1 0", "", *_expected(first, 1), "#line 3 0",
+                     "", "float two() { return 2.0; }", "#line 200001 2", "void main() {}"]
+    assert asm.sources == ["b.glsl", "a.glsl", "<main>"]
+    assert assemble("void main() {}", includes=["b.glsl"], roots=[lib]).text == asm.text
+
+    edited = "float one() { return 1.5; }  // longer, so the size changes too\n"
+    (lib / "a.glsl").write_text(edited)
+    again = assemble("void main() {}", includes=["b.glsl"], roots=[lib])
+    assert "return 1.5" in again.text and "return 1.0" not in again.text
+
+    (lib / "a.glsl").unlink()
+    with pytest.raises(IncludeError, match="a.glsl"):
+        assemble("void main() {}", includes=["b.glsl"], roots=[lib])

@@ -50,10 +50,14 @@ def test_create_override_reset_switch_save_reopen(window, qtbot, tmp_path):
     editor = window.create_instance(str(MASTER), str(path))
     qtbot.addWidget(editor)
     assert json.loads(path.read_text())["parameters"] == {}
-    # grouped and ordered as the master's settings say
-    assert editor.panel.group_order() == [
-        ("Paint", ["paint_color", "wear_amount", "scratch_amount", "scratch_angle"]),
-        ("Rust", ["rust_on", "rust_amount", "rust_reach"])]
+    # grouped and ordered as the master's settings say; each layer's own inputs and its
+    # visibility follow in its group, and a layer with no parameter node of its own last
+    order = editor.panel.group_order()
+    assert [g for g, _ in order] == ["Paint", "Rust", "Bare Steel"]
+    assert order[0][1][:4] == ["paint_color", "wear_amount", "scratch_amount", "scratch_angle"]
+    assert order[0][1][4] == "paint_visible" and "paint_roughness" in order[0][1]
+    assert order[1][1][:4] == ["rust_on", "rust_amount", "rust_reach", "rust_visible"]
+    assert order[2][1] == ["steel_tint", "steel_roughness"]
     head, body = editor.panel.groups["Rust"]
     head.click()
     assert not head.isChecked() and body.isHidden()

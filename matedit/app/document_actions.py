@@ -42,6 +42,7 @@ from matedit.app.recovery import (
 )
 from matedit.graph.model import MaterialDocument, Node
 from matedit.graph.nodes import Role, kind_for
+from matedit.io import library
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import FormatError, dumps, load, loads, read_document_text, save
 
@@ -88,6 +89,15 @@ def _same_file(a: Path, b: Path) -> bool:
     except (OSError, RuntimeError, ValueError):
         return False
 
+
+
+def user_documents_dir() -> Path:
+    """The artist's documents folder (Qt's DocumentsLocation; the home folder without one),
+    where a copy of a shipped sample is suggested."""
+    from PySide6.QtCore import QStandardPaths
+
+    loc = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.DocumentsLocation)
+    return Path(loc) if loc and Path(loc).is_dir() else Path.home()
 
 class DocumentActions(QObject):
     """Owns the file-level state of one document controller inside a window."""
@@ -308,19 +318,32 @@ class DocumentActions(QObject):
 
     # --- save ------------------------------------------------------------------------------
     def save(self) -> bool:
-        if self.document.path is None:
+        """Saves to the document's file; a new document, or one opened from the read-only
+        built-in library, asks where (a copy in the artist's documents folder, suggested)."""
+        if self.document.path is None or library.inside(self.document.path):
             return self.save_as()
         return self._write(Path(self.document.path))
 
     def save_as(self) -> bool:
-        suggestion = str(self.document.path) if self.document.path else \
-            (self.document.name or "material").lower().replace(" ", "_") + ".json"
+        stem = (self.document.name or "material").lower().replace(" ", "_") + ".json"
+        if self.document.path is None:
+            suggestion = stem
+        elif library.inside(self.document.path):  # a copy of a shipped file, in Documents
+            suggestion = str(user_documents_dir() / Path(self.document.path).name)
+        else:
+            suggestion = str(self.document.path)
         path = self.ask_save_path(suggestion)
         if not path:
             return False
         return self._write(Path(path))
 
     def _write(self, path: Path) -> bool:
+        if library.inside(path.parent):
+            self.show_error("The built-in library is read-only",
+                            f"{path.name} would be written into matedit's own library of "
+                            "samples, layers and functions, which updates replace. Save a "
+                            "copy in a folder of your own (File ▸ Save As…).")
+            return False
         old_path = self.document.path
         old_recovery = self.recovery_file()
         old_name = self.document.name

@@ -9,12 +9,12 @@ inspector turns their signals into commands.
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QEvent, QObject, QSize, Qt, Signal
-from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap, QValidator
+from PySide6.QtGui import QColor, QImage, QImageReader, QPixmap
 from PySide6.QtWidgets import (
     QAbstractScrollArea,
     QApplication,
@@ -33,10 +33,19 @@ from PySide6.QtWidgets import (
 
 from matedit.app import file_dialogs
 from matedit.app.controller import new_merge_id
+from matedit.app.spinbox import (  # noqa: F401 - the field kit's names, used from here too
+    SPIN_LIMIT,
+    NumberSpin,
+    linear_to_srgb,
+    split_hdr,
+    srgb_to_linear,
+)
 from matedit.app.theme import icon
 
+if TYPE_CHECKING:
+    from matedit.app.hdr_picker import HdrColorDialog
+
 SLIDER_STEPS = 1000
-SPIN_LIMIT = 1e12  # a typed 1e9 stays 1e9 (float32 uniforms hold it)
 IMAGE_FILTER = "Images (*.png *.jpg *.jpeg *.tga *.tif *.tiff *.exr *.hdr *.bmp);;All files (*)"
 
 
@@ -60,40 +69,6 @@ def guard_wheel(widget: QWidget) -> QWidget:
     widget.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
     widget.installEventFilter(WheelGuard(widget))
     return widget
-
-
-# What a number field reads as a number while it is typed: a sign, digits with one decimal
-# separator ('.' or the locale's ','), and an exponent (1e9, 2.5E-3).
-_NUMBER = re.compile(r"[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?")
-_PARTIAL = re.compile(r"[+-]?(\d*([.,]\d*)?)([eE][+-]?\d*)?")
-
-
-class NumberSpin(QDoubleSpinBox):
-    """A spin box that reads what artists type: `1e9`, `2,5` as well as `2.5`, and shows a
-    large value in full (digits, not a cut-off "100000.000")."""
-
-    def validate(self, text: str, pos: int):  # noqa: D102 - Qt's
-        t = text.strip()
-        if _NUMBER.fullmatch(t):
-            return QValidator.State.Acceptable, text, pos
-        if _PARTIAL.fullmatch(t):
-            return QValidator.State.Intermediate, text, pos
-        return QValidator.State.Invalid, text, pos
-
-    def valueFromText(self, text: str) -> float:  # noqa: N802 - Qt's name
-        try:
-            v = float(text.strip().replace(",", "."))
-        except ValueError:
-            return self.value()
-        return min(max(v, self.minimum()), self.maximum()) if math.isfinite(v) else self.value()
-
-    def textFromValue(self, value: float) -> str:  # noqa: N802 - Qt's name
-        if abs(value) >= 1e4:  # no decimals past ten thousand: the digits fit the field
-            return f"{value:.0f}"
-        return f"{value:.{self.decimals()}f}"
-
-    def fixup(self, text: str) -> str:
-        return text.strip().replace(",", ".")
 
 
 def _spin(decimals: int = 3) -> QDoubleSpinBox:
@@ -224,24 +199,8 @@ class VectorField(QWidget):
         self.edited.emit(self.value(), None)
 
 
-def linear_to_srgb(c: float) -> float:
-    c = max(0.0, min(1.0, c))
-    return 12.92 * c if c <= 0.0031308 else 1.055 * c ** (1 / 2.4) - 0.055
-
-
-def srgb_to_linear(c: float) -> float:
-    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
-
-
-def split_hdr(rgb: list[float]) -> tuple[list[float], float]:
-    """An HDR linear colour as (colour with components <= 1, intensity >= 1)."""
-    peak = max(rgb) if rgb else 0.0
-    k = peak if peak > 1.0 else 1.0
-    return [c / k for c in rgb], k
-
-
 class ColorField(QWidget):
-    """A swatch (opens QColorDialog, in sRGB; stored linear) and an intensity multiplier, so
+    """A swatch (opens the float HDR picker; stored linear) and an intensity multiplier, so
     HDR colours (components above 1) stay editable."""
 
     edited = Signal(object, object)
@@ -269,7 +228,7 @@ class ColorField(QWidget):
         self._base: list[float] = []  # the first value is split afresh
         self.set_value(value)
         self.dialog_factory = QColorDialog.getColor  # replaced: a modal dialog (tests)
-        self.live_dialog: QColorDialog | None = None
+        self.live_dialog: HdrColorDialog | None = None
 
     def value(self) -> list[float]:
         k = float(self.intensity.value())
@@ -316,10 +275,10 @@ class ColorField(QWidget):
         v = self.value()
         self.swatch.setToolTip("linear RGB " + ", ".join(f"{c:.3f}" for c in v))
 
-    def pick(self) -> QColorDialog | None:
-        """A colour picker that stays open beside the canvas and edits live (one undo step
-        for the whole pick); the intensity field beside it makes the colour HDR. A replaced
-        `dialog_factory` (the stock modal dialog) is the fallback."""
+    def pick(self) -> HdrColorDialog | None:
+        """A float, HDR colour picker (matedit.app.hdr_picker) that stays open beside the
+        canvas and edits live (one undo step for the whole pick). A replaced
+        `dialog_factory` (a modal dialog returning a QColor) is used instead where set."""
         r, g, b = (int(round(linear_to_srgb(c) * 255)) for c in self._base)
         if self.dialog_factory is QColorDialog.getColor:
             return self._pick_live(QColor(r, g, b))
@@ -332,31 +291,21 @@ class ColorField(QWidget):
         self._paint()
         self.edited.emit(self.value(), None)
 
-    def _pick_live(self, start: QColor) -> QColorDialog:
+    def _pick_live(self, _start: QColor) -> HdrColorDialog:
+        from matedit.app.hdr_picker import HdrColorDialog
+
         if self.live_dialog is not None:
             self.live_dialog.raise_()
             return self.live_dialog
-        dlg = QColorDialog(start, self)
-        dlg.setWindowTitle("Colour (× intensity for HDR)")
-        dlg.setModal(False)
+        dlg = HdrColorDialog(self.value(), self, (list(self._base),
+                                                  float(self.intensity.value())))
         merge = new_merge_id()
-        before = self.value()
 
-        def changed(c: QColor) -> None:
-            if not c.isValid():
-                return
-            self._base = [round(srgb_to_linear(x), 6) for x in (c.redF(), c.greenF(),
-                                                                 c.blueF())]
-            self._unmute()
-            self._paint()
+        def changed(v: list[float]) -> None:  # Cancel comes back here too, in the same step
+            self.set_value(v)
             self.edited.emit(self.value(), merge)
 
-        def cancelled() -> None:  # back to the colour before the pick, in the same step
-            self.set_value(before)
-            self.edited.emit(self.value(), merge)
-
-        dlg.currentColorChanged.connect(changed)
-        dlg.rejected.connect(cancelled)
+        dlg.colorChanged.connect(changed)
         dlg.finished.connect(lambda _r: setattr(self, "live_dialog", None))
         dlg.show()
         self.live_dialog = dlg

@@ -1,5 +1,6 @@
-"""The Help menu's pages: a searchable keyboard reference, per-node documentation from the
-node catalogue (ports, types, defaults and ranges), and the About box."""
+"""The Help menu's pages: a searchable keyboard reference, the node reference (an index of
+every node kind of the catalogue, searchable, with each kind's ports, types, defaults and
+ranges and a thumbnail), and the About box."""
 
 from __future__ import annotations
 
@@ -7,20 +8,27 @@ import platform
 from html import escape
 
 from PySide6.QtCore import Qt
+from PySide6.QtGui import QPixmap
 from PySide6.QtWidgets import (
     QDialog,
     QDialogButtonBox,
     QHeaderView,
+    QLabel,
     QLineEdit,
     QMessageBox,
+    QSplitter,
     QTableWidget,
     QTableWidgetItem,
     QTextBrowser,
+    QTreeWidget,
+    QTreeWidgetItem,
     QVBoxLayout,
     QWidget,
 )
 
 from matedit.graph import nodes
+
+THUMB = 96  # the index's thumbnail, pixels
 
 # (keys, what it does, where): what is not a canvas command. The canvas's commands come from
 # its action table (`canvas_rows`), so the reference shows the keys the canvas answers to.
@@ -159,24 +167,140 @@ def node_doc_html(kind: str) -> str:
     return "\n".join(out)
 
 
-class NodeDocs(QDialog):
-    """A node kind's documentation; not modal, so it can stay open beside the canvas."""
+def kind_matches(kind: str, words: list[str]) -> bool:
+    """Whether every search word is in the kind's title, id, category, description or port
+    names (case-insensitive)."""
+    d = nodes.REGISTRY.get(kind)
+    if d is None:
+        return False
+    hay = " ".join([d.title, d.kind, d.category, d.description,
+                    *(p.name for p in (*d.inputs, *d.outputs, *d.values)),
+                    *(s.name for s in d.settings)]).lower()
+    return all(w in hay for w in words)
 
-    def __init__(self, kind: str, parent: QWidget | None = None) -> None:
+
+class NodeDocs(QDialog):
+    """Help › Node Reference: every node kind of the catalogue, by category, searchable by
+    name, category, description and port, with the kind's page and a thumbnail of its first
+    output at its defaults (the CPU evaluator on the preview sphere). Not modal, so it can
+    stay open beside the canvas."""
+
+    def __init__(self, kind: str = "", parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("nodeDocs")
         self.setWindowFlag(Qt.WindowType.Tool, True)
+        self.kind = ""
+        self._thumbs: dict[str, QPixmap | None] = {}
+        self.search = QLineEdit()
+        self.search.setPlaceholderText("Search nodes: name, category, port…")
+        self.search.setClearButtonEnabled(True)
+        self.search.textChanged.connect(self._filter)
+        self.tree = QTreeWidget()
+        self.tree.setHeaderHidden(True)
+        self.tree.setObjectName("nodeIndex")
+        self.count = QLabel()
+        self.thumbnail = QLabel()
+        self.thumbnail.setFixedSize(THUMB + 4, THUMB + 4)
+        self.thumbnail.setAlignment(Qt.AlignmentFlag.AlignCenter)
         self.browser = QTextBrowser()
+        left = QWidget()
+        ll = QVBoxLayout(left)
+        ll.setContentsMargins(0, 0, 0, 0)
+        ll.addWidget(self.search)
+        ll.addWidget(self.tree, 1)
+        ll.addWidget(self.count)
+        right = QWidget()
+        rl = QVBoxLayout(right)
+        rl.setContentsMargins(0, 0, 0, 0)
+        rl.addWidget(self.thumbnail)
+        rl.addWidget(self.browser, 1)
+        split = QSplitter()
+        split.addWidget(left)
+        split.addWidget(right)
+        split.setSizes([240, 560])
         lay = QVBoxLayout(self)
-        lay.addWidget(self.browser)
-        self.resize(620, 520)
-        self.show_kind(kind)
+        lay.addWidget(split)
+        self.resize(860, 600)
+        self._items: dict[str, QTreeWidgetItem] = {}
+        by_cat: dict[str, list] = {}
+        for d in nodes.REGISTRY.values():
+            by_cat.setdefault(d.category, []).append(d)
+        for cat in sorted(by_cat):
+            top = QTreeWidgetItem([cat])
+            top.setFlags(Qt.ItemFlag.ItemIsEnabled)
+            self.tree.addTopLevelItem(top)
+            for d in sorted(by_cat[cat], key=lambda d: d.title.lower()):
+                it = QTreeWidgetItem([d.title])
+                it.setData(0, Qt.ItemDataRole.UserRole, d.kind)
+                it.setToolTip(0, d.kind)
+                top.addChild(it)
+                self._items[d.kind] = it
+        self.tree.expandAll()
+        self.tree.currentItemChanged.connect(self._picked)
+        self._filter("")
+        self.show_kind(kind or min(self._items, key=lambda k: self._items[k].text(0).lower()))
 
     def show_kind(self, kind: str) -> None:
+        """Shows `kind`'s page; an unknown kind gets its own "unknown" page."""
         self.kind = kind
         d = nodes.REGISTRY.get(kind)
         self.setWindowTitle(f"{d.title if d else kind} — node reference")
         self.browser.setHtml(node_doc_html(kind))
+        self._show_thumbnail(kind)
+        it = self._items.get(kind)
+        if it is not None and self.tree.currentItem() is not it:
+            if it.isHidden():
+                self.search.clear()
+            self.tree.setCurrentItem(it)
+            self.tree.scrollToItem(it)
+
+    def shown_kinds(self) -> list[str]:
+        """The kinds the search leaves in the index, in its order."""
+        out = []
+        for i in range(self.tree.topLevelItemCount()):
+            top = self.tree.topLevelItem(i)
+            out += [top.child(j).data(0, Qt.ItemDataRole.UserRole)
+                    for j in range(top.childCount()) if not top.child(j).isHidden()]
+        return out
+
+    def _filter(self, text: str) -> None:
+        words = text.lower().split()
+        shown = 0
+        for i in range(self.tree.topLevelItemCount()):
+            top = self.tree.topLevelItem(i)
+            any_shown = False
+            for j in range(top.childCount()):
+                it = top.child(j)
+                ok = kind_matches(it.data(0, Qt.ItemDataRole.UserRole), words)
+                it.setHidden(not ok)
+                any_shown |= ok
+                shown += ok
+            top.setHidden(not any_shown)
+        self.count.setText(f"{shown} of {len(self._items)} node kinds")
+        kinds = self.shown_kinds()
+        if words and kinds and self.kind not in kinds:
+            self.show_kind(kinds[0])
+
+    def _picked(self, item: QTreeWidgetItem | None, _previous=None) -> None:
+        kind = item.data(0, Qt.ItemDataRole.UserRole) if item is not None else None
+        if kind and kind != self.kind:
+            self.show_kind(kind)
+
+    def _show_thumbnail(self, kind: str) -> None:
+        if kind not in self._thumbs:
+            from matedit.app.previews import kind_thumbnail
+
+            img = kind_thumbnail(kind, THUMB)
+            self._thumbs[kind] = QPixmap.fromImage(img) if img is not None else None
+        pix = self._thumbs[kind]
+        if pix is None:
+            self.thumbnail.clear()
+            self.thumbnail.setText("no preview")
+        else:
+            self.thumbnail.setPixmap(pix)
+
+    def has_thumbnail(self) -> bool:
+        return self._thumbs.get(self.kind) is not None
 
 
 def _version(dist: str) -> str:

@@ -163,12 +163,28 @@ class InstanceEditor(QWidget):
             return
         used = {u.parameter for u in self.compiled.ir.uniforms if u.parameter}
         used |= {t.parameter for t in self.compiled.ir.textures}
+        by_port = self._uniform_names()
         self.panel.set_live({n for n, p in self.parameters.items()
-                             if p.type == "switch" or n in used})
+                             if p.type == "switch" or n in used or n in by_port})
+
+    def _uniform_names(self) -> dict[str, str]:
+        """Parameter -> its uniform in the compiled instance: `p_<name>` for a parameter
+        node, the stack port's input uniform for a layer's input (none where compiled out)."""
+        if self.compiled is None:
+            return {}
+        at = {(u.node, u.port): u.name for u in self.compiled.ir.uniforms}
+        compiled = set(at.values())
+        out = {}
+        for n, p in self.parameters.items():
+            if p.type in ("scalar", "vector", "color"):
+                name = f"p_{n}" if p.port == "value" else at.get((p.node, p.port))
+                if name and name in compiled:
+                    out[n] = name
+        return out
 
     def _uniforms(self) -> dict[str, Any]:
-        return {f"p_{n}": v for n, v in self.resolved.values.items()
-                if self.parameters[n].type in ("scalar", "vector", "color")}
+        names = self._uniform_names()
+        return {names[n]: v for n, v in self.resolved.values.items() if n in names}
 
     def _textures(self) -> dict[str, Path | None]:
         out: dict[str, Path | None] = {}
@@ -185,7 +201,9 @@ class InstanceEditor(QWidget):
         elif kind == "texture":
             self.view.set_values({}, {f"t_{name}": self._textures()[f"t_{name}"]})
         else:
-            self.view.set_values({f"p_{name}": self.resolved.values[name]}, {})
+            uniform = self._uniform_names().get(name)
+            if uniform:
+                self.view.set_values({uniform: self.resolved.values[name]}, {})
 
     def set_value(self, name: str, value: Any) -> None:
         """Override `name` with `value` (an edit of a row overrides it)."""
@@ -418,7 +436,10 @@ def attach_instances(material_items: list[QTreeWidgetItem], files: list[Path],
     while pending and progress:  # parents first, whatever the file order
         progress = False
         for f, doc in list(pending):
-            parent_item = by_path.get(str(doc.parent_path().resolve()))
+            try:
+                parent_item = by_path.get(str(doc.parent_path().resolve()))
+            except ValueError:  # a library name that leads nowhere
+                parent_item = None
             if parent_item is None:
                 continue
             it = QTreeWidgetItem(parent_item, [doc.name or f.stem])

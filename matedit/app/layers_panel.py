@@ -38,6 +38,7 @@ from matedit.graph.commands import (
     Connect,
     Disconnect,
     Macro,
+    MoveNodes,
     SetSetting,
     SetValue,
 )
@@ -47,6 +48,11 @@ from matedit.graph.nodes import Role, kind_for, role_of
 from matedit.graph.ports import COLOR_LAYER_BLENDS, LAYER_BLENDS
 from matedit.io.document import FormatError, load
 from matedit.resources import graphs_dir
+
+# The base layer "Create layer stack" makes of what the output showed: one
+# MaterialAttributes input, passed through.
+GRAPH_LAYER = graphs_dir() / "layers" / "graph_input.json"
+STACK_SHIFT = 300.0  # how far the output moves right for the new stack
 
 LAYER_MIME = "application/x-matedit-layer"  # absolute path of a layer file (from the library)
 ROW_MIME = "application/x-matedit-layer-row"  # id of a layer being reordered
@@ -117,11 +123,20 @@ def wire_report(cmd) -> str:
 class _LayerRow(QWidget):
     """Eye, name, blend and opacity of one layer."""
 
+    def contextMenuEvent(self, ev) -> None:  # noqa: N802 - Qt's
+        s = self.panel.stack
+        menu = QMenu(self)
+        solo = s is not None and s.is_solo(self.layer_id)
+        act = menu.addAction("Show every layer" if solo else "Solo (alone over the base)")
+        act.triggered.connect(lambda _=False: self.panel.solo(self.layer_id))
+        self.panel.run_menu(menu, ev.globalPos())
+
     def __init__(self, panel: LayersPanel, layer: Layer, is_base: bool, opacity: float,
                  parked: list[dict] | None = None):
         super().__init__()
         self.setObjectName("layerRow")
         self.layer_id = layer.id
+        self.panel = panel
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 3, 4, 3)
         lay.setSpacing(2)
@@ -131,8 +146,9 @@ class _LayerRow(QWidget):
         self.eye.setCheckable(True)
         self.eye.setChecked(layer.visible)
         self.eye.setIcon(icon("eye" if layer.visible else "eye-off"))
-        self.eye.setToolTip("Show or hide this layer")
-        self.eye.toggled.connect(lambda on: panel.set_visible(layer.id, on))
+        self.eye.setToolTip("Show or hide this layer (Alt+click: this layer alone over the "
+                            "base, again: every layer)")
+        self.eye.clicked.connect(lambda on: panel.eye_clicked(layer.id, on))
         self.name = QLineEdit(layer.name or layer.id)
         self.name.setFrame(False)
         self.name.setStyleSheet("background: transparent; font-weight: bold;")
@@ -289,6 +305,7 @@ class LayersPanel(QWidget):
         super().__init__(parent)
         self.controller = controller
         self.costs: dict[str, tuple[float, float]] = {}  # layer id -> (instructions, share)
+        self.run_menu = lambda menu, at: menu.exec(at)  # tests read the menu instead
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.setSpacing(4)
@@ -454,6 +471,26 @@ class LayersPanel(QWidget):
     def set_visible(self, layer_id: str, on: bool) -> None:
         self._push(lambda s: s.set(layer_id, visible=bool(on)))
 
+    def eye_clicked(self, layer_id: str, on: bool) -> None:
+        """The eye: show or hide; with Alt, solo (`solo`)."""
+        from PySide6.QtWidgets import QApplication
+
+        if QApplication.keyboardModifiers() & Qt.KeyboardModifier.AltModifier:
+            self.solo(layer_id)
+        else:
+            self.set_visible(layer_id, on)
+
+    def solo(self, layer_id: str) -> bool:
+        """This layer alone over the base; on a solo layer, every layer shown again."""
+        s = self.stack
+        was = s.is_solo(layer_id) if s is not None else False
+        if not self._push(lambda st: st.solo(layer_id)):
+            return False
+        self.message.emit("Every layer shown" if was else
+                          f"Solo: {layer_id} over the base (Alt+click its eye again to show "
+                          "every layer)")
+        return True
+
     def set_blend(self, layer_id: str, blend: str | None) -> None:
         if not isinstance(blend, str) or not blend:  # a separator row
             return
@@ -533,22 +570,39 @@ class LayersPanel(QWidget):
         return None
 
     def create_stack(self, first_layer: Path | None = None) -> str | None:
-        """Adds a layer stack node (with a first layer) wired into the material output."""
-        graph = self.controller.document.graph
+        """Adds a layer stack node wired into the material output. What the output was
+        wired to is adopted as the base layer (the "From the graph" layer, whose input it
+        feeds), so the material looks as it did; `first_layer` goes on top of it. The id of
+        `first_layer`'s entry (or of the base, without one)."""
+        doc = self.controller.document
+        graph = doc.graph
+        out = next((n for n in sorted(graph.nodes.values(), key=lambda n: n.id)
+                    if role_of(n.kind) == Role.MATERIAL_OUTPUT), None)
+        fed = graph.incoming(out.id, "attributes") if out is not None else None
         entries = []
         lid = None
+        if fed is not None:  # adopt the graph the output shows as the base layer
+            lid = "graph"
+            entries.append(Layer(lid, reference_for(doc, GRAPH_LAYER), "From the graph",
+                                 "alpha").to_json())
         if first_layer is not None:
             fn = load(first_layer)
             lid = "".join(c for c in first_layer.stem.split("_")[0] if c.isalnum()) or "layer"
             lid = (lid if lid[0].isalpha() else "l" + lid) + "1"
-            entries.append(Layer(lid, reference_for(self.controller.document, first_layer),
+            lid = lid if lid != "graph" else "graph2"
+            entries.append(Layer(lid, reference_for(doc, first_layer),
                                  fn.name or first_layer.stem).to_json())
-        out = next((n for n in sorted(graph.nodes.values(), key=lambda n: n.id)
-                    if role_of(n.kind) == Role.MATERIAL_OUTPUT), None)
-        pos = (out.position[0] - 260, out.position[1]) if out else (0.0, 0.0)
         sid = graph.new_id("stack")
-        cmds = [AddNode(Node(sid, kind_for(Role.LAYER_STACK), pos, {"layers": entries}))]
-        if out is not None and graph.incoming(out.id, "attributes") is None:
+        # The stack takes the output's place and the output moves right, so the stack sits
+        # between what fed the output and the output, on neither.
+        pos = out.position if out is not None else (0.0, 0.0)
+        cmds: list = [AddNode(Node(sid, kind_for(Role.LAYER_STACK), pos, {"layers": entries}))]
+        if out is not None:
+            cmds.append(MoveNodes({out.id: (out.position[0] + STACK_SHIFT, out.position[1])}))
+        if fed is not None:
+            cmds += [Disconnect(fed),
+                     Connect(Link(fed.src, fed.src_port, sid, f"{entries[0]['id']}_attributes"))]
+        if out is not None:
             cmds.append(Connect(Link(sid, "attributes", out.id, "attributes")))
         if not self.controller.push(Macro(cmds, text="add layer stack")):
             return None

@@ -154,10 +154,12 @@ class MainWindow(QMainWindow):
         self._shortcuts.raise_()
         return self._shortcuts
 
-    def show_docs(self, kind: str) -> NodeDocs:
+    def show_docs(self, kind: str = "") -> NodeDocs:
+        """The node reference, at `kind` (empty: where it was, or its first kind)."""
         if self._docs is None:
             self._docs = NodeDocs(kind, self)
-        self._docs.show_kind(kind)
+        elif kind:
+            self._docs.show_kind(kind)
         self._docs.show()
         self._docs.raise_()
         return self._docs

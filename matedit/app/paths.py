@@ -7,6 +7,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from matedit.graph.model import MaterialDocument
+from matedit.io import library
+from matedit.io.document import reference_from
 
 if TYPE_CHECKING:
     from matedit.compiler.api import CompiledMaterial
@@ -19,7 +21,7 @@ def reference_for(doc: MaterialDocument, target: str | os.PathLike) -> str:
     if doc.path is None:
         return target.as_posix()
     try:
-        return Path(os.path.relpath(target, Path(doc.path).resolve().parent)).as_posix()
+        return reference_from(target, Path(doc.path).resolve().parent)
     except ValueError:  # another drive on Windows
         return target.as_posix()
 
@@ -27,6 +29,11 @@ def reference_for(doc: MaterialDocument, target: str | os.PathLike) -> str:
 def absolute_of(doc: MaterialDocument, ref: str) -> Path | None:
     if not ref:
         return None
+    if library.is_library_ref(ref):
+        try:
+            return library.library_path(ref)
+        except ValueError:
+            return None
     p = Path(ref)
     if p.is_absolute():
         return p
@@ -44,7 +51,7 @@ def relativise_references(doc: MaterialDocument, new_path: Path) -> None:
         ref = container[key]
         if isinstance(ref, str) and ref and Path(ref).is_absolute():
             try:
-                container[key] = Path(os.path.relpath(ref, base)).as_posix()
+                container[key] = reference_from(Path(ref), base)
             except ValueError:
                 pass
 

@@ -23,7 +23,7 @@ from matedit.compiler.cpu_eval import evaluate
 from matedit.compiler.cpu_nodes import SurfaceArrays
 from matedit.compiler.lower import CompileError, lower_document
 from matedit.graph import nodes
-from matedit.graph.nodes import Thumbnail
+from matedit.graph.nodes import Role, Thumbnail
 from matedit.graph.types import PortType
 from matedit.nodes.twin import sphere_surface
 from matedit.shading import thumbnail
@@ -67,6 +67,44 @@ def to_image(value, inside: np.ndarray | None = None, size: int = SIZE) -> QImag
     pixels = np.ascontiguousarray((srgb * 255 + 0.5).astype(np.uint8).reshape(size, size, 3))
     img = QImage(pixels.data, size, size, 3 * size, QImage.Format.Format_RGB888)
     return img.copy()  # own the pixels
+
+
+def kind_thumbnail(kind: str, size: int = SIZE) -> QImage | None:
+    """A node kind alone, at its defaults: its first float, vector or MaterialAttributes
+    output on the preview sphere, as the canvas shows it (the Node Reference's picture).
+    None for kinds that need a wire, a function or a texture to make a value."""
+    from matedit.graph.model import DocumentKind, MaterialDocument, Node
+    from matedit.io.document import FileResolver
+
+    d = nodes.get(kind)
+    if d is None or d.role == Role.MATERIAL_OUTPUT:
+        return None
+    doc = MaterialDocument(kind=DocumentKind.MATERIAL, name="reference")
+    doc.graph.nodes["n"] = Node("n", kind, (0.0, 0.0), {s.name: s.default for s in d.settings})
+    doc.graph.nodes["out"] = Node("out", nodes.kind_for(Role.MATERIAL_OUTPUT))
+    surface, inside = preview_sphere(size)
+    probe: dict = {}
+    try:
+        ir = lower_document(doc, FileResolver())
+        with np.errstate(all="ignore"):
+            evaluate(ir, surface, textures={}, probe=probe)
+    except (CompileError, LookupError, ValueError, KeyError, TypeError, FloatingPointError):
+        return None
+    n = size * size
+    for o in d.outputs:
+        value = probe.get(f"n.{o.name}")
+        if value is None:
+            continue
+        if not isinstance(value, dict):
+            a = np.asarray(value, dtype=np.float64)
+            if a.ndim == 0 or (a.ndim == 1 and len(a) in (2, 3, 4)):  # a constant
+                a = np.broadcast_to(a, (n,) + a.shape)
+            if a.shape[0] != n or a.ndim > 2 or (a.ndim == 2 and a.shape[1] > 4):
+                return None  # not a picture (a matrix, a struct of arrays)
+            value = a
+        with np.errstate(all="ignore"):
+            return to_image(value, inside, size)
+    return None
 
 
 class TextureCache:

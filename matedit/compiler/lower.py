@@ -8,6 +8,7 @@ conversions (a float splatted to a vector) are made explicit here.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -185,12 +186,41 @@ class _Lowerer:
         for nid in self.a.order:
             node = self.doc.graph.nodes[nid]
             role = nodes.role_of(node.kind)
+            if node.muted and role == Role.LAYER_STACK:
+                # A bypassed stack is its base layer: every layer above it hidden.
+                layers = node.settings.get("layers")
+                if isinstance(layers, list):
+                    node = dataclasses.replace(node, settings={**node.settings, "layers": [
+                        e if i == 0 or not isinstance(e, dict) else {**e, "visible": False}
+                        for i, e in enumerate(layers)]})
+            elif node.muted and nodes.can_bypass(node.kind):
+                self._bypass(nid)
+                continue
             special = getattr(self, f"_k_{role.name.lower()}", None) if role else None
             (special or self._generic)(nid, node)
         for (nid, port), e in self.alias.items():
             # An alias is what the node outputs (a layer stack's blended result), even where
             # the node also emitted ops under its id (the layers' calls).
             self.scope.sockets[(nid, port)] = e
+
+    def _bypass(self, nid: str) -> None:
+        """A bypassed (muted) node emits nothing: each output is its first input of the
+        output's type, as wired or at its value (still a uniform, so its slider works), or
+        the type's zero (a default MaterialAttributes) when it has no such input."""
+        ins, ports = self.a.in_types[nid], self.a.ports[nid]
+        for o in ports.outputs:
+            t = self.a.out_types[nid][o.name]
+            through = next((p for p in ports.inputs if ins[p.name] == t), None)
+            if through is not None:
+                self.alias[(nid, o.name)] = self.arg(nid, through.name, t, through.default)
+            elif t == MA:
+                self.alias[(nid, o.name)] = Lit(None, PortType.MATERIAL)
+            elif t.is_numeric:
+                self.alias[(nid, o.name)] = convert(literal(PortType.FLOAT, 0.0), t)
+            else:
+                raise CompileError([Diagnostic(
+                    Severity.ERROR, f"a bypassed node has no {t.value} input to pass through to "
+                    f"{o.name!r}; un-bypass it", nid, o.name, self.file)])
 
     def _inputs(self, nid: str) -> list[Expr]:
         ins = self.a.in_types[nid]

@@ -66,6 +66,52 @@ class Assembly:
         return _ERROR_LOC.sub(repl, log)
 
 
+@dataclass(frozen=True)
+class _Parsed:
+    """A file's lines split at its `#include` lines: `chunks[k]` is the text (lines joined by
+    newlines, None when there are none) before include k, `includes[k]` its (line number,
+    name)."""
+
+    chunks: tuple[str | None, ...]
+    includes: tuple[tuple[int, str], ...]
+
+
+def _parse(text: str) -> _Parsed:
+    chunks: list[str | None] = []
+    includes: list[tuple[int, str]] = []
+    run: list[str] = []
+    for i, line in enumerate(text.splitlines(), start=1):
+        m = _INCLUDE.match(line) if "include" in line else None
+        if m is None:
+            run.append(line)
+            continue
+        chunks.append("\n".join(run) if run else None)
+        includes.append((i, m.group(1)))
+        run = []
+    chunks.append("\n".join(run) if run else None)
+    return _Parsed(tuple(chunks), tuple(includes))
+
+
+# Library files parsed once per version of the file: (mtime_ns, size) -> its parse. Every
+# compile splices the same few dozen files, so a structural edit re-reads none of them; an
+# edited shader (a new mtime or size) is read again.
+_FILES: dict[Path, tuple[int, int, _Parsed]] = {}
+# Where an include name was found, and a file's name relative to the roots: the lookups are
+# stat and resolve calls, and the same few dozen repeat on every compile.
+_FOUND: dict[tuple[str, Path | None, tuple[Path, ...]], Path] = {}
+_NAMES: dict[tuple[Path, tuple[Path, ...]], str] = {}
+
+
+def _parsed_file(path: Path) -> _Parsed:
+    st = path.stat()
+    hit = _FILES.get(path)
+    if hit is not None and hit[0] == st.st_mtime_ns and hit[1] == st.st_size:
+        return hit[2]
+    parsed = _parse(path.read_text())
+    _FILES[path] = (st.st_mtime_ns, st.st_size, parsed)
+    return parsed
+
+
 class Assembler:
     """Splices includes; one instance per generated shader (source numbering is per shader)."""
 
@@ -75,6 +121,12 @@ class Assembler:
         self._seen: set[Path] = set()
 
     def _name(self, path: Path) -> str:
+        key = (path, tuple(self.roots))
+        if key not in _NAMES:
+            _NAMES[key] = self._relative_name(path)
+        return _NAMES[key]
+
+    def _relative_name(self, path: Path) -> str:
         for root in self.roots:
             try:
                 return path.resolve().relative_to(root.resolve()).as_posix()
@@ -83,10 +135,15 @@ class Assembler:
         return str(path)
 
     def _resolve(self, name: str, base: Path | None, where: str) -> Path:
+        key = (name, base, tuple(self.roots))
+        found = _FOUND.get(key)
+        if found is not None:
+            return found
         candidates = ([base / name] if base else []) + [r / name for r in self.roots]
         for c in candidates:
             if c.is_file():
-                return c.resolve()
+                _FOUND[key] = c.resolve()
+                return _FOUND[key]
         raise IncludeError(f'{where}: cannot find include "{name}"')
 
     def source_number(self, name: str) -> int:
@@ -108,22 +165,30 @@ class Assembler:
         if path in self._seen:
             return ""
         self._seen.add(path)
-        return self._expand_lines(path.read_text(), self._name(path), path.parent, (*stack, path))
+        try:
+            parsed = _parsed_file(path)
+        except OSError as e:  # found once, gone (or unreadable) now: look again next time
+            _FOUND.clear()
+            raise IncludeError(f"cannot read include {self._name(path)}: {e.strerror}") from e
+        return self._expand(parsed, self._name(path), path.parent, (*stack, path))
 
     def _expand_lines(self, text: str, name: str, base: Path | None, stack: tuple) -> str:
+        return self._expand(_parse(text), name, base, stack)
+
+    def _expand(self, parsed: _Parsed, name: str, base: Path | None, stack: tuple) -> str:
         src = self.source_number(name)
         out = [_line_directive(1, src)]
-        for i, line in enumerate(text.splitlines(), start=1):
-            m = _INCLUDE.match(line)
-            if not m:
-                out.append(line)
-                continue
-            target = self._resolve(m.group(1), base, f"{name}:{i}")
+        if parsed.chunks[0] is not None:
+            out.append(parsed.chunks[0])
+        for (i, target_name), chunk in zip(parsed.includes, parsed.chunks[1:]):
+            target = self._resolve(target_name, base, f"{name}:{i}")
             spliced = self._splice(target, stack)
             if spliced:
                 out.append(spliced)
             # Back in this file: the next line is line i + 1 (GLSL >= 330 semantics).
             out.append(_line_directive(i + 1, src))
+            if chunk is not None:
+                out.append(chunk)
         return "\n".join(out)
 
     def assembly(self, text: str) -> Assembly:

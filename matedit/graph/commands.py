@@ -215,6 +215,35 @@ class SetLabel(Command):
 
 
 @dataclass
+class SetMuted(Command):
+    """Bypasses (mutes) nodes, or lets them work again: a bypassed node passes its first input
+    of each output's type through (matedit.compiler.lower), so a look can be seen without
+    it and brought back without rewiring. Structural: the generated code changes."""
+
+    node_ids: tuple[str, ...]
+    muted: bool
+    text: str = "bypass nodes"
+    _old: dict[str, bool] = field(default_factory=dict)
+
+    def apply(self, graph):
+        for nid in self.node_ids:
+            node = graph.nodes.get(nid)
+            if node is None:
+                raise CommandError(f"no node {nid!r}")
+            if self.muted and not nodes.can_bypass(node.kind):
+                d = nodes.REGISTRY.get(node.kind)
+                raise CommandError(f"{d.title if d else node.kind} cannot be bypassed: it "
+                                   "has no input to pass through")
+        self._old = {nid: graph.nodes[nid].muted for nid in self.node_ids}
+        for nid in self.node_ids:
+            graph._set_muted(nid, self.muted)
+
+    def revert(self, graph):
+        for nid, was in self._old.items():
+            graph._set_muted(nid, was)
+
+
+@dataclass
 class PutComment(Command):
     """Adds, edits (same id) or, with comment=None, removes a comment frame."""
 

@@ -163,6 +163,27 @@ class LayerStack:
         # The layer that becomes the base parks its blend wires; the old base gets its back.
         return self._set(entries, f"move layer {layer_id}")
 
+    def is_solo(self, layer_id: str) -> bool:
+        """Whether `layer_id` is the only layer shown over the base (or the base alone)."""
+        entries = self._entries()
+        return any(e["id"] == layer_id for e in entries) and all(
+            bool(e.get("visible", True)) == (e["id"] == layer_id)
+            for e in entries[1:])  # the base always shows
+
+    def solo(self, layer_id: str) -> Command:
+        """Shows `layer_id` alone over the base (the base alone, for the base) by hiding the
+        other layers; on a layer already solo, shows every layer again."""
+        entries = self._entries()
+        if not any(e["id"] == layer_id for e in entries):
+            raise CommandError(f"no layer {layer_id!r}")
+        if self.is_solo(layer_id):
+            for e in entries:
+                e["visible"] = True
+            return self._set(entries, "show every layer")
+        for e in entries[1:]:
+            e["visible"] = e["id"] == layer_id
+        return self._set(entries, f"solo layer {layer_id}")
+
     def set(self, layer_id: str, **changes) -> Command:
         """Changes a layer's name, blend, visibility or function."""
         entries = self._entries()

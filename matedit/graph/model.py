@@ -50,6 +50,8 @@ class Node:
     label: str = ""
     # Fields of the file's node object this version does not know: kept and written back.
     extra: dict[str, Any] = field(default_factory=dict)
+    # Bypassed: its first input of each output's type passes through (graph.bypass)
+    muted: bool = False
 
     def clone(self) -> Node:
         return copy.deepcopy(self)
@@ -141,7 +143,7 @@ class MaterialGraph:
         return (
             sorted(
                 (n.id, n.kind, n.position, repr(sorted(n.settings.items())),
-                 repr(sorted(n.values.items())), n.label)
+                 repr(sorted(n.values.items())), n.label, n.muted)
                 for n in self.nodes.values()
             ),
             sorted(self.links),
@@ -190,6 +192,10 @@ class MaterialGraph:
     def _set_position(self, node_id: str, pos: tuple[float, float]) -> None:
         self.nodes[node_id].position = (float(pos[0]), float(pos[1]))
         self.emit(ChangeEvent(ChangeKind.LAYOUT, "moved", (node_id,)))
+
+    def _set_muted(self, node_id: str, muted: bool) -> None:
+        self.nodes[node_id].muted = bool(muted)
+        self.emit(ChangeEvent(ChangeKind.STRUCTURAL, "muted", (node_id,)))
 
     def _set_label(self, node_id: str, label: str) -> None:
         self.nodes[node_id].label = label

@@ -20,6 +20,7 @@ from typing import Any
 
 from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.nodes import Role, role_of
+from matedit.io import library
 from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
 from matedit.io.errors import FormatError
 from matedit.io.jsontext import JSONTextError, check_json_value, parse_json
@@ -179,8 +180,10 @@ def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocumen
         _expect(isinstance(values, dict), file, "values must be an object", nid, "values")
         label = n.get("label", "")
         _expect(isinstance(label, str), file, "label must be a string", nid, "label")
+        muted = n.get("muted", False)
+        _expect(isinstance(muted, bool), file, "muted must be true or false", nid, "muted")
         doc.graph.nodes[nid] = Node(nid, kind, (float(pos[0]), float(pos[1])), settings,
-                                    values, label, _unknown(n, NODE_FIELDS))
+                                    values, label, _unknown(n, NODE_FIELDS), muted)
 
     links = raw.get("links", [])
     _expect(isinstance(links, list), file, "'links' must be a list", field="links")
@@ -226,7 +229,7 @@ def _from_dict(raw: Any, file: str | None, path: Path | None) -> MaterialDocumen
 
 TOP_FIELDS = frozenset({"format", "version", "name", "description", "preview", "nodes",
                         "links", "comments"})
-NODE_FIELDS = frozenset({"id", "kind", "position", "settings", "values", "label"})
+NODE_FIELDS = frozenset({"id", "kind", "position", "settings", "values", "label", "muted"})
 LINK_FIELDS = frozenset({"from", "to"})
 COMMENT_FIELDS = frozenset({"id", "text", "rect", "color"})
 
@@ -255,6 +258,8 @@ def to_dict(doc: MaterialDocument) -> dict:
             entry["values"] = n.values
         if n.label:
             entry["label"] = n.label
+        if n.muted:
+            entry["muted"] = True
         out["nodes"].append(entry)
     if g.comments:
         out["comments"] = [
@@ -297,19 +302,33 @@ def reference_fields(doc: MaterialDocument):
 
 
 def rebase_references(doc: MaterialDocument, new_path: Path) -> None:
-    """Rewrites relative references so they still point at the same files from `new_path`."""
+    """Rewrites relative references so they still point at the same files from `new_path`.
+    Saved outside the built-in library, a reference to a library file becomes its stable
+    `library:` name (matedit.io.library); `library:` names are kept as they are."""
     if doc.path is None:
         return
     old_dir = Path(os.path.realpath(doc.path)).parent
     new_dir = Path(os.path.realpath(new_path)).parent
-    if old_dir == new_dir:
-        return
     for container, key in reference_fields(doc):
         ref = container[key]
-        if not ref or Path(ref).is_absolute():
+        if not ref or library.is_library_ref(ref) or Path(ref).is_absolute():
             continue
         target = Path(os.path.realpath(old_dir / ref))
-        container[key] = Path(os.path.relpath(target, new_dir)).as_posix()
+        new = reference_from(target, new_dir)
+        # In the same folder only a path into the library changes (to its library name: how
+        # documents written before library names migrate on their next save).
+        if old_dir != new_dir or library.is_library_ref(new):
+            container[key] = new
+
+
+def reference_from(target: Path, folder: Path) -> str:
+    """How a document in `folder` refers to `target`: its library name when the target is in
+    the built-in library and the document is not, else the relative path."""
+    if not library.inside(folder):
+        name = library.library_name(target)
+        if name is not None:
+            return name
+    return Path(os.path.relpath(target, folder)).as_posix()
 
 
 def save(doc: MaterialDocument, path: str | os.PathLike | None = None) -> Path:
@@ -370,6 +389,8 @@ class FileResolver:
         self._recent: dict[Path, tuple[tuple[int, int, int, int], MaterialDocument]] = {}
 
     def path_of(self, ref: str, owner: MaterialDocument | None) -> Path:
+        if library.is_library_ref(ref):
+            return library.library_path(ref)  # ValueError for a name out of the library
         base = Path(owner.path).parent if owner is not None and owner.path else Path.cwd()
         return Path(os.path.realpath(base / ref))
 

@@ -39,6 +39,7 @@ from matedit.graph.model import MaterialDocument
 from matedit.graph.names import identifier_problem
 from matedit.graph.nodes import REGISTRY
 from matedit.graph.numbers import describe_number, gpu_number_problem, gpu_numbers_problem
+from matedit.io import library
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import (
     FormatError,
@@ -46,6 +47,7 @@ from matedit.io.document import (
     parse_json_text,
     read_document_text,
     rebase_references,
+    reference_from,
 )
 from matedit.io.jsontext import JSONTextError, parse_json
 from matedit.io.migrations import CURRENT_VERSION
@@ -83,6 +85,8 @@ class InstanceDocument:
     extra: dict[str, Any] = field(default_factory=dict)  # unknown fields, kept on save
 
     def parent_path(self) -> Path:
+        if library.is_library_ref(self.parent):
+            return library.library_path(self.parent)  # ValueError out of the library
         base = Path(self.path).parent if self.path else Path.cwd()
         return base / self.parent
 
@@ -97,6 +101,9 @@ class ParameterInfo:
     kind: str
     default: Any  # the material's own value
     settings: dict[str, Any]  # presentation: group, order, ui_min, ui_max, tooltip, ...
+    # Where the value goes: a parameter node's `value`; for a layer's input, the layer
+    # stack's port (`LAYER_VISIBLE` for a layer's visibility switch)
+    port: str = "value"
 
     @property
     def group(self) -> str:
@@ -275,10 +282,15 @@ def rebase(doc: InstanceDocument, new_path: Path, parameters: dict[str, Paramete
     """Rewrites the parent, texture overrides and preview files for a file at `new_path`."""
     old_dir = Path(doc.path).parent if doc.path else Path.cwd()
     new_dir = Path(new_path).parent
+    if not library.is_library_ref(doc.parent) and not Path(doc.parent).is_absolute():
+        parent = reference_from(Path(os.path.realpath(old_dir / doc.parent)),
+                                Path(os.path.realpath(new_dir)))
+        # In the same folder only a parent in the library changes (to its library name).
+        if library.is_library_ref(parent) or \
+                os.path.realpath(old_dir) != os.path.realpath(new_dir):
+            doc.parent = parent
     if os.path.realpath(old_dir) == os.path.realpath(new_dir):
         return
-    if not Path(doc.parent).is_absolute():
-        doc.parent = _relative(old_dir / doc.parent, new_dir)
     for name, value in doc.parameters.items():
         known = (parameters or {}).get(name)
         is_tex = (known.type == "texture") if known else doc.parent_parameters.get(name) == \
@@ -331,8 +343,12 @@ def save_instance(doc: InstanceDocument, path: str | os.PathLike | None = None,
 
 # --- parameters of a material ---------------------------------------------------------------
 
-def material_parameters(doc: MaterialDocument) -> dict[str, ParameterInfo]:
-    """The parameters a material exposes (the top graph's parameter and switch nodes)."""
+def material_parameters(doc: MaterialDocument, layers: bool = False,
+                        resolver=None) -> dict[str, ParameterInfo]:
+    """The parameters a material exposes (the top graph's parameter and switch nodes). With
+    `layers`, also every layer's unwired inputs on each layer stack (named as the stack's
+    port, `<layer>_<input>`, grouped by layer name) and a visibility switch per layer above
+    the base (`<layer>_visible`), as an instance sees them."""
     out: dict[str, ParameterInfo] = {}
     for nid in sorted(doc.graph.nodes):
         n = doc.graph.nodes[nid]
@@ -351,6 +367,56 @@ def material_parameters(doc: MaterialDocument) -> dict[str, ParameterInfo]:
         else:
             default = n.values.get("value", d.values[0].default if d.values else 0.0)
         out[name] = ParameterInfo(name, t, nid, n.kind, copy.deepcopy(default), settings)
+    if layers:
+        for name, p in _layer_parameters(doc, resolver).items():
+            out.setdefault(name, p)  # a parameter node of the same name wins
+    return out
+
+
+LAYER_VISIBLE = "@visible"  # a layer's visibility switch: no port, the layer's entry
+LAYER_ORDER = 10_000  # layer parameters' `order`, past any a parameter node sets
+_LAYER_TYPES = {"float": "scalar", "vec3": "color", "vec4": "vector"}
+
+
+def _layer_parameters(doc: MaterialDocument, resolver) -> dict[str, ParameterInfo]:
+    from matedit.graph.nodes import Role, role_of
+    from matedit.graph.ports import layer_entries, node_ports
+    from matedit.io.document import FileResolver
+
+    resolver = resolver if resolver is not None else FileResolver()
+    out: dict[str, ParameterInfo] = {}
+    wired = {(l.dst, l.dst_port) for l in doc.graph.links}
+    for nid in sorted(doc.graph.nodes):
+        n = doc.graph.nodes[nid]
+        if role_of(n.kind) != Role.LAYER_STACK:
+            continue
+        try:
+            ports = {p.name: p for p in node_ports(n, resolver, doc).inputs}
+        except (LookupError, ValueError, OSError):
+            continue  # the material's own validation reports it
+        for index, e in enumerate(layer_entries(n)):
+            lid, title = e["id"], str(e.get("name") or e["id"])
+            prefix = f"{lid}_"
+            # after the material's own parameters, in a group and among groups; top layer
+            # last, as the stack reads from the base up
+            order = LAYER_ORDER + 100 * index
+            for pname, port in ports.items():
+                t = _LAYER_TYPES.get(str(port.type))
+                if not pname.startswith(prefix) or t is None or (nid, pname) in wired \
+                        or pname.endswith("_mask"):
+                    continue
+                settings: dict[str, Any] = {"group": title, "order": order + 1 + len(out),
+                                            "tooltip": port.doc or ""}
+                if port.range:
+                    settings["ui_min"], settings["ui_max"] = port.range
+                value = n.values.get(pname, port.default)
+                out[pname] = ParameterInfo(pname, t, nid, n.kind, copy.deepcopy(value),
+                                           settings, pname)
+            if index > 0:
+                out[f"{lid}_visible"] = ParameterInfo(
+                    f"{lid}_visible", "switch", nid, n.kind, bool(e.get("visible", True)),
+                    {"group": title, "order": order,
+                     "tooltip": f"Show the {title} layer"}, f"{LAYER_VISIBLE}:{lid}")
     return out
 
 
@@ -405,8 +471,11 @@ def resolve(inst: InstanceDocument) -> ResolvedInstance:
     chain: list[Path] = [_real(inst.path) if inst.path else Path("<unsaved instance>")]
     current = inst
     while True:
-        ppath = current.parent_path()
         here = str(current.path) if current.path else "<instance>"
+        try:
+            ppath = current.parent_path()
+        except ValueError as exc:
+            raise InstanceError(here, f"parent {current.parent}: {exc}") from None
         if len(chain) > MAX_CHAIN:
             raise InstanceError(here, f"the parent chain is more than {MAX_CHAIN} deep")
         real = _real(ppath)
@@ -440,7 +509,7 @@ def resolve(inst: InstanceDocument) -> ResolvedInstance:
 
 def _apply(inst: InstanceDocument, chain_docs: list[InstanceDocument], chain: list[Path],
            material: MaterialDocument) -> ResolvedInstance:
-    params = material_parameters(material)
+    params = material_parameters(material, layers=True)
     values = {n: copy.deepcopy(p.default) for n, p in params.items()}
     problems: list[Problem] = []
     anchor = Path(inst.path) if inst.path else Path.cwd() / "instance.json"
@@ -481,6 +550,15 @@ def _apply(inst: InstanceDocument, chain_docs: list[InstanceDocument], chain: li
     for name, p in params.items():
         n = doc.graph.nodes[p.node]
         v = values[name]
+        if p.port.startswith(LAYER_VISIBLE):  # a layer shown or hidden
+            lid = p.port.split(":", 1)[1]
+            for e in n.settings.get("layers", []):
+                if isinstance(e, dict) and e.get("id") == lid:
+                    e["visible"] = bool(v)
+            continue
+        if p.port != "value":  # a layer's input, on its stack
+            n.values[p.port] = copy.deepcopy(v)
+            continue
         if p.type == "texture":
             if name not in texture_dirs:
                 v = n.settings.get("path", "")  # the material's own, rebased above

@@ -336,6 +336,22 @@ def role_of(kind: str) -> Role | None:
     return d.role if d is not None else None
 
 
+# Kinds with nothing to pass through when bypassed: sources (parameters, constants, the
+# function's inputs) and the ends of a graph (outputs).
+_NOT_BYPASSED = frozenset({Role.CONSTANT, Role.SCALAR_PARAMETER, Role.VECTOR_PARAMETER,
+                           Role.COLOR_PARAMETER, Role.TEXTURE_PARAMETER, Role.FUNCTION_INPUT,
+                           Role.FUNCTION_OUTPUT, Role.MATERIAL_OUTPUT, Role.REROUTE})
+
+
+def can_bypass(kind: str) -> bool:
+    """Whether a node of `kind` can be bypassed (muted): it has outputs and inputs, or
+    inputs its settings make (a layer stack's layers, a function call's signature)."""
+    d = REGISTRY.get(kind)
+    if d is None or d.role in _NOT_BYPASSED:
+        return False
+    return bool(d.outputs or d.ports_rule) and bool(d.inputs or d.ports_rule)
+
+
 def kind_for(role: Role) -> str:
     """The kind that plays `role`, to create a node of it (a new material's output, say)."""
     for d in REGISTRY.values():

@@ -75,6 +75,16 @@ TABLE: tuple[CanvasCommand, ...] = (
                   tip="Frame the selected nodes in a comment", enabled=_has_nodes_selected),
     CanvasCommand("rename", "&Rename Node", lambda v: v.rename_selected(), ("F2",),
                   tip="Rename the selected node", enabled=_one_node_selected),
+    CanvasCommand("collapse", "Collapse to &Function…", lambda v: v.collapse_selection(),
+                  ("Ctrl+G",), tip="Move the selected nodes into a new material function "
+                  "file; the cut wires become its inputs and outputs, and a call takes their "
+                  "place", enabled=_has_nodes_selected),
+    CanvasCommand("expand", "E&xpand Function", lambda v: v.expand_selected_call(),
+                  ("Ctrl+Shift+G",), tip="Put the selected function call's nodes in its place",
+                  enabled=_one_node_selected),
+    CanvasCommand("bypass", "&Bypass", lambda v: v.toggle_bypass(), ("B",),
+                  tip="Bypass the selected nodes (their first input of each output's type "
+                      "passes through), or make them work again", enabled=_has_nodes_selected),
     CanvasCommand("arrange", "Arran&ge", lambda v: v.arrange_selection(), ("L",),
                   tip="Lay out the selected nodes (everything when fewer than two are "
                       "selected) in columns, outputs on the right"),
@@ -90,14 +100,15 @@ TABLE: tuple[CanvasCommand, ...] = (
                   "after spirv-opt -O); the figures are in its tooltip",
                   checked=lambda v: v.cost_overlay.active),
     CanvasCommand("node_docs", "&Node Reference", lambda v: v.request_docs(), ("F1",),
-                  tip="Documentation of the selected node kind", enabled=_one_node_selected),
+                  tip="Browse and search every node kind: ports, defaults, ranges and a "
+                      "thumbnail (the selected node's kind first)"),
 )
 
-EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", None,
-             "arrange", "add_node")
+EDIT_MENU = ("delete", "cut", "copy", "paste", "duplicate", "comment", "rename", "bypass",
+             None, "collapse", "expand", None, "arrange", "add_node")
 VIEW_MENU = ("frame_all", "frame_selection", "minimap", "cost_overlay")
-CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename", "arrange",
-                "frame_all")
+CONTEXT_MENU = ("copy", "cut", "paste", "duplicate", "delete", "comment", "rename", "bypass",
+                "collapse", "expand", "arrange", "frame_all")
 
 
 def key_text(command: CanvasCommand) -> str:

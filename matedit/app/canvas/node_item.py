@@ -200,6 +200,7 @@ class NodeItem(QGraphicsRectItem):
         self.diagnostics: list[tuple[str, str]] = []  # (severity, message)
         self._tooltip = ""  # the node's own tooltip, before the cost overlay's lines
         self.cost: tuple[float, str] | None = None  # the cost overlay's (tint 0-1, text)
+        self.muted = False  # bypassed: drawn faded, its pass-through drawn across it
         self._preview: QPixmap | None = None
         self._ports: dict[tuple[str, bool], PortItem] = {}
         self._badge: BadgeItem | None = None
@@ -227,6 +228,11 @@ class NodeItem(QGraphicsRectItem):
         self._tooltip = tooltip
         self._show_tooltip()
         self._relayout()
+
+    def set_muted(self, muted: bool) -> None:
+        if muted != self.muted:
+            self.muted = muted
+            self.update()
 
     def set_cost(self, cost: tuple[float, str] | None) -> None:
         """The cost overlay: tint (0 none, 1 the costliest node) and the figures' text for the
@@ -446,12 +452,17 @@ class NodeItem(QGraphicsRectItem):
             tint = min(1.0, self.cost[0])  # denser for costlier nodes; none on free ones
             painter.setBrush(QColor(255, 96, 32, int(24 + 168 * tint)))
             painter.drawPath(body)
+        if self.muted:  # bypassed: faded under a dark veil, with a dashed edge
+            painter.setBrush(C.BYPASS_VEIL)
+            painter.drawPath(body)
         if self.isSelected():
             edge = QPen(C.NODE_SELECTED, 2.0 if not overview else 2.0 / max(lod, 0.1))
         elif self.has_error():
             edge = QPen(C.ERROR, 1.6 if not overview else 1.6 / max(lod, 0.1))
         else:
             edge = QPen(C.NODE_BODY_EDGE, 1.2)
+        if self.muted:
+            edge.setStyle(Qt.PenStyle.DashLine)
         painter.setPen(edge)
         painter.setBrush(Qt.BrushStyle.NoBrush)
         painter.drawPath(body)

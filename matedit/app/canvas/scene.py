@@ -71,9 +71,14 @@ def describe(node: Node, function_name: str = "") -> tuple[str, str, str, str]:
                              if isinstance(e, dict))
     if node.label and not sub:
         sub = kind_title
+    if node.muted:
+        sub = "bypassed" + (f" · {sub}" if sub else "")
     tip = f"<b>{escape(title)}</b> &nbsp;<i>{node.kind}</i> &nbsp;id {node.id}"
     if d is not None:
         tip += f"<br>{escape(d.description)}"
+    if node.muted:
+        tip += ("<br><i>Bypassed (B): its first input of each output's type passes "
+                "through</i>")
     return title, sub, d.category if d else "", tip
 
 
@@ -209,6 +214,7 @@ class NodeScene(QGraphicsScene):
         if expanded is not None and node_id in self._peeked:
             expanded = expanded | self._peeked[node_id]
         item.set_content(title, sub, category, ins, outs, tip, expanded)
+        item.set_muted(node.muted)
         self._update_connected(node_id)
 
     def function_name(self, node: Node) -> str:
@@ -295,7 +301,7 @@ class NodeScene(QGraphicsScene):
                 if (link.src, link.dst, link.dst_port) == (src, dst, ev.port) \
                         and link not in self.graph.links:
                     self._remove_wire(link)
-        elif what in ("value", "setting", "label"):
+        elif what in ("value", "setting", "label", "muted"):
             self._refresh_node(ev.node_ids[0])
         elif what == "moved":
             nid = ev.node_ids[0]

@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from matedit.app.canvas import arrange, clipboard, placement
+from matedit.app.canvas import arrange, clipboard, functions, placement
 from matedit.app.canvas import constants as C
 from matedit.app.canvas.actions import CONTEXT_MENU, CanvasActions
 from matedit.app.canvas.comment_item import CommentItem
@@ -50,6 +50,7 @@ from matedit.graph.commands import (
     PutComment,
     RemoveNode,
     SetLabel,
+    SetMuted,
 )
 from matedit.graph.model import Comment, Link, MaterialDocument, Node
 from matedit.graph.types import PortType
@@ -105,6 +106,9 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self.setStyleSheet("QGraphicsView { background: #1b1e24; border: none; }")
         self.setAcceptDrops(True)
         self.run_menu = lambda menu, at: menu.exec(at)  # tests read the menu instead
+        # where Collapse to Function writes the new function (a save dialog; tests answer)
+        self.ask_function_path = lambda suggestion: functions.ask_function_path(self,
+                                                                                suggestion)
 
         self.node_palette = NodePalette(self)
         self.node_palette.chosen.connect(self._palette_chosen)
@@ -228,12 +232,12 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         return self.start_rename(ids[0]) if len(ids) == 1 else None
 
     def request_docs(self) -> bool:
-        """Asks for the selected node kind's documentation (`docsRequested`)."""
+        """Opens the node reference (`docsRequested`) at the selected node's kind, or where it
+        was when no single node is selected (an empty kind)."""
         ids = self.selected_ids()
-        node = self.controller.document.graph.nodes.get(ids[0]) if ids else None
-        if node is not None:
-            self.docsRequested.emit(node.kind)
-        return node is not None
+        node = self.controller.document.graph.nodes.get(ids[0]) if len(ids) == 1 else None
+        self.docsRequested.emit(node.kind if node is not None else "")
+        return True
 
     # --- edits -------------------------------------------------------------------------------
     def delete_selection(self) -> bool:
@@ -290,6 +294,34 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         payload = clipboard.copy_payload(self.controller.document, node_ids)
         clip = clipboard.from_mime(clipboard.to_mime(payload))
         return self._paste_doc(clip, (40.0, 40.0), "duplicate") if clip else []
+
+    def collapse_selection(self) -> str:
+        """Edit › Collapse to Function (matedit.app.canvas.functions); the call's id."""
+        return functions.collapse_selection(self)
+
+    def expand_selected_call(self) -> list[str]:
+        """Edit › Expand Function: the selected call's nodes inline; the new ids."""
+        return functions.expand_call(self)
+
+    def toggle_bypass(self) -> list[str]:
+        """Edit › Bypass (B): the selected nodes that can be bypassed stop working (their first
+        input of each output's type passes through), or, when all of them already are, work
+        again; one undo step. The ids changed."""
+        graph = self.controller.document.graph
+        ids = [nid for nid in self.selected_ids()
+               if nid in graph.nodes and nodes.can_bypass(graph.nodes[nid].kind)]
+        if not ids:
+            self.message.emit("Nothing to bypass: sources and outputs have no input to pass "
+                              "through")
+            return []
+        mute = not all(graph.nodes[nid].muted for nid in ids)
+        verb = "bypass" if mute else "restore"
+        text = f"{verb} {len(ids)} node{'s' if len(ids) != 1 else ''}"
+        if not self.controller.push(SetMuted(tuple(ids), mute, text=text)):
+            return []
+        self.message.emit(("Bypassed " if mute else "Restored ") +
+                          f"{len(ids)} node{'s' if len(ids) != 1 else ''}")
+        return ids
 
     def arrange_selection(self) -> list[str]:
         """Edit › Arrange: the selected nodes (every node when fewer than two are selected)
