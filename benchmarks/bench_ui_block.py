@@ -186,6 +186,11 @@ def child(warm: bool, edits: int) -> dict:
         "warmed": sum(1 for g, _, r in worker.warmed if r.ok),
         "runs": runs,
     }
+    return _finish(w, app, display, out)
+
+
+def _finish(w, app, display, out: dict) -> dict:
+    """Closes the window; in a child with its own X server, prints `out` and exits."""
     w.actions.ask_save_changes = lambda name: "discard"
     w.close()
     app.processEvents()
@@ -348,15 +353,7 @@ def cases_child(only: tuple[str, ...] = CASES) -> dict:
                                   "runs": runs}
 
     ticks.timer.stop()
-    w.actions.ask_save_changes = lambda name: "discard"
-    w.close()
-    app.processEvents()
-    if display is not None:
-        print(json.dumps(out))
-        sys.stdout.flush()
-        display.stop()
-        os._exit(0)
-    return out
+    return _finish(w, app, display, out)
 
 
 def measure(warm: bool | None, edits: int, timeout: float = 600) -> dict:
