@@ -112,38 +112,37 @@ def _impl(thickness, n_film, F0, cos1, n_out=1.0):
 @pytest.mark.parametrize("base", list(BASES))
 @pytest.mark.parametrize("n_film", [1.3, 1.6])
 def test_airy_fresnel_equals_the_spectral_reference(base, n_film):
-    """At cosines 1 and 0.7, every thickness: the implementation (Belcour & Barla's first two
-    Fourier orders) equals the spectral Airy sum to 1e-3 (measured: dielectric 2.5e-6, metals
-    under a film of 1.3 8e-4). A film of 1.6 over a metal reflects more at its first
-    interface, and the orders the extension drops grow: measured 2.6e-3 (gold-like) and
-    4.4e-3 (blue), tolerance 5e-3 there. The reference's negative Rec.709 values are clamped
-    to 0 as the implementation clamps. Film 1.6 over the dielectric base (1.5) flips the
-    second interface's phase."""
+    """At cosines 1, 0.7, 0.5, 0.3 and 0.15, every thickness: the implementation (Belcour &
+    Barla's Fourier form, THIN_FILM_ORDERS = 12 orders) equals the spectral Airy sum to 1e-3
+    (measured at most 6.8e-4: gold-like metal under a film of 1.6 at cos 0.15). The
+    reference's negative Rec.709 values are clamped to 0 as the implementation clamps. Film
+    1.6 over the dielectric base (1.5) flips the second interface's phase."""
     F0 = BASES[base]
-    tol = 5e-3 if (n_film > 1.5 and base != "dielectric") else 1e-3
     for d in THICKNESSES:
-        for c in (1.0, 0.7):
+        for c in (1.0, 0.7, 0.5, 0.3, 0.15):
             ref = np.maximum(spectral_reference(d, n_film, F0, c), 0.0)
             got = _impl(d, n_film, F0, c)
-            assert np.abs(got - ref).max() <= tol, (d, c, got, ref)
+            assert np.abs(got - ref).max() <= 1e-3, (d, c, got, ref)
     # the film does something: colour shifts of several hundredths from the plain Fresnel
     plain = _schlick(np.asarray(F0), 1.0)
     assert max(np.abs(_impl(d, n_film, F0, 1.0) - plain).max() for d in THICKNESSES) > 0.02
 
 
-def test_airy_fresnel_at_grazing_angles_truncation_stated():
-    """At cosine 0.3 the two orders are not the whole series where the base reflects much
-    (r123 = sqrt(R12 R23) ~ 0.4 for a metal): measured 4e-2 at most (gold-like metal, 200 nm),
-    1.2e-4 for the dielectric. Tolerances 5e-2 and 1e-3. (Six orders instead of two measure
-    4e-4: the difference is the truncation the extension makes, not the phase or spectra.)"""
-    worst = {}
-    for base, F0 in BASES.items():
+def test_the_extensions_two_orders_are_what_leaves_grazing_angles_off():
+    """Why twelve orders: the same Fourier form cut at the extension's two orders is 4e-2 off
+    the spectral sum at cos 0.3 over a metal (measured 3.9e-2 to 4.1e-2), and within 1e-3
+    near normal incidence, where a glTF viewer's film looks as ours."""
+    from unittest import mock
+
+    worst_grazing, worst_normal = 0.0, 0.0
+    with mock.patch.object(tf, "THIN_FILM_ORDERS", 2):
         for d in THICKNESSES:
-            ref = np.maximum(spectral_reference(d, 1.3, F0, 0.3), 0.0)
-            worst[base] = max(worst.get(base, 0.0), np.abs(_impl(d, 1.3, F0, 0.3) - ref).max())
-    print("\ngrazing (cos 0.3) worst differences:", worst)
-    assert worst["dielectric"] <= 1e-3
-    assert max(worst.values()) <= 5e-2
+            F0 = BASES["gold-like metal"]
+            worst_grazing = max(worst_grazing, np.abs(
+                _impl(d, 1.3, F0, 0.3) - np.maximum(spectral_reference(d, 1.3, F0, 0.3), 0)).max())
+            worst_normal = max(worst_normal, np.abs(
+                _impl(d, 1.3, F0, 1.0) - np.maximum(spectral_reference(d, 1.3, F0, 1.0), 0)).max())
+    assert 1e-2 < worst_grazing < 5e-2 and worst_normal <= 1e-3, (worst_grazing, worst_normal)
 
 
 @pytest.mark.parametrize("base", list(BASES))

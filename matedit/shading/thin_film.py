@@ -18,6 +18,8 @@ _MEAN = np.array([1.6810e6, 1.7953e6, 2.2084e6])
 _VAR = np.array([4.3278e9, 9.3046e9, 6.6121e9])
 _X2 = (9.7470e-14, 2.2399e6, 4.5282e9)
 _NORM = 1.0685e-7
+# Orders of the Airy sum's Fourier form kept (the extension keeps 2; thin_film.glsl)
+THIN_FILM_ORDERS = 12
 # XYZ to linear Rec.709 (IEC 61966-2-1), rows the output channels
 XYZ_TO_REC709 = np.array([[3.2404542, -1.5371385, -0.4985314],
                           [-0.9692660, 1.8760108, 0.0415560],
@@ -94,7 +96,7 @@ def thinFilmFresnel(f: ThinFilm, cosTheta1) -> np.ndarray:
     Rs = (T121 * T121)[..., None] * R23 / (1.0 - R123)
     intensity = R12[..., None] + Rs
     Cm = Rs - T121[..., None]
-    for m in (1, 2):
+    for m in range(1, THIN_FILM_ORDERS + 1):
         Cm = Cm * r123
         intensity = intensity + Cm * 2.0 * thinFilmSensitivity(m * opd, m * phi)
     return np.where(tir[..., None], 1.0, np.maximum(intensity, 0.0))
