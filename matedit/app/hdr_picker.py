@@ -44,7 +44,21 @@ def parse_hex(text: str) -> list[float] | None:
     return [srgb_to_linear(int(t[i:i + 2], 16) / 255) for i in (0, 2, 4)]
 
 
-class _SVSquare(QWidget):
+class _PickArea(QWidget):
+    """A widget picked by pressing or dragging the left button (`_pick` says what)."""
+
+    def _pick(self, ev: QMouseEvent) -> None:
+        raise NotImplementedError
+
+    def mousePressEvent(self, ev: QMouseEvent) -> None:  # noqa: N802 - Qt's
+        self._pick(ev)
+
+    def mouseMoveEvent(self, ev: QMouseEvent) -> None:  # noqa: N802 - Qt's
+        if ev.buttons() & Qt.MouseButton.LeftButton:
+            self._pick(ev)
+
+
+class _SVSquare(_PickArea):
     """Saturation (across) and value (down) of one hue, in sRGB."""
 
     changed = Signal(float, float)  # saturation, value in 0..1
@@ -84,15 +98,8 @@ class _SVSquare(QWidget):
         self.update()
         self.changed.emit(s, v)
 
-    def mousePressEvent(self, ev: QMouseEvent) -> None:  # noqa: N802 - Qt's
-        self._pick(ev)
 
-    def mouseMoveEvent(self, ev: QMouseEvent) -> None:  # noqa: N802 - Qt's
-        if ev.buttons() & Qt.MouseButton.LeftButton:
-            self._pick(ev)
-
-
-class _HueStrip(QWidget):
+class _HueStrip(_PickArea):
     changed = Signal(float)  # hue in 0..1
 
     def __init__(self, parent=None) -> None:
@@ -121,13 +128,6 @@ class _HueStrip(QWidget):
         h = min(0.9999, max(0.0, ev.position().y() / max(1, self.height())))
         self.set_hue(h)
         self.changed.emit(h)
-
-    def mousePressEvent(self, ev: QMouseEvent) -> None:  # noqa: N802 - Qt's
-        self._pick(ev)
-
-    def mouseMoveEvent(self, ev: QMouseEvent) -> None:  # noqa: N802 - Qt's
-        if ev.buttons() & Qt.MouseButton.LeftButton:
-            self._pick(ev)
 
 
 class _Swatch(QWidget):

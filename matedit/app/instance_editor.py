@@ -74,6 +74,7 @@ class InstanceEditor(QWidget):
         self.resolver = FileResolver()
         self.resolved: ResolvedInstance = resolve(doc)
         self.compiled = None
+        self._uniform_of: dict[str, str] = {}  # parameter -> uniform, of `compiled`
         self.compile_count = 0
         self.dirty = False
         self.panel = ParameterPanel()
@@ -154,6 +155,7 @@ class InstanceEditor(QWidget):
             self.message.emit(f"cannot compile the instance: {exc}")
             return
         self.compile_count += 1
+        self._uniform_of = self._uniform_names()  # one map per compile, not per slider step
         self._apply_live()
         self.view.set_material(self.compiled)
         self.view.set_values(self._uniforms(), self._textures())
@@ -163,7 +165,7 @@ class InstanceEditor(QWidget):
             return
         used = {u.parameter for u in self.compiled.ir.uniforms if u.parameter}
         used |= {t.parameter for t in self.compiled.ir.textures}
-        by_port = self._uniform_names()
+        by_port = self._uniform_of
         self.panel.set_live({n for n, p in self.parameters.items()
                              if p.type == "switch" or n in used or n in by_port})
 
@@ -183,7 +185,7 @@ class InstanceEditor(QWidget):
         return out
 
     def _uniforms(self) -> dict[str, Any]:
-        names = self._uniform_names()
+        names = self._uniform_of
         return {names[n]: v for n, v in self.resolved.values.items() if n in names}
 
     def _textures(self) -> dict[str, Path | None]:
@@ -201,7 +203,7 @@ class InstanceEditor(QWidget):
         elif kind == "texture":
             self.view.set_values({}, {f"t_{name}": self._textures()[f"t_{name}"]})
         else:
-            uniform = self._uniform_names().get(name)
+            uniform = self._uniform_of.get(name)
             if uniform:
                 self.view.set_values({uniform: self.resolved.values[name]}, {})
 

@@ -10,8 +10,8 @@ parameter is what an artist or an instance sets, so it feeds the function from o
 Expand: a Function Call's nodes are copied into the graph under fresh ids; what fed the
 call's inputs feeds the nodes its Function Inputs fed (an unwired input gives those nodes
 the call's value, or the input's default), and what read the call's outputs reads what fed
-its Function Outputs. File references inside the function are rebased by the caller's
-`rebase`.
+its Function Outputs. File references inside the function are the caller's to rebase
+for the material's folder first (matedit.io.document.rebase_references).
 
 Both build plain commands (one undo step through `Macro`); nothing here reads or writes a
 file.
@@ -20,7 +20,6 @@ file.
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable
 
 from matedit.graph.commands import AddNode, Command, Connect, RemoveNode, SetValue
 from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node
@@ -131,10 +130,10 @@ def collapse(doc: MaterialDocument, analysis: Analysis, node_ids: list[str], fun
     return fn, commands, call
 
 
-def expand(doc: MaterialDocument, call_id: str, function: MaterialDocument,
-           rebase: Callable[[str], str] = lambda ref: ref) -> tuple[list[Command], list[str]]:
+def expand(doc: MaterialDocument, call_id: str,
+           function: MaterialDocument) -> tuple[list[Command], list[str]]:
     """(commands that put `function`'s nodes in place of the call `call_id`, the new ids).
-    `rebase` rewrites a file reference of the function's for the material's folder."""
+    The nodes' file references are copied as `function` holds them."""
     g = doc.graph
     call = g.nodes.get(call_id)
     if call is None or role_of(call.kind) != Role.FUNCTION_CALL:
@@ -155,7 +154,6 @@ def expand(doc: MaterialDocument, call_id: str, function: MaterialDocument,
     for nid, new in rename.items():
         n = copy.deepcopy(fg.nodes[nid])
         n.id, n.position = new, (n.position[0] + ox, n.position[1] + oy)
-        _rebase_node(n, rebase)
         commands.append(AddNode(n))
     into = {l.dst_port: l for l in g.links if l.dst == call_id}
     read = [l for l in g.links if l.src == call_id]
@@ -187,20 +185,3 @@ def expand(doc: MaterialDocument, call_id: str, function: MaterialDocument,
     commands += [Connect(l) for l in sorted(links)]
     commands += values
     return commands, sorted(rename.values())
-
-
-def _rebase_node(n: Node, rebase: Callable[[str], str]) -> None:
-    role = role_of(n.kind)
-    if role == Role.FUNCTION_CALL and isinstance(n.settings.get("function"), str):
-        n.settings["function"] = rebase(n.settings["function"])
-    elif role == Role.TEXTURE_PARAMETER and isinstance(n.settings.get("path"), str):
-        n.settings["path"] = rebase(n.settings["path"])
-    elif role == Role.LAYER_STACK and isinstance(n.settings.get("layers"), list):
-        for e in n.settings["layers"]:
-            if isinstance(e, dict):
-                if isinstance(e.get("function"), str):
-                    e["function"] = rebase(e["function"])
-                if isinstance(e.get("blend"), str) and e["blend"].endswith(".json"):
-                    e["blend"] = rebase(e["blend"])
-
-

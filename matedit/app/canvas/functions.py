@@ -3,6 +3,7 @@ the file part (where the function is written, references rebased) and the undo s
 
 from __future__ import annotations
 
+import copy
 import os
 import re
 from pathlib import Path
@@ -14,7 +15,7 @@ from matedit.graph.collapse import CollapseError, collapse, collapsible, expand
 from matedit.graph.commands import AddNode, Macro
 from matedit.graph.nodes import Role, role_of
 from matedit.io import library
-from matedit.io.document import reference_from, save
+from matedit.io.document import rebase_references, reference_fields, save
 
 if TYPE_CHECKING:
     from matedit.app.canvas.view import NodeCanvasView
@@ -63,7 +64,8 @@ def collapse_selection(view: NodeCanvasView) -> str:
         return ""
     name = target_path.stem.replace("_", " ").capitalize()
     try:
-        fn, _, _ = collapse(doc, analysis, ids, "", name)
+        fn, commands, call = collapse(doc, analysis, ids, reference_for(doc, target_path),
+                                      name)
         fn.path = Path(doc.path) if doc.path else None  # its references are the material's
         save(fn, target_path)  # atomic; relative references rebased to the function's folder
     except CollapseError as exc:
@@ -72,8 +74,6 @@ def collapse_selection(view: NodeCanvasView) -> str:
     except (OSError, ValueError) as exc:
         view.message.emit(f"Cannot write {target_path.name}: {exc}")
         return ""
-    ref = reference_for(doc, target_path)
-    _, commands, call = collapse(doc, analysis, ids, ref, name)
     for c in commands:  # the call lands in free space, off the nodes that stay
         if isinstance(c, AddNode):
             shift = placement.free_offset([placement.node_rect(c.node)],
@@ -104,17 +104,17 @@ def expand_call(view: NodeCanvasView) -> list[str]:
     except (LookupError, ValueError, OSError) as exc:
         view.message.emit(f"Cannot expand: {exc}")
         return []
-    fn_dir = Path(os.path.realpath(fn.path)).parent if fn.path else Path.cwd()
-    doc_dir = Path(os.path.realpath(doc.path)).parent if doc.path else None
-
-    def rebase(r: str) -> str:
-        if not r or library.is_library_ref(r) or Path(r).is_absolute():
-            return r
-        target = Path(os.path.realpath(fn_dir / r))
-        return reference_from(target, doc_dir) if doc_dir else target.as_posix()
-
+    inline = copy.deepcopy(fn)  # the resolver's document is shared: rebase a copy
+    if doc.path is not None:
+        rebase_references(inline, Path(doc.path))  # its references, from the material's folder
+    else:  # an unsaved material holds absolute references (made relative on its first save)
+        base = Path(os.path.realpath(fn.path)).parent if fn.path else Path.cwd()
+        for container, key in reference_fields(inline):
+            r = container[key]
+            if r and not library.is_library_ref(r) and not Path(r).is_absolute():
+                container[key] = Path(os.path.realpath(base / r)).as_posix()
     try:
-        commands, new_ids = expand(doc, node.id, fn, rebase)
+        commands, new_ids = expand(doc, node.id, inline)
     except CollapseError as exc:
         view.message.emit(str(exc))
         return []
