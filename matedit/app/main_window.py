@@ -65,6 +65,7 @@ class MainWindow(QMainWindow):
         self.stats = install_stats(self, self.controller, self.layers, self.problems,
                                    self.tabs.material.canvas.cost_overlay, p.history_dock)
         self.menus: Menus = install_menus(self, self, [*p.docks(), self.stats.dock])
+        self.menus.view.insertAction(self.menus.snap, self.viewport.follow_action)
         self._build_status()
         self._connect()
         # File › New Instance, the Parameters dock, the Library's instances
@@ -116,6 +117,7 @@ class MainWindow(QMainWindow):
             lambda nid, port: self.compiler.set_preview(PreviewTarget(nid, port)))
         self.tabs.activeChanged.connect(self._on_active)
         self.tabs.selectionChanged.connect(self.inspector.set_selection)
+        self.tabs.selectionChanged.connect(self._follow_selection)
         self.tabs.message.connect(self.status)
         self.tabs.functionSaved.connect(lambda _p: self.controller.reanalyse())
         self.inspector.message.connect(self.status)
@@ -230,6 +232,12 @@ class MainWindow(QMainWindow):
         self.inspector.show_node(node_id)
         self.panels.inspector_dock.show()
         self.panels.inspector_dock.raise_()
+
+    def _follow_selection(self, node_ids: list[str]) -> None:
+        """View › Follow Selection: the material tab's selected node in the viewport."""
+        m = self.tabs.material
+        if self.tabs.active is m:
+            self.viewport.follow_selection(list(node_ids), m.canvas.previewable_output)
 
     def _layer_selected(self, stack_id: str) -> None:
         if self.tabs.active is not self.tabs.material:

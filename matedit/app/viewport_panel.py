@@ -9,6 +9,7 @@ import os
 from pathlib import Path
 
 from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QAction
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
@@ -24,6 +25,7 @@ from matedit.app import file_dialogs
 from matedit.app.compile_service import MaterialCompiler, uniform_values, uniforms_by_port
 from matedit.app.controller import ValueChange
 from matedit.app.environment import ENVIRONMENTS, EnvironmentChoice, environment_combo
+from matedit.app.node_preview import PreviewTarget
 from matedit.app.paths import texture_paths
 from matedit.app.theme import icon
 from matedit.app.viewport import ViewportWidget
@@ -112,6 +114,17 @@ class ViewportPanel(QWidget):
         self.diff_label.hide()
         self.diff_label.setToolTip("Reference and difference modes: samples a pixel so far, "
                                    "and the mean difference from the split-sum image")
+        # View › Follow Selection, and its button on the bar
+        self.follow_action = QAction(icon("follow"), "&Follow Selection in Viewport", self)
+        self.follow_action.setObjectName("view.follow_selection")
+        self.follow_action.setCheckable(True)
+        self.follow_action.setToolTip("Follow the selection: the viewport previews the node you "
+                                      "select (pin the banner to keep one while you select "
+                                      "others)")
+        self.follow_action.toggled.connect(self._follow_toggled)
+        self.follow_button = QToolButton()
+        self.follow_button.setObjectName("followSelection")
+        self.follow_button.setDefaultAction(self.follow_action)
         self.save_button = QToolButton()
         self.save_button.setIcon(icon("save"))
         self.save_button.setToolTip("Save the viewport image (PNG as shown, or linear EXR)")
@@ -124,6 +137,7 @@ class ViewportPanel(QWidget):
         bl.addWidget(self.exposure, 1)
         bl.addWidget(self.exposure_spin)
         bl.addStretch(1)
+        bl.addWidget(self.follow_button)
         bl.addWidget(self.save_button)
         bl.addWidget(reset)
         lay.addWidget(bar)
@@ -137,8 +151,19 @@ class ViewportPanel(QWidget):
         self.banner_clear = QToolButton()
         self.banner_clear.setText("Show material")
         self.banner_clear.setToolTip("Stop previewing the node: show the whole material again")
-        self.banner_clear.clicked.connect(lambda: compiler.set_preview(None))
+        self.banner_clear.clicked.connect(self.show_material)
+        self.pin_button = QToolButton()
+        self.pin_button.setObjectName("pinPreview")
+        self.pin_button.setIcon(icon("pin"))
+        self.pin_button.setText("Pin")
+        self.pin_button.setCheckable(True)
+        self.pin_button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        self.pin_button.setToolTip("Keep previewing this node while you select others")
+        self.pin_button.toggled.connect(lambda _on: self._preview_changed(compiler.preview))
+        self.pin_button.clicked.connect(self._pin_clicked)
+        self.pin_button.hide()
         bn.addWidget(self.banner_label, 1)
+        bn.addWidget(self.pin_button)
         bn.addWidget(self.banner_clear)
         self.banner.hide()
         lay.addWidget(self.view, 1)
@@ -167,6 +192,8 @@ class ViewportPanel(QWidget):
         compiler.previewChanged.connect(self._preview_changed)
         self.controller.valuesChanged.connect(self._values_changed)
         self._by_port: tuple[object, dict] = (None, {})  # (compiled, uniforms_by_port)
+        # the material canvas's selection and its previewable outputs (follow_selection)
+        self._selection: tuple[list[str], object] = ([], lambda _nid: "")
 
     # --- material --------------------------------------------------------------------------
     def on_compiled(self, compiled) -> None:
@@ -361,11 +388,59 @@ class ViewportPanel(QWidget):
         event.acceptProposedAction()
         self.choose_environment(path)
 
+    # --- previewing a node ----------------------------------------------------------------
+    @property
+    def following(self) -> bool:
+        """The viewport previews each node the artist selects (unless pinned)."""
+        return self.follow_action.isChecked()
+
+    @property
+    def pinned(self) -> bool:
+        return self.pin_button.isChecked() and self.compiler.preview is not None
+
+    def set_following(self, on: bool) -> None:
+        self.follow_action.setChecked(on)
+
+    def pin(self, on: bool = True) -> None:
+        self.pin_button.setChecked(on)
+
+    def show_material(self) -> None:
+        """Back to the whole material: the preview and its pin end."""
+        self.pin_button.setChecked(False)
+        self.compiler.set_preview(None)
+
+    def follow_selection(self, node_ids: list[str], output_of) -> bool:
+        """With Follow on and nothing pinned, preview the one selected node: its first
+        output the viewport can show (`output_of(node_id)`, "" if none), or the material
+        for a node with none (the output). True when the preview changed."""
+        self._selection = (list(node_ids), output_of)
+        if not self.following or self.pinned or len(node_ids) != 1:
+            return False
+        port = output_of(node_ids[0])
+        target = PreviewTarget(node_ids[0], port) if port else None
+        if target == self.compiler.preview:
+            return False
+        return self.compiler.set_preview(target)
+
+    def _follow_toggled(self, on: bool) -> None:
+        self.pin_button.setVisible(on)
+        if not on:
+            self.pin_button.setChecked(False)
+        self._preview_changed(self.compiler.preview)
+        if on:
+            self.follow_selection(*self._selection)
+
+    def _pin_clicked(self, on: bool) -> None:
+        if not on:  # unpinned by the artist: what is selected now
+            self.follow_selection(*self._selection)
+
     def _preview_changed(self, target) -> None:
         if target is None:
             self.banner.hide()
+            self.pin_button.setChecked(False)
             return
-        self.banner_label.setText(f"Previewing {target.label()}, not the material")
+        verb = "Pinned to" if self.pinned else "Previewing"
+        self.banner_label.setText(f"{verb} {target.label()}, not the material")
         self._place_banner()
         self.banner.show()
         self.banner.raise_()
