@@ -65,7 +65,8 @@ class MainWindow(QMainWindow):
         self.stats = install_stats(self, self.controller, self.layers, self.problems,
                                    self.tabs.material.canvas.cost_overlay, p.history_dock)
         self.menus: Menus = install_menus(self, self, [*p.docks(), self.stats.dock])
-        self.menus.view.insertAction(self.menus.snap, self.viewport.follow_action)
+        for a in (self.viewport.follow_action, self.viewport.ab_action):
+            self.menus.view.insertAction(self.menus.snap, a)
         self._build_status()
         self._connect()
         # File › New Instance, the Parameters dock, the Library's instances

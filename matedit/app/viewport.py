@@ -88,6 +88,8 @@ class ViewportWidget(QOpenGLWidget):
         self._slicer.setSingleShot(True)
         self._slicer.setInterval(0)
         self._slicer.timeout.connect(self._advance)
+        self._compare = None  # (compiled, uniforms, textures) of an A/B split's A side
+        self._split = 0.5
 
     # --- GL lifecycle ----------------------------------------------------------------------
     def initializeGL(self) -> None:  # noqa: N802 - Qt's name
@@ -126,6 +128,10 @@ class ViewportWidget(QOpenGLWidget):
             cm, self._pending_material = self._pending_material, None
             self._apply_material(cm)
         self._flush_values()
+        if hasattr(self.renderer, "set_split"):
+            self.renderer.set_split(self._split)
+        if self._compare is not None:
+            self._apply_compare()
 
     def _apply_view_state(self, set_environment: bool = True) -> None:
         r = self.renderer
@@ -283,6 +289,48 @@ class ViewportWidget(QOpenGLWidget):
             self._pending_textures = {}
         finally:
             self.doneCurrent()
+
+    # --- A/B split -------------------------------------------------------------------------
+    def set_compare(self, compiled, uniforms: dict[str, Any] | None = None,
+                    textures: dict[str, Path | None] | None = None) -> bool:
+        """The A side of an A/B split (None: no split): `compiled` with these uniform values
+        and texture files, left of the divider (Renderer.set_compare)."""
+        self._compare = None if compiled is None else (compiled, dict(uniforms or {}),
+                                                       dict(textures or {}))
+        return self._apply_compare()
+
+    def _apply_compare(self) -> bool:
+        r = self.renderer
+        if r is None or not hasattr(r, "set_compare"):
+            return False
+        self.makeCurrent()
+        try:
+            if self._compare is None:
+                status = r.set_compare(None)
+            else:
+                cm, uniforms, textures = self._compare
+                status = r.set_compare(cm, uniforms, {k: str(v) if v else None
+                                                      for k, v in textures.items()})
+        except Exception as exc:  # noqa: BLE001 - the split is an aid: say it, keep drawing
+            self.statusMessage.emit(f"A/B split: {type(exc).__name__}: {exc}")
+            return False
+        finally:
+            self.doneCurrent()
+        if not status.ok:
+            self.statusMessage.emit("A/B split: the earlier material no longer builds")
+        self.update()
+        return bool(status.ok)
+
+    @property
+    def split(self) -> float:
+        return self._split
+
+    def set_split(self, fraction: float) -> None:
+        """The divider, as a fraction of the width from the left."""
+        self._split = min(0.95, max(0.05, float(fraction)))
+        if self.renderer is not None and hasattr(self.renderer, "set_split"):
+            self.renderer.set_split(self._split)
+            self.update()
 
     # --- view state ------------------------------------------------------------------------
     def set_mesh(self, name: str) -> None:

@@ -125,6 +125,19 @@ class ViewportPanel(QWidget):
         self.follow_button = QToolButton()
         self.follow_button.setObjectName("followSelection")
         self.follow_button.setDefaultAction(self.follow_action)
+        # View › A/B Split, and its button: the material before the last structural edit
+        # (A, left of the divider) against the material now (B)
+        self.ab_action = QAction("A/B &Split: Before the Last Edit", self)
+        self.ab_action.setObjectName("view.ab_split")
+        self.ab_action.setCheckable(True)
+        self.ab_action.setIconText("A/B")
+        self.ab_action.setToolTip("A/B split: the material before the last structural edit on "
+                                  "the left, as it is now on the right (drag the divider)")
+        self.ab_action.toggled.connect(self._ab_toggled)
+        self.ab_button = QToolButton()
+        self.ab_button.setObjectName("abSplit")
+        self.ab_button.setDefaultAction(self.ab_action)
+        self.ab_button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
         self.save_button = QToolButton()
         self.save_button.setIcon(icon("save"))
         self.save_button.setToolTip("Save the viewport image (PNG as shown, or linear EXR)")
@@ -137,6 +150,7 @@ class ViewportPanel(QWidget):
         bl.addWidget(self.exposure, 1)
         bl.addWidget(self.exposure_spin)
         bl.addStretch(1)
+        bl.addWidget(self.ab_button)
         bl.addWidget(self.follow_button)
         bl.addWidget(self.save_button)
         bl.addWidget(reset)
@@ -194,11 +208,33 @@ class ViewportPanel(QWidget):
         self._by_port: tuple[object, dict] = (None, {})  # (compiled, uniforms_by_port)
         # the material canvas's selection and its previewable outputs (follow_selection)
         self._selection: tuple[list[str], object] = ([], lambda _nid: "")
+        # A/B split: what the view shows now, and what it showed before the last structural
+        # edit: (compiled, uniform values, texture files) each
+        self._shown: list = [None, {}, {}]
+        self._before: tuple | None = None
+        self.divider = SplitDivider(self)
+        self.divider.moved.connect(self._divider_moved)
+        self.a_label = _overlay_label(self, "abLabelA")
+        self.b_label = _overlay_label(self, "abLabelB")
+        for w in (self.divider, self.a_label, self.b_label):
+            w.hide()
 
     # --- material --------------------------------------------------------------------------
     def on_compiled(self, compiled) -> None:
+        old = self._shown[0]
+        if old is not None and old.structure_hash != compiled.structure_hash:
+            self._before = (old, dict(self._shown[1]), dict(self._shown[2]))
+        self._shown = [compiled, {}, {}]
         self.view.set_material(compiled)
         self.push_values()
+        if self.comparing:
+            self._apply_compare()
+
+    def _send_values(self, uniforms: dict, textures: dict) -> None:
+        """Values to the view, kept as what it shows (the A side of a later A/B split)."""
+        self._shown[1].update(uniforms)
+        self._shown[2].update(textures)
+        self.view.set_values(uniforms, textures)
 
     # --- a document with nothing to draw -------------------------------------------------
     def _failure_notice(self) -> QWidget:
@@ -236,6 +272,45 @@ class ViewportPanel(QWidget):
     def _document_changed(self) -> None:
         self.view.clear_material()
         self._hide_failure()
+        self._shown, self._before = [None, {}, {}], None  # another document: no "before"
+        if self.comparing:
+            self.ab_action.setChecked(False)
+
+    # --- A/B split -------------------------------------------------------------------------
+    @property
+    def comparing(self) -> bool:
+        return self.ab_action.isChecked()
+
+    def set_comparing(self, on: bool) -> None:
+        self.ab_action.setChecked(on)
+
+    def _ab_toggled(self, on: bool) -> None:
+        if on:
+            self._apply_compare()
+        else:
+            self.view.set_compare(None)
+        for w in (self.divider, self.a_label, self.b_label):
+            w.setVisible(on)
+        self._place_banner()
+
+    def _apply_compare(self) -> None:
+        """A: the material before the last structural edit (the material now, until there is
+        one), with the values it was drawn with."""
+        before = self._before
+        if before is None and self._shown[0] is not None:
+            before = (self._shown[0], dict(self._shown[1]), dict(self._shown[2]))
+        if before is None:
+            return
+        self.view.set_compare(*before)
+        self.a_label.setText("A · before the last edit" if self._before is not None else
+                             "A · as it was when the split began")
+        self.b_label.setText("B · now")
+        self._place_banner()
+
+    def _divider_moved(self, x: int) -> None:
+        g = self.view.geometry()
+        self.view.set_split((x - g.x()) / max(1, g.width()))
+        self._place_banner()
 
     def _compile_failed(self, diagnostics) -> None:
         """A compile failed: with an earlier good version of this document the view keeps
@@ -276,7 +351,7 @@ class ViewportPanel(QWidget):
         if cm is None:
             return
         doc = self.controller.document
-        self.view.set_values(uniform_values(cm, doc), texture_paths(cm, doc))
+        self._send_values(uniform_values(cm, doc), texture_paths(cm, doc))
 
     def _values_changed(self, change: ValueChange) -> None:
         """One port's edit sets the uniforms that read it; a setting (a texture's path), many
@@ -291,7 +366,7 @@ class ViewportPanel(QWidget):
             self._by_port = (cm, uniforms_by_port(cm))
         uniforms = self._by_port[1].get((change.node, change.port))
         if uniforms:
-            self.view.set_values(uniform_values(cm, self.controller.document, uniforms), {})
+            self._send_values(uniform_values(cm, self.controller.document, uniforms), {})
 
     # --- the typed interface the window uses ------------------------------------------------
     def set_lights(self, lights: list) -> None:
@@ -458,6 +533,17 @@ class ViewportPanel(QWidget):
                                      width, max(40, height))
         self.diff_label.adjustSize()
         self.diff_label.move(g.x() + 4, g.y() + g.height() - self.diff_label.height() - 4)
+        if self.comparing:
+            x = g.x() + int(round(self.view.split * g.width()))
+            self.divider.setGeometry(x - SplitDivider.GRIP // 2, g.y(), SplitDivider.GRIP,
+                                     g.height())
+            top = g.y() + 4 + (self.banner.height() if self.banner.isVisible() else 0)
+            for label in (self.a_label, self.b_label):
+                label.adjustSize()
+            self.a_label.move(max(g.x() + 4, x - self.a_label.width() - 8), top)
+            self.b_label.move(min(x + 8, g.x() + g.width() - self.b_label.width() - 4), top)
+            for w in (self.divider, self.a_label, self.b_label):
+                w.raise_()
 
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().resizeEvent(event)
@@ -567,3 +653,35 @@ class ViewportPanel(QWidget):
     def choose_environment(self, spec: str) -> bool:
         """Bakes `spec` (studio, sky or a file) with a progress dialog; False on a bad file."""
         return self.environment.choose(spec)
+
+
+def _overlay_label(parent: QWidget, name: str) -> QLabel:
+    label = QLabel("", parent)
+    label.setObjectName(name)
+    label.setStyleSheet("background: rgba(20, 22, 27, 190); color: #f0f2f5; padding: 1px 6px;"
+                        " font-weight: bold;")
+    return label
+
+
+class SplitDivider(QWidget):
+    """The A/B split's divider over the view: a line in a grip the artist drags sideways."""
+
+    GRIP = 9  # px: the line is 2 px, the rest is the area that takes the mouse
+    moved = Signal(int)  # the line's x in the parent's coordinates
+
+    def __init__(self, parent: QWidget) -> None:
+        super().__init__(parent)
+        self.setObjectName("abDivider")
+        self.setCursor(Qt.CursorShape.SplitHCursor)
+        self.setToolTip("Drag to move the A/B divider")
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
+        from PySide6.QtGui import QColor, QPainter
+
+        p = QPainter(self)
+        p.fillRect(self.width() // 2 - 1, 0, 2, self.height(), QColor("#f0f2f5"))
+        p.end()
+
+    def mouseMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if event.buttons() & Qt.MouseButton.LeftButton:
+            self.moved.emit(self.mapToParent(event.position().toPoint()).x())

@@ -64,6 +64,10 @@ class Renderer(PreviewSettings):
         self.slice_budget_ms: float | None = None
         self.planner = BandPlanner()
         self.targets: SceneTargets | None = None
+        # A/B split: another material drawn left of `split` (a fraction of the width), the
+        # current one right of it (set_compare); None: the current material everywhere
+        self.compare: _CompareSlot | None = None
+        self.split = 0.5
         self.set_mesh("sphere")
         self.resize(*size)
         if environment is not None:
@@ -146,6 +150,40 @@ class Renderer(PreviewSettings):
         self.reset_accumulation()
         return MaterialStatus(True)
 
+    def set_compare(self, compiled: CompiledMaterial | None, values: dict[str, Any] | None = None,
+                    textures: dict[str, str | None] | None = None) -> MaterialStatus:
+        """A/B split: `compiled` (with these uniform values and texture files) drawn on the
+        part of the frame left of `split`, the current material on the rest; None ends the
+        split. Programs come from the same cache as the current material's."""
+        if compiled is None:
+            if self.compare is not None:
+                self.compare.resources.release()
+                self.compare = None
+                self.reset_accumulation()
+            return MaterialStatus(True)
+        vals = {u.name: u.default for u in compiled.ir.uniforms}
+        vals.update(values or {})
+        forward = self._forward(compiled, vals)
+        prog = self.programs.link(compiled, forward, self.energy_compensation, self.view)
+        if isinstance(prog, MaterialStatus):
+            return prog
+        slot = self.compare or _CompareSlot(MaterialResources(self.ctx))
+        slot.program, slot.forward = prog, forward
+        slot.resources.load(compiled, vals)
+        for name, path in (textures or {}).items():
+            slot.resources.set_texture(name, path)
+        self.compare = slot
+        self.reset_accumulation()
+        return MaterialStatus(True)
+
+    def set_split(self, fraction: float) -> None:
+        """Where the A/B split's divider is, as a fraction of the width (0.05 .. 0.95)."""
+        fraction = min(0.95, max(0.05, float(fraction)))
+        if fraction != self.split:
+            self.split = fraction
+            if self.compare is not None:
+                self.reset_accumulation()
+
     def _forward(self, compiled: CompiledMaterial, values: dict) -> bool:
         """The path a material takes: forward when not deferred, when the material wants it
         (translucent, lobes beyond the talk) or in an attribute view (FORWARD entry only)."""
@@ -170,7 +208,16 @@ class Renderer(PreviewSettings):
                 self.view = old
                 raise
             self.is_forward = forward
+        self._relink_compare()
         self.reset_accumulation()
+
+    def _relink_compare(self) -> None:
+        """The A side's program for the current view and energy compensation."""
+        c = self.compare
+        if c is not None and c.resources.compiled is not None:
+            c.forward = self._forward(c.resources.compiled, c.resources.values)
+            c.program = self.programs.material(c.resources.compiled, c.forward,
+                                               self.energy_compensation, self.view)
 
     @property
     def has_material(self) -> bool:
@@ -191,6 +238,7 @@ class Renderer(PreviewSettings):
         if self._compiled is not None:
             self._program = self.programs.material(self._compiled, self.is_forward, bool(on),
                                                    self.view)
+        self._relink_compare()
         self.reset_accumulation()
 
     def set_uniforms(self, values: dict[str, Any]) -> None:
@@ -233,17 +281,26 @@ class Renderer(PreviewSettings):
         return self.accumulator.frames
 
     def _scene(self, ibl_mode: int, offset=(0.0, 0.0), band=None) -> None:
-        """The scene into the targets, only the rows of `band` (x, y, w, h) when given."""
-        program = self._program
-        if ibl_mode == IBL_MODE_REFERENCE and self.is_forward and self._compiled is not None:
-            program = self.programs.reference(self._compiled, self.energy_compensation,
-                                              fallback=program, view=self.view)
-        self.targets.scissor = band
-        try:
-            self.scene.draw(self, self.targets, self._mesh, program, self.is_forward,
-                            self.material, ibl_mode, offset)
-        finally:
-            self.targets.scissor = None
+        """The scene into the targets, only the rows of `band` (x, y, w, h) when given; with
+        an A/B split, the compared material left of the divider and the current one right."""
+        parts = [(self._program, self.is_forward, self.material, band)]
+        if self.compare is not None and self._program is not None:
+            w, h = self.targets.size
+            cut = int(round(self.split * w))
+            c, whole = self.compare, band or (0, 0, w, h)
+            parts = [p for p in ((c.program, c.forward, c.resources, _clip(whole, 0, cut)),
+                                 (self._program, self.is_forward, self.material,
+                                  _clip(whole, cut, w))) if p[3] is not None]
+        for program, forward, material, rect in parts:
+            if ibl_mode == IBL_MODE_REFERENCE and forward and material.compiled is not None:
+                program = self.programs.reference(material.compiled, self.energy_compensation,
+                                                  fallback=program, view=self.view)
+            self.targets.scissor = rect
+            try:
+                self.scene.draw(self, self.targets, self._mesh, program, forward, material,
+                                ibl_mode, offset)
+            finally:
+                self.targets.scissor = None
 
     def render(self, target: moderngl.Framebuffer | None = None) -> None:
         """Draws one frame into `target` (default: an internal sRGB8 image, see read_image).
@@ -315,6 +372,23 @@ class Renderer(PreviewSettings):
     def release(self) -> None:
         self._release_targets()
         self.programs.release(self._mesh.forget if self._mesh is not None else None)
+        self.set_compare(None)
         for part in (self.scene, self._mesh, self.material, self.accumulator, self._quad):
             if part is not None:
                 part.release()
+
+
+class _CompareSlot:
+    """The A side of an A/B split: its program, path and resources."""
+
+    def __init__(self, resources: MaterialResources) -> None:
+        self.resources = resources
+        self.program: moderngl.Program | None = None
+        self.forward = True
+
+
+def _clip(band: tuple[int, int, int, int], x0: int, x1: int):
+    """`band` (x, y, w, h) within columns x0 .. x1, None when nothing is left."""
+    x, y, w, h = band
+    left, right = max(x, x0), min(x + w, x1)
+    return (left, y, right - left, h) if right > left else None
