@@ -86,19 +86,24 @@ def test_start_without_a_file_offers_every_recovery_file(qtbot, graphs):
     w2 = make_window(qtbot, answers={"recover_all": _recover_everything(seen)})
     assert len(seen) == 3  # both materials and the function, one question
     assert {e.is_function for e in seen} == {True, False}
-    # The oldest material (the untitled one) opens here, unsaved; the other in a window.
+    # The oldest material (the untitled one) opens, unsaved; the other in a tab of its own.
+    docs = w2.documents
+    assert docs.count() == 2 and docs.index == 0
     assert dumps(w2.controller.document) == untitled_text and w2.controller.dirty
-    (other,) = w2.extra_windows
-    qtbot.addWidget(other)
-    assert dumps(other.controller.document) == sample_text and other.controller.dirty
-    assert other.controller.document.path == sample
+    assert docs.names()[1].endswith("*")
+    docs.activate(1)
+    assert dumps(w2.controller.document) == sample_text and w2.controller.dirty
+    assert w2.controller.document.path == sample
+    docs.activate(0)
     fn_tabs = [t for t in w2.tabs.all_tabs() if t.is_function]
     assert len(fn_tabs) == 1 and fn_tabs[0].controller.dirty
     assert fn_tabs[0].controller.document.graph.nodes[node].label == "edited in a tab"
     # Recovered files stay until the work is saved: a second crash loses nothing.
     assert all(e.rec.is_file() for e in seen)
-    assert other.actions.save()
+    docs.activate(1)
+    assert w2.actions.save()
     assert not next(e for e in seen if e.document == sample).rec.exists()
+    assert next(e for e in seen if e.document is None).rec.is_file()  # still unsaved work
 
 
 def test_start_with_a_file_argument_still_offers_the_other_recovery_files(qtbot, graphs):
@@ -109,9 +114,9 @@ def test_start_with_a_file_argument_still_offers_the_other_recovery_files(qtbot,
     w = make_window(qtbot, car, answers={"recover_all": _recover_everything(seen)})
     assert len(seen) == 1 and seen[0].document is None
     assert w.controller.document.path == car and not w.controller.dirty  # the file asked for
-    (other,) = w.extra_windows
-    qtbot.addWidget(other)
-    assert dumps(other.controller.document) == untitled_text
+    assert w.documents.count() == 2  # the left-over untitled work: a tab of its own
+    w.documents.activate(1)
+    assert dumps(w.controller.document) == untitled_text and w.controller.dirty
 
 
 def test_recovery_files_are_deleted_only_once_the_artist_has_answered(qtbot):

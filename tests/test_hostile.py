@@ -1800,11 +1800,11 @@ def test_launch_with_hostile_recovery_entries_offers_the_good_ones(qtbot, capfd)
 
     w = test_app_support.make_window(qtbot, answers={"recover_all": recover_all})
     assert len(seen) == 2 and all(e.document is None for e in seen)
-    labels = {n.label for win in [w, *w.extra_windows]
-              for n in win.controller.document.graph.nodes.values()}
+    labels = set()
+    for i in range(w.documents.count()):  # each recovered material in a tab of its own
+        w.documents.activate(i)
+        labels |= {n.label for n in w.controller.document.graph.nodes.values()}
     assert {"first crash", "second crash"} <= labels
-    for other in w.extra_windows:
-        qtbot.addWidget(other)
     assert len(w.actions.skipped_recoveries) == len(HOSTILE_RECOVERY)
     qtbot.waitUntil(lambda: "damaged recovery file" in w.statusBar().currentMessage(),
                     timeout=5000)

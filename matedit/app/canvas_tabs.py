@@ -65,6 +65,8 @@ class CanvasTabs(QWidget):
         self.tabs.setDocumentMode(True)
         self.tabs.setTabsClosable(True)
         self.tabs.setMovable(False)
+        # the material's own tab is named by its document tab: this row shows with functions
+        self.tabs.setTabBarAutoHide(True)
         self.tabs.tabCloseRequested.connect(self.close_tab)
         self.tabs.currentChanged.connect(self._current_changed)
         lay.addWidget(self.tabs, 1)
@@ -78,6 +80,7 @@ class CanvasTabs(QWidget):
         bar.setTabButton(0, bar.ButtonPosition.RightSide, None)
         bar.setTabButton(0, bar.ButtonPosition.LeftSide, None)
         material.documentReplaced.connect(self._material_replaced)
+        material.undoStackReplaced.connect(self._material_stack_replaced)
         self._refresh_crumbs()
 
     # --- tabs ------------------------------------------------------------------------------
@@ -181,6 +184,16 @@ class CanvasTabs(QWidget):
             if tab in self._tabs and not self.close_tab(self._tabs.index(tab)):
                 return False
         return True
+
+    def _material_stack_replaced(self, old) -> None:
+        """Another document tab: the material's undo stack is its own."""
+        stack = self.material.controller.undo_stack
+        self.undo_group.removeStack(old)
+        old.cleanChanged.disconnect(self._clean_changed)
+        self.undo_group.addStack(stack)
+        stack.cleanChanged.connect(self._clean_changed)
+        if self.active is self.material:
+            self.undo_group.setActiveStack(stack)
 
     def _material_replaced(self) -> None:
         self._retitle(self.material)

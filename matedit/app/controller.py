@@ -122,6 +122,7 @@ class DocumentController(QObject):
     valuesChanged = Signal(object)  # ValueChange
     documentReplaced = Signal()
     analysed = Signal(object)
+    undoStackReplaced = Signal(object)  # the stack that was the controller's (swap)
 
     def __init__(self, document: MaterialDocument | None = None, parent=None) -> None:
         super().__init__(parent)
@@ -145,6 +146,19 @@ class DocumentController(QObject):
         self.document.graph.subscribe(self._on_event)
         self.undo_stack.clear()
         self.undo_stack.setClean()
+        self.documentReplaced.emit()
+        self._settle()
+
+    def swap(self, document: MaterialDocument, undo_stack: QUndoStack) -> None:
+        """Shows another open document with its own undo history (a document tab): nothing
+        of either is lost, and the one swapped out can be swapped back as it was."""
+        self._debounce.stop()
+        self.document.graph.unsubscribe(self._on_event)
+        old = self.undo_stack
+        self.document, self.undo_stack = document, undo_stack
+        self.document.graph.subscribe(self._on_event)
+        if old is not undo_stack:
+            self.undoStackReplaced.emit(old)
         self.documentReplaced.emit()
         self._settle()
 

@@ -24,6 +24,7 @@ from matedit.app.compile_service import MaterialCompiler
 from matedit.app.controller import DocumentController
 from matedit.app.docks import Panels, build_docks
 from matedit.app.document_actions import DocumentActions, document_title, new_material
+from matedit.app.documents import DocumentTabs
 from matedit.app.export_dialog import ExportDialog
 from matedit.app.help import NodeDocs, ShortcutReference, show_about
 from matedit.app.instance_editor import InstanceEditor, Instances
@@ -54,7 +55,8 @@ class MainWindow(QMainWindow):
         self.undo_group = QUndoGroup(self)
 
         self.tabs = CanvasTabs(self.controller, self.actions, self.undo_group, self)
-        self.setCentralWidget(self.tabs)
+        self.documents = DocumentTabs(self.controller, self.actions, self)
+        self.setCentralWidget(self.documents.over(self.tabs))
         self.panels: Panels = build_docks(self, self.compiler, self.controller,
                                           self.undo_group)
         p = self.panels  # the panels the window's own code reaches most, by name
@@ -78,14 +80,13 @@ class MainWindow(QMainWindow):
         self.undo_group.setActiveStack(self.controller.undo_stack)
         self._on_active(self.tabs.active)
         self._retitle()
-        self.extra_windows: list[MainWindow] = []  # recovered materials opened at start-up
         self._shortcuts: ShortcutReference | None = None
         self._docs: NodeDocs | None = None
         self._tab_filter = PaletteOnTab(self, lambda: self.canvas)  # Tab over the canvas
         QApplication.instance().installEventFilter(self._tab_filter)
         self.actions.open_recovered_function = lambda e, doc: self.tabs.open_function(
             e.document, self.tabs.material, recovered=doc)
-        self.actions.open_recovered_material = self._open_recovered_material
+        self.actions.open_recovered_material = self.documents.open_recovered
         self.actions.open_function = lambda p: self.tabs.open_function(p, self.tabs.material)
         self.actions.preview_settings = self.viewport.document_preview
         if start:
@@ -102,6 +103,7 @@ class MainWindow(QMainWindow):
     def _connect(self) -> None:
         c = self.controller
         c.undo_stack.cleanChanged.connect(self._clean_changed)
+        c.undoStackReplaced.connect(self._undo_stack_replaced)
         c.documentReplaced.connect(self._document_replaced)
         c.analysed.connect(lambda _a: self._refresh_problems())
         self.actions.opened.connect(lambda _p: self._retitle())
@@ -145,9 +147,8 @@ class MainWindow(QMainWindow):
 
     # --- documents -------------------------------------------------------------------------
     def open_material(self, path: str | Path) -> bool:
-        if not self.tabs.close_functions():
-            return False
-        return self.actions.open(path)
+        """A material in a document tab of its own (the tab that has it, if one does)."""
+        return self.documents.open(path)
 
     # --- help ------------------------------------------------------------------------------
     def show_shortcuts(self) -> ShortcutReference:
@@ -180,17 +181,6 @@ class MainWindow(QMainWindow):
     def create_instance(self, parent_file: str | Path, path: str | Path) -> InstanceEditor:
         return self.instances.create(parent_file, path)
 
-    def _open_recovered_material(self, entry, doc) -> None:
-        """A second recovered material gets a window of its own."""
-        w = MainWindow(restore_layout=False, start=False)
-        w.actions.ask_save_changes = self.actions.ask_save_changes
-        w.actions.ask_recover = self.actions.ask_recover
-        w.actions.show_error = self.actions.show_error
-        w.actions._adopt(entry, doc)
-        w.compiler.recompile()
-        w.show()
-        self.extra_windows.append(w)
-
     def save_active(self) -> bool:
         return self.tabs.active.actions.save()
 
@@ -209,6 +199,10 @@ class MainWindow(QMainWindow):
         self.viewport.set_preview(self.controller.document.preview,
                                   self.controller.document.path)
         self.inspector.show_node(None)
+
+    def _undo_stack_replaced(self, old) -> None:
+        old.cleanChanged.disconnect(self._clean_changed)
+        self.controller.undo_stack.cleanChanged.connect(self._clean_changed)
 
     def _clean_changed(self, _clean: bool) -> None:
         self._retitle()
@@ -284,7 +278,7 @@ class MainWindow(QMainWindow):
 
     # --- closing ---------------------------------------------------------------------------
     def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802 - Qt's name
-        if not self.tabs.close_functions() or not self.actions.close():
+        if not self.tabs.close_functions() or not self.documents.may_quit():
             event.ignore()
             return
         self.save_layout()

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from matedit.app.canvas_tabs import CanvasTabs
     from matedit.app.controller import DocumentController
     from matedit.app.document_actions import DocumentActions
+    from matedit.app.documents import DocumentTabs
     from matedit.app.interop_actions import InteropActions
 
 K = QKeySequence.StandardKey
@@ -37,6 +38,7 @@ class MenuHost(Protocol):
     actions: DocumentActions
     controller: DocumentController
     tabs: CanvasTabs
+    documents: DocumentTabs
     undo_group: QUndoGroup
 
     def save_active(self) -> bool: ...
@@ -151,9 +153,20 @@ def install_menus(window: QMainWindow, w: MenuHost, docks: Iterable[QDockWidget]
     from matedit.app.interop_actions import InteropActions
 
     canvas = w.tabs.canvas_actions
-    new = make_action(window, "&New", w.actions.new, K.New, "new", "New material", "file.new")
-    open_ = make_action(window, "&Open…", w.actions.open_dialog, K.Open, "open",
-                        "Open a material or a material function", "file.open")
+    new = make_action(window, "&New", w.documents.new, K.New, "new",
+                      "New material, in a tab of its own", "file.new")
+    open_ = make_action(window, "&Open…", w.documents.open_dialog, K.Open, "open",
+                        "Open a material (in a tab of its own) or a material function",
+                        "file.open")
+    close = make_action(window, "&Close", lambda: w.documents.close(), "Ctrl+W",
+                        tip="Close the material in the active document tab",
+                        action_id="file.close")
+    close_all = make_action(window, "Close A&ll", w.documents.close_all, "Ctrl+Shift+W",
+                            tip="Close every document tab, asking about unsaved work",
+                            action_id="file.close_all")
+    save_all = make_action(window, "Save A&ll", w.documents.save_all, "Ctrl+Alt+S",
+                           tip="Save every document tab with unsaved work",
+                           action_id="file.save_all")
     save = make_action(window, "&Save", w.save_active, K.Save, "save",
                        "Save the document in the active tab", "file.save")
     save_as = make_action(window, "Save &As…", w.save_active_as, K.SaveAs, "save-as",
@@ -186,7 +199,7 @@ def install_menus(window: QMainWindow, w: MenuHost, docks: Iterable[QDockWidget]
     recent = RecentMenu(w.actions, w.open_material, window)
     recent.menuAction().setObjectName("file.recent")
     f.addMenu(recent)
-    _add(f, (None, save, save_as, None, export, save_image))
+    _add(f, (None, save, save_as, save_all, None, close, close_all, None, export, save_image))
     interop = InteropActions(window, w)
     insert_after(f, "file.export", interop.entries())
     _add(f, (None, quit_))

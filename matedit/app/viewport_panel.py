@@ -96,7 +96,7 @@ class ViewportPanel(QWidget):
         self.exposure.setRange(-60, 60)  # tenths of EV: the arrow keys step 0.1 EV
         self.exposure.setSingleStep(1)
         self.exposure.setPageStep(10)
-        self.exposure.setMinimumWidth(140)
+        self.exposure.setMinimumWidth(100)
         self.exposure.setToolTip("Exposure (EV); arrow keys step 0.1 EV, Page Up/Down 1 EV")
         self.exposure_spin = QDoubleSpinBox()
         self.exposure_spin.setRange(-6.0, 6.0)
