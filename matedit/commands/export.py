@@ -25,13 +25,14 @@ def register(sub) -> None:
                        "asset (.usda with its textures beside it, or a .usdz package: preview "
                        "mesh, UsdPreviewSurface on baked maps, MaterialX network).")
     p.add_argument("file", metavar="FILE")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.gltf|OUT.glb|OUT.mtlx|OUT.usda|OUT.usdz")
+    p.add_argument("-o", "--output", required=True,
+                   metavar="OUT.gltf|OUT.glb|OUT.mtlx|OUT.usda|OUT.usdz")
     p.add_argument("--size", default=None, metavar="N",
                    help="baked map size in texels (default 1024 for glTF and USD, 512 for "
                    "the MaterialX bakes)")
     p.add_argument("--mesh", default=None,
-                   help="glTF and USD only: sphere, cube, plane, cylinder (or builtin:sphere, ...) or "
-                   "an OBJ file (./sphere for a file of that name) (default: the file's "
+                   help="glTF and USD only: sphere, cube, plane, cylinder (or builtin:sphere, "
+                   "...) or an OBJ file (./sphere for a file of that name) (default: the file's "
                    "preview mesh, else sphere)")
     declare_inputs(p, file="document", mesh="mesh")
     p.set_defaults(run=run)
@@ -177,7 +178,7 @@ def _usd(args, out: Path) -> int:
     maps = maps_from(attrs, ir.attributes, "png")
     mtlx = None
     try:
-        mx = mtlx_export.export_ir(lowered, out, size, out.stem)
+        mx = mtlx_export.export_ir(lowered, out, size, usd.file_stem(out))
         mtlx = usd.MtlxPart(mx.text, {p.name: a for p, a in mx.images.items()},
                             usd.relative_textures(ir, out.parent))
         notes += [f"node {node}: baked to an image for the MaterialX network ({why})"

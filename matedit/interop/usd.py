@@ -26,6 +26,7 @@ asset names no folder of this machine.
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,6 +53,12 @@ UNHELD = {
 # Fields only meaningful while another is on: field -> the field that turns it on.
 NEEDS = {"coatColor": "coat", "coatIor": "coat", "coatNormal": "coat",
          "attenuationDistance": "transmission"}
+
+
+def file_stem(out: Path) -> str:
+    """The stem of the files the layer names: OUT's stem with every character but ASCII
+    letters, digits, '.', '-' and '_' made '_' (asset paths are UTF-8, and portable)."""
+    return re.sub(r"[^A-Za-z0-9._-]", "_", Path(out).stem) or "material"
 
 
 class UsdExportError(ValueError):
@@ -116,7 +123,7 @@ def preview_lobes(stats, mtlx: bool) -> tuple[dict[str, float], list[str]]:
         if name not in stats:
             continue
         mean, lo, hi = stats[name]
-        if name == "coatRoughness" and "coat" not in values:
+        if name == "coatRoughness" and "clearcoat" not in values:
             continue
         values[inp] = round(float(mean[0]), 6)
         if float(hi[0] - lo[0]) > VARYING:
@@ -124,7 +131,7 @@ def preview_lobes(stats, mtlx: bool) -> tuple[dict[str, float], list[str]]:
                          f"UsdPreviewSurface {inp} gets its mean {values[inp]:.6g}; {where}")
     if "ior" in values:
         values["ior"] = max(1.0, values["ior"])
-    if "coat" in values and "clearcoatRoughness" not in values:
+    if "clearcoat" in values and "clearcoatRoughness" not in values:
         values["clearcoatRoughness"] = 0.0  # ours; UsdPreviewSurface's default is 0.01
     if values.get("clearcoat", 0.0) <= 0.0:
         values.pop("clearcoat", None)
@@ -393,7 +400,7 @@ def build(out: Path, maps: list[BakedMap], mesh, name: str, emissive_max: float,
     from pxr import Sdf, Tf, Usd, UsdGeom, UsdShade
 
     out = Path(out)
-    stem = out.stem
+    stem = file_stem(out)
     lobes, lobe_notes = preview_lobes(stats, mtlx is not None)
     side: dict[str, bytes] = {}
     files: dict[str, str] = {}
