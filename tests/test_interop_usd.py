@@ -224,11 +224,12 @@ def _mx_doc(name: str, out: Path):
     from matedit.compiler.lower import lower_document
     from matedit.interop import mtlx_export
     from matedit.interop.mtlx_colorspace import stdlib
-    from matedit.interop.usd import file_stem
+    from matedit.interop.usd import file_stem, texture_copies
     from matedit.io.document import FileResolver
 
     ir = lower_document(load_material(MATERIALS / f"{name}.json"), FileResolver())
-    result = mtlx_export.export_ir(ir, out, SIZE, file_stem(out))
+    copies = {name: file for name, (file, _) in texture_copies(ir, out).items()}
+    result = mtlx_export.export_ir(ir, out, SIZE, file_stem(out), copies)
     doc = mx.createDocument()
     mx.readFromXmlString(doc, result.text)
     own = [n.getName() for n in doc.getNodeGraphs()], [n.getName() for n in doc.getNodes()]

@@ -178,9 +178,11 @@ def _usd(args, out: Path) -> int:
     maps = maps_from(attrs, ir.attributes, "png")
     mtlx = None
     try:
-        mx = mtlx_export.export_ir(lowered, out, size, usd.file_stem(out))
+        copies = usd.texture_copies(lowered, out)
+        mx = mtlx_export.export_ir(lowered, out, size, usd.file_stem(out),
+                                   {name: file for name, (file, _) in copies.items()})
         mtlx = usd.MtlxPart(mx.text, {p.name: a for p, a in mx.images.items()},
-                            usd.relative_textures(ir, out.parent))
+                            dict(copies.values()))
         notes += [f"node {node}: baked to an image for the MaterialX network ({why})"
                   for node, why in mx.baked]
     except mtlx_export.MtlxExportError as exc:

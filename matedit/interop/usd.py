@@ -25,7 +25,6 @@ asset names no folder of this machine.
 
 from __future__ import annotations
 
-import os
 import re
 import tempfile
 from dataclasses import dataclass, field
@@ -386,7 +385,8 @@ class _MtlxWriter:
 @dataclass
 class MtlxPart:
     """The MaterialX export to carry: its text, its baked images (document file name ->
-    pixels) and the texture files it reads (document file value -> the file)."""
+    pixels) and the copies of the texture files it reads (the name beside the layer, which
+    the document's image nodes name, -> the file)."""
 
     text: str
     images: dict[str, np.ndarray]
@@ -419,10 +419,10 @@ def build(out: Path, maps: list[BakedMap], mesh, name: str, emissive_max: float,
                 raise UsdExportError(f"{out}: two textures would be named {file}")
             side[file] = _exr_bytes(arr)
             mx_files[doc_name] = file
-        for k, (doc_name, src) in enumerate(sorted(mtlx.textures.items())):
-            file = f"{stem}_texture{k}{Path(src).suffix.lower()}"
+        for file, src in sorted(mtlx.textures.items()):
+            if file in side:
+                raise UsdExportError(f"{out}: two textures would be named {file}")
             side[file] = read_bounded(src, MAX_TEXTURE_BYTES)
-            mx_files[doc_name] = file
 
     layer = Sdf.Layer.CreateAnonymous(".usda")
     stage = Usd.Stage.Open(layer)
@@ -430,7 +430,7 @@ def build(out: Path, maps: list[BakedMap], mesh, name: str, emissive_max: float,
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
     root = UsdGeom.Xform.Define(stage, "/Root")
     stage.SetDefaultPrim(root.GetPrim())
-    prim_name = Tf.MakeValidIdentifier(name or "material")
+    prim_name = Tf.MakeValidIdentifier(re.sub(r"[^A-Za-z0-9_]", "_", name) or "material")
     mesh_prim = _mesh(stage, f"/Root/{prim_name}", mesh)
     UsdGeom.Scope.Define(stage, "/Root/Materials")
     material = UsdShade.Material.Define(stage, f"/Root/Materials/{prim_name}")
@@ -475,11 +475,13 @@ def write(result: UsdExport) -> None:
         stage.write_bytes(result.out, result.layer)
 
 
-def relative_textures(ir, folder: Path) -> dict[str, Path]:
-    """The MaterialX export's file value (the path relative to `folder`) -> the file, for
-    every texture of `ir` with a file."""
-    out = {}
-    for t in ir.textures:
-        if t.path:
-            out[Path(os.path.relpath(t.path, folder)).as_posix()] = Path(t.path)
-    return out
+def texture_copies(ir, out: Path) -> dict[str, tuple[str, Path]]:
+    """texture name -> (the name of its copy beside the layer, the file) for every texture
+    of `ir` with a file: the MaterialX network reads the copies (the asset names no folder
+    of this machine, and a name in any encoding becomes a portable one)."""
+    stem = file_stem(out)
+    out_map = {}
+    for k, t in enumerate(sorted((t for t in ir.textures if t.path), key=lambda t: t.name)):
+        suffix = re.sub(r"[^A-Za-z0-9.]", "_", Path(t.path).suffix.lower())
+        out_map[t.name] = (f"{stem}_texture{k}{suffix}", Path(t.path))
+    return out_map
