@@ -429,3 +429,18 @@ def test_usd_refuses_an_output_that_is_the_input(tmp_path):
     r = cli("export", doc, "-o", doc, "--size", 8)
     assert r.returncode == 2 and r.stderr.startswith("error: "), r.stderr
     assert doc.read_bytes() == (MATERIALS / "velvet.json").read_bytes()
+
+
+def test_a_material_materialx_refuses_exports_its_preview(tmp_path):
+    """A material the MaterialX export refuses (a varying anisotropy direction) still
+    exports: the preview network alone, and a note says why there is no mtlx network."""
+    out = tmp_path / "r.usda"
+    r = cli("export", MATERIALS / "radial_brushed_aluminium.json", "-o", out, "--size", 16)
+    assert r.returncode == 0, r.stderr
+    assert "note: " in r.stderr and "no MaterialX network" in r.stderr, r.stderr
+    assert "anisotropy has no UsdPreviewSurface input; dropped" in r.stderr, r.stderr
+    assert validation_errors(out) == []
+    stage = Usd.Stage.Open(str(out))
+    _, mat = _material(stage)
+    _preview(mat)
+    assert not mat.GetSurfaceOutput("mtlx")

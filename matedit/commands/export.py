@@ -139,13 +139,9 @@ def _mtlx(args, out: Path) -> int:
 def _usd(args, out: Path) -> int:
     """USD: the preview mesh bound to a Material with a UsdPreviewSurface network on the
     baked maps and the MaterialX export as a network in the mtlx render context."""
-    import numpy as np
-
     from matedit.compiler import CompileError
-    from matedit.compiler.lower import lower_document
-    from matedit.interop import mtlx_export, usd
-    from matedit.interop.bake import bake_attributes, maps_from
-    from matedit.interop.export import stem_of
+    from matedit.interop import usd
+    from matedit.interop.bake import bake_attributes
     from matedit.io.document import FileResolver
     from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
     from matedit.render.context import headless
@@ -166,32 +162,14 @@ def _usd(args, out: Path) -> int:
         raise UsageError(str(exc)) from None
     except OSError as exc:
         raise UsageError(f"{mesh_spec}: cannot read mesh: {exc.strerror or exc}") from None
-    notes: list[str] = []
     try:
         with headless() as ctx:
             attrs, ir = bake_attributes(ctx, doc, resolver, size, progress_printer("baking"))
-        lowered = lower_document(doc, resolver)
-    except CompileError as exc:
-        raise compile_error(exc, path) from None
-    emax = float(max(1.0, np.max(attrs["emissive"])))
-    attrs["emissive"] = attrs["emissive"] / emax
-    maps = maps_from(attrs, ir.attributes, "png")
-    mtlx = None
-    try:
-        copies = usd.texture_copies(lowered, out)
-        mx = mtlx_export.export_ir(lowered, out, size, usd.file_stem(out),
-                                   {name: file for name, (file, _) in copies.items()})
-        mtlx = usd.MtlxPart(mx.text, {p.name: a for p, a in mx.images.items()},
-                            dict(copies.values()))
-        notes += [f"node {node}: baked to an image for the MaterialX network ({why})"
-                  for node, why in mx.baked]
-    except mtlx_export.MtlxExportError as exc:
-        notes.append(f"no MaterialX network (the mtlx render context): {exc}")
-    try:
-        result = usd.build(out, maps, mesh, stem_of(doc), emax, usd.lobe_stats(ir), mtlx,
-                           notes)
+        result = usd.export_baked(doc, resolver, attrs, ir, mesh, out, size)
         refuse_overwrite(result.files, inputs)
         usd.write(result)
+    except CompileError as exc:
+        raise compile_error(exc, path) from None
     except usd.UsdExportError as exc:
         raise UsageError(f"{path}: {exc}") from None
     except OverwriteError as exc:

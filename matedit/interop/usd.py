@@ -422,7 +422,11 @@ def build(out: Path, maps: list[BakedMap], mesh, name: str, emissive_max: float,
         for file, src in sorted(mtlx.textures.items()):
             if file in side:
                 raise UsdExportError(f"{out}: two textures would be named {file}")
-            side[file] = read_bounded(src, MAX_TEXTURE_BYTES)
+            try:
+                side[file] = read_bounded(src, MAX_TEXTURE_BYTES)
+            except OSError as exc:
+                raise UsdExportError(f"{src}: cannot copy the texture into the asset: "
+                                     f"{exc.strerror or exc}") from None
 
     layer = Sdf.Layer.CreateAnonymous(".usda")
     stage = Usd.Stage.Open(layer)
@@ -444,6 +448,37 @@ def build(out: Path, maps: list[BakedMap], mesh, name: str, emissive_max: float,
     if out.suffix.lower() == ".usdz":
         return UsdExport(out, _package(stem, layer, side), {}, all_notes)
     return UsdExport(out, text.encode("utf-8"), side, all_notes)
+
+
+def export_baked(doc, resolver, attrs: dict[str, np.ndarray], ir, mesh, out: Path,
+                 size: int) -> UsdExport:
+    """The asset of `doc` from its bake (`bake.bake_attributes`: the attributes and the
+    optimised IR) on `mesh`: the MaterialX export (of the lowered document, its baked nodes
+    `size` texels wide) carried where it can be written, else a note says why not. Raises
+    CompileError, UsdExportError."""
+    from matedit.compiler.lower import lower_document
+    from matedit.interop import mtlx_export
+    from matedit.interop.bake import maps_from
+    from matedit.interop.export import stem_of
+
+    attrs = dict(attrs)
+    emax = float(max(1.0, np.max(attrs["emissive"])))
+    attrs["emissive"] = attrs["emissive"] / emax
+    maps = maps_from(attrs, ir.attributes, "png")
+    lowered = lower_document(doc, resolver)
+    notes: list[str] = []
+    mtlx = None
+    try:
+        copies = texture_copies(lowered, out)
+        mx = mtlx_export.export_ir(lowered, out, size, file_stem(out),
+                                   {name: file for name, (file, _) in copies.items()})
+        mtlx = MtlxPart(mx.text, {p.name: a for p, a in mx.images.items()},
+                        dict(copies.values()))
+        notes += [f"node {node}: baked to an image for the MaterialX network ({why})"
+                  for node, why in mx.baked]
+    except mtlx_export.MtlxExportError as exc:
+        notes.append(f"no MaterialX network (the mtlx render context): {exc}")
+    return build(out, maps, mesh, stem_of(doc), emax, lobe_stats(ir), mtlx, notes)
 
 
 def _package(stem: str, layer, side: dict[str, bytes]) -> bytes:
