@@ -392,7 +392,7 @@ def test_usdz_is_a_valid_package(tmp_path):
     assert os.fsencode(str(tmp_path)) not in out.read_bytes()
 
 
-@pytest.mark.parametrize("instance", ["worn_paint_red", "rusty_metal_heavy"])
+@pytest.mark.parametrize("instance", ["worn_paint_red"])
 def test_instances_export(tmp_path, instance):
     src = graphs_dir() / "instances" / f"{instance}.json"
     out = tmp_path / "i.usda"
@@ -444,3 +444,45 @@ def test_a_material_materialx_refuses_exports_its_preview(tmp_path):
     _, mat = _material(stage)
     _preview(mat)
     assert not mat.GetSurfaceOutput("mtlx")
+
+
+def test_a_texture_the_material_reads_is_copied_beside_the_layer(tmp_path):
+    """The MaterialX network's image node reads a copy of the material's texture, beside
+    the layer under a portable name, with the texture's colour space; the usdz holds it."""
+    from hostile import base_material
+
+    from matedit.io.images import write_image
+
+    src = tmp_path / "src"
+    src.mkdir()
+    pixels = np.zeros((4, 4, 3), np.float32)
+    pixels[..., 0] = 0.5
+    write_image(src / "my albedo.png", pixels)
+    raw = base_material()
+    raw["nodes"] += [
+        {"id": "tex", "kind": "texture_parameter", "position": [0, 300],
+         "settings": {"name": "albedo", "path": "my albedo.png"}},
+        {"id": "samp", "kind": "texture_sample", "position": [200, 300]}]
+    raw["links"] = [lk for lk in raw["links"] if lk["to"] != ["make", "baseColor"]]
+    raw["links"] += [{"from": ["tex", "texture"], "to": ["samp", "texture"]},
+                     {"from": ["samp", "rgb"], "to": ["make", "baseColor"]}]
+    doc = src / "m.json"
+    doc.write_text(json.dumps(raw))
+    out = tmp_path / "out" / "t.usda"
+    out.parent.mkdir()
+    r = cli("export", doc, "-o", out, "--size", 8)
+    assert r.returncode == 0, r.stderr
+    assert (out.parent / "t_texture0.png").read_bytes() == (src / "my albedo.png").read_bytes()
+    assert validation_errors(out) == []
+    stage = Usd.Stage.Open(str(out))
+    images = [UsdShade.Shader(p) for p in stage.Traverse()
+              if p.IsA(UsdShade.Shader) and
+              str(UsdShade.Shader(p).GetIdAttr().Get()).startswith("ND_image_")]
+    (image,) = images
+    file = image.GetInput("file")
+    assert file.Get().path == "./t_texture0.png"
+    assert file.GetAttr().GetColorSpace() == "srgb_texture"
+    r = cli("export", doc, "-o", tmp_path / "out" / "t.usdz", "--size", 8)
+    assert r.returncode == 0, r.stderr
+    with zipfile.ZipFile(tmp_path / "out" / "t.usdz") as z:
+        assert z.read("t_texture0.png") == (src / "my albedo.png").read_bytes()
