@@ -56,9 +56,9 @@ LAYERS: tuple[Layer, ...] = (
                            "matedit.ibl.environment", "matedit.ibl.cache"), ("numpy",)),
     # GGX prefiltering and the BRDF LUT on a context it is given; IBL textures
     Layer("ibl", ("matedit.ibl",), ("numpy", "moderngl")),
-    # the compiled-shader files, HLSL/MSL, texture baking, glTF, MaterialX
+    # the compiled-shader files, HLSL/MSL, texture baking, glTF, MaterialX, USD
     Layer("interop", ("matedit.interop",),
-          ("MaterialX", "pygltflib", "OpenImageIO", "numpy", "moderngl")),
+          ("MaterialX", "pygltflib", "pxr", "OpenImageIO", "numpy", "moderngl")),
     # the preview renderer on any moderngl context
     Layer("render", ("matedit.render",), ("numpy", "moderngl")),
     # the PySide6 editor

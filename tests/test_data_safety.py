@@ -502,6 +502,10 @@ COMMAND_CASES = {
                lambda kind: "m.bin", _export("gltf")),
     "export .mtlx": (("document", "texture", "function"), lambda kind: "m.mtlx",
                      _export("mtlx")),
+    "export .usda": (("document", "texture", "function", "preview_mesh", "mesh"),
+                     lambda kind: "m_orm.png", _export("usda")),
+    "export .usdz": (("document", "texture", "function", "preview_mesh", "mesh"),
+                     lambda kind: "m.usdz", _export("usdz")),
     "import": (("mtlx", "mtlx_image"), lambda kind: "mat.json",
                lambda p, o, kind: ["import", p["mtlx"], "-o", o]),
     "import .json": (("mtlx", "mtlx_image"), lambda kind: "mat.json",
@@ -595,6 +599,9 @@ MULTI_FILE_OUTPUTS = {  # command -> its arguments, the input planted, each of i
                   "ibl.json"]),
     "export": (lambda p, o: ["export", p["document"], "-o", o / "m.gltf", "--size", "8"],
                ["m.gltf", "m.bin"]),
+    "export .usda": (lambda p, o: ["export", p["document"], "-o", o / "m.usda", "--size", "8"],
+                     ["m.usda", "m_base_color.png", "m_normal.png", "m_orm.png",
+                      "m_texture0.png"]),
 }
 
 
@@ -834,6 +841,10 @@ OUTPUT_CASES = {
                                                "--size", "8")),
     "export-mtlx": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "x.mtlx",
                                                 "--size", "8")),
+    "export-usda": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "u.usda",
+                                                "--size", "8")),
+    "export-usdz": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "u.usdz",
+                                                "--size", "8")),
     "import-dir": (True, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d,
                                               *_replacing("import"))),
     "import-json": (False, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d / "one.json",
@@ -842,8 +853,10 @@ OUTPUT_CASES = {
                                                   d / "sheet.png", "--size", "32")),
     "ibl-cache": (True, _ibl_cache_case),
 }
-MULTI_FILE_CASES = ["compile", "bake", "bake-ibl", "export-gltf", "export-mtlx", "import-dir"]
+MULTI_FILE_CASES = ["compile", "bake", "bake-ibl", "export-gltf", "export-mtlx", "export-usda",
+                    "import-dir"]
 GL_CASES = {"render", "bake", "bake-ibl", "brdf-lut", "export-gltf", "export-glb",
+            "export-usda", "export-usdz",
             "contact-sheet", "ibl-cache"}
 _LEARNED: dict[str, list[str]] = {}
 

@@ -629,6 +629,9 @@ NON_UTF8_CASES = {
     "export .gltf": (["export", "doc", "-o", b"OUT.gltf", "--size", "8", "--mesh", "obj"],
                      [b"OUT.gltf", b"OUT.bin"]),
     "export .glb": (["export", "doc", "-o", b"OUT.glb", "--size", "8"], [b"OUT.glb"]),
+    "export .usda": (["export", "doc", "-o", b"OUT.usda", "--size", "8", "--mesh", "obj"],
+                     [b"OUT.usda", b"out___orm.png"]),
+    "export .usdz": (["export", "doc", "-o", b"OUT.usdz", "--size", "8"], [b"OUT.usdz"]),
     "contact-sheet": (["contact-sheet", "doc", "-o", b"OUT.png", "--size", "16"],
                       [b"OUT.png"]),
 }

@@ -147,7 +147,8 @@ def test_export_refuses_to_overwrite_its_mesh(tmp_path):
 
 def test_export_rejects_unknown_suffix(tmp_path):
     r = cli("export", str(SAMPLES[0]), "-o", str(tmp_path / "x.fbx"))
-    assert r.returncode == 2 and r.stderr.count("\n") == 1 and ".gltf, .glb or .mtlx" in r.stderr
+    assert r.returncode == 2 and r.stderr.count("\n") == 1
+    assert ".gltf, .glb, .mtlx, .usda or .usdz" in r.stderr
 
 
 @pytest.mark.gl

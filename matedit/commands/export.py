@@ -1,9 +1,11 @@
-"""`matedit export FILE -o OUT.gltf|OUT.glb|OUT.mtlx [--size N] [--mesh ...]`.
+"""`matedit export FILE -o OUT.gltf|OUT.glb|OUT.mtlx|OUT.usda|OUT.usdz [--size N] [--mesh ...]`.
 
 glTF 2.0: the preview mesh with tangents and a metallic-roughness material on maps baked
 over UV space (matedit.interop.gltf). MaterialX: a nodegraph reproducing the attribute graph
 feeding one standard_surface (matedit.interop.mtlx_export); subgraphs MaterialX cannot
-express are baked to EXR images beside the document, and reported."""
+express are baked to EXR images beside the document, and reported. USD: the preview mesh
+bound to a Material with a UsdPreviewSurface network on the baked maps and the MaterialX
+export in the mtlx render context (matedit.interop.usd)."""
 
 from __future__ import annotations
 
@@ -16,18 +18,21 @@ from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
-    p = sub.add_parser("export", help="export a material to glTF 2.0 or MaterialX",
+    p = sub.add_parser("export", help="export a material to glTF 2.0, MaterialX or USD",
                        description="Export a material as a glTF 2.0 asset (.gltf or .glb: "
                        "preview mesh, baked maps, metallic-roughness material) or as a "
-                       "MaterialX document (.mtlx: nodegraph and standard_surface).")
+                       "MaterialX document (.mtlx: nodegraph and standard_surface) or as a USD "
+                       "asset (.usda with its textures beside it, or a .usdz package: preview "
+                       "mesh, UsdPreviewSurface on baked maps, MaterialX network).")
     p.add_argument("file", metavar="FILE")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.gltf|OUT.glb|OUT.mtlx")
+    p.add_argument("-o", "--output", required=True,
+                   metavar="OUT.gltf|OUT.glb|OUT.mtlx|OUT.usda|OUT.usdz")
     p.add_argument("--size", default=None, metavar="N",
-                   help="baked map size in texels (default 1024 for glTF, 512 for the "
-                   "MaterialX bakes)")
+                   help="baked map size in texels (default 1024 for glTF and USD, 512 for "
+                   "the MaterialX bakes)")
     p.add_argument("--mesh", default=None,
-                   help="glTF only: sphere, cube, plane, cylinder (or builtin:sphere, ...) or "
-                   "an OBJ file (./sphere for a file of that name) (default: the file's "
+                   help="glTF and USD only: sphere, cube, plane, cylinder (or builtin:sphere, "
+                   "...) or an OBJ file (./sphere for a file of that name) (default: the file's "
                    "preview mesh, else sphere)")
     declare_inputs(p, file="document", mesh="mesh")
     p.set_defaults(run=run)
@@ -36,14 +41,16 @@ def register(sub) -> None:
 def run(args) -> int:
     out = Path(args.output)
     kind = out.suffix.lower()
-    if kind not in (".gltf", ".glb", ".mtlx"):
-        raise UsageError(f"{out}: the output must end in .gltf, .glb or .mtlx")
+    if kind not in (".gltf", ".glb", ".mtlx", ".usda", ".usdz"):
+        raise UsageError(f"{out}: the output must end in .gltf, .glb, .mtlx, .usda or .usdz")
     if not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
     if kind == ".mtlx":
         if args.mesh:
-            raise UsageError("--mesh applies to glTF exports only")
+            raise UsageError("--mesh applies to glTF and USD exports only")
         return _mtlx(args, out)
+    if kind in (".usda", ".usdz"):
+        return _usd(args, out)
     return _gltf(args, out)
 
 
@@ -126,4 +133,51 @@ def _mtlx(args, out: Path) -> int:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
     for node, why in result.baked:
         report("note", f"{path}: node {node}: baked to an image ({why})")
+    return 0
+
+
+def _usd(args, out: Path) -> int:
+    """USD: the preview mesh bound to a Material with a UsdPreviewSurface network on the
+    baked maps and the MaterialX export as a network in the mtlx render context."""
+    from matedit.compiler import CompileError
+    from matedit.interop import usd
+    from matedit.interop.bake import bake_attributes
+    from matedit.io.document import FileResolver
+    from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
+    from matedit.render.context import headless
+    from matedit.render.mesh import MeshError, mesh_from_spec
+
+    size = parse_size(args.size or "1024")
+    path = Path(args.file)
+    doc = load_material(path)
+    resolver = FileResolver()
+    mesh_spec = args.mesh or preview_spec(doc, "mesh", "sphere")
+    inputs = command_inputs(args, [doc], resolver)
+    try:
+        refuse_overwrite([out], inputs)
+        mesh = mesh_from_spec(mesh_spec)
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    except MeshError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"{mesh_spec}: cannot read mesh: {exc.strerror or exc}") from None
+    try:
+        with headless() as ctx:
+            attrs, ir = bake_attributes(ctx, doc, resolver, size, progress_printer("baking"))
+        result = usd.export_baked(doc, resolver, attrs, ir, mesh, out, size)
+        refuse_overwrite(result.files, inputs)
+        usd.write(result)
+    except CompileError as exc:
+        raise compile_error(exc, path) from None
+    except usd.UsdExportError as exc:
+        raise UsageError(f"{path}: {exc}") from None
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"{exc.filename or out}: cannot write: {exc.strerror or exc}") from None
+    for note in result.notes:
+        report("note", f"{path}: {note}")
+    if sys.stderr.isatty():
+        print(f"exported {path} to {', '.join(str(p) for p in result.files)}", file=sys.stderr)
     return 0

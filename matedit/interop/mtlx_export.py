@@ -142,6 +142,8 @@ class _Exporter:
         self.baked: list[tuple[str, str]] = []
         self._uv = None
         self._iface: dict[str, str] = {}
+        # texture name -> the file value to write (default: the path relative to folder)
+        self.texture_files: dict[str, str] = {}
 
     # --- MaterialX building blocks ---------------------------------------------------------
     def name(self, hint: str) -> str:
@@ -369,7 +371,8 @@ class _Exporter:
                 decoded = space != WORKING
                 n = self.ng.addNode("image", self.name(hint), "color4" if decoded else "vector4")
                 if info.path:
-                    rel = os.path.relpath(info.path, self.folder)
+                    rel = self.texture_files.get(info.name) or os.path.relpath(info.path,
+                                                                               self.folder)
                     n.setInputValue("file", Path(rel).as_posix(), "filename")
                     n.getInput("file").setColorSpace(space)
                 self.set_input(n, "texcoord", args[1].ref(), "vector2")
@@ -731,8 +734,12 @@ def validate(text: str) -> tuple[bool, str]:
     return bool(ok), msg
 
 
-def export_ir(ir: MaterialIR, out: Path, size: int, stem: str) -> MtlxExport:
+def export_ir(ir: MaterialIR, out: Path, size: int, stem: str,
+              texture_files: dict[str, str] | None = None) -> MtlxExport:
+    """`texture_files`: texture name -> the file value its image nodes get (where a caller
+    copies the texture beside the document under another name)."""
     ex = _Exporter(ir, size, Path(out).parent, stem)
+    ex.texture_files = dict(texture_files or {})
     try:
         (attrs,) = ex.scope(ir.main, {}, "")
         ex.surface(attrs)
