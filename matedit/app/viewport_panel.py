@@ -47,6 +47,8 @@ VIEW_TIPS = {
                   "amber with the anisotropy",
     "thin-film": "The thin film's thickness in micrometres as a grey level (linear)",
 }
+OBJ_ITEM = "OBJ file…"
+OBJ_FILTER = "Wavefront OBJ (*.obj)"
 MODES = {"Split-sum": "splitsum", "Reference": "reference", "Difference": "difference"}
 SAVE_FILTER = "PNG image, as shown (*.png);;OpenEXR, linear radiance (*.exr)"
 
@@ -73,7 +75,10 @@ class ViewportPanel(QWidget):
         bl.setSpacing(4)
         self.mesh_combo = QComboBox()
         self.mesh_combo.addItems(list(MESHES))
-        self.mesh_combo.setToolTip("Preview mesh")
+        self.mesh_combo.insertSeparator(len(MESHES))
+        self.mesh_combo.addItem(OBJ_ITEM, OBJ_ITEM)
+        self.mesh_combo.setToolTip("Preview mesh: a built-in one, or an OBJ file of yours")
+        self._mesh_index = 0  # the entry shown (OBJ… goes back to it when cancelled)
         self.mode_combo = QComboBox()
         self.mode_combo.addItems(list(MODES))
         self.mode_combo.setToolTip("Image-based lighting: split-sum approximation, brute-force "
@@ -184,7 +189,7 @@ class ViewportPanel(QWidget):
         self.failure = self._failure_notice()  # laid over the view: "does not compile"
         self.save_dialog = file_dialogs.save_file  # tests replace it
         self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment
-        self.mesh_combo.currentTextChanged.connect(self.view.set_mesh)
+        self.mesh_combo.currentIndexChanged.connect(self._mesh_chosen)
         self.mode_combo.currentTextChanged.connect(self._mode_changed)
         self.view_combo.currentIndexChanged.connect(self._view_changed)
         self.exposure.valueChanged.connect(self._exposure_changed)
@@ -549,6 +554,61 @@ class ViewportPanel(QWidget):
         super().resizeEvent(event)
         self._place_banner()
 
+    # --- mesh ------------------------------------------------------------------------------
+    def mesh_spec(self) -> str:
+        """The mesh shown: a built-in name, or an OBJ file's absolute path."""
+        data = self.mesh_combo.currentData()
+        return data if isinstance(data, str) and data != OBJ_ITEM else \
+            self.mesh_combo.currentText()
+
+    def _mesh_chosen(self, index: int) -> None:
+        if self.mesh_combo.itemData(index) == OBJ_ITEM:
+            path, _ = file_dialogs.open_file(self, "Open an OBJ mesh", "", OBJ_FILTER)
+            if not path or not self.load_mesh_file(path):
+                self.mesh_combo.setCurrentIndex(self._mesh_index)
+            return
+        self._mesh_index = index
+        self.view.set_mesh(self.mesh_spec())
+
+    def load_mesh_file(self, path: str | Path) -> bool:
+        """An OBJ file as the preview mesh (checked first: a bad file is a status message,
+        and the mesh shown stays); it joins the mesh list by its file name."""
+        from matedit.render.mesh import MeshError, mesh_from_spec
+
+        path = Path(path).resolve()
+        try:
+            mesh_from_spec(str(path))
+        except MeshError as exc:
+            self.statusMessage.emit(f"{path.name}: not a mesh the viewport can show: {exc}")
+            return False
+        except OSError as exc:
+            self.statusMessage.emit(f"{path.name}: cannot be read: {exc.strerror or exc}")
+            return False
+        at = self.mesh_combo.findData(str(path))
+        if at < 0:
+            at = self.mesh_combo.count() - 1  # before "OBJ file…"
+            self.mesh_combo.insertItem(at, path.name, str(path))
+            self.mesh_combo.setItemData(at, str(path), Qt.ItemDataRole.ToolTipRole)
+        self.mesh_combo.setCurrentIndex(at)
+        return True
+
+    def _set_mesh_spec(self, mesh: str, doc_path: Path | None = None) -> None:
+        """A mesh from settings or a document: a built-in name, or an OBJ file (relative to
+        `doc_path`)."""
+        from matedit.io.inputs import BUILTIN_PREFIX
+
+        name = mesh.removeprefix(BUILTIN_PREFIX)
+        if name in MESHES:
+            self.mesh_combo.setCurrentText(name)
+            return
+        p = Path(mesh)
+        if not p.is_absolute() and doc_path is not None:
+            p = Path(doc_path).resolve().parent / p
+        if p.suffix.lower() == ".obj" and p.is_file():
+            self.load_mesh_file(p)
+        else:
+            self.statusMessage.emit(f"the preview mesh {mesh} is missing")
+
     # --- bar -------------------------------------------------------------------------------
     def _mode_changed(self, text: str) -> None:
         self.view.set_mode(MODES[text])
@@ -591,15 +651,15 @@ class ViewportPanel(QWidget):
     def view_state(self) -> dict:
         """Mesh, mode, exposure, environment and energy compensation, as remembered across
         restarts."""
-        return {"mesh": self.mesh_combo.currentText(), "mode": self.mode_combo.currentText(),
+        return {"mesh": self.mesh_spec(), "mode": self.mode_combo.currentText(),
                 "exposure": self.exposure.value() / 10.0,
                 "environment": self.environment.current,
                 "energy_compensation": self.view.settings.energy_compensation}
 
     def restore_view_state(self, state: dict) -> None:
         mesh, mode = state.get("mesh"), state.get("mode")
-        if isinstance(mesh, str) and mesh in MESHES:
-            self.mesh_combo.setCurrentText(mesh)
+        if isinstance(mesh, str) and mesh:
+            self._set_mesh_spec(mesh)
         if isinstance(mode, str) and mode in MODES:
             self.mode_combo.setCurrentText(mode)
         ev = state.get("exposure")
@@ -625,15 +685,22 @@ class ViewportPanel(QWidget):
                     saved_as).resolve().parent)).as_posix(), "environment")
             except ValueError:  # another drive
                 env = Path(env).resolve().as_posix()
-        return {"mesh": self.mesh_combo.currentText(), "environment": env}
+        mesh = self.mesh_spec()
+        if mesh not in MESHES:  # an OBJ file, relative to the document like the HDR
+            try:
+                mesh = as_reference(Path(os.path.relpath(Path(mesh), Path(
+                    saved_as).resolve().parent)).as_posix(), "mesh")
+            except ValueError:
+                mesh = Path(mesh).as_posix()
+        return {"mesh": mesh, "environment": env}
 
     def set_preview(self, preview: dict, doc_path: Path | None = None) -> None:
         """Mesh and environment stored with a document (a file relative to `doc_path`)."""
         from matedit.io.inputs import BUILTIN_PREFIX
 
-        mesh = preview.get("mesh")  # `cube` or `builtin:cube`
-        if isinstance(mesh, str) and mesh.removeprefix(BUILTIN_PREFIX) in MESHES:
-            self.mesh_combo.setCurrentText(mesh.removeprefix(BUILTIN_PREFIX))
+        mesh = preview.get("mesh")  # `cube`, `builtin:cube` or an OBJ file
+        if isinstance(mesh, str) and mesh:
+            self._set_mesh_spec(mesh, doc_path)
         env = preview.get("environment")
         if not isinstance(env, str) or not env:
             return
