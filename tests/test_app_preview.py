@@ -176,11 +176,34 @@ def test_save_viewport_image_as_png_and_linear_exr(window, qtbot, tmp_path):
     w = window
     shown = frame(qtbot, w.viewport.view)
     w.viewport.save_dialog = lambda *a: (str(tmp_path / "shot.png"), "")
+    dialogs = []
+
+    def size_dialog(view_size, parent):  # the options dialog, answered at the view's size
+        from matedit.app.image_dialog import ImageSizeDialog
+
+        dlg = ImageSizeDialog(view_size, parent)
+        dlg.exec = lambda: True
+        dialogs.append(dlg)
+        return dlg
+
+    w.viewport.size_dialog = size_dialog
     assert w.viewport.save_image_dialog()
+    assert dialogs[0].chosen() == (w.viewport.view_pixels(), "png")
     png = read_image(tmp_path / "shot.png").pixels[..., :3]
     assert png.shape == shown.shape
     assert np.abs(png - shown).max() < 1.5 / 255  # the frame as shown, 8-bit
     assert w.menus.save_image in w.menus.file.actions()
+
+    # another size: drawn offscreen, the same picture at that size; the view unchanged
+    assert w.viewport.save_image(tmp_path / "big.png", (640, 480))
+    big = read_image(tmp_path / "big.png").pixels[..., :3]
+    assert big.shape == (480, 640, 3)
+    assert w.viewport.view.renderer.size == w.viewport.view_pixels()
+    assert abs(float(big.mean()) - float(shown.mean())) < 0.05  # the same scene, framed alike
+    assert w.viewport.save_image(tmp_path / "big.exr", (320, 200))
+    big_exr = read_image(tmp_path / "big.exr")
+    assert big_exr.pixels.shape[:2] == (200, 320) and not big_exr.is_ldr
+    np.testing.assert_allclose(frame(qtbot, w.viewport.view), shown, atol=1.5 / 255)
 
     assert w.viewport.save_image(tmp_path / "shot.exr")
     exr = read_image(tmp_path / "shot.exr")

@@ -458,6 +458,29 @@ class ViewportWidget(QOpenGLWidget):
         finally:
             self.doneCurrent()
 
+    def render_offscreen(self, width: int, height: int):
+        """(display image, scene-linear radiance), each (H, W, 3) floats, of the view drawn
+        at `width` x `height` (reference mode converged), then the view's own size again;
+        None without a renderer."""
+        r = self.renderer
+        if r is None:
+            return None
+        self.makeCurrent()
+        size, budget = r.size, r.slice_budget_ms
+        try:
+            r.resize(int(width), int(height))
+            r.slice_budget_ms = None
+            r.reset_accumulation()
+            r.render_converged()
+            return r.read_image(), r.read_hdr()
+        finally:
+            r.slice_budget_ms = budget
+            r.resize(*size)
+            r.reset_accumulation()
+            self._fbo = None
+            self.doneCurrent()
+            self.update()
+
     def read_image(self):
         """(H, W, 3) sRGB floats of the last frame, through the renderer."""
         if self.renderer is None:

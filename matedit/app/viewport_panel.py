@@ -188,6 +188,9 @@ class ViewportPanel(QWidget):
         lay.addWidget(self.view, 1)
         self.failure = self._failure_notice()  # laid over the view: "does not compile"
         self.save_dialog = file_dialogs.save_file  # tests replace it
+        from matedit.app.image_dialog import ImageSizeDialog
+
+        self.size_dialog = ImageSizeDialog  # so do they
         self.setAcceptDrops(True)  # an HDR/EXR dropped here becomes the environment
         self.mesh_combo.currentIndexChanged.connect(self._mesh_chosen)
         self.mode_combo.currentTextChanged.connect(self._mode_changed)
@@ -388,9 +391,24 @@ class ViewportPanel(QWidget):
 
     # --- saving the picture; dropped environments -------------------------------------------
     def save_image_dialog(self) -> bool:
-        path, _ = self.save_dialog(self, "Save the viewport image", "viewport.png",
-                                   SAVE_FILTER)
-        return bool(path) and self.save_image(path)
+        """File › Save Viewport Image: the size (the view's, or any other, drawn offscreen)
+        and the format, then where."""
+        view_size = self.view_pixels()
+        dlg = self.size_dialog(view_size, self)
+        if not dlg.exec():
+            return False
+        size, fmt = dlg.chosen()
+        name = "viewport." + fmt
+        path, _ = self.save_dialog(self, "Save the viewport image", name,
+                                   SAVE_FILTER if fmt == "png" else
+                                   ";;".join(reversed(SAVE_FILTER.split(";;"))))
+        if not path:
+            return False
+        return self.save_image(path, None if size == view_size else size)
+
+    def view_pixels(self) -> tuple[int, int]:
+        dpr = self.view.devicePixelRatioF()
+        return (max(1, int(self.view.width() * dpr)), max(1, int(self.view.height() * dpr)))
 
     def _inputs(self) -> dict[Path, str]:
         """Files the document reads (matedit.io.inputs: the document, its functions and
@@ -402,9 +420,10 @@ class ViewportPanel(QWidget):
             out.setdefault(Path(os.path.realpath(self.environment.current)), "the environment")
         return out
 
-    def save_image(self, path: str | Path) -> bool:
+    def save_image(self, path: str | Path, size: tuple[int, int] | None = None) -> bool:
         """The current frame as PNG (display-referred, as shown) or as EXR (scene-linear
-        radiance, before exposure and display transform)."""
+        radiance, before exposure and display transform); with `size` (width, height), the
+        view drawn offscreen at that size (reference mode converged first)."""
         path = Path(path)
         if path.suffix.lower() not in (".png", ".exr"):
             path = path.with_suffix(path.suffix + ".png") if path.suffix else \
@@ -421,27 +440,52 @@ class ViewportPanel(QWidget):
             self.statusMessage.emit("no image to save: the renderer is not running")
             return False
         try:
-            if path.suffix.lower() == ".exr":
+            if size is not None:
+                self._save_offscreen(path, size)
+            elif path.suffix.lower() == ".exr":
                 from matedit.io.images import write_image
 
                 write_image(path, self.view.read_hdr())
             else:
-                from PySide6.QtCore import QBuffer, QByteArray, QIODevice
-
-                from matedit.io.atomic import atomic_write_bytes
-
-                data = QByteArray()
-                buf = QBuffer(data)
-                buf.open(QIODevice.OpenModeFlag.WriteOnly)
-                if not self.view.grabFramebuffer().save(buf, "PNG"):
-                    raise OSError("PNG encoding failed")
-                buf.close()
-                atomic_write_bytes(path, bytes(data.data()))
+                self._write_png(path, self.view.grabFramebuffer())
         except (OSError, ValueError) as exc:
             self.statusMessage.emit(f"cannot save {path.name}: {exc}")
             return False
         self.statusMessage.emit(f"saved the viewport image to {path}")
         return True
+
+    def _save_offscreen(self, path: Path, size: tuple[int, int]) -> None:
+        import numpy as np
+
+        from matedit.io.images import write_image
+
+        shown = self.view.render_offscreen(*size)
+        if shown is None:
+            raise OSError("the renderer is not running")
+        display, linear = shown
+        if path.suffix.lower() == ".exr":
+            write_image(path, linear)
+        else:  # 8-bit sRGB, as the view shows it
+            from PySide6.QtGui import QImage
+
+            codes = np.ascontiguousarray(np.clip(np.rint(display * 255.0), 0, 255)
+                                         .astype(np.uint8))
+            h, w, _ = codes.shape
+            self._write_png(path, QImage(codes.data, w, h, 3 * w, QImage.Format.Format_RGB888))
+
+    @staticmethod
+    def _write_png(path: Path, image) -> None:
+        from PySide6.QtCore import QBuffer, QByteArray, QIODevice
+
+        from matedit.io.atomic import atomic_write_bytes
+
+        data = QByteArray()
+        buf = QBuffer(data)
+        buf.open(QIODevice.OpenModeFlag.WriteOnly)
+        if not image.save(buf, "PNG"):
+            raise OSError("PNG encoding failed")
+        buf.close()
+        atomic_write_bytes(path, bytes(data.data()))
 
     @staticmethod
     def _dropped_environment(mime) -> str:
