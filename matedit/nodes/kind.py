@@ -104,6 +104,7 @@ class Role(Enum):
     APPEND = auto()
     REROUTE = auto()
     TEXTURE_SAMPLE = auto()
+    ADDRESSED_TEXTURE_SAMPLE = auto()  # MaterialX image's address modes and filter
     COLOR_RAMP = auto()
     MAKE_ATTRIBUTES = auto()
     SET_ATTRIBUTES = auto()
