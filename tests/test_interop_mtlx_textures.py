@@ -1,0 +1,186 @@
+"""MaterialX's texture nodes, imported: each against MaterialX's own GLSL generator.
+
+A document of the texture nodes real files use (tiledimage, place2d in both operation
+orders, gltf_image, gltf_colorimage, gltf_normalmap, image under clamp, mirror, constant and
+closest, a normalmap of scale other than 1, rgbtohsv) on a 5 x 4 float image: each output,
+drawn by MaterialX's GLSL generator on the bake plane (tests/mtlx_gpu.py, which binds each
+image's sampler as MaterialX's own GLSL renderer does), equals the imported material's
+attribute from our CPU evaluator at the texel centres within 2e-3 (float32 GPU maths and
+llvmpipe's 8-bit bilinear weights against float64). The nodes made of nodegraphs are read
+through MaterialX's definitions (matedit.interop.mtlx_import, `expand`), so this is the
+check that each stdlib node inside them is read by MaterialX's rule.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+mx = pytest.importorskip("MaterialX")
+SIZE = 24
+W, H = 5, 4
+TOL = 2e-3
+
+# output name -> (the nodegraph's nodes for it, the node it reads, the surface input it
+# feeds); place2d's texcoord defaults to (0, 0), not the mesh's UVs: it is connected
+_IMG = '<input name="file" type="filename" value="tex.exr" />'
+_PLACE = ('<texcoord name="{n}_uv" type="vector2" /><place2d name="{n}" type="vector2">'
+          '<input name="texcoord" type="vector2" nodename="{n}_uv" />'
+          '<input name="pivot" type="vector2" '
+          'value="0.3, 0.6" /><input name="scale" type="vector2" value="{s}" />'
+          '<input name="rotate" type="float" value="30" /><input name="offset" '
+          'type="vector2" value="{o}" /><input name="operationorder" type="integer" '
+          'value="{k}" /></place2d>')
+CASES = {
+    "tiled": (f'<tiledimage name="tiled_n" type="color3">{_IMG}<input name="uvtiling" '
+              'type="vector2" value="2.5, 1.5" /><input name="uvoffset" type="vector2" '
+              'value="0.3, -0.2" /><input name="realworldimagesize" type="vector2" '
+              'value="2, 1" /><input name="realworldtilesize" type="vector2" value="1, 3" />'
+              '</tiledimage>', "tiled_n", "base_color"),
+    "srt": (_PLACE.format(n="p_srt", s="1.5, 0.7", o="0.1, 0.2", k=0)
+            + f'<image name="srt_n" type="color3">{_IMG}<input name="texcoord" '
+            'type="vector2" nodename="p_srt" /></image>', "srt_n", "base_color"),
+    "trs": (_PLACE.format(n="p_trs", s="1.5, 0.7", o="0.1, 0.2", k=1)
+            + f'<image name="trs_n" type="color3">{_IMG}<input name="texcoord" '
+            'type="vector2" nodename="p_trs" /></image>', "trs_n", "base_color"),
+    "gltf": (f'<gltf_image name="gltf_n" type="color3">{_IMG}<input name="factor" '
+             'type="color3" value="0.5, 0.8, 1" /><input name="scale" type="vector2" '
+             'value="2, 3" /><input name="rotate" type="float" value="40" /><input '
+             'name="offset" type="vector2" value="0.25, 0.1" /></gltf_image>', "gltf_n",
+             "base_color"),
+    "gltf_color": (f'<gltf_colorimage name="gc_n" type="multioutput">{_IMG}<input '
+                   'name="color" type="color4" value="0.9, 0.7, 0.5, 1" /><input '
+                   'name="rotate" type="float" value="10" /><input name="offset" '
+                   'type="vector2" value="0.1, 0.3" /></gltf_colorimage>', "gc_n",
+                   "base_color"),
+    "clamp_mirror": (_PLACE.format(n="p_cm", s="0.4, 0.3", o="0.5, 0.4", k=0)
+                     + f'<image name="cm_n" type="color3">{_IMG}<input name="texcoord" '
+                     'type="vector2" nodename="p_cm" /><input name="uaddressmode" '
+                     'type="string" value="clamp" /><input name="vaddressmode" '
+                     'type="string" value="mirror" /></image>', "cm_n", "base_color"),
+    "constant": (_PLACE.format(n="p_c", s="0.4, 0.3", o="0.5, 0.4", k=0)
+                 + f'<image name="c_n" type="color3">{_IMG}<input name="texcoord" '
+                 'type="vector2" nodename="p_c" /><input name="uaddressmode" type="string" '
+                 'value="constant" /><input name="vaddressmode" type="string" '
+                 'value="mirror" /><input name="default" type="color3" '
+                 'value="0.2, 0.9, 0.4" /></image>', "c_n", "base_color"),
+    "closest": (f'<gltf_image name="cl_n" type="color3">{_IMG}<input name="scale" '
+                'type="vector2" value="0.4, 0.3" /><input name="filtertype" type="string" '
+                'value="closest" /><input name="vaddressmode" type="string" '
+                'value="clamp" /></gltf_image>', "cl_n", "base_color"),
+    "normal_scaled": (f'<image name="ni" type="vector3">{_IMG}</image><normalmap '
+                      'name="nm_n" type="vector3"><input name="in" type="vector3" '
+                      'nodename="ni" /><input name="scale" type="vector2" value="0.5, 1.8" />'
+                      '</normalmap>', "nm_n", "normal"),
+    "gltf_normal": (f'<gltf_normalmap name="gn_n" type="vector3">{_IMG}<input '
+                    'name="rotate" type="float" value="25" /></gltf_normalmap>', "gn_n",
+                    "normal"),
+    # rgbtohsv (read as our RGB to HSV) of an image: hue in turns, saturation, value
+    "hsv": (f'<image name="hi" type="color3">{_IMG}</image><rgbtohsv name="hsv_n" '
+            'type="color3"><input name="in" type="color3" nodename="hi" /></rgbtohsv>',
+            "hsv_n", "base_color"),
+}
+ATTRIBUTE = {"base_color": "baseColor", "normal": "normal"}
+
+
+def _document() -> str:
+    outputs, nodes, body = [], [], []
+    for name, (xml, node, surface_input) in CASES.items():
+        nodes.append(xml)
+        out_type = "vector3" if surface_input == "normal" else "color3"
+        port = ' output="outcolor"' if node == "gc_n" else ""
+        outputs.append(f'<output name="o_{name}" type="{out_type}" nodename="{node}"{port} />')
+        body.append(
+            f'<standard_surface name="S_{name}" type="surfaceshader"><input '
+            f'name="{surface_input}" type="{out_type}" nodegraph="NG" output="o_{name}" />'
+            f'</standard_surface><surfacematerial name="M_{name}" type="material"><input '
+            f'name="surfaceshader" type="surfaceshader" nodename="S_{name}" />'
+            '</surfacematerial>')
+    return ('<?xml version="1.0"?>\n<materialx version="1.39" colorspace="lin_rec709">'
+            f'<nodegraph name="NG">{"".join(nodes)}{"".join(outputs)}</nodegraph>'
+            f'{"".join(body)}</materialx>\n')
+
+
+def _texture(folder: Path) -> np.ndarray:
+    from matedit.io.images import write_image
+
+    rng = np.random.default_rng(26)
+    px = rng.uniform(0.05, 0.95, (H, W, 3)).astype(np.float32)
+    write_image(folder / "tex.exr", px)
+    return px
+
+
+@pytest.fixture(scope="module")
+def imported(tmp_path_factory):
+    from matedit.interop.mtlx_import import import_all
+
+    folder = tmp_path_factory.mktemp("tex")
+    _texture(folder)
+    src = folder / "textures.mtlx"
+    src.write_text(_document(), encoding="utf-8")
+    warnings: list[str] = []
+    docs = import_all(src, folder / "out", warnings)
+    for path, d in docs.items():
+        from matedit.io.document import save
+
+        path.parent.mkdir(exist_ok=True)
+        save(d, path)
+    return folder, src, {d.name: p for p, d in docs.items()}, warnings
+
+
+def test_the_texture_nodes_import_without_a_warning(imported):
+    _folder, _src, docs, warnings = imported
+    assert sorted(docs) == sorted(f"M_{n}" for n in CASES)
+    assert warnings == []
+
+
+def test_the_addressing_and_placement_map_to_our_nodes(imported):
+    from matedit.graph.nodes import Role, kind_for
+    from matedit.io.document import load
+
+    _folder, _src, docs, _ = imported
+    addressed = kind_for(Role.ADDRESSED_TEXTURE_SAMPLE)
+    got = {}
+    for name in ("clamp_mirror", "constant", "closest", "tiled"):
+        d = load(docs[f"M_{name}"])
+        got[name] = [(n.values.get("u_address"), n.values.get("v_address"),
+                      n.values.get("filter"), n.values.get("default_color"))
+                     for n in d.graph.nodes.values() if n.kind == addressed]
+    assert got["clamp_mirror"] == [(1.0, 2.0, 0.0, None)]
+    assert got["constant"] == [(3.0, 2.0, 0.0, [0.2, 0.9, 0.4, 0.0])]
+    assert got["closest"] == [(0.0, 1.0, 1.0, None)]
+    assert got["tiled"] == []  # periodic and linear: the plain Texture Sample
+
+
+@pytest.mark.gl
+def test_each_texture_node_matches_materialx_glsl(ctx, imported):
+    from matedit.compiler.api import lower_and_optimise
+    from matedit.interop import bake
+    from matedit.io.document import FileResolver, load
+    from tests.mtlx_gpu import MtlxDrawer
+
+    folder, src, docs, _ = imported
+    doc = mx.createDocument()
+    mx.readFromXmlFile(doc, str(src))
+    lib = mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
+    doc.importLibrary(lib)
+    ok, msg = doc.validate()
+    assert ok, msg
+    drawer = MtlxDrawer(ctx, SIZE)
+    checked = []
+    try:
+        for name, (_xml, _node, surface_input) in CASES.items():
+            got = drawer.draw(doc, doc.getNodeGraph("NG").getOutput(f"o_{name}"), folder)
+            ir = lower_and_optimise(load(docs[f"M_{name}"]), FileResolver())
+            want = bake.attributes_cpu(ir, SIZE)[ATTRIBUTE[surface_input]]
+            if surface_input == "normal":  # ours normalises in the (T, B, N) frame
+                want = want / np.linalg.norm(want, axis=-1, keepdims=True)
+            np.testing.assert_allclose(got[..., :3], want[..., :3], atol=TOL, err_msg=name)
+            assert np.ptp(want[..., 0]) > 0.05, name  # a varying image, not a constant
+            checked.append(name)
+    finally:
+        drawer.release()
+    assert checked == list(CASES)
