@@ -184,3 +184,125 @@ def test_each_texture_node_matches_materialx_glsl(ctx, imported):
     finally:
         drawer.release()
     assert checked == list(CASES)
+
+
+# --- what the import reads, warns about and refuses -----------------------------------------
+
+def _one(graph: str, surface_input: str = "base_color", out_type: str = "color3",
+         node: str = "n") -> str:
+    return ('<?xml version="1.0"?>\n<materialx version="1.39"><nodegraph name="NG">'
+            f'{graph}<output name="o" type="{out_type}" nodename="{node}" /></nodegraph>'
+            f'<standard_surface name="S" type="surfaceshader"><input name="{surface_input}" '
+            f'type="{out_type}" nodegraph="NG" output="o" /></standard_surface>'
+            '<surfacematerial name="M" type="material"><input name="surfaceshader" '
+            'type="surfaceshader" nodename="S" /></surfacematerial></materialx>\n')
+
+
+def _import(tmp_path, text: str):
+    from matedit.interop.mtlx_import import import_mtlx
+
+    src = tmp_path / "in.mtlx"
+    src.write_text(text, encoding="utf-8")
+    warnings: list[str] = []
+    doc = import_mtlx(src, tmp_path / "out.json", warnings=warnings)
+    return doc, warnings
+
+
+def _errors(tmp_path, text: str) -> list[str]:
+    from matedit.interop.mtlx_import import MtlxImportError
+
+    with pytest.raises(MtlxImportError) as exc:
+        _import(tmp_path, text)
+    return exc.value.messages
+
+
+def test_a_second_uv_set_and_cubic_filtering_warn_by_name(tmp_path):
+    text = _one('<texcoord name="uv1" type="vector2"><input name="index" type="integer" '
+                f'value="1" /></texcoord><image name="n" type="color3">{_IMG}<input '
+                'name="texcoord" type="vector2" nodename="uv1" /><input name="filtertype" '
+                'type="string" value="cubic" /></image>')
+    _doc, warnings = _import(tmp_path, text)
+    assert sorted(warnings) == [
+        "in.mtlx: material M: filtertype 'cubic' of image NG/n is read as linear (bilinear) "
+        "filtering; approximated",
+        "in.mtlx: material M: index 1 of texcoord NG/uv1 names a texture coordinate set "
+        "matedit does not have (one UV set): set 0 is read; approximated"]
+
+
+def test_inputs_an_expanded_node_does_not_use_warn_on_the_node(tmp_path):
+    """gltf_colorimage's definition fixes periodic addressing whatever its own address
+    inputs say; tiledimage's frame inputs are not ours: each is named, on the node."""
+    text = _one(f'<gltf_colorimage name="gc" type="multioutput">{_IMG}<input '
+                'name="uaddressmode" type="string" value="clamp" /></gltf_colorimage>'
+                f'<tiledimage name="t" type="color3">{_IMG}<input name="frameoffset" '
+                'type="integer" value="3" /></tiledimage><multiply name="n" type="color3">'
+                '<input name="in1" type="color3" nodename="gc" output="outcolor" />'
+                '<input name="in2" type="color3" nodename="t" /></multiply>')
+    _doc, warnings = _import(tmp_path, text)
+    assert sorted(warnings) == [
+        "in.mtlx: material M: frameoffset 3 of tiledimage NG/t is not supported; dropped",
+        "in.mtlx: material M: uaddressmode 'clamp' of gltf_colorimage NG/gc is not "
+        "supported; dropped"]
+
+
+def test_two_instances_of_one_definition_keep_their_own_inputs(tmp_path):
+    from matedit.graph.nodes import Role, kind_for
+
+    text = _one(f'<tiledimage name="a" type="color3">{_IMG}<input name="uvtiling" '
+                'type="vector2" value="2, 3" /></tiledimage>'
+                f'<tiledimage name="b" type="color3">{_IMG}<input name="uvtiling" '
+                'type="vector2" value="5, 7" /></tiledimage><add name="n" type="color3">'
+                '<input name="in1" type="color3" nodename="a" /><input name="in2" '
+                'type="color3" nodename="b" /></add>')
+    doc, warnings = _import(tmp_path, text)
+    assert warnings == []
+    samples = [n for n in doc.graph.nodes.values() if n.kind == kind_for(Role.TEXTURE_SAMPLE)]
+    assert len(samples) == 2
+    tilings = sorted(tuple(n.values.get("b", ())) for n in doc.graph.nodes.values()
+                     if isinstance(n.values.get("b"), list) and len(n.values["b"]) == 2)
+    assert [(2.0, 3.0), (5.0, 7.0)] == [t for t in tilings if t in ((2.0, 3.0), (5.0, 7.0))]
+
+
+@pytest.mark.parametrize("graph, needle", [
+    (f'<image name="n" type="color3">{_IMG}<input name="uaddressmode" type="string" '
+     'value="wrap" /></image>', "node NG/n: uaddressmode 'wrap' is not supported"),
+    (f'<image name="n" type="color3">{_IMG}<input name="filtertype" type="string" '
+     'value="sharp" /></image>', "node NG/n: filtertype 'sharp' is not supported"),
+    (f'<image name="n" type="color3">{_IMG}<input name="uaddressmode" type="string" '
+     'value="constant" /><input name="default" type="color3" value="1e39, 0, 0" /></image>',
+     "node NG/n: input default"),
+    (f'<place2d name="p" type="vector2"><input name="operationorder" type="integer" '
+     'value="x" /></place2d><image name="n" type="color3">'
+     f'{_IMG}<input name="texcoord" type="vector2" nodename="p" /></image>',
+     "input which"),
+    (f'<image name="n" type="color3">{_IMG}</image><image name="t" type="vector3">{_IMG}'
+     '</image><normalmap name="nm" type="vector3"><input name="in" type="vector3" '
+     'nodename="t" /><input name="tangent" type="vector3" nodename="n" /></normalmap>',
+     "node NG/nm: a normalmap with its own tangent input is not supported"),
+    (f'<image name="t" type="vector3">{_IMG}</image><normalmap name="nm" type="vector3">'
+     '<input name="in" type="vector3" nodename="t" /><input name="scale" type="float" '
+     'value="3e38" /></normalmap>', "node NG/nm: input scale"),
+    (f'<hextiledimage name="n" type="color3">{_IMG}</hextiledimage>',
+     "node NG/n: unsupported MaterialX node 'hextiledimage'"),
+])
+def test_what_the_texture_import_refuses_is_an_error_naming_the_node(tmp_path, graph, needle):
+    surface = "normal" if "normalmap" in graph else "base_color"
+    out = "vector3" if surface == "normal" else "color3"
+    node = "nm" if surface == "normal" else "n"
+    errors = _errors(tmp_path, _one(graph, surface, out, node))
+    assert any(needle in e for e in errors), errors
+    assert all(e.startswith("in.mtlx: ") for e in errors)
+
+
+def test_a_normalmap_on_the_surfaces_own_frame_imports(tmp_path):
+    text = _one(f'<image name="t" type="vector3">{_IMG}</image><bitangent name="bt" '
+                'type="vector3"><input name="space" type="string" value="world" /></bitangent>'
+                '<normalmap name="nm" type="vector3"><input name="in" type="vector3" '
+                'nodename="t" /><input name="bitangent" type="vector3" nodename="bt" />'
+                '<input name="scale" type="float" value="0.5" /></normalmap>', "normal",
+                "vector3", "nm")
+    doc, warnings = _import(tmp_path, text)
+    assert warnings == []
+    scaled = [n.values["b"] for n in doc.graph.nodes.values()
+              if isinstance(n.values.get("b"), list) and len(n.values["b"]) == 3]
+    assert [1.0, 1.0, 2.0] in scaled and [0.5, 0.5, 1.0] in scaled  # in x 2s - s

@@ -12,6 +12,7 @@
 //   closest  the addressed coordinate moved to its texel's centre.
 
 float node_address_axis(float t, float mode, float n) {
+    // the coordinate to read along one axis of n texels (the table above)
     if (mode < 0.5) {
         return t;
     }
@@ -20,6 +21,7 @@ float node_address_axis(float t, float mode, float n) {
 }
 
 float node_address_weight(float t, float mode, float n, bool closest) {
+    // the weight of the image against the border colour along one axis (constant only)
     if (mode < 2.5) {
         return 1.0;
     }
@@ -31,6 +33,7 @@ void node_texture_sample_addressed(sampler2D tex, vec2 uv, vec4 default_value,
                                    float u_address, float v_address, float filter_type,
                                    out vec4 rgba, out vec3 rgb, out float r, out float g,
                                    out float b, out float a) {
+    // GL sampler semantics (OpenGL 4.6 section 8.14.2) in one bilinear read
     vec2 n = vec2(textureSize(tex, 0));
     vec2 mode = floor(clamp(vec2(u_address, v_address), 0.0, 3.0) + 0.5);
     bool closest = filter_type >= 0.5;
