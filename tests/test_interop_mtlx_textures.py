@@ -6,7 +6,8 @@ closest, a normalmap of scale other than 1, rgbtohsv) on a 5 x 4 float image: ea
 drawn by MaterialX's GLSL generator on the bake plane (tests/mtlx_gpu.py, which binds each
 image's sampler as MaterialX's own GLSL renderer does), equals the imported material's
 attribute from our CPU evaluator at the texel centres within 2e-3 (float32 GPU maths and
-llvmpipe's 8-bit bilinear weights against float64). The nodes made of nodegraphs are read
+llvmpipe's 8-bit bilinear weights against float64), and so does our own GLSL of it (the
+bake's GPU pass). The nodes made of nodegraphs are read
 through MaterialX's definitions (matedit.interop.mtlx_import, `expand`), so this is the
 check that each stdlib node inside them is read by MaterialX's rule.
 """
@@ -176,6 +177,10 @@ def test_each_texture_node_matches_materialx_glsl(ctx, imported):
             got = drawer.draw(doc, doc.getNodeGraph("NG").getOutput(f"o_{name}"), folder)
             ir = lower_and_optimise(load(docs[f"M_{name}"]), FileResolver())
             want = bake.attributes_cpu(ir, SIZE)[ATTRIBUTE[surface_input]]
+            # our own GLSL of the imported material (the renderer's path) agrees too
+            ours, _ = bake.bake_attributes(ctx, load(docs[f"M_{name}"]), FileResolver(), SIZE)
+            np.testing.assert_allclose(ours[ATTRIBUTE[surface_input]][..., :3],
+                                       want[..., :3], atol=TOL, err_msg=f"{name}: our GLSL")
             if surface_input == "normal":  # ours normalises in the (T, B, N) frame
                 want = want / np.linalg.norm(want, axis=-1, keepdims=True)
             np.testing.assert_allclose(got[..., :3], want[..., :3], atol=TOL, err_msg=name)
