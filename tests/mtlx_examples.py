@@ -87,7 +87,7 @@ def section(results: list[Outcome] | None = None) -> str:
         "checked by tests/test_interop_mtlx_examples.py, so it is what the import does today.",
         "",
         f"**{n['clean']} import clean, {n['warnings']} with warnings, "
-        f"{n['refused']} are refused.**",
+        f"{n['refused']} {'is' if n['refused'] == 1 else 'are'} refused.**",
         "",
         "| document | surface | materials | import |",
         "|---|---|---|---|",

@@ -77,11 +77,12 @@ def test_each_example_imports_or_is_refused_by_name(results):
 
 def test_the_tiled_and_gltf_texture_examples_import(results):
     """The documents the texture nodes were refused in before (tiledimage, gltf_image,
-    gltf_colorimage, gltf_normalmap, rgbtohsv) import now."""
+    gltf_colorimage, gltf_normalmap, rgbtohsv, hextiledimage) import now."""
     by = {r.name: r for r in results}
     for name in ("standard_surface_brass_tiled.mtlx", "standard_surface_wood_tiled.mtlx",
                  "usd_preview_surface_brass_tiled.mtlx", "gltf_pbr_boombox.mtlx",
-                 "standard_surface_brick_procedural.mtlx"):
+                 "standard_surface_brick_procedural.mtlx",
+                 "standard_surface_onyx_hextiled.mtlx"):
         assert by[name].status != "refused", (name, by[name].errors)
 
 

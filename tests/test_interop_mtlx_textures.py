@@ -2,7 +2,8 @@
 
 A document of the texture nodes real files use (tiledimage, place2d in both operation
 orders, gltf_image, gltf_colorimage, gltf_normalmap, image under clamp, mirror, constant and
-closest, a normalmap of scale other than 1, rgbtohsv) on a 5 x 4 float image: each output,
+closest, hextiledimage, a normalmap of scale other than 1, rgbtohsv) on a 5 x 4 float
+image: each output,
 drawn by MaterialX's GLSL generator on the bake plane (tests/mtlx_gpu.py, which binds each
 image's sampler as MaterialX's own GLSL renderer does), equals the imported material's
 attribute from our CPU evaluator at the texel centres within 2e-3 (float32 GPU maths and
@@ -78,6 +79,13 @@ CASES = {
     "gltf_normal": (f'<gltf_normalmap name="gn_n" type="vector3">{_IMG}<input '
                     'name="rotate" type="float" value="25" /></gltf_normalmap>', "gn_n",
                     "normal"),
+    "hex": (f'<hextiledimage name="hex_n" type="color3">{_IMG}<input name="tiling" '
+            'type="vector2" value="1.7, 1.3" /><input name="rotationrange" type="vector2" '
+            'value="10, 200" /><input name="scalerange" type="vector2" value="0.7, 1.6" />'
+            '<input name="falloff" type="float" value="0.3" /><input name="falloffcontrast" '
+            'type="float" value="0.8" /></hextiledimage>', "hex_n", "base_color"),
+    "hex_defaults": (f'<hextiledimage name="hexd_n" type="color3">{_IMG}</hextiledimage>',
+                     "hexd_n", "base_color"),
     # rgbtohsv (read as our RGB to HSV) of an image: hue in turns, saturation, value
     "hsv": (f'<image name="hi" type="color3">{_IMG}</image><rgbtohsv name="hsv_n" '
             'type="color3"><input name="in" type="color3" nodename="hi" /></rgbtohsv>',
@@ -287,8 +295,8 @@ def test_two_instances_of_one_definition_keep_their_own_inputs(tmp_path):
     (f'<image name="t" type="vector3">{_IMG}</image><normalmap name="nm" type="vector3">'
      '<input name="in" type="vector3" nodename="t" /><input name="scale" type="float" '
      'value="3e38" /></normalmap>', "node NG/nm: input scale"),
-    (f'<hextiledimage name="n" type="color3">{_IMG}</hextiledimage>',
-     "node NG/n: unsupported MaterialX node 'hextiledimage'"),
+    ('<fractal3d name="n" type="color3" />',
+     "node NG/n (fractal3d, its N_fractal3d): unsupported MaterialX node 'fractal3d'"),
 ])
 def test_what_the_texture_import_refuses_is_an_error_naming_the_node(tmp_path, graph, needle):
     surface = "normal" if "normalmap" in graph else "base_color"

@@ -175,6 +175,12 @@ _READS: dict[str, set[str]] = {
     "normalmap": {"in", "scale", "normal", "tangent", "bitangent"},
     "switch": {"which", *(f"in{k}" for k in range(1, 11))},
 }
+# hextiledimage's inputs -> our Hex-Tiled Texture's
+_HEXTILED = {"tiling": "tiling", "rotation": "rotation", "rotationrange": "rotation_range",
+             "scale": "scale", "scalerange": "scale_range", "offset": "offset",
+             "offsetrange": "offset_range", "falloff": "falloff",
+             "falloffcontrast": "falloff_contrast", "lumacoeffs": "luma"}
+_READS["hextiledimage"] = {"file", "texcoord", *_HEXTILED}
 
 
 def connected(inp) -> bool:
@@ -720,6 +726,8 @@ class _Importer:
             return Src(nid, "value", width=width)
         if cat == "image":
             return self.image(node, depth, where, width)
+        if cat == "hextiledimage":
+            return self.hextiled(node, depth, where, width)
         impl = self.implementation(node)
         if impl is not None:
             return self.expand(node, impl, output, depth)
@@ -799,12 +807,60 @@ class _Importer:
                  f"property {geomprop!r}, which is not supported: connect it")
         return None
 
-    def image(self, node, depth: int, where: str, width: int) -> Src | None:
+    def image_file(self, node, where: str):
+        """(the file input, its relative path), or None after an error."""
         file_in = self.outer_input(node, "file")
         file = file_in.getValueString() if file_in is not None else ""
         if not file or Path(file).is_absolute() or "\0" in file or ":" in file:
             self.err(f"{where}: image file must be a relative path, got {file[:60]!r}")
             return None
+        return file_in, file
+
+    def texture_parameter(self, node, file_in, file: str, where: str, depth: int) -> str | None:
+        """A Texture Parameter of the node's file, in its colour space (None after an
+        error): the file's path relative to the output, never read here."""
+        srgb, space = False, ""
+        if node.getType() in ("color3", "color4"):  # MaterialX decodes colour types only
+            active = file_in.getActiveColorSpace()
+            found = from_materialx(active)
+            if found is None:
+                self.err(f"{where}: unknown colour space {active!r} on its file")
+                return None
+            srgb, space = found
+        target = (self.source.parent / file)
+        rel = Path(os.path.relpath(os.path.abspath(target),
+                                   os.path.abspath(self.out.parent))).as_posix()
+        pname = self.new_id(f"{self.hint(node)}_file")
+        self.ids.discard(pname)
+        settings = {"name": pname, "path": rel, "srgb": srgb}
+        if space:
+            settings["color_space"] = space
+        return self.add(pname, kind_for(Role.TEXTURE_PARAMETER), settings, depth=depth)
+
+    def hextiled(self, node, depth: int, where: str, width: int) -> Src | None:
+        """hextiledimage as our Hex-Tiled Texture: the same tiles, randomisation and blend
+        (its `default` is the colour of a missing file only: unread, so it warns)."""
+        found = self.image_file(node, where)
+        if found is None:
+            return None
+        tex = self.texture_parameter(node, *found, where, depth)
+        if tex is None:
+            return None
+        nid = self.add(self.hint(node), kind_for(Role.HEX_TILED_TEXTURE), depth=depth)
+        self.connect(Src(tex, "texture"), nid, "texture")
+        uv = self.input_src(node, "texcoord", depth)
+        if uv is not None:
+            self.connect(uv, nid, "uv")
+        for mxin, ours in _HEXTILED.items():
+            self.connect(self.input_src(node, mxin, depth), nid, ours)
+        self._defaults(node, nid, _HEXTILED)
+        return Src(nid, "rgba", width=4) if width == 4 else Src(nid, "rgb", width=3)
+
+    def image(self, node, depth: int, where: str, width: int) -> Src | None:
+        found = self.image_file(node, where)
+        if found is None:
+            return None
+        file_in, file = found
         modes = []
         for opt in ("uaddressmode", "vaddressmode"):
             el = self.outer_input(node, opt)
@@ -840,24 +896,10 @@ class _Importer:
                 return None
             default = (vals * 4 if len(vals) == 1 else vals + [0.0] * 4)[:4]
             self.image_default.add((self.scope(), node.getNamePath()))
-        srgb, space = False, ""
-        if node.getType() in ("color3", "color4"):  # MaterialX decodes colour types only
-            active = file_in.getActiveColorSpace()
-            found = from_materialx(active)
-            if found is None:
-                self.err(f"{where}: unknown colour space {active!r} on its file")
-                return None
-            srgb, space = found
-        target = (self.source.parent / file)
-        rel = Path(os.path.relpath(os.path.abspath(target),
-                                   os.path.abspath(self.out.parent))).as_posix()
         name = self.hint(node)
-        pname = self.new_id(f"{name}_file")
-        self.ids.discard(pname)
-        settings = {"name": pname, "path": rel, "srgb": srgb}
-        if space:
-            settings["color_space"] = space
-        tex = self.add(pname, kind_for(Role.TEXTURE_PARAMETER), settings, depth=depth)
+        tex = self.texture_parameter(node, file_in, file, where, depth)
+        if tex is None:
+            return None
         if modes == [0, 0] and not closest:
             nid = self.add(name, kind_for(Role.TEXTURE_SAMPLE), depth=depth)
         else:  # MaterialX's addressing and filter, exactly (tests/test_texture_addressed.py)

@@ -4,7 +4,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from matedit.nodes.kind import MESH_UV, MxRecipe, NodeDef, Role, Thumbnail, _i, _o, register
+from matedit.nodes.kind import (
+    MESH_UV,
+    UNIT,
+    MxRecipe,
+    NodeDef,
+    Role,
+    Thumbnail,
+    _i,
+    _o,
+    register,
+)
 from matedit.nodes.twin import _col
 
 
@@ -122,4 +132,126 @@ register(NodeDef(
     glsl="node_texture_sample_addressed", role=Role.ADDRESSED_TEXTURE_SAMPLE, impure=True,
     thumbnail=Thumbnail.ALWAYS,
     numpy=_texture_sample_addressed,  # image (vector4) under its address modes
+))
+
+
+# --- hex tiling (Mikkelsen 2022, as MaterialX's hextiledimage parameterises it) -------------
+_F32 = np.float32
+_SQRT3_2 = _F32(np.sqrt(3.0) * 2.0)  # the triangle grid's scale: keeps the image's fit
+_SKEW = _F32(1.15470054)  # 2 tan 30: skewed space's v, and its inverse
+
+
+def hex_hash(p: np.ndarray) -> np.ndarray:
+    """Two uniform numbers in 0..1 per grid vertex (Dave Hoskins' hash without sine, the one
+    hextiledimage uses), in float32 as the GPU computes it. p: (N, 2)."""
+    p = p.astype(_F32)
+    p3 = np.stack([p[:, 0], p[:, 1], p[:, 0]], -1) * np.asarray([0.1031, 0.1030, 0.0973], _F32)
+    p3 = p3 - np.floor(p3)
+    d = np.sum(p3 * (p3[:, [1, 2, 0]] + _F32(33.33)), -1, dtype=_F32)
+    p3 = p3 + d[:, None]
+    h = (p3[:, [0, 0]] + p3[:, [1, 2]]) * p3[:, [2, 1]]
+    return h - np.floor(h)
+
+
+def _gain(x: np.ndarray, r) -> np.ndarray:
+    """Schlick's gain (Graphics Gems IV), r clamped to 0.001..0.999."""
+    rr = np.clip(r, 0.001, 0.999)
+    a = (1.0 / rr - 2.0) * (1.0 - 2.0 * x)
+    return np.where(x < 0.5, x / (a + 1.0), (a - x) / (a - 1.0))
+
+
+def hex_tiles(coord: np.ndarray, rotation, rotation_range, scale, scale_range, offset,
+              offset_range) -> tuple[list[np.ndarray], np.ndarray]:
+    """The three hex tiles over each point: their lookup coordinates (each tile's own
+    random rotation about its centre, scale and offset) and barycentric weights (N, 3)."""
+    coord = coord.astype(np.float64)
+    st = coord * float(_SQRT3_2)
+    sk = np.stack([st[:, 0] - 0.57735027 * st[:, 1], 1.15470054 * st[:, 1]], -1)
+    frac = sk - np.floor(sk)
+    z = 1.0 - frac[:, 0] - frac[:, 1]
+    s = (-z >= 0.0).astype(np.float64)  # upper triangle of the cell
+    s2 = 2.0 * s - 1.0
+    weights = np.stack([-z * s2, s - frac[:, 1] * s2, s - frac[:, 0] * s2], -1)
+    base = np.floor(sk)
+    si = s[:, None]
+    ids = [base + np.concatenate([si, si], 1), base + np.concatenate([si, 1.0 - si], 1),
+           base + np.concatenate([1.0 - si, si], 1)]
+    rr = np.radians(np.asarray(rotation_range, np.float64))
+    coords = []
+    for vid in ids:
+        g = vid / float(_SQRT3_2)
+        centre = np.stack([g[:, 0] + 0.5 * g[:, 1], g[:, 1] / float(_SKEW)], -1)
+        rand = hex_hash(vid + _F32(0.12345)).astype(np.float64)
+        angle = rr[..., 0] + (rr[..., 1] - rr[..., 0]) * rand[:, 0] * rotation
+        c, sn = np.cos(angle), np.sin(angle)
+        srange = np.asarray(scale_range, np.float64)
+        k = 1.0 + (srange[..., 0] + (srange[..., 1] - srange[..., 0]) * rand[:, 1] - 1.0) * scale
+        orange = np.asarray(offset_range, np.float64)
+        off = orange[..., :1] + (orange[..., 1:] - orange[..., :1]) * rand * _col(offset)
+        d = coord - centre
+        turned = np.stack([c * d[:, 0] - sn * d[:, 1], sn * d[:, 0] + c * d[:, 1]], -1)
+        coords.append(turned / _col(k) + centre + off)
+    return coords, weights
+
+
+def hex_blend_weights(luma: np.ndarray, tile: np.ndarray, falloff) -> np.ndarray:
+    """The three samples' weights: luminance x barycentric^7, normalised, then (falloff
+    other than 0.5) Schlick's gain of each, normalised again."""
+    w = luma * np.power(np.maximum(tile, 0.0), 7.0)
+    w = w / w.sum(-1, keepdims=True)
+    f = np.broadcast_to(np.asarray(falloff, np.float64), (len(w),))[:, None]
+    g = _gain(w, f)
+    g = g / g.sum(-1, keepdims=True)
+    return np.where(f != 0.5, g, w)
+
+
+def sample_hex_tiled(tex, uv, tiling, rotation, rotation_range, scale, scale_range, offset,
+                     offset_range, falloff, falloff_contrast, luma) -> np.ndarray:
+    """hextiledimage: three hex tiles' reads (bilinear, periodic) blended by luminance
+    (mixed towards 1 by 1 - falloff_contrast) and barycentric weight. (N, 4)."""
+    tex = np.asarray(tex)
+    coords, tile = hex_tiles(uv * tiling, rotation, rotation_range, scale, scale_range,
+                             offset, offset_range)
+    reads = [sample_bilinear(tex, c) for c in coords]
+    luma = np.asarray(luma, np.float64)
+    fc = _col(np.broadcast_to(falloff_contrast, (len(uv),)))
+    cw = np.stack([np.sum(r[:, :3] * luma, -1) for r in reads], -1)
+    cw = 1.0 + (cw - 1.0) * fc
+    w = hex_blend_weights(cw, tile, falloff)
+    aw = hex_blend_weights(np.ones_like(cw), tile, falloff)
+    rgb = sum(w[:, i:i + 1] * reads[i][:, :3] for i in range(3))
+    a = sum(aw[:, i:i + 1] * reads[i][:, 3:4] for i in range(3))
+    return np.concatenate([rgb, a], -1)
+
+
+def _hex_tiled_texture(ctx, tex, uv, tiling, rotation, rotation_range, scale, scale_range,
+                       offset, offset_range, falloff, falloff_contrast, luma):
+    rgba = sample_hex_tiled(tex, uv, tiling, rotation, rotation_range, scale, scale_range,
+                            offset, offset_range, falloff, falloff_contrast, luma).astype(
+        uv.dtype, copy=False)
+    return rgba, rgba[:, :3]
+
+
+register(NodeDef(
+    "hex_tiled_texture", "Hex-Tiled Texture", "Texture",
+    "Samples a texture over a hexagonal grid of randomly turned, scaled and shifted tiles, "
+    "blended so that no repeat shows (MaterialX's hextiledimage).",
+    inputs=(_i("texture", "texture2d", None, "from a Texture Parameter", required=True),
+            _i("uv", "vec2", MESH_UV, "texture coordinates"),
+            _i("tiling", "vec2", [1.0, 1.0], "repeats across the surface"),
+            _i("rotation", "float", 1.0, "amount of random rotation", UNIT),
+            _i("rotation_range", "vec2", [0.0, 360.0], "random rotation range, degrees"),
+            _i("scale", "float", 1.0, "amount of random scale", UNIT),
+            _i("scale_range", "vec2", [0.5, 2.0], "random scale range"),
+            _i("offset", "float", 1.0, "amount of random offset", UNIT),
+            _i("offset_range", "vec2", [0.0, 1.0], "random offset range, UV units"),
+            _i("falloff", "float", 0.5, "blend falloff (0.5: none)", UNIT),
+            _i("falloff_contrast", "float", 0.5, "how much brighter texels win the blend",
+               UNIT),
+            _i("luma", "vec3", [0.2722287, 0.6740818, 0.0536895],
+               "luminance coefficients of the blend (ACEScg's by default)")),
+    outputs=(_o("rgba", "vec4"), _o("rgb", "vec3")),
+    glsl="node_hex_tiled_texture", role=Role.HEX_TILED_TEXTURE, impure=True,
+    thumbnail=Thumbnail.ALWAYS,
+    numpy=_hex_tiled_texture,  # hextiledimage (color4)
 ))
