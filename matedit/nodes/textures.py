@@ -147,7 +147,7 @@ def hex_hash(p: np.ndarray) -> np.ndarray:
     p = p.astype(_F32)
     p3 = np.stack([p[:, 0], p[:, 1], p[:, 0]], -1) * np.asarray([0.1031, 0.1030, 0.0973], _F32)
     p3 = p3 - np.floor(p3)
-    d = np.sum(p3 * (p3[:, [1, 2, 0]] + _F32(33.33)), -1, dtype=_F32)
+    d: np.ndarray = np.asarray(np.sum(p3 * (p3[:, [1, 2, 0]] + _F32(33.33)), -1, dtype=_F32))
     p3 = p3 + d[:, None]
     h = (p3[:, [0, 0]] + p3[:, [1, 2]]) * p3[:, [2, 1]]
     return h - np.floor(h)
