@@ -1,4 +1,5 @@
-"""Writes docs/materialx.md, the MaterialX mapping of every catalogue kind, from the catalogue.
+"""Writes docs/materialx.md, the MaterialX mapping of every catalogue kind, from the catalogue,
+and its import tally of MaterialX's example documents (tests/mtlx_examples.py).
 
     .venv/bin/python docs/materialx.py
 """
@@ -13,7 +14,8 @@ sys.path.insert(0, str(ROOT))
 
 from matedit.interop.mtlx_map import document  # noqa: E402
 from matedit.io.atomic import atomic_write_text  # noqa: E402
+from tests.mtlx_examples import section  # noqa: E402
 
 if __name__ == "__main__":
-    atomic_write_text(ROOT / "docs" / "materialx.md", document())
+    atomic_write_text(ROOT / "docs" / "materialx.md", document() + "\n" + section())
     print(ROOT / "docs" / "materialx.md")

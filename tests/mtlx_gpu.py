@@ -14,6 +14,32 @@ import numpy as np
 from matedit.interop import bake
 from matedit.io.images import read_image
 
+# MaterialX's GLSL renderer (MaterialXRenderGlsl's texture handler) reads an image's
+# address modes and filter type as sampler state: these GL values.
+GL_WRAP = {"periodic": 0x2901, "clamp": 0x812F, "mirror": 0x8370, "constant": 0x812D}
+
+
+def sampler_state(ctx, tex, node) -> None:
+    """Bind `tex`'s sampler as MaterialX's renderer does for `node`: its address modes (the
+    default colour as the border of constant addressing) and filter type (cubic and linear:
+    GL_LINEAR, closest: GL_NEAREST); the node's definition's defaults where it sets none."""
+    import ctypes
+
+    from tests.gpu_eval import _libgl
+
+    def text(name: str, default: str) -> str:
+        inp = node.getInput(name)
+        return (inp.getValueString().strip() if inp is not None else "") or default
+
+    f = ctx.NEAREST if text("filtertype", "linear") == "closest" else ctx.LINEAR
+    tex.filter = (f, f)
+    gl = _libgl()
+    gl.glTexParameteri(0x0DE1, 0x2802, GL_WRAP[text("uaddressmode", "periodic")])
+    gl.glTexParameteri(0x0DE1, 0x2803, GL_WRAP[text("vaddressmode", "periodic")])
+    border = [float(x) for x in text("default", "0,0,0").split(",")]
+    border = (border * 4 if len(border) == 1 else border + [0.0] * 4)[:4]
+    gl.glTexParameterfv(0x0DE1, 0x1004, (ctypes.c_float * 4)(*border))
+
 
 class MtlxDrawer:
     def __init__(self, ctx, size: int) -> None:
@@ -73,7 +99,10 @@ class MtlxDrawer:
             prog["u_viewPosition"].value = bake.CAMERA
         textures = []
         graph = element.getParent()
-        for unit, img in enumerate(graph.getNodes("image")):
+        # every node reading a file (image, and the nodes made of one: tiledimage,
+        # gltf_image...; MaterialX names the sampler after the node)
+        readers = [n for n in graph.getNodes() if n.getInput("file") is not None]
+        for unit, img in enumerate(readers):
             name = f"{img.getName()}_file"
             if name not in prog:
                 continue
@@ -85,6 +114,7 @@ class MtlxDrawer:
             tex = ctx.texture((px.shape[1], px.shape[0]), 4,
                               np.ascontiguousarray(px, "f4").tobytes(), dtype="f4")
             tex.use(unit)
+            sampler_state(ctx, tex, img)
             prog[name].value = unit
             textures.append(tex)
         vao = ctx.vertex_array(prog, [(buf, fmt, name) for name, (buf, fmt)

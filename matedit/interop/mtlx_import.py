@@ -35,6 +35,7 @@ from matedit.graph.numbers import gpu_number_problem
 from matedit.interop import mtlx_map
 from matedit.interop.mtlx_colorspace import WORKING, from_materialx
 from matedit.io.atomic import read_bounded
+from matedit.nodes.textures import ADDRESS_MODES, FILTER_TYPES
 
 MAX_MTLX_BYTES = 16 << 20
 MAX_NODES = 20000
@@ -172,7 +173,14 @@ _READS: dict[str, set[str]] = {
     "viewdirection": set(), "time": set(), "constant": {"value"}, "dot": {"in"},
     "image": {"file", "uaddressmode", "vaddressmode", "filtertype", "texcoord"},
     "normalmap": {"in", "scale", "normal", "tangent", "bitangent"},
+    "switch": {"which", *(f"in{k}" for k in range(1, 11))},
 }
+# hextiledimage's inputs -> our Hex-Tiled Texture's
+_HEXTILED = {"tiling": "tiling", "rotation": "rotation", "rotationrange": "rotation_range",
+             "scale": "scale", "scalerange": "scale_range", "offset": "offset",
+             "offsetrange": "offset_range", "falloff": "falloff",
+             "falloffcontrast": "falloff_contrast", "lumacoeffs": "luma"}
+_READS["hextiledimage"] = {"file", "texcoord", *_HEXTILED}
 
 
 def connected(inp) -> bool:
@@ -274,9 +282,19 @@ class _Importer:
         self.noted: set[str] = set()  # the surface's inputs already warned about
         self.mat = MaterialDocument(kind=DocumentKind.MATERIAL, path=out)
         self.ids: set[str] = set()
-        self.done: dict[tuple[str, str], Src] = {}
+        self.done: dict[tuple[tuple[str, ...], str, str], Src | None] = {}
         self.params: dict[str, Src] = {}
         self.count = 0
+        # Stdlib nodes MaterialX implements as a nodegraph of other stdlib nodes (tiledimage,
+        # place2d, gltf_image...) are read through that nodegraph (`expand`): the instances
+        # being expanded, outermost first, each with its implementation. An interface input
+        # of the implementation reads the instance's input, or the definition's default.
+        self.stack: list[tuple[Any, Any]] = []
+        # outermost expanded instance (by name path) -> the node, and its inputs read
+        self.instances: dict[str, Any] = {}
+        self.iface_read: dict[str, set[str]] = {}
+        # images whose default is read (the border colour of constant addressing)
+        self.image_default: set[tuple[tuple[str, ...], str]] = set()
 
     # --- helpers ---------------------------------------------------------------------------
     def err(self, what: str) -> None:
@@ -304,6 +322,8 @@ class _Importer:
         for inp in node.getInputs():
             if inp.getName() in read or is_default(inp, nd):
                 continue
+            if self.stack and inp.getInterfaceName():
+                continue  # the instance's input: checked on the instance (`build`)
             self.warn_input(node, inp, "is not supported; dropped")
 
     def new_id(self, hint: str) -> str:
@@ -341,6 +361,115 @@ class _Importer:
     def name_of(self, el) -> str:
         return el.getNamePath() if el is not None else "?"
 
+    # --- stdlib nodes implemented as nodegraphs ---------------------------------------------
+    def scope(self) -> tuple[str, ...]:
+        """The instances being expanded: a node of an implementation is converted once per
+        instance (two tiledimages share the library's nodegraph, not their inputs)."""
+        return tuple(inst.getNamePath() for inst, _ in self.stack)
+
+    def hint(self, node) -> str:
+        """A node's id hint: its name, or inside an expansion the outermost instance's name
+        (the image itself) or that name and the inner node's."""
+        if not self.stack:
+            return node.getName()
+        outer = self.stack[0][0].getName()
+        return outer if node.getCategory() == "image" else f"{outer}_{node.getName()}"
+
+    def where(self, node) -> str:
+        if not self.stack:
+            return f"node {self.name_of(node)}"
+        inst = self.stack[0][0]
+        return f"node {self.name_of(inst)} ({inst.getCategory()}, its {node.getName()})"
+
+    def in_implementation(self, inp, level: int | None = None) -> bool:
+        """Whether `inp` belongs to a node of the implementation expanded at `level` (the
+        innermost one by default), so its interface name is an input of that instance."""
+        level = len(self.stack) if level is None else level
+        if level <= 0:
+            return False
+        node = inp.getParent()
+        graph = node.getParent() if node is not None else None
+        return graph is not None and graph.getNamePath() == self.stack[level - 1][1].getNamePath()
+
+    def record(self, iface: str, level: int) -> None:
+        if level == 1:
+            self.iface_read.setdefault(self.stack[0][0].getNamePath(), set()).add(iface)
+
+    def outer_input(self, node, name: str):
+        """The element that gives `node`'s input `name` its value, through the interface of
+        each implementation being expanded: the instance's own input, or its definition's
+        input (the default) where the instance does not set it; None where neither has it."""
+        inp = node.getInput(name)
+        level = len(self.stack)
+        while inp is not None and inp.getInterfaceName() and self.in_implementation(inp, level):
+            inst, ng = self.stack[level - 1]
+            iface = inp.getInterfaceName()
+            self.record(iface, level)
+            outer = inst.getInput(iface)
+            if outer is None:
+                nd = inst.getNodeDef()
+                return nd.getActiveInput(iface) if nd is not None else None
+            inp, level = outer, level - 1
+        if inp is None:
+            nd = node.getNodeDef()
+            return nd.getActiveInput(name) if nd is not None else None
+        return inp
+
+    def interface_src(self, iface: str, depth: int, where: str) -> Src | None:
+        """An interface input of the innermost implementation: the instance's input, read
+        where the instance is, or its definition's default."""
+        inst, _ng = frame = self.stack[-1]
+        self.record(iface, len(self.stack))
+        outer = inst.getInput(iface)
+        self.stack.pop()
+        try:
+            if outer is not None:
+                return self.input_el(outer, depth, f"node {self.name_of(inst)}: input {iface}")
+            nd = inst.getNodeDef()
+            d = nd.getActiveInput(iface) if nd is not None else None
+            if d is None:
+                return None
+            if d.getDefaultGeomPropString():
+                return self.geometry_src(inst, iface, d.getDefaultGeomPropString())
+            if not d.getValueString() or d.getType() not in _WIDTH:
+                return None
+            try:
+                return Src(value=_floats(d.getValueString(), where), width=_WIDTH[d.getType()])
+            except ValueError as exc:
+                self.err(str(exc))
+                return None
+        finally:
+            self.stack.append(frame)
+
+    def implementation(self, node):
+        """The nodegraph MaterialX implements `node`'s definition with; None for a node
+        implemented in code (hextiledimage, image) or without a definition."""
+        import MaterialX as mx
+
+        nd = node.getNodeDef()
+        impl = nd.getImplementation() if nd is not None else None
+        return impl if isinstance(impl, mx.NodeGraph) else None
+
+    def push(self, node, impl) -> None:
+        if not self.stack:
+            self.instances.setdefault(node.getNamePath(), node)
+            self.iface_read.setdefault(node.getNamePath(), set())
+        self.stack.append((node, impl))
+
+    def expand(self, node, impl, output: str, depth: int) -> Src | None:
+        """`node` read through its definition's nodegraph: MaterialX's own definition of
+        the node in the stdlib nodes it is made of (the same graph its code generators
+        emit), so each of those is read by its own rule and nothing else is assumed."""
+        out = impl.getOutput(output)
+        if out is None:
+            self.err(f"{self.where(node)}: unknown output {output!r}")
+            return None
+        self.push(node, impl)
+        try:
+            return self.output_el(out, depth)
+        finally:
+            self.stack.pop()
+
     # --- inputs ----------------------------------------------------------------------------
     def input_src(self, node, name: str, depth: int) -> Src | None:
         """The source of input `name` of MaterialX `node`: None when unset (our default)."""
@@ -352,6 +481,8 @@ class _Importer:
     def input_el(self, inp, depth: int, where: str) -> Src | None:
         width = _WIDTH.get(inp.getType(), 0)
         iface = inp.getInterfaceName()
+        if iface and self.in_implementation(inp):
+            return self.interface_src(iface, depth, where)
         if iface:
             graph = inp.getParent().getParent()
             gin = graph.getInput(iface) if graph is not None else None
@@ -466,7 +597,7 @@ class _Importer:
     def node_src(self, node, output: str, depth: int) -> Src | None:
         # by name path: MaterialX hands out a new Python wrapper for each look-up, so a
         # node read twice (a shared subgraph) is converted once
-        key = (node.getNamePath(), output)
+        key = (self.scope(), node.getNamePath(), output)
         if key in self.done:
             return self.done[key]
         if depth > 2000:
@@ -480,16 +611,18 @@ class _Importer:
         src = self._convert(node, output, depth)
         cat = node.getCategory()
         read = set(DIRECT[cat][1]) if cat in DIRECT else _READS.get(cat)
+        if read is not None and (self.scope(), node.getNamePath()) in self.image_default:
+            read = read | {"default"}
         if read is not None:  # (an unsupported node is an error already)
             self.unread(node, read)
         return src
 
     def _convert(self, node, output: str, depth: int) -> Src | None:
         cat = node.getCategory()
-        name = node.getName()
+        name = self.hint(node)
         t = node.getType()
         width = _WIDTH.get(t, 0)
-        where = f"node {self.name_of(node)}"
+        where = self.where(node)
         if cat in DIRECT:
             kind, ports = DIRECT[cat]
             nid = self.add(name, kind, depth=depth)
@@ -545,12 +678,20 @@ class _Importer:
                      f"{t} is not supported")
             return None
         if cat == "texcoord":
-            idx_in = node.getInput("index")
-            if idx_in is not None and idx_in.getValueString() not in ("", "0"):
-                self.err(f"{where}: only texture coordinate set 0 is supported")
+            idx_in = self.outer_input(node, "index")
+            if idx_in is not None and connected(idx_in):
+                self.err(f"{where}: input index: only a constant texture coordinate set is "
+                         "supported")
                 return None
+            text = idx_in.getValueString().strip() if idx_in is not None else ""
+            if text not in ("", "0"):  # our meshes carry one UV set
+                self.warn_input(idx_in.getParent(), idx_in, "names a texture coordinate set "
+                                "matedit does not have (one UV set): set 0 is read; "
+                                "approximated")
             nid = self.add(name, _kind("tiled_texcoord"), depth=depth)
             return Src(nid, "uv", width=2)
+        if cat == "switch":
+            return self.switch(node, depth, where, width)
         if cat in ("position", "normal"):
             space = node.getInputValue("space") if node.getInput("space") else "object"
             if space != "world":
@@ -585,8 +726,30 @@ class _Importer:
             return Src(nid, "value", width=width)
         if cat == "image":
             return self.image(node, depth, where, width)
+        if cat == "hextiledimage":
+            return self.hextiled(node, depth, where, width)
+        impl = self.implementation(node)
+        if impl is not None:
+            return self.expand(node, impl, output, depth)
         self.err(f"{where}: unsupported MaterialX node {cat!r} (type {t})")
         return None
+
+    def switch(self, node, depth: int, where: str, width: int) -> Src | None:
+        """switch by a constant `which` (place2d's operation order, say): input
+        in(floor(which) + 1), clamped to in1..in10; the others are never read."""
+        w = self.outer_input(node, "which")
+        if w is not None and connected(w):
+            self.err(f"{where}: input which: only a constant is supported")
+            return None
+        try:
+            vals = _floats(w.getValueString() if w is not None else "0", f"{where}: input which")
+        except ValueError as exc:
+            self.err(str(exc))
+            return None
+        k = min(max(int(math.floor(vals[0])) if vals else 0, 0), 9)
+        src = self.input_src(node, f"in{k + 1}", depth)
+        return src if src is not None else Src(value=[0.0] * max(width, 1),
+                                               width=max(width, 1))
 
     def index(self, node, where: str) -> int | None:
         """extract's index: an integer 0 to 3 given as a value (None after an error)."""
@@ -630,30 +793,32 @@ class _Importer:
     def _geometry_default(self, node, nid: str, ours: str, geomprop: str) -> None:
         """An unset input that MaterialX reads from the geometry (reflect's normal is the
         world normal): the same geometry node of ours, or an error naming it."""
-        name = node.getName()
-        if geomprop == "Nworld":
-            src = Src(self.add(f"{name}_{ours}", _kind("normal")), "normal", width=3)
-        elif geomprop == "UV0":
-            src = Src(self.add(f"{name}_{ours}", _kind("tiled_texcoord")), "uv", width=2)
-        else:
-            self.err(f"node {self.name_of(node)}: input {ours!r} defaults to the geometric "
-                     f"property {geomprop!r}, which is not supported: connect it")
-            return
-        self.connect(src, nid, ours)
+        src = self.geometry_src(node, ours, geomprop)
+        if src is not None:
+            self.connect(src, nid, ours)
 
-    def image(self, node, depth: int, where: str, width: int) -> Src | None:
-        file_in = node.getInput("file")
+    def geometry_src(self, node, ours: str, geomprop: str) -> Src | None:
+        name = self.hint(node)
+        if geomprop == "Nworld":
+            return Src(self.add(f"{name}_{ours}", _kind("normal")), "normal", width=3)
+        if geomprop == "UV0":
+            return Src(self.add(f"{name}_{ours}", _kind("tiled_texcoord")), "uv", width=2)
+        self.err(f"{self.where(node)}: input {ours!r} defaults to the geometric "
+                 f"property {geomprop!r}, which is not supported: connect it")
+        return None
+
+    def image_file(self, node, where: str):
+        """(the file input, its relative path), or None after an error."""
+        file_in = self.outer_input(node, "file")
         file = file_in.getValueString() if file_in is not None else ""
         if not file or Path(file).is_absolute() or "\0" in file or ":" in file:
             self.err(f"{where}: image file must be a relative path, got {file[:60]!r}")
             return None
-        for opt, ok in (("uaddressmode", ("", "periodic")), ("vaddressmode", ("", "periodic")),
-                        ("filtertype", ("", "linear"))):
-            v = node.getInput(opt)
-            if v is not None and v.getValueString() not in ok:
-                self.err(f"{where}: {opt} {v.getValueString()!r} is not supported (periodic "
-                         "addressing, linear filtering only)")
-                return None
+        return file_in, file
+
+    def texture_parameter(self, node, file_in, file: str, where: str, depth: int) -> str | None:
+        """A Texture Parameter of the node's file, in its colour space (None after an
+        error): the file's path relative to the output, never read here."""
         srgb, space = False, ""
         if node.getType() in ("color3", "color4"):  # MaterialX decodes colour types only
             active = file_in.getActiveColorSpace()
@@ -665,13 +830,85 @@ class _Importer:
         target = (self.source.parent / file)
         rel = Path(os.path.relpath(os.path.abspath(target),
                                    os.path.abspath(self.out.parent))).as_posix()
-        pname = self.new_id(f"{node.getName()}_file")
+        pname = self.new_id(f"{self.hint(node)}_file")
         self.ids.discard(pname)
         settings = {"name": pname, "path": rel, "srgb": srgb}
         if space:
             settings["color_space"] = space
-        tex = self.add(pname, kind_for(Role.TEXTURE_PARAMETER), settings, depth=depth)
-        nid = self.add(node.getName(), kind_for(Role.TEXTURE_SAMPLE), depth=depth)
+        return self.add(pname, kind_for(Role.TEXTURE_PARAMETER), settings, depth=depth)
+
+    def hextiled(self, node, depth: int, where: str, width: int) -> Src | None:
+        """hextiledimage as our Hex-Tiled Texture: the same tiles, randomisation and blend
+        (its `default` is the colour of a missing file only: unread, so it warns)."""
+        found = self.image_file(node, where)
+        if found is None:
+            return None
+        tex = self.texture_parameter(node, *found, where, depth)
+        if tex is None:
+            return None
+        nid = self.add(self.hint(node), kind_for(Role.HEX_TILED_TEXTURE), depth=depth)
+        self.connect(Src(tex, "texture"), nid, "texture")
+        uv = self.input_src(node, "texcoord", depth)
+        if uv is not None:
+            self.connect(uv, nid, "uv")
+        for mxin, ours in _HEXTILED.items():
+            self.connect(self.input_src(node, mxin, depth), nid, ours)
+        self._defaults(node, nid, _HEXTILED)
+        return Src(nid, "rgba", width=4) if width == 4 else Src(nid, "rgb", width=3)
+
+    def image(self, node, depth: int, where: str, width: int) -> Src | None:
+        found = self.image_file(node, where)
+        if found is None:
+            return None
+        file_in, file = found
+        modes = []
+        for opt in ("uaddressmode", "vaddressmode"):
+            el = self.outer_input(node, opt)
+            text = el.getValueString().strip() if el is not None else ""
+            if el is not None and connected(el) or (text or "periodic") not in ADDRESS_MODES:
+                self.err(f"{where}: {opt} {value_text(el) if el is not None else ''} is not "
+                         f"supported ({', '.join(ADDRESS_MODES)}, as a constant)")
+                return None
+            modes.append(ADDRESS_MODES.index(text or "periodic"))
+        el = self.outer_input(node, "filtertype")
+        ftype = el.getValueString().strip() if el is not None else ""
+        if el is not None and connected(el) or (ftype or "linear") not in (*FILTER_TYPES,
+                                                                           "cubic"):
+            self.err(f"{where}: filtertype {value_text(el) if el is not None else ''} is not "
+                     "supported (closest, linear or cubic, as a constant)")
+            return None
+        if ftype == "cubic":  # MaterialX's GLSL renderer binds it as GL_LINEAR too
+            self.warn_input(el.getParent(), el, "is read as linear (bilinear) filtering; "
+                            "approximated")
+        closest = FILTER_TYPES.index("closest") if ftype == "closest" else 0
+        default = None
+        if ADDRESS_MODES.index("constant") in modes:  # the border colour
+            d = self.outer_input(node, "default")
+            if d is not None and connected(d):
+                self.err(f"{where}: input default: only a constant is supported under "
+                         "constant addressing (it is the border colour)")
+                return None
+            try:
+                vals = _floats(d.getValueString(), f"{where}: input default") \
+                    if d is not None else []
+            except ValueError as exc:
+                self.err(str(exc))
+                return None
+            default = (vals * 4 if len(vals) == 1 else vals + [0.0] * 4)[:4]
+            self.image_default.add((self.scope(), node.getNamePath()))
+        name = self.hint(node)
+        tex = self.texture_parameter(node, file_in, file, where, depth)
+        if tex is None:
+            return None
+        if modes == [0, 0] and not closest:
+            nid = self.add(name, kind_for(Role.TEXTURE_SAMPLE), depth=depth)
+        else:  # MaterialX's addressing and filter, exactly (tests/test_texture_addressed.py)
+            values: dict[str, Any] = {"u_address": float(modes[0]),
+                                      "v_address": float(modes[1]), "filter": float(closest)}
+            if default is not None:
+                values["default_color"] = default
+            nid = self.add(name, kind_for(Role.ADDRESSED_TEXTURE_SAMPLE), values=values,
+                           depth=depth)
         self.connect(Src(tex, "texture"), nid, "texture")
         uv = self.input_src(node, "texcoord", depth)
         if uv is not None:
@@ -682,7 +919,7 @@ class _Importer:
             return Src(nid, "rgb", width=3)
         if width == 4:
             return Src(nid, "rgba", width=4)
-        m = self.add(f"{node.getName()}_xy", kind_for(Role.COMPONENT_MASK), {"channels": "xy"},
+        m = self.add(f"{name}_xy", kind_for(Role.COMPONENT_MASK), {"channels": "xy"},
                      depth=depth)
         self.connect(Src(nid, "rgba", width=4), m, "value")
         return Src(m, "result", width=2)
@@ -824,6 +1061,8 @@ class _Importer:
         if cat == "gltf_pbr":
             self.gltf_volume(shader, make, out)
         self.approximations(shader, cat)
+        for path, inst in self.instances.items():  # an expanded node's own inputs
+            self.unread(inst, self.iface_read.get(path, set()))
         nd = shader.getNodeDef()
         for el in shader.getInputs():  # the rule: nothing the file sets is dropped silently
             name = el.getName()
@@ -1031,6 +1270,11 @@ class _Importer:
             if src is not None:
                 self.connect(src, make, port)
             return
+        if not connected(inp):  # one world direction everywhere: not a tangent-space map
+            self.noted.add(name)
+            self.warn_input(shader, inp, "is a constant world-space normal (ours is the "
+                            "surface's own normal, or a tangent-space map); dropped")
+            return
         up = None
         if inp.getNodeGraphString():
             ng = self.mxdoc.getNodeGraph(inp.getNodeGraphString())
@@ -1038,41 +1282,84 @@ class _Importer:
             up = ng.getNode(o.getNodeName()) if o is not None and o.getNodeName() else None
         elif inp.getNodeName():
             up = self.mxdoc.getNode(inp.getNodeName())
-        if up is None or up.getCategory() != "normalmap":
-            self.err(f"node {self.name_of(shader)}: input {name}: a world-space normal is "
-                     "supported only from a normalmap node (a tangent-space normal map)")
-            return
-        where = f"node {self.name_of(up)}"
+        pushed = 0
+        # a node made of a normalmap (gltf_normalmap): read through its nodegraph
+        while up is not None and up.getCategory() != "normalmap":
+            impl = self.implementation(up)
+            o = impl.getOutput("out") if impl is not None else None
+            if o is None or not o.getNodeName():
+                break
+            self.push(up, impl)
+            pushed += 1
+            up = impl.getNode(o.getNodeName())
+        try:
+            if up is None or up.getCategory() != "normalmap":
+                self.err(f"node {self.name_of(shader)}: input {name}: a world-space normal is "
+                         "supported only from a normalmap node (a tangent-space normal map)")
+                return
+            self.normalmap(up, make, port)
+        finally:
+            del self.stack[len(self.stack) - pushed:]
+
+    def _geometric(self, el, frame: str) -> bool:
+        """Whether a normalmap's normal, tangent or bitangent input is the surface's own
+        (its definition's default, or a world-space node of that name): our frame."""
+        if el is None or el.getDefaultGeomPropString():
+            return True
+        scope = el.getParent().getParent()
+        up = scope.getNode(el.getNodeName()) if el.getNodeName() and scope is not None else None
+        if up is None or up.getCategory() != frame:
+            return False
+        space = self.outer_input(up, "space")
+        return space is not None and space.getValueString().strip() == "world"
+
+    def normalmap(self, up, make: str, port: str) -> None:
+        """normalmap: (in x 2 - 1) x (scale.x, scale.y, 1) in the surface's tangent frame,
+        normalised (MaterialX's definition; ours normalises after the frame too)."""
+        where = self.where(up)
         self.unread(up, _READS["normalmap"])
-        for extra in ("normal", "tangent", "bitangent"):
-            if up.getInput(extra) is not None:
-                self.err(f"{where}: a normalmap with its own {extra} input is not supported")
-        sc = up.getInput("scale")
+        for frame in ("normal", "tangent", "bitangent"):
+            if not self._geometric(self.outer_input(up, frame), frame):
+                self.err(f"{where}: a normalmap with its own {frame} input is not supported "
+                         f"(only the surface's, or a world-space {frame} node)")
+        scale = [1.0, 1.0]
+        sc = self.outer_input(up, "scale")
+        if sc is not None and connected(sc):
+            self.err(f"{where}: input scale: only a constant normalmap scale is supported")
+            return
         if sc is not None:
             try:
-                ones = not (sc.getNodeName() or sc.getInterfaceName()) and all(
-                    v == 1.0 for v in _floats(sc.getValueString() or "1",
-                                              f"{where}: input scale"))
+                vals = _floats(sc.getValueString() or "1", f"{where}: input scale")
             except ValueError as exc:
                 self.err(str(exc))
-            else:
-                if not ones:
-                    self.err(f"{where}: input scale: normalmap scale other than 1 is not "
-                             "supported")
+                return
+            if len(vals) not in (1, 2):
+                self.err(f"{where}: input scale: expected 1 or 2 numbers, got {len(vals)}")
+                return
+            scale = vals * 2 if len(vals) == 1 else vals
+        sx, sy = scale
         enc = self.input_src(up, "in", 1)
         if enc is None:
             return
         if enc.node is None:
             try:
-                decoded = _computed([v * 2.0 - 1.0 for v in enc.value], f"{where}: input in")
+                decoded = _computed([(v * 2.0 - 1.0) * k for v, k in zip(enc.value,
+                                                                          (sx, sy, 1.0))],
+                                    f"{where}: input in")
             except ValueError as exc:
                 self.err(str(exc))
                 return
             self.connect(Src(value=decoded, width=3), make, port)
             return
-        two = self.add(f"{up.getName()}_x2", _kind("multiply"), values={"b": [2.0, 2.0, 2.0]})
+        name = self.hint(up)
+        try:  # (2 in - 1) x scale = in x 2 scale - scale
+            doubled = _computed([2.0 * sx, 2.0 * sy, 2.0], f"{where}: input scale")
+        except ValueError as exc:
+            self.err(str(exc))
+            return
+        two = self.add(f"{name}_x2", _kind("multiply"), values={"b": doubled})
         self.connect(enc, two, "a")
-        one = self.add(up.getName(), _kind("subtract"), values={"b": [1.0, 1.0, 1.0]})
+        one = self.add(name, _kind("subtract"), values={"b": [sx, sy, 1.0]})
         self.connect(Src(two, "result", width=3), one, "a")
         self.connect(Src(one, "result", width=3), make, port)
 

@@ -114,6 +114,9 @@ _fn("luminance", "Luminance", "Colour", "Rec. 709 luminance of a linear colour."
     numpy=lambda ctx, color: (_luminance(color),))
 _fn("rgb_to_hsv", "RGB to HSV", "Colour", "Hue (turns), saturation and value of a colour.",
     [_i(*_C)], [_o("hsv", "vec3")],
+    # MaterialX's rgbtohsv: the same hue (turns), saturation and value (the import reads it;
+    # tests/test_interop_mtlx_textures.py checks it against MaterialX's GLSL)
+    mtlx_reads=MxNode("rgbtohsv", (("color", "in"),)),
     numpy=lambda ctx, color: (rgb_to_hsv(color),))
 
 

@@ -104,6 +104,8 @@ class Role(Enum):
     APPEND = auto()
     REROUTE = auto()
     TEXTURE_SAMPLE = auto()
+    ADDRESSED_TEXTURE_SAMPLE = auto()  # MaterialX image's address modes and filter
+    HEX_TILED_TEXTURE = auto()  # MaterialX hextiledimage
     COLOR_RAMP = auto()
     MAKE_ATTRIBUTES = auto()
     SET_ATTRIBUTES = auto()
