@@ -304,7 +304,8 @@ class DocumentTabs(QObject):
         self.retitle()
 
     def retitle(self) -> None:
-        if not shiboken6.isValid(self.bar) or not shiboken6.isValid(self.controller.undo_stack):
+        stacks = [self.bar, self.controller.undo_stack, *(s.undo_stack for s in self.sessions)]
+        if not all(shiboken6.isValid(x) for x in stacks):
             return  # the window is going away
         for i, s in enumerate(self.sessions):
             doc = self.controller.document if i == self.index else s.document

@@ -64,6 +64,7 @@ class InspectorPanel(QScrollArea):
     message = Signal(str)
     functionOpenRequested = Signal(str)
     docsRequested = Signal(str)  # a node kind's documentation
+    textureSlotChosen = Signal(str, str, str)  # node, texture input, image file ("": clear)
 
     def __init__(self, controller: DocumentController, parent=None) -> None:
         super().__init__(parent)
@@ -129,6 +130,8 @@ class InspectorPanel(QScrollArea):
             self._rebuild_timer.start()
         elif event.kind == ChangeKind.LAYOUT and touches and event.what == "label":
             self._rebuild_timer.start()
+        elif event.kind == ChangeKind.VALUE and any(k[0] == "slot" for k in self._fields):
+            self.refresh_values()  # the image of a parameter wired into a texture slot
 
     def _on_analysed(self, _analysis) -> None:
         if self.node_id is not None:
@@ -423,6 +426,8 @@ class InspectorPanel(QScrollArea):
                     lid = next((k for k in layer_names if p.name.startswith(k + "_")), None)
                     if lid:
                         label_text = p.name[len(lid) + 1:]
+                if p.type == "texture2d" and self._texture_slot(form, node, p, label_text):
+                    continue
                 if p.name in connected:
                     src = connected[p.name]
                     form.addRow(self._label(label_text, p.doc),
@@ -448,6 +453,27 @@ class InspectorPanel(QScrollArea):
                                         p.name, node.kind,
                                         lambda val, m, port=p.name: self._set_value(port, val, m))
                 form.addRow(self._label(label_text, p.doc), w)
+
+    def _texture_slot(self, form, node: Node, p: Port, label: str) -> bool:
+        """A texture input's file field: the image of the Texture Parameter wired in, or
+        none yet (choosing one makes the parameter, `textureSlotChosen`). False when the
+        input is fed by something else (its source is shown instead)."""
+        graph = self.controller.document.graph
+        link = graph.incoming(node.id, p.name)
+        ref = ""
+        if link is not None:
+            src = graph.nodes.get(link.src)
+            if src is None or role_of(src.kind) != Role.TEXTURE_PARAMETER:
+                return False
+            ref = str(src.settings.get("path", ""))
+        f = TextureField(ref, absolute_of(self.controller.document, ref) if ref else None)
+        f.setToolTip(f"the image {link.src} reads" if link is not None else
+                     "choose an image: a Texture Parameter on it is made and wired in")
+        f.edited.connect(lambda v, _m, n=node.id, port=p.name:
+                         self.textureSlotChosen.emit(n, port, str(v or "")))
+        self._fields[("slot", p.name)] = f
+        form.addRow(self._label(label, p.doc), f)
+        return True
 
     @staticmethod
     def _hint(text: str) -> QLabel:
@@ -476,6 +502,12 @@ class InspectorPanel(QScrollArea):
         a = self.controller.analysis
         ports = a.ports.get(node.id) if a else None
         for (where, name), f in self._fields.items():
+            if where == "slot":  # the image of the parameter wired in (a value edit there)
+                link = self.controller.document.graph.incoming(node.id, name)
+                src = self.controller.document.graph.nodes.get(link.src) if link else None
+                ref = str(src.settings.get("path", "")) if src is not None else ""
+                f.set_value(ref, absolute_of(self.controller.document, ref) if ref else None)
+                continue
             if where == "setting":
                 if isinstance(f, TextureField):
                     ref = str(node.settings.get("path", ""))

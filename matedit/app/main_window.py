@@ -116,6 +116,8 @@ class MainWindow(QMainWindow):
         self.tabs.materialOpenRequested.connect(self.open_material)
         self.tabs.docsRequested.connect(self.show_docs)
         self.inspector.docsRequested.connect(self.show_docs)
+        self.inspector.textureSlotChosen.connect(
+            lambda nid, port, path: self.canvas.fill_texture_slot(nid, port, path))
         self.tabs.previewRequested.connect(
             lambda nid, port: self.compiler.set_preview(PreviewTarget(nid, port)))
         self.tabs.activeChanged.connect(self._on_active)
