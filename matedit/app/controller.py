@@ -188,6 +188,22 @@ class DocumentController(QObject):
             self.undo_stack.push(MergingUndoCommand(self, command, merge_id, applied=True))
         return True
 
+    def amend(self, extra: Command) -> bool:
+        """Applies `extra` as part of the last edit, so that one undo takes back both (the
+        room a node takes when it grows); a separate edit when the last one cannot take it
+        (nothing pushed, a merging value edit, or undone steps above it)."""
+        i = self.undo_stack.index()
+        top = self.undo_stack.command(i - 1) if i > 0 else None
+        if type(top) is not ModelUndoCommand or i != self.undo_stack.count():
+            return self.push(extra)
+        try:
+            with self.batch(False):
+                extra.apply(self.document.graph)
+        except CommandError:
+            return False
+        top.command = Macro([top.command, extra], text=top.command.text)
+        return True
+
     def push_all(self, commands: list[Command], text: str) -> bool:
         return self.push(Macro(list(commands), text=text)) if commands else False
 

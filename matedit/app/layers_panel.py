@@ -9,6 +9,7 @@ manager) are added on top.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtCore import QMimeData, Qt, QTimer, Signal
@@ -306,6 +307,8 @@ class LayersPanel(QWidget):
         self.controller = controller
         self.costs: dict[str, tuple[float, float]] = {}  # layer id -> (instructions, share)
         self.run_menu = lambda menu, at: menu.exec(at)  # tests read the menu instead
+        # node id -> new positions of the nodes a grown stack covers (the window's canvas)
+        self.make_room: Callable[[str], dict] | None = None
         lay = QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.setSpacing(4)
@@ -462,6 +465,11 @@ class LayersPanel(QWidget):
             return False
         if not self.controller.push(cmd):
             return False
+        if self.make_room is not None:  # the stack grew: it never covers its neighbours
+            self.controller.flush()  # its new ports, measured on the canvas
+            moves = self.make_room(s.node_id)
+            if moves:
+                self.controller.amend(MoveNodes(moves, text="make room"))
         report = wire_report(cmd)
         if report:
             self.message.emit(report)

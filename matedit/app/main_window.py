@@ -19,6 +19,7 @@ from PySide6.QtWidgets import QApplication, QLabel, QMainWindow
 
 from matedit.app.canvas import NodeCanvasView
 from matedit.app.canvas.actions import PaletteOnTab
+from matedit.app.canvas.placement import make_room
 from matedit.app.canvas_tabs import CanvasTab, CanvasTabs
 from matedit.app.compile_service import MaterialCompiler
 from matedit.app.controller import DocumentController
@@ -129,6 +130,7 @@ class MainWindow(QMainWindow):
         self.inspector.functionOpenRequested.connect(
             lambda p: self.tabs.open_function(p, self.tabs.active))
         self.layers.message.connect(self.status)
+        self.layers.make_room = lambda nid: make_room(self.tabs.material.canvas.scene(), nid)
         self.layers.layerSelected.connect(self._layer_selected)
         self.library.materialOpenRequested.connect(self.open_material)
         self.library.functionOpenRequested.connect(

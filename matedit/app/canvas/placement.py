@@ -77,3 +77,32 @@ def place(node: Node, scene) -> Node:
     node.position = (round(node.position[0] + shift.x(), 1),
                      round(node.position[1] + shift.y(), 1))
     return node
+
+
+def make_room(scene, node_id: str) -> dict[str, tuple[float, float]]:
+    """New positions for the nodes that `node_id`'s item (grown: a layer stack with a new
+    layer) now covers: each moves straight down until it is GAP clear of it, and of the
+    nodes moved before it (top first), so nothing lands on anything. {} when nothing is
+    covered."""
+    item = scene.node_items.get(node_id)
+    if item is None:
+        return {}
+    grown = item.sceneBoundingRect()
+    rects = {nid: it.sceneBoundingRect() for nid, it in scene.node_items.items()
+             if nid != node_id}
+    shifts: dict[str, float] = {}
+    blockers = [grown.adjusted(-GAP, -GAP, GAP, GAP)]
+    for nid in sorted(rects, key=lambda n: (rects[n].top(), rects[n].left())):
+        r = rects[nid]
+        dy = 0.0
+        for _ in range(len(blockers) + 1):  # each pass clears one more blocker, or stops
+            hit = [b for b in blockers if r.translated(0.0, dy).intersects(b)]
+            if not hit:
+                break
+            dy = max(b.bottom() for b in hit) - r.top()
+        if dy > 0.0:
+            shifts[nid] = dy
+            blockers.append(r.translated(0.0, dy).adjusted(-GAP, -GAP, GAP, GAP))
+    graph = scene.graph
+    return {nid: (graph.nodes[nid].position[0], round(graph.nodes[nid].position[1] + dy, 1))
+            for nid, dy in shifts.items() if nid in graph.nodes}
