@@ -77,7 +77,7 @@ def test_split_shows_the_material_before_the_last_edit_on_the_left(window, qtbot
                                atol=1.5 / 255)
     assert np.abs(repainted[:, cut + margin:] - edited[:, cut + margin:]).mean() > 0.005
 
-    vp.ab_action.setChecked(False)
+    vp.set_comparing(False)
     assert not vp.divider.isVisibleTo(vp)
     off = frame(qtbot, vp.view)
     assert np.abs(off[:, :cut - margin] - original[:, :cut - margin]).mean() > 0.005

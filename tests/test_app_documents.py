@@ -142,3 +142,37 @@ def test_closing_the_window_asks_about_every_tab_with_unsaved_work(qtbot, two):
     assert w.close()
     assert asked == ["rusty_painted_metal.json", "velvet.json"]
     assert not recovery_path(b).exists() and not recovery_path(a).exists()
+
+
+def test_an_instance_opens_in_a_tab_with_the_windows_undo_and_close(qtbot, two):
+    root = two[0].parents[1]
+    inst = root / "instances" / "worn_paint_green.json"
+    asked = []
+    w = make_window(qtbot, two[0], show=True)
+    w.actions.ask_save_changes = lambda name: asked.append(name) or "discard"
+    docs = w.documents
+    assert w.open_material(inst)  # File › Open on an instance: a tab of its own
+    assert docs.count() == 2 and docs.index == 1
+    (editor,) = w.instances.editors
+    assert docs.current.editor is editor and docs.pages.currentWidget() is editor
+    assert not editor.isWindow() and docs.names()[1] == editor.name
+    assert w.undo_group.activeStack() is editor.undo_stack
+
+    name = next(n for n, p in editor.parameters.items() if p.type == "scalar")
+    before = editor.value(name)
+    editor.set_value(name, 0.123)
+    editor.set_value(name, 0.321)  # one drag: one undo step
+    assert editor.dirty and docs.names()[1].endswith("*")
+    assert editor.undo_stack.count() == 1
+    w.undo_group.undo()  # Edit › Undo in the instance's tab
+    assert editor.value(name) == before and not editor.dirty
+    w.undo_group.redo()
+    assert editor.value(name) == 0.321 and editor.dirty
+
+    docs.activate(0)  # the material: its canvas and its own undo again
+    assert docs.pages.currentIndex() == 0 and w.controller.document.path == two[0]
+    assert w.undo_group.activeStack() is w.controller.undo_stack
+    assert w.open_material(inst) and docs.index == 1  # already open: its tab
+    assert docs.close()  # the instance's unsaved override: asked, discarded
+    assert asked == [editor.name] and docs.count() == 1 and docs.index == 0
+    assert w.controller.document.path == two[0]

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtGui import QAction
+from PySide6.QtGui import QAction, QUndoCommand, QUndoStack
 from PySide6.QtWidgets import (
     QDockWidget,
     QHBoxLayout,
@@ -57,6 +57,7 @@ from matedit.io.instance import (
 if TYPE_CHECKING:
     from matedit.app.controller import DocumentController
     from matedit.app.document_actions import DocumentActions
+    from matedit.app.documents import DocumentTabs
 
 INSTANCE_FILTER = "Material instances (*.json)"
 
@@ -77,6 +78,8 @@ class InstanceEditor(QWidget):
         self._uniform_of: dict[str, str] = {}  # parameter -> uniform, of `compiled`
         self.compile_count = 0
         self.dirty = False
+        self.undo_stack = QUndoStack(self)  # the main window's Edit › Undo, in its tab
+        self.undo_stack.cleanChanged.connect(lambda clean: self._set_dirty(not clean))
         self.panel = ParameterPanel()
         self.view = ViewportWidget()
         self.chain_label = QLabel()
@@ -124,8 +127,7 @@ class InstanceEditor(QWidget):
         return Path(self.doc.path).parent if self.doc.path else Path.cwd()
 
     def _title(self) -> str:
-        name = self.doc.name or (Path(self.doc.path).stem if self.doc.path else "instance")
-        return f"{name}{' *' if self.dirty else ''} — instance — matedit"
+        return f"{self.name}{' *' if self.dirty else ''} — instance — matedit"
 
     def _rebuild(self) -> None:
         r = self.resolved
@@ -208,15 +210,23 @@ class InstanceEditor(QWidget):
                 self.view.set_values({uniform: self.resolved.values[name]}, {})
 
     def set_value(self, name: str, value: Any) -> None:
-        """Override `name` with `value` (an edit of a row overrides it)."""
+        """Override `name` with `value` (an edit of a row overrides it), undoably; the
+        steps of one drag of one row are one undo step."""
         if name not in self.parameters:
             return
         if self.parameters[name].type == "texture" and value and Path(value).is_absolute():
             value = Path(os.path.relpath(value, self._base())).as_posix()  # file-relative
-        self.doc.parameters[name] = copy.deepcopy(value)
+        self.undo_stack.push(_OverrideEdit(self, name, copy.deepcopy(value), True))
+
+    def _apply_override(self, name: str, value: Any, present: bool) -> None:
+        """`name` overridden with `value`, or (not `present`) back to the parent's."""
+        if present:
+            self.doc.parameters[name] = copy.deepcopy(value)
+        else:
+            self.doc.parameters.pop(name, None)
         self._re_resolve()
-        self.panel.update_row(name, self.resolved.values[name], True)
-        self._set_dirty()
+        self.panel.update_row(name, self.resolved.values[name], present)
+        self._set_dirty(not self.undo_stack.isClean())
         self._push(name)
 
     def _override_toggled(self, name: str, on: bool) -> None:
@@ -226,14 +236,19 @@ class InstanceEditor(QWidget):
             self.reset(name)
 
     def reset(self, name: str) -> None:
-        """Reset to the parent's value: the override is removed from the file."""
+        """Reset to the parent's value: the override is removed from the file (undoably)."""
         if name not in self.doc.parameters:
             return
-        del self.doc.parameters[name]
-        self._re_resolve()
-        self.panel.update_row(name, self.resolved.values[name], False)
-        self._set_dirty()
-        self._push(name)
+        self.undo_stack.push(_OverrideEdit(self, name, None, False))
+
+    def embed(self) -> None:
+        """A document tab of the main window from now on, not a window of its own."""
+        self.setWindowFlag(Qt.WindowType.Window, False)
+        self.layout().setContentsMargins(0, 0, 0, 0)
+
+    @property
+    def name(self) -> str:
+        return self.doc.name or (Path(self.doc.path).stem if self.doc.path else "instance")
 
     # --- files ------------------------------------------------------------------------
     def save(self) -> bool:
@@ -244,6 +259,7 @@ class InstanceEditor(QWidget):
         except OSError as exc:
             QMessageBox.warning(self, "Save failed", f"{self.doc.path}: {exc}")
             return False
+        self.undo_stack.setClean()
         self._set_dirty(False)
         self.message.emit(f"saved {self.doc.path}")
         return True
@@ -256,6 +272,7 @@ class InstanceEditor(QWidget):
         save_instance(self.doc, path, resolved=self.resolved)
         self._re_resolve()
         self._rebuild()
+        self.undo_stack.setClean()
         self._set_dirty(False)
         return True
 
@@ -270,6 +287,36 @@ class InstanceEditor(QWidget):
                 event.ignore()
                 return
         super().closeEvent(event)
+
+
+class _OverrideEdit(QUndoCommand):
+    """One override set (or removed, `present` False) in an instance editor; consecutive
+    settings of one parameter merge (a drag)."""
+
+    ID = 7301
+
+    def __init__(self, editor: InstanceEditor, name: str, value: Any, present: bool) -> None:
+        super().__init__(f"{'override' if present else 'reset'} {name}")
+        self.editor, self.name = editor, name
+        self.new, self.new_present = value, present
+        self.old_present = name in editor.doc.parameters
+        self.old = copy.deepcopy(editor.doc.parameters.get(name))
+
+    def id(self) -> int:  # noqa: A003 - Qt's name
+        return self.ID
+
+    def mergeWith(self, other) -> bool:  # noqa: N802 - Qt's name
+        if not isinstance(other, _OverrideEdit) or other.name != self.name or \
+                not (self.new_present and other.new_present):
+            return False
+        self.new = other.new
+        return True
+
+    def redo(self) -> None:
+        self.editor._apply_override(self.name, self.new, self.new_present)
+
+    def undo(self) -> None:
+        self.editor._apply_override(self.name, self.old, self.old_present)
 
 
 def open_instance(path: str | Path, parent=None) -> InstanceEditor:
@@ -293,6 +340,7 @@ class InstanceHost(Protocol):
 
     controller: DocumentController
     actions: DocumentActions
+    documents: DocumentTabs
 
     def status(self, text: str) -> None: ...
 
@@ -328,9 +376,10 @@ class Instances:
         attach_instances(self.library.items("material"), files, PATH_ROLE, KIND_ROLE)
 
     def _show(self, editor: InstanceEditor) -> InstanceEditor:
+        """The editor in a document tab of the window, with its undo and menus."""
         self.editors.append(editor)
         editor.message.connect(self.host.status)
-        editor.show()
+        self.host.documents.add_instance(editor)
         return editor
 
     def open(self, path: str) -> InstanceEditor | None:

@@ -131,6 +131,7 @@ class MainWindow(QMainWindow):
             lambda p: self.tabs.open_function(p, self.tabs.active))
         self.layers.message.connect(self.status)
         self.layers.make_room = lambda nid: make_room(self.tabs.material.canvas.scene(), nid)
+        self.documents.follow_undo(self.undo_group, lambda: self.tabs.active.controller)
         self.layers.layerSelected.connect(self._layer_selected)
         self.library.materialOpenRequested.connect(self.open_material)
         self.library.functionOpenRequested.connect(
@@ -186,10 +187,12 @@ class MainWindow(QMainWindow):
         return self.instances.create(parent_file, path)
 
     def save_active(self) -> bool:
-        return self.tabs.active.actions.save()
+        done = self.documents.save_active()  # an instance tab's editor
+        return done if done is not None else self.tabs.active.actions.save()
 
     def save_active_as(self) -> bool:
-        return self.tabs.active.actions.save_as()
+        editor = self.documents.current.editor
+        return editor.save_as() if editor is not None else self.tabs.active.actions.save_as()
 
     def export_shaders(self) -> None:
         if self.compiler.current is None:
