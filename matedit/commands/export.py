@@ -52,7 +52,7 @@ def _gltf(args, out: Path) -> int:
 
     from matedit.compiler import CompileError
     from matedit.interop import gltf
-    from matedit.interop.bake import bake_attributes, maps_from
+    from matedit.interop.bake import bake_for_export, maps_from
     from matedit.interop.export import stem_of
     from matedit.io.document import FileResolver
     from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
@@ -78,7 +78,9 @@ def _gltf(args, out: Path) -> int:
         raise UsageError(f"{mesh_spec}: cannot read mesh: {exc.strerror or exc}") from None
     try:
         with headless() as ctx:
-            attrs, ir = bake_attributes(ctx, doc, resolver, size, progress_printer("baking"))
+            attrs, ir, bake_notes = bake_for_export(
+                ctx, doc, resolver, size, None if _is_plane(mesh_spec) else mesh,
+                progress_printer("baking"))
     except CompileError as exc:
         raise compile_error(exc, path) from None
     emax = float(max(1.0, np.max(attrs["emissive"])))
@@ -90,11 +92,16 @@ def _gltf(args, out: Path) -> int:
         gltf.write(files)
     except OSError as exc:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    for note in lobes.notes:
+    for note in [*bake_notes, *lobes.notes]:
         report("note", f"{path}: {note}")
     if sys.stderr.isatty():
         print(f"exported {path} to {', '.join(str(p) for p in files)}", file=sys.stderr)
     return 0
+
+
+def _is_plane(spec) -> bool:
+    """The built-in plane: baked on the UV plane (matedit.interop.bake), as `matedit bake`."""
+    return str(spec) in ("plane", "builtin:plane")
 
 
 def _mtlx(args, out: Path) -> int:
