@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli_support import UsageError, report
+from matedit.commands import export_check
 from matedit.commands.bake import compile_error, load_material, parse_size, progress_printer
 from matedit.io.inputs import declare_inputs
 
@@ -29,6 +30,7 @@ def register(sub) -> None:
                    help="glTF only: sphere, cube, plane, cylinder (or builtin:sphere, ...) or "
                    "an OBJ file (./sphere for a file of that name) (default: the file's "
                    "preview mesh, else sphere)")
+    export_check.register(p)
     declare_inputs(p, file="document", mesh="mesh")
     p.set_defaults(run=run)
 
@@ -40,6 +42,7 @@ def run(args) -> int:
         raise UsageError(f"{out}: the output must end in .gltf, .glb or .mtlx")
     if not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
+    export_check.validate(args, out)
     if kind == ".mtlx":
         if args.mesh:
             raise UsageError("--mesh applies to glTF exports only")
@@ -96,6 +99,7 @@ def _gltf(args, out: Path) -> int:
         report("note", f"{path}: {note}")
     if sys.stderr.isatty():
         print(f"exported {path} to {', '.join(str(p) for p in files)}", file=sys.stderr)
+    export_check.after_write(args, path, doc, out, str(mesh_spec))
     return 0
 
 
@@ -133,4 +137,5 @@ def _mtlx(args, out: Path) -> int:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
     for node, why in result.baked:
         report("note", f"{path}: node {node}: baked to an image ({why})")
+    export_check.after_write(args, path, doc, out)
     return 0
