@@ -69,6 +69,7 @@ def _gltf(args, out: Path) -> int:
     mesh_spec = args.mesh or preview_spec(doc, "mesh", "sphere")
     inputs = command_inputs(args, [doc], resolver)
     outputs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
+    outputs += export_check.outputs(args)
     try:
         refuse_overwrite(outputs, inputs)
     except OverwriteError as exc:
@@ -122,7 +123,7 @@ def _mtlx(args, out: Path) -> int:
     inputs = command_inputs(args, [doc], resolver)
     try:
         result = mtlx_export.export(doc, resolver, out, size)
-        refuse_overwrite(result.files, inputs)
+        refuse_overwrite([*result.files, *export_check.outputs(args)], inputs)
         mtlx_export.write(result)
     except CompileError as exc:
         raise compile_error(exc, path) from None

@@ -60,6 +60,11 @@ def validate(args, out: Path) -> None:
             raise UsageError(f"{img}: --check-image must not be the export's output")
 
 
+def outputs(args) -> list[Path]:
+    """The files --check writes (its image), for the export's refuse_overwrite."""
+    return [Path(args.check_image)] if getattr(args, "check_image", None) else []
+
+
 def parse_render_size(text: str) -> int:
     try:
         n = int(text)
@@ -153,20 +158,68 @@ def reimport_gltf_maps(out: Path, work: Path):
         "emissive_strength": float(strength),
     }
     doc = load(graphs_dir().joinpath(*TEMPLATE))
+    lobes = lobe_fields(mat.extensions or {})
     for n in doc.graph.nodes.values():
         name = n.settings.get("name")
         if role_of(n.kind) == Role.TEXTURE_PARAMETER and name in paths:
             n.settings["path"] = paths[name]
+        elif role_of(n.kind) == Role.MAKE_ATTRIBUTES:
+            n.values.update(lobes)
         elif name in values:
             n.values["value"] = values[name]
     if mat.alphaMode in (None, "OPAQUE"):  # the template reads opacity from the alpha
         doc.graph.links = {lk for lk in doc.graph.links if lk.dst_port != "opacity"}
     doc.path = work / "roundtrip.json"
+    unread = sorted(set(mat.extensions or {}) - set(LOBE_EXTENSIONS)
+                    - {"KHR_materials_emissive_strength"})
     notes = []
-    lobes = sorted(k for k in (mat.extensions or {}) if k != "KHR_materials_emissive_strength")
-    if lobes:
-        notes.append(f"round trip import: {', '.join(lobes)} not read back (core maps only)")
+    if unread:
+        notes.append(f"round trip import: {', '.join(unread)} not read back")
     return doc, notes
+
+
+# glTF extension -> (its factor, the MaterialAttributes field it came from): the inverse of
+# matedit.interop.gltf.lobe_extensions for the factors it writes
+LOBE_EXTENSIONS: dict[str, tuple[tuple[str, str], ...]] = {
+    "KHR_materials_ior": (("ior", "ior"),),
+    "KHR_materials_specular": (("specularColorFactor", "specularColor"),),
+    "KHR_materials_clearcoat": (("clearcoatFactor", "coat"),
+                                ("clearcoatRoughnessFactor", "coatRoughness")),
+    "KHR_materials_sheen": (("sheenColorFactor", "sheenColor"),
+                            ("sheenRoughnessFactor", "sheenRoughness")),
+    "KHR_materials_anisotropy": (("anisotropyStrength", "anisotropy"),),
+    "KHR_materials_transmission": (("transmissionFactor", "transmission"),),
+    "KHR_materials_volume": (("thicknessFactor", "thickness"),
+                             ("attenuationDistance", "attenuationDistance"),
+                             ("attenuationColor", "attenuationColor")),
+    "KHR_materials_iridescence": (("iridescenceThicknessMaximum", "thinFilmThickness"),
+                                  ("iridescenceIor", "thinFilmIor")),
+}
+
+
+def lobe_fields(extensions: dict) -> dict:
+    """MaterialAttributes field -> constant value from the material's KHR_materials_*
+    extensions (LOBE_EXTENSIONS; the anisotropy's rotation as a direction in the tangent
+    plane)."""
+    import math
+
+    out: dict = {}
+    for ext, pairs in LOBE_EXTENSIONS.items():
+        data = extensions.get(ext)
+        if not isinstance(data, dict):
+            continue
+        for key, field in pairs:
+            v = data.get(key)
+            if isinstance(v, (int, float)) and math.isfinite(v):
+                out[field] = float(v)
+            elif isinstance(v, list) and len(v) == 3 and all(
+                    isinstance(x, (int, float)) and math.isfinite(x) for x in v):
+                out[field] = [float(x) for x in v]
+        if ext == "KHR_materials_anisotropy" and isinstance(
+                data.get("anisotropyRotation"), (int, float)):
+            a = float(data["anisotropyRotation"])
+            out["anisotropyDirection"] = [math.cos(a), math.sin(a), 0.0]
+    return out
 
 
 REIMPORTERS: dict[str, Callable] = {
@@ -199,8 +252,8 @@ class RoundTrip:
 def render_display(docs, resolver, size: int, mesh: str) -> list[np.ndarray]:
     """Display images (size x size, sRGB in [0, 1]) of each document, all under one
     renderer: `matedit render`'s defaults (studio, default rig, split-sum, exposure 0)."""
-    from matedit.compiler import CompileError, compile_document
     from matedit.commands.render import _renderer
+    from matedit.compiler import CompileError, compile_document
     from matedit.render import MeshError, Renderer
     from matedit.render.context import headless_context
 
@@ -272,15 +325,9 @@ def after_write(args, path: Path, doc, out: Path, mesh: str | None = None) -> No
     if not getattr(args, "check", False):
         return
     from matedit.io.document import FileResolver
-    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
     resolver = FileResolver()
     image = Path(args.check_image) if args.check_image else None
-    if image is not None:
-        try:
-            refuse_overwrite([image], command_inputs(args, [doc], resolver))
-        except OverwriteError as exc:
-            raise UsageError(str(exc)) from None
     size = parse_render_size(args.check_size) if args.check_size else DEFAULT_SIZE
     with tempfile.TemporaryDirectory(prefix="matedit-check-") as tmp:
         back, notes = REIMPORTERS[out.suffix.lower()](out, Path(tmp))
