@@ -629,6 +629,9 @@ NON_UTF8_CASES = {
     "export .gltf": (["export", "doc", "-o", b"OUT.gltf", "--size", "8", "--mesh", "obj"],
                      [b"OUT.gltf", b"OUT.bin"]),
     "export .glb": (["export", "doc", "-o", b"OUT.glb", "--size", "8"], [b"OUT.glb"]),
+    "export --check": (["export", "doc", "-o", b"OUT.gltf", "--size", "8", "--check",
+                        "--check-size", "16", "--check-image", b"dir/chk.png"],
+                       [b"OUT.gltf", b"OUT.bin", b"dir/chk.png"]),
     "contact-sheet": (["contact-sheet", "doc", "-o", b"OUT.png", "--size", "16"],
                       [b"OUT.png"]),
 }

@@ -25,14 +25,16 @@ FORMATS = (".mtlx", ".glb")
 LINE = re.compile(r"round trip: mean ΔE ([\d.]+) max ΔE ([\d.]+)")
 
 
-def measure(sample: Path, suffix: str, folder: Path) -> tuple[float, float]:
+def measure(sample: Path, suffix: str, folder: Path) -> tuple[float, float] | str:
     """(mean, max) ΔE00 of `matedit export SAMPLE -o OUT{suffix} --check` at the table's
-    sizes."""
+    sizes, or the export's own `error:` line when the format cannot take the sample."""
     out = folder / f"{sample.stem}{suffix}"
     r = subprocess.run([sys.executable, "-m", "matedit", "export", str(sample), "-o", str(out),
                         "--size", str(BAKE_SIZE), "--check", "--check-size",
                         str(RENDER_SIZE)], capture_output=True, text=True, cwd=ROOT)
     m = LINE.search(r.stderr)
+    if r.returncode == 2 and r.stderr.startswith("error: ") and "--check" not in r.stderr:
+        return r.stderr.strip().removeprefix("error: ")
     if r.returncode != 0 or m is None:
         raise SystemExit(f"{sample.name} {suffix}: {r.stderr.strip()[-400:]}")
     return float(m.group(1)), float(m.group(2))
@@ -41,17 +43,23 @@ def measure(sample: Path, suffix: str, folder: Path) -> tuple[float, float]:
 def table(samples: list[Path]) -> str:
     rows = ["| sample | .mtlx mean | .mtlx max | .glb mean | .glb max |",
             "|---|---|---|---|---|"]
+    refused = []
     with tempfile.TemporaryDirectory() as tmp:
         for s in samples:
             cells = []
             for suffix in FORMATS:
                 folder = Path(tmp) / suffix.lstrip(".") / s.stem
                 folder.mkdir(parents=True)
-                mean, worst = measure(s, suffix, folder)
-                cells += [f"{mean:.2f}", f"{worst:.2f}"]
+                got = measure(s, suffix, folder)
+                if isinstance(got, str):
+                    cells += ["no export", "no export"]
+                    refused.append(f"`{s.stem}` to `{suffix}`: {got.split(': ', 1)[-1]}")
+                else:
+                    cells += [f"{got[0]:.2f}", f"{got[1]:.2f}"]
             rows.append(f"| `{s.stem}` | " + " | ".join(cells) + " |")
             print(rows[-1], file=sys.stderr)
-    return "\n".join(rows)
+    notes = "".join(f"\n\nNo export: {r}" for r in refused)
+    return "\n".join(rows) + notes
 
 
 def section(body: str) -> str:
@@ -65,10 +73,12 @@ pixels the mesh covers (docs/cli.md, `export`). Every sample, exported at `--siz
 Made by `python tools/roundtrip_table.py --write`; tests/test_export_check.py holds a few
 samples within 1.5 times their row.
 
-A mean under 1 is a difference few people see side by side; the max is a few pixels, most
-often at highlights and where baked noise at {BAKE_SIZE} texels meets its procedural original.
-The glTF column includes what glTF does not carry (lobes past its core material read back
-only as their core maps, see the notes `--check` prints).
+A mean ΔE00 under about 1 is a difference hard to see side by side. What the figures hold:
+the maps baked at {BAKE_SIZE} texels (a pattern finer than that is lost, in both formats
+where MaterialX bakes a node), what glTF has no place for (lobe fields that vary over the
+surface go out as their means, subsurface is dropped; the export's `note:` lines name them)
+and what the MaterialX importer approximates (its `note: ... round trip import:` lines).
+The max is a few pixels, mostly at highlights and silhouettes.
 
 {body}
 """
@@ -87,10 +97,11 @@ def read_table(text: str) -> dict[str, dict[str, tuple[float, float]]]:
     out = {}
     start = text.find(HEADING + "\n")
     for line in text[start:].splitlines():
-        m = re.match(r"\| `([\w-]+)` \| ([\d.]+) \| ([\d.]+) \| ([\d.]+) \| ([\d.]+) \|", line)
+        m = re.match(r"\| `([\w-]+)` \|" + r" ([\d.]+|no export) \|" * 4, line)
         if m:
-            v = [float(x) for x in m.groups()[1:]]
-            out[m.group(1)] = {".mtlx": (v[0], v[1]), ".glb": (v[2], v[3])}
+            v = [None if x == "no export" else float(x) for x in m.groups()[1:]]
+            out[m.group(1)] = {suffix: (v[2 * i], v[2 * i + 1])
+                               for i, suffix in enumerate(FORMATS) if v[2 * i] is not None}
     return out
 
 

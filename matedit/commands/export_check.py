@@ -121,8 +121,15 @@ def reimport_gltf_maps(out: Path, work: Path):
     if blob is None and g.buffers and g.buffers[0].uri:
         from matedit.io.atomic import read_bounded
 
+        import os
+        import urllib.parse
+
+        uri = g.buffers[0].uri  # percent-encoded bytes of the file name (gltf.buffer_uri)
+        if uri.startswith("data:") or "/" in uri:
+            raise UsageError(f"{out}: --check: its buffer is not a file beside it")
         try:
-            blob = read_bounded(out.parent / g.buffers[0].uri, 1 << 31)
+            blob = read_bounded(out.parent / os.fsdecode(urllib.parse.unquote_to_bytes(uri)),
+                                1 << 31)
         except OSError as exc:
             raise UsageError(f"{out}: --check: cannot read its buffer: "
                              f"{exc.strerror or exc}") from None
