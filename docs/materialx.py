@@ -1,4 +1,6 @@
-"""Writes docs/materialx.md, the MaterialX mapping of every catalogue kind, from the catalogue.
+"""Writes docs/materialx.md, the MaterialX mapping of every catalogue kind, from the catalogue
+(keeping its measured `## Round trip` section at the end, which tools/roundtrip_table.py
+writes).
 
     .venv/bin/python docs/materialx.py
 """
@@ -14,6 +16,12 @@ sys.path.insert(0, str(ROOT))
 from matedit.interop.mtlx_map import document  # noqa: E402
 from matedit.io.atomic import atomic_write_text  # noqa: E402
 
+# The measured section after the generated part (tools/roundtrip_table.py writes it): kept.
+MEASURED = "\n## Round trip\n"
+
 if __name__ == "__main__":
-    atomic_write_text(ROOT / "docs" / "materialx.md", document())
+    path = ROOT / "docs" / "materialx.md"
+    old = path.read_text(encoding="utf-8") if path.exists() else ""
+    tail = old[old.find(MEASURED):] if MEASURED in old else ""
+    atomic_write_text(path, document() + tail)
     print(ROOT / "docs" / "materialx.md")

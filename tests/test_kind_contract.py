@@ -192,7 +192,9 @@ def test_the_materialx_doc_matches_the_catalogue():
 
     doc = Path(__file__).resolve().parent.parent / "docs" / "materialx.md"
     text = doc.read_text(encoding="utf-8")
-    assert text == mtlx_map.document(), "docs/materialx.md is stale: run docs/materialx.py"
+    measured = text.find("\n## Round trip\n")  # tools/roundtrip_table.py's, kept at the end
+    generated = text[:measured] if measured >= 0 else text
+    assert generated == mtlx_map.document(), "docs/materialx.md is stale: run docs/materialx.py"
     for kind in mtlx_map.mapped_kinds() + mtlx_map.baked_kinds() + mtlx_map.lowered_kinds():
         assert f"`{kind}`" in text
     assert len(mtlx_map.mapped_kinds() + mtlx_map.baked_kinds()

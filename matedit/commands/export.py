@@ -55,7 +55,7 @@ def _gltf(args, out: Path) -> int:
 
     from matedit.compiler import CompileError
     from matedit.interop import gltf
-    from matedit.interop.bake import bake_for_export, maps_from
+    from matedit.interop.bake import bake_for_export, is_plane_spec, maps_from
     from matedit.interop.export import stem_of
     from matedit.io.document import FileResolver
     from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
@@ -83,7 +83,7 @@ def _gltf(args, out: Path) -> int:
     try:
         with headless() as ctx:
             attrs, ir, bake_notes = bake_for_export(
-                ctx, doc, resolver, size, None if _is_plane(mesh_spec) else mesh,
+                ctx, doc, resolver, size, None if is_plane_spec(mesh_spec) else mesh,
                 progress_printer("baking"))
     except CompileError as exc:
         raise compile_error(exc, path) from None
@@ -102,11 +102,6 @@ def _gltf(args, out: Path) -> int:
         print(f"exported {path} to {', '.join(str(p) for p in files)}", file=sys.stderr)
     export_check.after_write(args, path, doc, out, str(mesh_spec))
     return 0
-
-
-def _is_plane(spec) -> bool:
-    """The built-in plane: baked on the UV plane (matedit.interop.bake), as `matedit bake`."""
-    return str(spec) in ("plane", "builtin:plane")
 
 
 def _mtlx(args, out: Path) -> int:

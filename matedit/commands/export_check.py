@@ -28,7 +28,6 @@ import numpy as np
 from matedit.cli_support import UsageError, report
 
 DEFAULT_SIZE = 256
-TEMPLATE = ("interop", "gltf_metallic_roughness.json")
 COVER_THRESHOLD = 0.05  # display difference that marks a pixel as the mesh's (see `coverage`)
 
 
@@ -92,141 +91,14 @@ def reimport_mtlx(out: Path, work: Path):
     return doc, [f"round trip import: {w}" for w in warnings]
 
 
-def _flat_png(path: Path, rgb) -> None:
-    import OpenImageIO as oiio
-
-    from matedit.io.images import write_oiio
-
-    px = np.full((1, 1, 3), np.rint(np.asarray(rgb) * 255), np.uint8)
-    write_oiio(path, oiio.ImageSpec(1, 1, 3, "uint8"), px)
-
-
 def reimport_gltf_maps(out: Path, work: Path):
-    """The glTF asset's first material on its own maps (module notes)."""
-    import pygltflib
-
-    from matedit.graph.nodes import Role, role_of
-    from matedit.io.atomic import atomic_write_bytes
-    from matedit.io.document import load
-    from matedit.resources import graphs_dir
+    """The glTF asset's first material on its own maps (matedit.interop.gltf_readback)."""
+    from matedit.interop.gltf_readback import GltfReadbackError, read_material
 
     try:
-        g = pygltflib.GLTF2().load(str(out))
-    except Exception as exc:  # pygltflib raises what its parsers raise
-        raise UsageError(f"{out}: --check: cannot read the export back: {exc}") from None
-    if not g.materials:
-        raise UsageError(f"{out}: --check: the asset has no material")
-    mat = g.materials[0]
-    blob = g.binary_blob() if out.suffix.lower() == ".glb" else None
-    if blob is None and g.buffers and g.buffers[0].uri:
-        from matedit.io.atomic import read_bounded
-
-        import os
-        import urllib.parse
-
-        uri = g.buffers[0].uri  # percent-encoded bytes of the file name (gltf.buffer_uri)
-        if uri.startswith("data:") or "/" in uri:
-            raise UsageError(f"{out}: --check: its buffer is not a file beside it")
-        try:
-            blob = read_bounded(out.parent / os.fsdecode(urllib.parse.unquote_to_bytes(uri)),
-                                1 << 31)
-        except OSError as exc:
-            raise UsageError(f"{out}: --check: cannot read its buffer: "
-                             f"{exc.strerror or exc}") from None
-
-    def image(info, name: str, default) -> str:
-        path = work / f"{name}.png"
-        if info is None:
-            _flat_png(path, default)
-            return str(path)
-        img = g.images[g.textures[info.index].source]
-        if img.bufferView is None or blob is None:
-            raise UsageError(f"{out}: --check: image {info.index} is not in the asset's buffer")
-        view = g.bufferViews[img.bufferView]
-        start = view.byteOffset or 0
-        atomic_write_bytes(path, blob[start:start + view.byteLength])
-        return str(path)
-
-    pbr = mat.pbrMetallicRoughness or pygltflib.PbrMetallicRoughness()
-    paths = {
-        "base_color_texture": image(pbr.baseColorTexture, "base_color", (1.0, 1.0, 1.0)),
-        "metallic_roughness_texture": image(pbr.metallicRoughnessTexture, "mr",
-                                            (1.0, 1.0, 1.0)),
-        "normal_texture": image(mat.normalTexture, "normal", (0.5, 0.5, 1.0)),
-        "emissive_texture": image(mat.emissiveTexture, "emissive", (1.0, 1.0, 1.0)),
-    }
-    strength = ((mat.extensions or {}).get("KHR_materials_emissive_strength") or {}).get(
-        "emissiveStrength", 1.0)
-    values = {
-        "base_color_factor": list((pbr.baseColorFactor or [1, 1, 1, 1])[:3]),
-        "metallic_factor": 1.0 if pbr.metallicFactor is None else pbr.metallicFactor,
-        "roughness_factor": 1.0 if pbr.roughnessFactor is None else pbr.roughnessFactor,
-        "emissive_factor": list(mat.emissiveFactor or [0.0, 0.0, 0.0]),
-        "emissive_strength": float(strength),
-    }
-    doc = load(graphs_dir().joinpath(*TEMPLATE))
-    lobes = lobe_fields(mat.extensions or {})
-    for n in doc.graph.nodes.values():
-        name = n.settings.get("name")
-        if role_of(n.kind) == Role.TEXTURE_PARAMETER and name in paths:
-            n.settings["path"] = paths[name]
-        elif role_of(n.kind) == Role.MAKE_ATTRIBUTES:
-            n.values.update(lobes)
-        elif name in values:
-            n.values["value"] = values[name]
-    if mat.alphaMode in (None, "OPAQUE"):  # the template reads opacity from the alpha
-        doc.graph.links = {lk for lk in doc.graph.links if lk.dst_port != "opacity"}
-    doc.path = work / "roundtrip.json"
-    unread = sorted(set(mat.extensions or {}) - set(LOBE_EXTENSIONS)
-                    - {"KHR_materials_emissive_strength"})
-    notes = []
-    if unread:
-        notes.append(f"round trip import: {', '.join(unread)} not read back")
-    return doc, notes
-
-
-# glTF extension -> (its factor, the MaterialAttributes field it came from): the inverse of
-# matedit.interop.gltf.lobe_extensions for the factors it writes
-LOBE_EXTENSIONS: dict[str, tuple[tuple[str, str], ...]] = {
-    "KHR_materials_ior": (("ior", "ior"),),
-    "KHR_materials_specular": (("specularColorFactor", "specularColor"),),
-    "KHR_materials_clearcoat": (("clearcoatFactor", "coat"),
-                                ("clearcoatRoughnessFactor", "coatRoughness")),
-    "KHR_materials_sheen": (("sheenColorFactor", "sheenColor"),
-                            ("sheenRoughnessFactor", "sheenRoughness")),
-    "KHR_materials_anisotropy": (("anisotropyStrength", "anisotropy"),),
-    "KHR_materials_transmission": (("transmissionFactor", "transmission"),),
-    "KHR_materials_volume": (("thicknessFactor", "thickness"),
-                             ("attenuationDistance", "attenuationDistance"),
-                             ("attenuationColor", "attenuationColor")),
-    "KHR_materials_iridescence": (("iridescenceThicknessMaximum", "thinFilmThickness"),
-                                  ("iridescenceIor", "thinFilmIor")),
-}
-
-
-def lobe_fields(extensions: dict) -> dict:
-    """MaterialAttributes field -> constant value from the material's KHR_materials_*
-    extensions (LOBE_EXTENSIONS; the anisotropy's rotation as a direction in the tangent
-    plane)."""
-    import math
-
-    out: dict = {}
-    for ext, pairs in LOBE_EXTENSIONS.items():
-        data = extensions.get(ext)
-        if not isinstance(data, dict):
-            continue
-        for key, field in pairs:
-            v = data.get(key)
-            if isinstance(v, (int, float)) and math.isfinite(v):
-                out[field] = float(v)
-            elif isinstance(v, list) and len(v) == 3 and all(
-                    isinstance(x, (int, float)) and math.isfinite(x) for x in v):
-                out[field] = [float(x) for x in v]
-        if ext == "KHR_materials_anisotropy" and isinstance(
-                data.get("anisotropyRotation"), (int, float)):
-            a = float(data["anisotropyRotation"])
-            out["anisotropyDirection"] = [math.cos(a), math.sin(a), 0.0]
-    return out
+        return read_material(out, work)
+    except GltfReadbackError as exc:
+        raise UsageError(f"--check: cannot read the export back: {exc}") from None
 
 
 REIMPORTERS: dict[str, Callable] = {
@@ -296,12 +168,13 @@ def render_display(docs, resolver, size: int, mesh: str) -> list[np.ndarray]:
 def _probes():
     """Two versions of the glTF template, dark and glowing: where their renders differ is the
     mesh (its silhouette on the environment)."""
+    from matedit.interop import gltf_readback
     from matedit.io.document import load
     from matedit.resources import graphs_dir
 
     out = []
     for glow in (0.0, 40.0):
-        d = load(graphs_dir().joinpath(*TEMPLATE))
+        d = load(graphs_dir().joinpath(*gltf_readback.TEMPLATE))
         for n in d.graph.nodes.values():
             name = n.settings.get("name")
             if name == "base_color_factor":

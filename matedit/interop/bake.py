@@ -423,6 +423,11 @@ def bake_attributes(ctx, doc, resolver, size: int,
 OVERLAP_LIMIT = 0.005  # the share of covered texels two triangles may both claim
 
 
+def is_plane_spec(spec) -> bool:
+    """The built-in plane: the glTF export bakes it on the UV plane, as `matedit bake` does."""
+    return str(spec) in ("plane", "builtin:plane")
+
+
 def view_dependent_nodes(ir) -> list[str]:
     """The ids of the nodes left in the optimised IR (what reaches the output) whose code
     reads the view direction (their library file reads g_surface.view), in IR order."""
