@@ -1,8 +1,8 @@
 """`matedit export FILE -o OUT.gltf|OUT.glb|OUT.mtlx [--size N] [--mesh ...] [--check ...]`.
 
 glTF 2.0: the preview mesh with tangents and a metallic-roughness material on maps baked
-on that mesh in UV space (matedit.interop.bake.bake_for_export, matedit.interop.gltf). MaterialX: a nodegraph reproducing the attribute graph
-feeding one standard_surface (matedit.interop.mtlx_export); subgraphs MaterialX cannot
+on that mesh in UV space (matedit.interop.bake.bake_for_export, matedit.interop.gltf).
+MaterialX: a nodegraph reproducing the attribute graph feeding one standard_surface (matedit.interop.mtlx_export); subgraphs MaterialX cannot
 express are baked to EXR images beside the document, and reported. `--check` measures the
 round trip's loss (matedit.commands.export_check)."""
 
