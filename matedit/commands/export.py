@@ -2,9 +2,10 @@
 
 glTF 2.0: the preview mesh with tangents and a metallic-roughness material on maps baked
 on that mesh in UV space (matedit.interop.bake.bake_for_export, matedit.interop.gltf).
-MaterialX: a nodegraph reproducing the attribute graph feeding one standard_surface (matedit.interop.mtlx_export); subgraphs MaterialX cannot
-express are baked to EXR images beside the document, and reported. `--check` measures the
-round trip's loss (matedit.commands.export_check)."""
+MaterialX: a nodegraph reproducing the attribute graph feeding one standard_surface
+(matedit.interop.mtlx_export); subgraphs MaterialX cannot express are baked to EXR images
+beside the document, and reported. `--check` measures the round trip's loss
+(matedit.commands.export_check)."""
 
 from __future__ import annotations
 
