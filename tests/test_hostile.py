@@ -632,6 +632,9 @@ NON_UTF8_CASES = {
     "export .usda": (["export", "doc", "-o", b"OUT.usda", "--size", "8", "--mesh", "obj"],
                      [b"OUT.usda", b"out___orm.png"]),
     "export .usdz": (["export", "doc", "-o", b"OUT.usdz", "--size", "8"], [b"OUT.usdz"]),
+    "export --check": (["export", "doc", "-o", b"OUT.gltf", "--size", "8", "--check",
+                        "--check-size", "16", "--check-image", b"dir/chk.png"],
+                       [b"OUT.gltf", b"OUT.bin", b"dir/chk.png"]),
     "contact-sheet": (["contact-sheet", "doc", "-o", b"OUT.png", "--size", "16"],
                       [b"OUT.png"]),
 }

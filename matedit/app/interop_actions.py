@@ -159,7 +159,7 @@ class InteropActions:
         if out.suffix.lower() not in (".glb", ".gltf"):
             out = out.with_suffix(".glb")
         from matedit.interop import gltf
-        from matedit.interop.bake import bake_attributes, maps_from
+        from matedit.interop.bake import bake_for_export, is_plane_spec, maps_from
         from matedit.io.inputs import preview_spec, refuse_overwrite
         from matedit.render.mesh import mesh_from_spec
 
@@ -167,19 +167,21 @@ class InteropActions:
             mesh_spec = preview_spec(self.doc, "mesh", "sphere")  # builtin:cube, cube or a file
             outs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
             refuse_overwrite(outs, self._inputs())
-            attrs, ir = _in_worker(lambda ctx: bake_attributes(ctx, self.doc, self.resolver,
-                                                               size))
+            mesh = mesh_from_spec(mesh_spec)
+            on = None if is_plane_spec(mesh_spec) else mesh  # baked on the mesh, as the CLI
+            attrs, ir, notes = _in_worker(lambda ctx: bake_for_export(
+                ctx, self.doc, self.resolver, size, on))
             import numpy as np
 
             emax = float(max(1.0, np.max(attrs["emissive"])))
             attrs["emissive"] = attrs["emissive"] / emax
             lobes = gltf.lobes_of(ir)
-            files = gltf.files_for(out, maps_from(attrs, ir.attributes),
-                                   mesh_from_spec(mesh_spec), self._stem(), emax, lobes)
+            files = gltf.files_for(out, maps_from(attrs, ir.attributes), mesh, self._stem(),
+                                   emax, lobes)
             gltf.write(files)
         except Exception as exc:
             return self._fail(title, exc)
-        said = "".join(f"; note: {n}" for n in lobes.notes)
+        said = "".join(f"; note: {n}" for n in [*notes, *lobes.notes])
         return self._done(f"exported {', '.join(p.name for p in files)}{said}")
 
     def export_mtlx(self, out: Path | None = None, size: int = 512) -> bool:

@@ -1,11 +1,14 @@
-"""`matedit export FILE -o OUT.gltf|OUT.glb|OUT.mtlx|OUT.usda|OUT.usdz [--size N] [--mesh ...]`.
+"""`matedit export FILE -o OUT.gltf|OUT.glb|OUT.mtlx|OUT.usda|OUT.usdz [--size N] [--mesh ...]
+[--check ...]`.
 
 glTF 2.0: the preview mesh with tangents and a metallic-roughness material on maps baked
-over UV space (matedit.interop.gltf). MaterialX: a nodegraph reproducing the attribute graph
-feeding one standard_surface (matedit.interop.mtlx_export); subgraphs MaterialX cannot
-express are baked to EXR images beside the document, and reported. USD: the preview mesh
-bound to a Material with a UsdPreviewSurface network on the baked maps and the MaterialX
-export in the mtlx render context (matedit.interop.usd)."""
+on that mesh in UV space (matedit.interop.bake.bake_for_export, matedit.interop.gltf).
+MaterialX: a nodegraph reproducing the attribute graph feeding one standard_surface
+(matedit.interop.mtlx_export); subgraphs MaterialX cannot express are baked to EXR images
+beside the document, and reported. USD: the preview mesh bound to a Material with a
+UsdPreviewSurface network on the baked maps and the MaterialX export in the mtlx render
+context (matedit.interop.usd). `--check` measures the round trip's loss
+(matedit.commands.export_check)."""
 
 from __future__ import annotations
 
@@ -13,6 +16,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli_support import UsageError, report
+from matedit.commands import export_check
 from matedit.commands.bake import compile_error, load_material, parse_size, progress_printer
 from matedit.io.inputs import declare_inputs
 
@@ -34,6 +38,7 @@ def register(sub) -> None:
                    help="glTF and USD only: sphere, cube, plane, cylinder (or builtin:sphere, "
                    "...) or an OBJ file (./sphere for a file of that name) (default: the file's "
                    "preview mesh, else sphere)")
+    export_check.register(p)
     declare_inputs(p, file="document", mesh="mesh")
     p.set_defaults(run=run)
 
@@ -45,11 +50,15 @@ def run(args) -> int:
         raise UsageError(f"{out}: the output must end in .gltf, .glb, .mtlx, .usda or .usdz")
     if not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
+    export_check.validate(args, out)
     if kind == ".mtlx":
         if args.mesh:
             raise UsageError("--mesh applies to glTF and USD exports only")
         return _mtlx(args, out)
     if kind in (".usda", ".usdz"):
+        if args.check:
+            raise UsageError("--check reads back .gltf, .glb and .mtlx exports; USD has no "
+                             "importer yet")
         return _usd(args, out)
     return _gltf(args, out)
 
@@ -59,7 +68,7 @@ def _gltf(args, out: Path) -> int:
 
     from matedit.compiler import CompileError
     from matedit.interop import gltf
-    from matedit.interop.bake import bake_attributes, maps_from
+    from matedit.interop.bake import bake_for_export, is_plane_spec, maps_from
     from matedit.interop.export import stem_of
     from matedit.io.document import FileResolver
     from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
@@ -73,6 +82,7 @@ def _gltf(args, out: Path) -> int:
     mesh_spec = args.mesh or preview_spec(doc, "mesh", "sphere")
     inputs = command_inputs(args, [doc], resolver)
     outputs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
+    outputs += export_check.outputs(args)
     try:
         refuse_overwrite(outputs, inputs)
     except OverwriteError as exc:
@@ -85,7 +95,9 @@ def _gltf(args, out: Path) -> int:
         raise UsageError(f"{mesh_spec}: cannot read mesh: {exc.strerror or exc}") from None
     try:
         with headless() as ctx:
-            attrs, ir = bake_attributes(ctx, doc, resolver, size, progress_printer("baking"))
+            attrs, ir, bake_notes = bake_for_export(
+                ctx, doc, resolver, size, None if is_plane_spec(mesh_spec) else mesh,
+                progress_printer("baking"))
     except CompileError as exc:
         raise compile_error(exc, path) from None
     emax = float(max(1.0, np.max(attrs["emissive"])))
@@ -97,10 +109,11 @@ def _gltf(args, out: Path) -> int:
         gltf.write(files)
     except OSError as exc:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    for note in lobes.notes:
+    for note in [*bake_notes, *lobes.notes]:
         report("note", f"{path}: {note}")
     if sys.stderr.isatty():
         print(f"exported {path} to {', '.join(str(p) for p in files)}", file=sys.stderr)
+    export_check.after_write(args, path, doc, out, str(mesh_spec))
     return 0
 
 
@@ -118,7 +131,7 @@ def _mtlx(args, out: Path) -> int:
     inputs = command_inputs(args, [doc], resolver)
     try:
         result = mtlx_export.export(doc, resolver, out, size)
-        refuse_overwrite(result.files, inputs)
+        refuse_overwrite([*result.files, *export_check.outputs(args)], inputs)
         mtlx_export.write(result)
     except CompileError as exc:
         raise compile_error(exc, path) from None
@@ -133,6 +146,7 @@ def _mtlx(args, out: Path) -> int:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
     for node, why in result.baked:
         report("note", f"{path}: node {node}: baked to an image ({why})")
+    export_check.after_write(args, path, doc, out)
     return 0
 
 
@@ -141,7 +155,7 @@ def _usd(args, out: Path) -> int:
     baked maps and the MaterialX export as a network in the mtlx render context."""
     from matedit.compiler import CompileError
     from matedit.interop import usd
-    from matedit.interop.bake import bake_attributes
+    from matedit.interop.bake import bake_for_export, is_plane_spec
     from matedit.io.document import FileResolver
     from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
     from matedit.render.context import headless
@@ -163,8 +177,10 @@ def _usd(args, out: Path) -> int:
     except OSError as exc:
         raise UsageError(f"{mesh_spec}: cannot read mesh: {exc.strerror or exc}") from None
     try:
-        with headless() as ctx:
-            attrs, ir = bake_attributes(ctx, doc, resolver, size, progress_printer("baking"))
+        with headless() as ctx:  # on the mesh, as the glTF export bakes
+            attrs, ir, bake_notes = bake_for_export(
+                ctx, doc, resolver, size, None if is_plane_spec(mesh_spec) else mesh,
+                progress_printer("baking"))
         result = usd.export_baked(doc, resolver, attrs, ir, mesh, out, size)
         refuse_overwrite(result.files, inputs)
         usd.write(result)
@@ -176,7 +192,7 @@ def _usd(args, out: Path) -> int:
         raise UsageError(str(exc)) from None
     except OSError as exc:
         raise UsageError(f"{exc.filename or out}: cannot write: {exc.strerror or exc}") from None
-    for note in result.notes:
+    for note in [*bake_notes, *result.notes]:
         report("note", f"{path}: {note}")
     if sys.stderr.isatty():
         print(f"exported {path} to {', '.join(str(p) for p in result.files)}", file=sys.stderr)

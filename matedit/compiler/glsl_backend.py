@@ -190,10 +190,11 @@ def _define_line(define: str) -> str:
     return f"{name} {value or 1}"
 
 
-# Preview-only blocks of an entry file, `#ifdef NAME ... #else ... #endif` (no nesting):
+# Preview- and bake-only blocks of an entry file (the viewport's attribute views, the bake on
+# a mesh's view along the normal), `#ifdef NAME ... #else ... #endif` (no nesting):
 # emitted only when the caller defines NAME, so the default program text is the same as if
 # the block were not there (the exported shader and its structure hash do not change).
-PREVIEW_BLOCKS = ("MATEDIT_ATTRIBUTE_VIEW",)
+PREVIEW_BLOCKS = ("MATEDIT_ATTRIBUTE_VIEW", "MATEDIT_BAKE_VIEW_NORMAL")
 
 
 def _strip_preview_blocks(lines: list[str], defines: tuple[str, ...]) -> list[str]:

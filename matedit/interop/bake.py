@@ -19,6 +19,15 @@ renderer reads them):
 emissive and opacity only where the graph writes them (`MaterialIR.attributes`) and they are
 not the default everywhere (no emission, fully opaque): a layer that sets every field does
 not produce an all-black emissive map.
+
+On a mesh (`bake_on_mesh`, the glTF export): the mesh's triangles are drawn in UV space, so
+each texel the mesh covers gets the mesh's own interpolated world position, normal and
+tangent there (the object's space is the world's: the asset has no transform), and looks that
+depend on position, height or slope survive. The view is along the geometric normal at every
+texel (MATEDIT_BAKE_VIEW_NORMAL), the plane bake's straight-on view carried to the mesh. The
+maps are dilated `DILATE` texels past the covered texels so that filtering at UV seams does
+not blend in the background. A mesh whose UVs overlap or leave the unit square has no one
+surface point for some texels; it is baked on the plane (`mesh_bake_problem` says why).
 """
 
 from __future__ import annotations
@@ -36,6 +45,8 @@ CAMERA = (0.5, 0.5, 1000.0)
 MAP_NAMES = ("base_color", "normal", "orm", "emissive", "opacity")
 FORMATS = ("png", "exr")
 TILE = 512
+DILATE = 4  # texels grown past the mesh's UV islands
+VIEW_NORMAL_DEFINE = "MATEDIT_BAKE_VIEW_NORMAL"
 
 
 def surface(size: int, rows: tuple[int, int] | None = None) -> SurfaceArrays:
@@ -102,16 +113,164 @@ void main() {
 """
 
 
+_MESH_VERTEX = """#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec4 a_tangent;
+layout(location = 3) in vec2 a_uv;
+out vec3 v_position;
+out vec3 v_normal;
+out vec4 v_tangent;
+out vec2 v_uv;
+uniform vec4 uvRect;
+void main() {
+    v_position = a_position;
+    v_normal = a_normal;
+    v_tangent = a_tangent;
+    v_uv = a_uv;
+    gl_Position = vec4((a_uv - uvRect.xy) / uvRect.zw * 2.0 - 1.0, 0.0, 1.0);
+}
+"""
+
+_COUNT_FRAGMENT = """#version 330 core
+out vec4 o;
+void main() { o = vec4(1.0); }
+"""
+
+
+def _attrs_of(out: np.ndarray) -> dict[str, np.ndarray]:
+    return {
+        "baseColor": out[0, ..., :3], "metallic": out[0, ..., 3:4],
+        "normal": out[1, ..., :3], "roughness": out[1, ..., 3:4],
+        "emissive": out[2, ..., :3], "cavity": out[2, ..., 3:4],
+        "opacity": out[3, ..., 0:1],
+    }
+
+
 def attributes_gpu(ctx, compiled, size: int, uniforms=None,
                    progress: Callable[[float], None] | None = None) -> dict[str, np.ndarray]:
     """Draw the ATTRIBUTES-mode shader of `compiled` (glsl330, mode="attributes") over the
     bake surface in tiles; returns each attribute as (size, size, k) float32."""
+    return _attrs_of(_draw(ctx, compiled, size, uniforms, progress, None))
+
+
+def mesh_bake_problem(mesh) -> str | None:
+    """Why `mesh` cannot be baked on (its UVs leave the unit square or cover nothing), or
+    None. Overlaps are found by `uv_overlap` on the GPU."""
+    uv = np.asarray(mesh.uvs, np.float64)
+    idx = np.asarray(mesh.indices).reshape(-1, 3)
+    if len(idx) == 0:
+        return "the mesh has no triangles"
+    if uv.min() < -1e-6 or uv.max() > 1.0 + 1e-6:
+        return "its UVs leave the unit square (the maps would repeat over it)"
+    a, b, c = uv[idx[:, 0]], uv[idx[:, 1]], uv[idx[:, 2]]
+    area = 0.5 * np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1])
+                        - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+    if area.sum() < 1e-6:
+        return "it has no UV layout (every triangle has zero area in UV space)"
+    return None
+
+
+def uv_overlap(ctx, mesh, size: int = 256) -> float:
+    """The fraction of the texels a mesh covers in UV space (at size x size) that more than
+    one triangle covers: additive counts into a float target."""
+    prog = ctx.program(vertex_shader=_MESH_VERTEX, fragment_shader=_COUNT_FRAGMENT)
+    target = ctx.texture((size, size), 1, dtype="f4")
+    fbo = ctx.framebuffer(color_attachments=[target])
+    res = _mesh_buffers(ctx, mesh, prog)
+    vao = ctx.vertex_array(prog, res[:1], index_buffer=res[1])
+    previous = ctx.fbo
+    try:
+        fbo.use()
+        fbo.viewport = (0, 0, size, size)
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        if "uvRect" in prog:
+            prog["uvRect"].value = (0.0, 0.0, 1.0, 1.0)
+        ctx.enable(ctx.BLEND)
+        ctx.blend_func = ctx.ONE, ctx.ONE
+        vao.render()
+        ctx.disable(ctx.BLEND)
+        count = np.frombuffer(fbo.read(components=1, dtype="f4"), np.float32)
+        (previous or ctx.detect_framebuffer(0)).use()
+    finally:
+        for r in (vao, fbo, target, res[0][0], res[1], prog):
+            r.release()
+    covered = np.count_nonzero(count > 0.5)
+    return float(np.count_nonzero(count > 1.5) / covered) if covered else 0.0
+
+
+def _mesh_buffers(ctx, mesh, prog) -> list:
+    """[(vertex buffer, format, names...) of the attributes `prog` reads, index buffer]."""
+    data = np.hstack([np.asarray(mesh.positions, "f4"), np.asarray(mesh.normals, "f4"),
+                      np.asarray(mesh.tangents, "f4"), np.asarray(mesh.uvs, "f4")])
+    vbo = ctx.buffer(np.ascontiguousarray(data, "f4").tobytes())
+    ibo = ctx.buffer(np.ascontiguousarray(np.asarray(mesh.indices).reshape(-1), "u4").tobytes())
+    fmt, names = [], []
+    for name, n in (("a_position", 3), ("a_normal", 3), ("a_tangent", 4), ("a_uv", 2)):
+        if name in prog:  # the compiler drops the inputs a program does not read
+            fmt.append(f"{n}f")
+            names.append(name)
+        else:
+            fmt.append(f"{4 * n}x")
+    return [(vbo, " ".join(fmt), *names), ibo]
+
+
+def attributes_on_mesh(ctx, compiled, size: int, mesh, uniforms=None,
+                       progress: Callable[[float], None] | None = None,
+                       dilate: int = DILATE) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The ATTRIBUTES-mode shader of `compiled` drawn over `mesh`'s triangles laid out in UV
+    space, viewed along the normal (see the module notes); returns (attributes (size, size, k)
+    float32, dilated `dilate` texels past the mesh, the (size, size) bool mask of the texels
+    the mesh covers)."""
+    compiled = compiled.variant("attributes", (VIEW_NORMAL_DEFINE,))
+    out = _draw(ctx, compiled, size, uniforms, progress, mesh)
+    covered = out[3, ..., 3] > 0.5
+    out[3, ..., 3] = 1.0  # the last target's alpha was the coverage
+    grown = dilate_into(out, covered, dilate)
+    return _attrs_of(grown), covered
+
+
+def dilate_into(out: np.ndarray, covered: np.ndarray, steps: int) -> np.ndarray:
+    """`out` (..., H, W, C) with the texels outside `covered` filled, ring by ring for `steps`
+    rings, by the mean of their already-filled 8 neighbours (no wrap); texels further away
+    keep the mean of all covered texels, so nothing reads the cleared background."""
+    out = out.copy()
+    if not covered.any():
+        return out
+    filled = covered.copy()
+    mean = out[..., covered, :].mean(axis=-2)
+    for _ in range(steps):
+        acc = np.zeros_like(out)
+        cnt = np.zeros(filled.shape, np.float32)
+        pad_v = np.pad(out * filled[..., None], [(0, 0)] * (out.ndim - 3) + [(1, 1), (1, 1),
+                                                                               (0, 0)])
+        pad_f = np.pad(filled.astype(np.float32), 1)
+        h, w = filled.shape
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                if dy == 0 and dx == 0:
+                    continue
+                acc += pad_v[..., 1 + dy:1 + dy + h, 1 + dx:1 + dx + w, :]
+                cnt += pad_f[1 + dy:1 + dy + h, 1 + dx:1 + dx + w]
+        ring = ~filled & (cnt > 0)
+        if not ring.any():
+            break
+        out[..., ring, :] = acc[..., ring, :] / cnt[ring][:, None]
+        filled |= ring
+    out[..., ~filled, :] = mean[..., None, :]
+    return out
+
+
+def _draw(ctx, compiled, size: int, uniforms, progress, mesh) -> np.ndarray:
+    """(4, size, size, 4) float32: the four attribute targets over the plane (mesh None) or
+    over `mesh` in UV space (alpha of the last target 1 where a triangle covers the texel)."""
     import moderngl
 
     from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING
 
     out = np.zeros((4, size, size, 4), np.float32)
-    prog = ctx.program(vertex_shader=_VERTEX, fragment_shader=compiled.fragment_text)
+    prog = ctx.program(vertex_shader=_VERTEX if mesh is None else _MESH_VERTEX,
+                       fragment_shader=compiled.fragment_text)
     res = []
     try:
         frame = np.zeros(56, dtype=np.float32)  # 3 mat4 + 2 vec4
@@ -138,9 +297,14 @@ def attributes_gpu(ctx, compiled, size: int, uniforms=None,
         tile = min(size, TILE)
         targets = [ctx.texture((tile, tile), 4, dtype="f4") for _ in range(4)]
         fbo = ctx.framebuffer(color_attachments=targets)
-        quad = ctx.buffer(struct.pack("8f", -1, -1, 1, -1, -1, 1, 1, 1))
-        vao = ctx.vertex_array(prog, [(quad, "2f", "a_pos")])
-        res += [vao, fbo, quad, *targets]
+        if mesh is None:
+            quad = ctx.buffer(struct.pack("8f", -1, -1, 1, -1, -1, 1, 1, 1))
+            vao = ctx.vertex_array(prog, [(quad, "2f", "a_pos")])
+            res += [vao, fbo, quad, *targets]
+        else:
+            bufs = _mesh_buffers(ctx, mesh, prog)
+            vao = ctx.vertex_array(prog, bufs[:1], index_buffer=bufs[1])
+            res += [vao, fbo, bufs[0][0], bufs[1], *targets]
         previous = ctx.fbo
         fbo.use()
         tiles = [(x, y) for y in range(0, size, tile) for x in range(0, size, tile)]
@@ -149,7 +313,11 @@ def attributes_gpu(ctx, compiled, size: int, uniforms=None,
             fbo.viewport = (0, 0, w, h)
             if "uvRect" in prog:
                 prog["uvRect"].value = (x / size, y / size, w / size, h / size)
-            vao.render(mode=ctx.TRIANGLE_STRIP)
+            if mesh is None:
+                vao.render(mode=ctx.TRIANGLE_STRIP)
+            else:
+                fbo.clear(0.0, 0.0, 0.0, 0.0)
+                vao.render()
             for i in range(4):
                 data = fbo.read(viewport=(0, 0, w, h), components=4, attachment=i, dtype="f4")
                 out[i, y:y + h, x:x + w] = np.frombuffer(data, np.float32).reshape(h, w, 4)
@@ -160,12 +328,7 @@ def attributes_gpu(ctx, compiled, size: int, uniforms=None,
         for r in reversed(res):
             r.release()
         prog.release()
-    return {
-        "baseColor": out[0, ..., :3], "metallic": out[0, ..., 3:4],
-        "normal": out[1, ..., :3], "roughness": out[1, ..., 3:4],
-        "emissive": out[2, ..., :3], "cavity": out[2, ..., 3:4],
-        "opacity": out[3, ..., 0:1],
-    }
+    return out
 
 
 def linear_to_srgb(x: np.ndarray) -> np.ndarray:
@@ -255,3 +418,67 @@ def bake_attributes(ctx, doc, resolver, size: int,
     ir = lower_and_optimise(doc, resolver)
     compiled = compile_document(doc, resolver, "glsl330", mode="attributes", ir=ir)
     return attributes_gpu(ctx, compiled, size, progress=progress), ir
+
+
+OVERLAP_LIMIT = 0.005  # the share of covered texels two triangles may both claim
+
+
+def is_plane_spec(spec) -> bool:
+    """The built-in plane: the glTF export bakes it on the UV plane, as `matedit bake` does."""
+    return str(spec) in ("plane", "builtin:plane")
+
+
+def view_dependent_nodes(ir) -> list[str]:
+    """The ids of the nodes left in the optimised IR (what reaches the output) whose code
+    reads the view direction (their library file reads g_surface.view), in IR order."""
+    from matedit.compiler import ops
+    from matedit.graph import nodes
+    from matedit.resources import shaders_dir
+
+    found: list[str] = []
+    for scope in [*ir.functions, ir.main]:
+        for op in scope.ops:
+            units = list(ops.implementation(op.kind).units)
+            d = nodes.REGISTRY.get(op.kind)
+            if d is not None and d.glsl:
+                units.append(f"nodes/{op.kind}")  # a catalogue node's own library file
+            for unit in units:
+                if unit == "nodes/context":
+                    continue
+                f = shaders_dir() / f"{unit}.glsl"
+                if f.is_file() and "g_surface.view" in f.read_text() and op.node not in found:
+                    found.append(op.node)
+    return found
+
+
+def bake_for_export(ctx, doc, resolver, size: int, mesh=None,
+                    progress: Callable[[float], None] | None = None):
+    """(attributes, optimised IR, notes): baked on `mesh` (`attributes_on_mesh`) where it
+    can be, else (mesh None, or UVs that overlap or leave the unit square) on the plane;
+    `notes` says which where it matters, and how view-dependent nodes were baked."""
+    from matedit.compiler.api import compile_document, lower_and_optimise
+
+    ir = lower_and_optimise(doc, resolver)
+    compiled = compile_document(doc, resolver, "glsl330", mode="attributes", ir=ir)
+    notes: list[str] = []
+    why = None
+    if mesh is not None:
+        why = mesh_bake_problem(mesh)
+        if why is None:
+            share = uv_overlap(ctx, mesh)
+            if share > OVERLAP_LIMIT:
+                why = f"its UVs overlap ({share:.0%} of the texels it covers)"
+    view = view_dependent_nodes(ir)
+    if mesh is None or why is not None:
+        if why is not None:
+            notes.append(f"baked over UV space on a plane, not on the mesh: {why}; looks "
+                         "that depend on position or slope are those of the plane")
+        if view:
+            notes.append(f"node {', '.join(view)}: depends on the view; baked for a view "
+                         "straight down on the plane")
+        return attributes_gpu(ctx, compiled, size, progress=progress), ir, notes
+    attrs, _ = attributes_on_mesh(ctx, compiled, size, mesh, progress=progress)
+    if view:
+        notes.append(f"node {', '.join(view)}: depends on the view; baked for a view along "
+                     "the normal at every point")
+    return attrs, ir, notes
