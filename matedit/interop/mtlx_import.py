@@ -91,6 +91,8 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         "coatNormal": ("geometry_coat_normal", None), "sheenColor": ("fuzz_color", "fuzz_weight"),
         "sheenRoughness": ("fuzz_roughness", None),
         "anisotropy": ("specular_roughness_anisotropy", None),
+        # the tangent rotated about the normal by a constant angle (our export's)
+        "anisotropyDirection": ("geometry_tangent", None),
         # the mean free path subsurface_radius x subsurface_radius_scale, at our thickness 1
         "subsurface": ("subsurface_weight", None), "subsurfaceColor": ("subsurface_color", None),
         "subsurfaceRadius": ("subsurface_radius_scale", "subsurface_radius"),
@@ -978,6 +980,13 @@ class _Importer:
             if attr == "coatNormal":
                 self.normal(shader, inp, cat in WORLD_NORMAL, make, "coatNormal")
                 continue
+            if inp == "geometry_tangent":
+                angle = self.tangent_rotation(shader, inp)
+                if angle is not None:  # else not read: the rule warns it dropped
+                    self.mapped.add(inp)
+                    self.connect(Src(value=[math.cos(angle), math.sin(angle), 0.0], width=3),
+                                 make, attr)
+                continue
             src = self.surface_input(shader, inp)
             if src is None:
                 continue
@@ -1020,6 +1029,37 @@ class _Importer:
                     self.connect(src, mul, "a")
                     src = Src(mul, "result", width=src.width)
             self.connect(src, make, attr)
+
+    def tangent_rotation(self, shader, name: str) -> float | None:
+        """OpenPBR's geometry_tangent as our export writes it, the world tangent rotated
+        about the world normal by a constant angle (a rotate3d node): that angle in
+        radians, our anisotropy direction's; None for any other tangent."""
+        inp = shader.getInput(name)
+        up = None
+        if inp is not None and inp.getNodeGraphString():
+            ng = self.mxdoc.getNodeGraph(inp.getNodeGraphString())
+            o = ng.getOutput(inp.getOutputString()) if ng is not None else None
+            up = ng.getNode(o.getNodeName()) if o is not None and o.getNodeName() else None
+        if up is None or up.getCategory() != "rotate3d":
+            return None
+
+        def source(port: str) -> str:
+            i = up.getInput(port)
+            n = i.getConnectedNode() if i is not None else None
+            if n is None or n.getInputValue("space") not in (None, "world"):
+                return ""
+            return n.getCategory()
+
+        amount = up.getInput("amount")
+        if source("in") != "tangent" or source("axis") != "normal" or amount is None \
+                or connected(amount):
+            return None
+        try:
+            deg = _floats(amount.getValueString(), f"node {self.name_of(up)}: input amount")
+        except ValueError as exc:
+            self.err(str(exc))
+            return None
+        return math.radians(deg[0])
 
     def normal(self, shader, name: str, world: bool, make: str, port: str = "normal") -> None:
         inp = shader.getInput(name)
