@@ -260,3 +260,36 @@ def test_fine_detail_is_noted_with_a_larger_size(tmp_path):
     r = cli("export", src, "-o", tmp_path / "smooth.mtlx", "--size", "8")
     assert r.returncode == 0, r.stderr
     assert "baked map(s) at 8 x 8" in r.stderr and "detail finer" not in r.stderr
+
+
+def test_side_files_never_follow_a_planted_link_nor_overwrite_an_input(tmp_path):
+    """A link planted at OUT_textures (to a folder) is replaced by a real folder, nothing is
+    written through it; a side file that would land on a texture the material reads is
+    refused by name, and nothing is written."""
+    src = _textured(tmp_path / "in")
+    out = tmp_path / "o" / "look.mtlx"
+    out.parent.mkdir()
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (out.parent / "look_textures").symlink_to(victim)
+    r = cli("export", src, "-o", out, "--size", "8")
+    assert r.returncode == 0, r.stderr
+    assert list(victim.iterdir()) == []
+    side = out.parent / "look_textures"
+    assert side.is_dir() and not side.is_symlink() and (side / "albedo.png").is_file()
+    # exporting next to its own textures: the copy would be the texture itself
+    inside = tmp_path / "in" / "textured.mtlx"
+    shutil.rmtree(side)
+    (tmp_path / "in" / "textured_textures").mkdir()
+    shutil.move(str(tmp_path / "in" / "albedo.png"), tmp_path / "in" / "textured_textures")
+    d = json.loads(src.read_text())
+    for n in d["nodes"]:
+        if n.get("settings", {}).get("path") == "albedo.png":
+            n["settings"]["path"] = "textured_textures/albedo.png"
+    src.write_text(json.dumps(d))
+    before = (tmp_path / "in" / "textured_textures" / "albedo.png").read_bytes()
+    r = cli("export", src, "-o", inside, "--size", "8")
+    assert r.returncode == 2 and "refusing to write over" in r.stderr, r.stderr
+    assert r.stderr.count("\n") == 1
+    assert (tmp_path / "in" / "textured_textures" / "albedo.png").read_bytes() == before
+    assert not inside.exists()

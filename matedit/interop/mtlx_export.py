@@ -77,6 +77,12 @@ DETAIL_RMS = 1.0 / 255.0
 _MIN_THICKNESS = 1e-4
 
 
+def safe_name(name: str) -> str:
+    """A file or element name as text MaterialX can hold: bytes of a file name that are not
+    UTF-8 (Python's surrogate escapes) become '_'."""
+    return "".join("_" if 0xDC80 <= ord(c) <= 0xDCFF else c for c in name)
+
+
 class MtlxExportError(ValueError):
     """The material cannot be written as MaterialX (the message names the node)."""
 
@@ -150,7 +156,7 @@ class _Exporter:
         self.ir = ir
         self.size = size
         self.folder = folder
-        self.stem = stem
+        self.stem = stem = safe_name(stem)
         self.kind = kind
         self.fmt = fmt
         self.side = side  # the side-file folder, relative to the document's
@@ -394,13 +400,13 @@ class _Exporter:
         if not self.side or not src.is_file():
             if self.side:
                 self.note(f"texture {src.name}: no such file; referenced, not copied")
-            return Path(os.path.relpath(path, self.folder)).as_posix()
+            return safe_name(Path(os.path.relpath(path, self.folder)).as_posix())
         taken = {d.name.lower() for d in self.copies} | {
             p.name.lower() for p in self.images}
-        name, k = src.name, 1
+        name, k = safe_name(src.name), 1
         while name.lower() in taken:
             k += 1
-            name = f"{src.stem}_{k}{src.suffix}"
+            name = safe_name(f"{src.stem}_{k}{src.suffix}")
         dest = self.folder / self.side / name
         self.copies[dest] = src
         return dest.relative_to(self.folder).as_posix()
@@ -1015,7 +1021,7 @@ def validate(text: str) -> tuple[bool, str]:
 def side_folder(out: Path) -> str:
     """The folder of an export's side files (baked maps, texture copies), beside OUT.mtlx:
     OUT_textures."""
-    return f"{Path(out).stem}_textures"
+    return safe_name(f"{Path(out).stem}_textures")
 
 
 def export_ir(ir: MaterialIR, out: Path, size: int, stem: str, kind: str = DEFAULT_SURFACE,
@@ -1111,7 +1117,7 @@ def write(result: MtlxExport) -> None:
         buf = io.BytesIO()
         with tempfile.TemporaryDirectory() as tmp, \
                 zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
-            z.writestr(out.name, result.text)
+            z.writestr(safe_name(out.name), result.text)
             for path, img in result.images.items():
                 staged = Path(tmp) / path.name
                 _encode(staged, img)
@@ -1125,10 +1131,13 @@ def write(result: MtlxExport) -> None:
     if not side:
         atomic_write_text(out, result.text)
         return
+    side_dir = side[0].parent
     with staged_outputs(folder) as stage:
-        with staged_outputs(side[0].parent) as files:
+        stage.write_text(out, result.text)  # written first, moved into place last
+        if side_dir.is_symlink():  # a link planted at the folder's name is replaced
+            side_dir.unlink()
+        with staged_outputs(side_dir) as files:
             for path, img in result.images.items():
                 _encode(files.path(path), img)
             for dest, src in result.copies.items():
                 files.write_bytes(dest, read_bounded(src, MAX_TEXTURE_BYTES))
-        stage.write_text(out, result.text)
