@@ -1,14 +1,13 @@
 """A material as a MaterialX 1.39 document: one nodegraph reproducing the attribute graph,
-feeding one `standard_surface` through a `surfacematerial`.
-
-Why standard_surface: it is the surface every MaterialX 1.39 code generator and renderer
-(GLSL, OSL, MDL, MSL; USD Hydra, Arnold, the MaterialX viewer) implements, and our model,
-Karis' metallic-roughness one, maps onto its inputs without approximation: base_color and
-metalness; specular_roughness (both square it into the GGX alpha); its default specular IOR
-1.5 is our 0.04 dielectric F0. Our cavity "multiplies all lighting": it becomes `base` (which
-scales the diffuse and, through base_color, the metal's reflectance) and `specular` (which
-scales the dielectric reflection). open_pbr_surface would do as well, but is newer and less
-widely implemented; the importer reads both.
+feeding one surface shader through a `surfacematerial`: `open_pbr_surface` by default
+(MaterialX 1.39's own), `standard_surface` or `gltf_pbr` (SURFACE_KINDS). Each attribute
+field goes to the surface's input of the same meaning (docs/materialx.md, Export, has the
+table): base_color and the metalness; specular_roughness (all three square it into the GGX
+alpha); IORs as ours. Our cavity "multiplies all lighting": it becomes the base and specular
+weights of OpenPBR and standard_surface (which scale the diffuse and, through base_color,
+the metal's reflectance, and the dielectric reflection) and gltf_pbr's occlusion. A field a
+surface carries only approximately or not at all is a line in `notes` (the command prints
+them as `note:` lines).
 
 The graph comes from the lowered IR (matedit.compiler.lower), before optimisation, so the
 nodes are ours, one for one where the catalogue has a mapping (NodeDef.mtlx, read through
@@ -16,16 +15,19 @@ matedit.interop.mtlx_map): material function calls are inlined (their nodes name
 CALL_NODE), layer stacks are their blends, parameters are the nodegraph's interface inputs,
 other unconnected inputs are values. What cannot be
 expressed (`BAKE` in the map) is evaluated by the CPU evaluator over UV space (the bake plane
-of matedit.interop.bake) into a float EXR beside the document, read by an `image` node on
+of matedit.interop.bake) into a map in OUT_textures/, read by an `image` node on
 texture coordinate 0, and reported; a baked node that reads the position, normal, view or
 time is exact on the bake plane only, and the report says so.
 
-Textures are referenced relative to the document's folder, each image's file with the
-texture's colour space (matedit.interop.mtlx_colorspace: `srgb_texture` for sRGB, `lin_rec709`
-for linear, the MaterialX name of an OpenColorIO space); the document's colour space is
-`lin_rec709`, so MaterialX decodes a texture as matedit does (an image not in lin_rec709 is
-read as color4, the type MaterialX converts, then made a vector4). Baked images are float EXR
-in lin_rec709.
+The export is self-contained: baked maps and copies of the textures the material reads go
+into OUT_textures/ beside OUT.mtlx (`side_folder`), named in the document by relative
+paths; `write` puts them in place with the document, or packs them all into OUT.zip. Each
+image's file carries its colour space (matedit.interop.mtlx_colorspace: `srgb_texture` for
+sRGB, `lin_rec709` for linear, the MaterialX name of an OpenColorIO space); the document's
+colour space is `lin_rec709`, so MaterialX decodes a texture as matedit does (an image not
+in lin_rec709 is read as a colour type, which MaterialX converts, then made a vector).
+Baked maps are 8-bit PNGs (a colour map sRGB-encoded, `srgb_texture`; a data map linear) or
+float EXRs in lin_rec709; `detail_notes` says which lose detail at the bake size.
 """
 
 from __future__ import annotations
