@@ -884,8 +884,9 @@ class _Exporter:
 
     def rotated_tangent(self, f: dict) -> tuple:
         """OpenPBR's geometry_tangent for a constant tangent-space direction: the world
-        tangent rotated about the world normal by its angle (degrees, rotate3d's unit)."""
-        deg = math.degrees(self.direction_angle(f))
+        tangent rotated about the world normal by its angle (degrees, rotate3d's unit;
+        MaterialX's rotate3d turns clockwise about its axis, so the amount is negated)."""
+        deg = -math.degrees(self.direction_angle(f))
         t = self.node("tangent", "vector3", "tangent", strings=[("space", "world")])
         n = self.node("normal", "vector3", "normal_axis", strings=[("space", "world")])
         return self.node("rotate3d", "vector3", "anisotropy_tangent",

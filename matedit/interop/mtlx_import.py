@@ -1032,8 +1032,9 @@ class _Importer:
 
     def tangent_rotation(self, shader, name: str) -> float | None:
         """OpenPBR's geometry_tangent as our export writes it, the world tangent rotated
-        about the world normal by a constant angle (a rotate3d node): that angle in
-        radians, our anisotropy direction's; None for any other tangent."""
+        about the world normal by a constant angle (a rotate3d node, which turns clockwise
+        about its axis): our anisotropy direction's angle, anticlockwise from the tangent, in
+        radians; None for any other tangent."""
         inp = shader.getInput(name)
         up = None
         if inp is not None and inp.getNodeGraphString():
@@ -1059,7 +1060,7 @@ class _Importer:
         except ValueError as exc:
             self.err(str(exc))
             return None
-        return math.radians(deg[0])
+        return -math.radians(deg[0])  # rotate3d turns clockwise about its axis
 
     def normal(self, shader, name: str, world: bool, make: str, port: str = "normal") -> None:
         inp = shader.getInput(name)
