@@ -101,6 +101,30 @@ def test_exported_mtlx_validates(exported, path):
         assert f"baked map(s) at {SIZE} x {SIZE} texels" in notes[path.stem]
 
 
+@pytest.mark.parametrize("surface", ["open_pbr_surface", "gltf_pbr"])
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_exported_material_generates_with_materialx_glsl(request, path, surface):
+    """The whole material (the surface shader on its nodegraph) goes through MaterialX's own
+    GLSL generator, and the gltf_pbr export validates too."""
+    _exportable(path)
+    from MaterialX import PyMaterialXGenGlsl as mx_glsl
+    from MaterialX import PyMaterialXGenShader as mx_gen
+
+    folder, _ = request.getfixturevalue(
+        "exported" if surface == "open_pbr_surface" else "exported_gltf")
+    doc = load_with_stdlib(folder / f"{path.stem}.mtlx")
+    ok, msg = doc.validate()
+    assert ok, msg
+    assert [n.getCategory() for n in doc.getNodes() if n.getType() == "surfaceshader"] == [
+        surface]
+    gen = mx_glsl.GlslShaderGenerator.create()
+    context = mx_gen.GenContext(gen)
+    context.registerSourceCodeSearchPath(mx.getDefaultDataSearchPath())
+    (mat,) = doc.getMaterialNodes()
+    shader = gen.generate(mat.getName(), mat, context)
+    assert "void main" in shader.getSourceCode(mx_gen.PIXEL_STAGE)
+
+
 # standard_surface input -> our attribute
 SURFACE_INPUTS = {
     "base_color": "baseColor", "base": "cavity", "specular": "cavity",
