@@ -883,12 +883,28 @@ class _Exporter:
                                                      ("in2", ("value", k), "float")])
 
     def rotated_tangent(self, f: dict) -> tuple:
-        """OpenPBR's geometry_tangent for a constant tangent-space direction: the world
-        tangent rotated about the world normal by its angle (degrees, rotate3d's unit;
-        MaterialX's rotate3d turns clockwise about its axis, so the amount is negated)."""
-        deg = -math.degrees(self.direction_angle(f))
+        """OpenPBR's geometry_tangent for the tangent-space anisotropy direction: for a
+        constant, the world tangent rotated about the world normal by its angle (degrees,
+        rotate3d's unit; MaterialX's rotate3d turns clockwise about its axis, so the amount
+        is negated); for a varying one, the direction in world space, normalize(T x +
+        B y + N z) of the world tangent, bitangent and normal."""
         t = self.node("tangent", "vector3", "tangent", strings=[("space", "world")])
         n = self.node("normal", "vector3", "normal_axis", strings=[("space", "world")])
+        d = f["anisotropyDirection"]
+        if d.ref()[0] != "value":
+            b = self.node("bitangent", "vector3", "bitangent", strings=[("space", "world")])
+            terms = [self.node("multiply", "vector3", f"aniso_{axis}",
+                               [("in1", g, "vector3"),
+                                ("in2", self._extract(d.ref(), PortType.VEC3, i, "aniso"),
+                                 "float")])
+                     for i, (axis, g) in enumerate(zip("tbn", (t, b, n)))]
+            tb = self.node("add", "vector3", "aniso_tb", [("in1", terms[0], "vector3"),
+                                                          ("in2", terms[1], "vector3")])
+            s = self.node("add", "vector3", "aniso_tbn", [("in1", tb, "vector3"),
+                                                          ("in2", terms[2], "vector3")])
+            return self.node("normalize", "vector3", "anisotropy_tangent",
+                             [("in", s, "vector3")])
+        deg = -math.degrees(self.direction_angle(f))
         return self.node("rotate3d", "vector3", "anisotropy_tangent",
                          [("in", t, "vector3"), ("amount", ("value", deg), "float"),
                           ("axis", n, "vector3")])

@@ -981,11 +981,10 @@ class _Importer:
                 self.normal(shader, inp, cat in WORLD_NORMAL, make, "coatNormal")
                 continue
             if inp == "geometry_tangent":
-                angle = self.tangent_rotation(shader, inp)
-                if angle is not None:  # else not read: the rule warns it dropped
+                d = self.tangent_direction(shader, inp)
+                if d is not None:  # else not read: the rule warns it dropped
                     self.mapped.add(inp)
-                    self.connect(Src(value=[math.cos(angle), math.sin(angle), 0.0], width=3),
-                                 make, attr)
+                    self.connect(d, make, attr)
                 continue
             src = self.surface_input(shader, inp)
             if src is None:
@@ -1029,6 +1028,44 @@ class _Importer:
                     self.connect(src, mul, "a")
                     src = Src(mul, "result", width=src.width)
             self.connect(src, make, attr)
+
+    def tangent_direction(self, shader, name: str) -> Src | None:
+        """OpenPBR's geometry_tangent as our export writes it (`tangent_rotation` for a
+        constant direction; normalize(T x + B y + N z) of the world tangent, bitangent and
+        normal for a varying one, whose x, y, z extract one source: that source, our
+        tangent-space direction); None for any other tangent."""
+        angle = self.tangent_rotation(shader, name)
+        if angle is not None:
+            return Src(value=[math.cos(angle), math.sin(angle), 0.0], width=3)
+        inp = shader.getInput(name)
+        ng = self.mxdoc.getNodeGraph(inp.getNodeGraphString()) if inp is not None and \
+            inp.getNodeGraphString() else None
+        o = ng.getOutput(inp.getOutputString()) if ng is not None else None
+        up = ng.getNode(o.getNodeName()) if o is not None and o.getNodeName() else None
+
+        def node(n, port):
+            i = n.getInput(port) if n is not None else None
+            return i.getConnectedNode() if i is not None else None
+
+        if up is None or up.getCategory() != "normalize":
+            return None
+        tbn = node(up, "in")
+        tb = node(tbn, "in1")
+        terms = [node(tb, "in1"), node(tb, "in2"), node(tbn, "in2")]
+        if tbn is None or tb is None or tbn.getCategory() != "add" or tb.getCategory() != "add":
+            return None
+        sources = []
+        for i, (term, geo) in enumerate(zip(terms, ("tangent", "bitangent", "normal"))):
+            g, ex = node(term, "in1"), node(term, "in2")
+            if term is None or term.getCategory() != "multiply" or g is None or \
+                    g.getCategory() != geo or g.getInputValue("space") not in (None, "world") \
+                    or ex is None or ex.getCategory() != "extract" or \
+                    self.index(ex, f"node {self.name_of(ex)}") != i:
+                return None
+            sources.append(node(ex, "in"))
+        if sources[0] is None or any(s != sources[0] for s in sources):
+            return None
+        return self.input_src(terms[0].getInput("in2").getConnectedNode(), "in", 1)
 
     def tangent_rotation(self, shader, name: str) -> float | None:
         """OpenPBR's geometry_tangent as our export writes it, the world tangent rotated

@@ -167,9 +167,10 @@ _EXPORT_TEXT = [
     " | `sheen_color`, `sheen_roughness` |",
     "| anisotropy | `specular_roughness_anisotropy` | `specular_anisotropy` |"
     " `anisotropy_strength` |",
-    "| anisotropyDirection (a constant) | `geometry_tangent`: the world tangent turned"
-    " about the normal by its angle (`rotate3d`) | `specular_rotation` (turns) |"
-    " `anisotropy_rotation` (radians) |",
+    "| anisotropyDirection | `geometry_tangent`: a constant as the world tangent turned"
+    " about the normal by its angle (`rotate3d`), a varying one as normalize(T x + B y +"
+    " N z) | `specular_rotation` (turns; a constant) | `anisotropy_rotation` (radians; a"
+    " constant) |",
     "| subsurface, subsurfaceColor | `subsurface_weight`, `subsurface_color` |"
     " `subsurface`, `subsurface_color` | none: noted, dropped |",
     "| subsurfaceRadius, thickness | `subsurface_radius_scale` = radius,"
@@ -187,7 +188,8 @@ _EXPORT_TEXT = [
     " `attenuation_color`, `attenuation_distance` |",
     "| thin_walled (the output's) | `geometry_thin_walled` | `thin_walled` | `thickness` 0 |",
     "",
-    "A varying anisotropy direction is refused by name on all three. Baked maps and copies",
+    "A varying anisotropy direction is refused by name on standard_surface and gltf_pbr",
+    "(their rotation inputs take a constant here). Baked maps and copies",
     "of the textures the material reads go into `OUT_textures/` beside the document,",
     "named by relative paths (docs/cli.md, export).",
     "",
@@ -249,8 +251,9 @@ _TRANSMISSION_TEXT = [
     "  `subsurface_radius` × `subsurface_radius_scale`, `thin_film_thickness` (µm) ×",
     "  `thin_film_weight` (0 or 1), `thin_film_ior`, and `geometry_tangent` where it is",
     "  our export's: the world tangent turned about the world normal by a constant",
-    "  `rotate3d`, whose amount turns clockwise, read as the anisotropy direction; any other",
-    "  tangent warns, dropped).",
+    "  `rotate3d`, whose amount turns clockwise, or normalize(T x + B y + N z) of the world",
+    "  tangent, bitangent and normal, read as the anisotropy direction; any other tangent",
+    "  warns, dropped).",
     "- **gltf_pbr**: `base_color`, `metallic`, `roughness`, `normal`, `emissive` ×",
     "  `emissive_strength`, `alpha` under `alpha_mode` 2 (BLEND), `ior`, `specular_color`,",
     "  `transmission`, `thickness` (0: thin-walled where it transmits),",
