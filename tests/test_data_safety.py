@@ -8,6 +8,7 @@ import json
 import os
 import shutil
 import stat
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -510,6 +511,8 @@ COMMAND_CASES = {
                              lambda p, o, kind: ["export", p["document"], "-o", o / "m.glb",
                                                  "--size", "8", "--check", "--check-size",
                                                  "16", "--check-image", o / "chk.png"]),
+    "export .mtlx --zip": (("document", "texture", "function"), lambda kind: "m.zip",
+                           lambda p, o, kind: _export("mtlx")(p, o, kind) + ["--zip"]),
     "import": (("mtlx", "mtlx_image"), lambda kind: "mat.json",
                lambda p, o, kind: ["import", p["mtlx"], "-o", o]),
     "import .json": (("mtlx", "mtlx_image"), lambda kind: "mat.json",
@@ -849,6 +852,8 @@ OUTPUT_CASES = {
                                                 "--size", "8")),
     "export-usdz": (False, lambda s, d, mp: cli("export", s / "m.json", "-o", d / "u.usdz",
                                                 "--size", "8")),
+    "export-mtlx-zip": (False, lambda s, d, mp: cli("export", s / "m.json", "-o",
+                                                    d / "x.mtlx", "--size", "8", "--zip")),
     "import-dir": (True, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d,
                                               *_replacing("import"))),
     "import-json": (False, lambda s, d, mp: cli("import", s / "two.mtlx", "-o", d / "one.json",
@@ -859,6 +864,7 @@ OUTPUT_CASES = {
 }
 MULTI_FILE_CASES = ["compile", "bake", "bake-ibl", "export-gltf", "export-mtlx", "export-usda",
                     "import-dir"]
+# export-mtlx writes OUT.mtlx and OUT_textures/ (its baked maps); --zip one OUT.zip
 GL_CASES = {"render", "bake", "bake-ibl", "brdf-lut", "export-gltf", "export-glb",
             "export-usda", "export-usdz",
             "contact-sheet", "ibl-cache"}
@@ -883,7 +889,7 @@ def _output_names(case, src, root, monkeypatch) -> list[str]:
         dest = root / "learn" / ("ibl" if case == "ibl-cache" else "out")
         rc, _, err = _run_case(case, src, dest, monkeypatch)
         assert rc == 0, err
-        _LEARNED[case] = sorted(p.name for p in dest.iterdir())
+        _LEARNED[case] = _files(dest)
         assert _LEARNED[case] and _leftovers(dest) == []
     return _LEARNED[case]
 
@@ -923,6 +929,7 @@ def test_outputs_replace_a_link_planted_at_their_name(tmp_path, monkeypatch, _so
     decoys = {}
     for i, name in enumerate(names):
         decoys[name] = _decoy(tmp_path / "decoys", kind, i)
+        (dest / name).parent.mkdir(parents=True, exist_ok=True)  # a side folder's file
         (dest / name).symlink_to(decoys[name])
     rc, _, err = _run_case(case, _sources, dest, monkeypatch)
     assert rc == 0, err
@@ -1006,14 +1013,20 @@ def _full_disk_while_writing(monkeypatch, folder, victim):
     monkeypatch.setattr(os, "fsync", fsync_)
 
 
+def _files(dest):
+    """The files below `dest`, by their paths relative to it (side folders' too)."""
+    return sorted(p.relative_to(dest).as_posix() for p in dest.rglob("*") if not p.is_dir())
+
+
 def _old_set(dest, names):
     dest.mkdir(parents=True, exist_ok=True)
     for name in names:
+        (dest / name).parent.mkdir(parents=True, exist_ok=True)
         (dest / name).write_text(f"old {name}")
 
 
 def _assert_old_set(dest, names):
-    assert sorted(p.name for p in dest.iterdir()) == sorted(names), "files added or removed"
+    assert _files(dest) == sorted(names), "files added or removed"
     for name in names:
         assert (dest / name).read_text() == f"old {name}", f"{name} was replaced"
 
@@ -1033,8 +1046,8 @@ def test_outputs_of_several_files_are_whole_or_absent_on_a_full_disk(
         _old_set(dest, names)
     elif not creates_folder:
         dest.mkdir(parents=True)
-    _full_disk_while_writing(monkeypatch, tmp_path / "full",
-                             names[-1] if victim == "last" else names[0])
+    _full_disk_while_writing(monkeypatch, tmp_path / "full",  # a side file's own name
+                             Path(names[-1] if victim == "last" else names[0]).name)
     rc, _, err = _run_case(case, _sources, dest, monkeypatch)
     monkeypatch.undo()
     assert_clean_failure(rc, err)

@@ -635,6 +635,11 @@ NON_UTF8_CASES = {
     "export --check": (["export", "doc", "-o", b"OUT.gltf", "--size", "8", "--check",
                         "--check-size", "16", "--check-image", b"dir/chk.png"],
                        [b"OUT.gltf", b"OUT.bin", b"dir/chk.png"]),
+    # the side folder and the texture's copy: their names as text MaterialX can hold
+    "export .mtlx": (["export", "doc", "-o", b"OUT.mtlx", "--size", "8"],
+                     [b"OUT.mtlx", b"out___textures/tex__.png"]),
+    "export .mtlx --zip": (["export", "doc", "-o", b"OUT.mtlx", "--size", "8", "--zip"],
+                           [b"OUT.zip"]),
     "contact-sheet": (["contact-sheet", "doc", "-o", b"OUT.png", "--size", "16"],
                       [b"OUT.png"]),
 }

@@ -31,27 +31,39 @@ def cli(*args):
 
 @pytest.fixture(scope="module")
 def exported(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("mtlx")
+    """Every sample exported to the default surface (open_pbr_surface), maps as float EXR
+    (the bake itself: the 2e-3 comparisons below; PNG's 8 bits are checked against it in
+    tests/test_interop_mtlx_surfaces.py)."""
+    return _export_samples(tmp_path_factory.mktemp("mtlx"))
+
+
+@pytest.fixture(scope="module")
+def exported_gltf(tmp_path_factory):
+    return _export_samples(tmp_path_factory.mktemp("mtlx_gltf"), "gltf_pbr")
+
+
+def _export_samples(folder: Path, surface: str = "open_pbr_surface"):
     notes = {}
     for path in SAMPLES:
         r = cli("export", str(path), "-o", str(folder / f"{path.stem}.mtlx"), "--size",
-                str(SIZE))
-        if path.stem in REFUSED:  # refused by name, never exported wrong
-            assert r.returncode == 2 and REFUSED[path.stem] in r.stderr, r.stderr
+                str(SIZE), "--format", "exr", "--surface", surface)
+        if path.stem in REFUSED.get(surface, {}):  # refused by name, never exported wrong
+            assert r.returncode == 2 and REFUSED[surface][path.stem] in r.stderr, r.stderr
             continue
         assert r.returncode == 0, r.stderr
         notes[path.stem] = r.stderr
     return folder, notes
 
 
-# Samples standard_surface cannot carry, and the field the export refuses them by: a varying
-# anisotropy direction has no standard_surface input (its rotation takes a constant here).
-REFUSED = {"radial_brushed_aluminium": "anisotropyDirection"}
+# Samples a surface cannot carry, and the field the export refuses them by: a varying
+# anisotropy direction has no gltf_pbr (or standard_surface) input, whose rotation takes a
+# constant here; OpenPBR's geometry_tangent takes it in world space.
+REFUSED = {"gltf_pbr": {"radial_brushed_aluminium": "anisotropyDirection"}}
 
 
-def _exportable(path: Path) -> None:
-    if path.stem in REFUSED:
-        pytest.skip(f"{path.stem}: export refused by name ({REFUSED[path.stem]})")
+def _exportable(path: Path, surface: str = "open_pbr_surface") -> None:
+    if path.stem in REFUSED.get(surface, {}):
+        pytest.skip(f"{path.stem}: export refused by name ({REFUSED[surface][path.stem]})")
 
 
 def load_with_stdlib(path: Path):
@@ -73,22 +85,48 @@ def test_exported_mtlx_validates(exported, path):
     assert ok, msg
     text = out.read_text()
     assert str(folder) not in text and str(graphs_dir()) not in text
-    surfaces = [n for n in doc.getNodes() if n.getCategory() == "standard_surface"]
+    surfaces = [n for n in doc.getNodes() if n.getCategory() == "open_pbr_surface"]
     assert len(surfaces) == 1
     assert [m.getName() for m in doc.getMaterialNodes()] == [f"M_{path.stem}"]
-    # Every image the document references was written beside it, and is reported.
+    # Every image the document references was written in its side folder, and is reported.
     images = doc.getNodeGraph(f"NG_{path.stem}").getNodes("image")
     for img in images:
-        file = img.getInputValue("file")
-        assert "/" not in file and (folder / file).is_file()
+        file = img.getInput("file").getValueString()
+        assert file.startswith(f"{path.stem}_textures/") and (folder / file).is_file()
         # named <node>_<output>_baked; outputs may hold '_' themselves (tile_id)
         reported = re.findall(r"node (\w+): baked", notes[path.stem])
         assert any(img.getName().startswith(f"{n}_") for n in reported), img.getName()
     for line in notes[path.stem].splitlines():
-        assert line.startswith("note: ") and "baked to an image" in line
+        assert line.startswith("note: "), line
+    if images:
+        assert f"baked map(s) at {SIZE} x {SIZE} texels" in notes[path.stem]
 
 
-# standard_surface input -> (our attribute, how the surface input relates to it)
+@pytest.mark.parametrize("surface", ["open_pbr_surface", "gltf_pbr"])
+@pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
+def test_exported_material_generates_with_materialx_glsl(request, path, surface):
+    """The whole material (the surface shader on its nodegraph) goes through MaterialX's own
+    GLSL generator, and the gltf_pbr export validates too."""
+    _exportable(path, surface)
+    from MaterialX import PyMaterialXGenGlsl as mx_glsl
+    from MaterialX import PyMaterialXGenShader as mx_gen
+
+    folder, _ = request.getfixturevalue(
+        "exported" if surface == "open_pbr_surface" else "exported_gltf")
+    doc = load_with_stdlib(folder / f"{path.stem}.mtlx")
+    ok, msg = doc.validate()
+    assert ok, msg
+    assert [n.getCategory() for n in doc.getNodes() if n.getType() == "surfaceshader"] == [
+        surface]
+    gen = mx_glsl.GlslShaderGenerator.create()
+    context = mx_gen.GenContext(gen)
+    context.registerSourceCodeSearchPath(mx.getDefaultDataSearchPath())
+    (mat,) = doc.getMaterialNodes()
+    shader = gen.generate(mat.getName(), mat, context)
+    assert "void main" in shader.getSourceCode(mx_gen.PIXEL_STAGE)
+
+
+# standard_surface input -> our attribute
 SURFACE_INPUTS = {
     "base_color": "baseColor", "base": "cavity", "specular": "cavity",
     "metalness": "metallic", "specular_roughness": "roughness",
@@ -103,24 +141,64 @@ SURFACE_INPUTS = {
     "transmission": "transmission", "transmission_depth": "attenuationDistance",
     "transmission_color": "transmissionColor",  # attenuationColor where a depth is set
 }
+# Each surface's inputs -> (our attribute, the surface's value of it): "" as is, "inverse"
+# 1 / it (kept off 0, 1e-4), "milli" x 1e-3 (nm to um), "unit" normalised (world-space
+# directions on the bake plane: tangent +X, bitangent +Y, normal +Z).
+SURFACE_READS = {
+    "open_pbr_surface": {
+        "base_color": ("baseColor", ""), "base_weight": ("cavity", ""),
+        "specular_weight": ("cavity", ""), "base_metalness": ("metallic", ""),
+        "specular_roughness": ("roughness", ""), "geometry_normal": ("normal", "unit"),
+        "emission_color": ("emissive", ""), "geometry_opacity": ("opacity", ""),
+        "coat_weight": ("coat", ""), "coat_color": ("coatColor", ""),
+        "coat_roughness": ("coatRoughness", ""), "coat_ior": ("coatIor", ""),
+        "geometry_coat_normal": ("coatNormal", "unit"),
+        "specular_color": ("specularColor", ""), "specular_ior": ("ior", ""),
+        "fuzz_color": ("sheenColor", ""), "fuzz_roughness": ("sheenRoughness", ""),
+        "specular_roughness_anisotropy": ("anisotropy", ""),
+        "geometry_tangent": ("anisotropyDirection", "unit"),
+        "subsurface_weight": ("subsurface", ""), "subsurface_color": ("subsurfaceColor", ""),
+        "subsurface_radius_scale": ("subsurfaceRadius", ""),
+        "subsurface_radius": ("thickness", "inverse"),
+        "thin_film_thickness": ("thinFilmThickness", "milli"),
+        "thin_film_ior": ("thinFilmIor", ""), "transmission_weight": ("transmission", ""),
+        "transmission_depth": ("attenuationDistance", ""),
+        "transmission_color": ("transmissionColor", "")},
+    "gltf_pbr": {
+        "base_color": ("baseColor", ""), "metallic": ("metallic", ""),
+        "roughness": ("roughness", ""), "normal": ("normal", "unit"),
+        "occlusion": ("cavity", ""), "emissive": ("emissive", ""), "alpha": ("opacity", ""),
+        "specular_color": ("specularColor", ""), "ior": ("ior", ""),
+        "clearcoat": ("coat", ""), "clearcoat_roughness": ("coatRoughness", ""),
+        "clearcoat_normal": ("coatNormal", "unit"), "sheen_color": ("sheenColor", ""),
+        "sheen_roughness": ("sheenRoughness", ""),
+        "anisotropy_strength": ("anisotropy", ""), "transmission": ("transmission", ""),
+        "attenuation_color": ("attenuationColor", ""),
+        "attenuation_distance": ("attenuationDistance", ""),
+        "iridescence_thickness": ("thinFilmThickness", ""),
+        "iridescence_ior": ("thinFilmIor", ""), "thickness": ("thickness", "")},
+}
 # The talk's inputs, which every exported material has.
 TALK_INPUTS = {"base_color", "base", "specular", "metalness", "specular_roughness", "normal",
                "emission_color", "opacity"}
 
 
 @pytest.mark.gl
+@pytest.mark.parametrize("surface", ["open_pbr_surface", "gltf_pbr"])
 @pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.stem)
-def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
-    _exportable(path)
+def test_materialx_glsl_of_each_output_matches_cpu(ctx, request, path, surface):
+    _exportable(path, surface)
     from matedit.compiler.api import lower_and_optimise
     from matedit.interop import bake
     from matedit.io.document import FileResolver, load
     from tests.mtlx_gpu import MtlxDrawer
 
-    folder, _ = exported
+    folder, _ = request.getfixturevalue(
+        "exported" if surface == "open_pbr_surface" else "exported_gltf")
     doc = load_with_stdlib(folder / f"{path.stem}.mtlx")
     cpu = bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), SIZE)
-    shader = next(n for n in doc.getNodes() if n.getCategory() == "standard_surface")
+    shader = next(n for n in doc.getNodes() if n.getCategory() == surface)
+    reads = SURFACE_READS[surface]
     drawer = MtlxDrawer(ctx, SIZE)
     checked = []
     try:
@@ -129,17 +207,18 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
                 continue
             out = doc.getNodeGraph(inp.getNodeGraphString()).getOutput(inp.getOutputString())
             got = drawer.draw(doc, out, folder)
-            want = cpu[SURFACE_INPUTS[inp.getName()]]
+            attr, how = reads[inp.getName()]
+            want = cpu[attr]
             if inp.getName() == "transmission_color" and shader.getInput("transmission_depth"):
                 want = cpu["attenuationColor"]  # the absorption colour at that depth
-            if inp.getName() in ("normal", "coat_normal"):  # normalmap: T = +X, B = +Y, N = +Z
+            if how == "unit":  # normalmap and rotate3d: T = +X, B = +Y, N = +Z
                 want = want / np.linalg.norm(want, axis=-1, keepdims=True)
+            if how == "milli":
+                want = want * 1e-3
             k = want.shape[-1]
-            if inp.getName() == "opacity":
-                got, k = got[..., :1], 1
-            if inp.getName() == "subsurface_scale":  # 1 / thickness: relative, 1e-3
+            if how == "inverse":  # 1 / thickness: relative, 1e-3
                 np.testing.assert_allclose(got[..., :k], 1.0 / np.maximum(want, 1e-4),
-                                           rtol=1e-3, err_msg=f"{path.stem}: subsurface_scale")
+                                           rtol=1e-3, err_msg=f"{path.stem}: {inp.getName()}")
                 checked.append(inp.getName())
                 continue
             np.testing.assert_allclose(got[..., :k], want, atol=2e-3,
@@ -147,7 +226,7 @@ def test_materialx_glsl_of_each_output_matches_cpu(ctx, exported, path):
             checked.append(inp.getName())
     finally:
         drawer.release()
-    print(path.stem, "checked", checked)
+    print(path.stem, surface, "checked", checked)
     # every sample varies something over the surface (the soap bubble only its film), and a
     # base colour that varies is among what was compared
     assert checked, f"{path.stem}: no input is a node graph"
@@ -177,7 +256,12 @@ def test_round_trip_import_compile_evaluate_equals_original(exported, path):
     a = bake.attributes_cpu(lower_and_optimise(load(path), FileResolver()), SIZE)
     b = bake.attributes_cpu(lower_and_optimise(load(out), FileResolver()), SIZE)
     for k in a:
+        if k in ("thickness", "subsurfaceRadius"):
+            continue  # OpenPBR carries their ratio (and says so where thickness is not 1)
         np.testing.assert_allclose(b[k], a[k], atol=1e-6, err_msg=f"{path.stem} {k}")
+    np.testing.assert_allclose(b["subsurfaceRadius"] / b["thickness"],
+                               a["subsurfaceRadius"] / a["thickness"], rtol=1e-6,
+                               atol=1e-6, err_msg=f"{path.stem} subsurfaceRadius / thickness")
 
 
 def _doc(body: str) -> str:
@@ -649,7 +733,8 @@ def test_every_mapped_kind_matches_materialx_glsl_and_round_trips(ctx, tmp_path)
     src = _all_kinds_material(tmp_path)
     assert cli("validate", str(src)).returncode == 0
     out = tmp_path / "all_kinds.mtlx"
-    r = cli("export", str(src), "-o", str(out), "--size", str(SIZE))
+    r = cli("export", str(src), "-o", str(out), "--size", str(SIZE), "--surface",
+            "standard_surface")
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""  # nothing baked: every kind here maps
     doc = load_with_stdlib(out)
@@ -735,18 +820,22 @@ def test_texture_colour_spaces_in_materialx(ctx, tmp_path):
     n = 8
     src, albedo, _ = textured_material(tmp_path, n)
     out = tmp_path / "textured.mtlx"
-    r = cli("export", str(src), "-o", str(out), "--size", str(n))
+    r = cli("export", str(src), "-o", str(out), "--size", str(n), "--surface",
+            "standard_surface")
     assert r.returncode == 0 and r.stderr == "", r.stderr
     doc = load_with_stdlib(out)
     ok, msg = doc.validate()
     assert ok, msg
     assert doc.getColorSpace() == "lin_rec709"
-    images = {i.getInputValue("file"): i for i in doc.getNodeGraph("NG_textured").getNodes(
-        "image")}
-    assert set(images) == {"albedo.png", "data.png"}
-    assert images["albedo.png"].getInput("file").getColorSpace() == "srgb_texture"
-    assert images["albedo.png"].getType() == "color4"
-    assert images["data.png"].getInput("file").getColorSpace() == "lin_rec709"
+    images = {i.getInput("file").getValueString(): i
+              for i in doc.getNodeGraph("NG_textured").getNodes("image")}
+    # copies of the textures, in the export's side folder
+    albedo_file, data_file = "textured_textures/albedo.png", "textured_textures/data.png"
+    assert set(images) == {albedo_file, data_file}
+    assert images[albedo_file].getInput("file").getColorSpace() == "srgb_texture"
+    assert images[albedo_file].getType() == "color4"
+    assert images[data_file].getInput("file").getColorSpace() == "lin_rec709"
+    assert (tmp_path / albedo_file).read_bytes() == (tmp_path / "albedo.png").read_bytes()
     cpu = bake.attributes_cpu(lower_and_optimise(load(src), FileResolver()), n)
     np.testing.assert_allclose(cpu["baseColor"], srgb_decode(albedo), atol=1.0 / 255.0)
     shader = next(s for s in doc.getNodes() if s.getCategory() == "standard_surface")
@@ -766,8 +855,8 @@ def test_texture_colour_spaces_in_materialx(ctx, tmp_path):
     assert r.returncode == 0, r.stderr
     textures = {nd.settings["path"]: nd.settings for nd in load(back).graph.nodes.values()
                 if nd.kind == "texture_parameter"}
-    assert textures["albedo.png"]["srgb"] is True
-    assert textures["data.png"]["srgb"] is False
+    assert textures[albedo_file]["srgb"] is True
+    assert textures[data_file]["srgb"] is False
     again = bake.attributes_cpu(lower_and_optimise(load(back), FileResolver()), n)
     for k in cpu:
         np.testing.assert_allclose(again[k], cpu[k], atol=1e-6, err_msg=k)
@@ -786,13 +875,14 @@ def test_opencolorio_spaces_map_to_materialx_names_or_are_refused(tmp_path):
     doc = load_with_stdlib(out)
     assert doc.validate()[0]
     (img,) = [i for i in doc.getNodeGraph("NG_textured").getNodes("image")
-              if i.getInputValue("file") == "albedo.png"]
+              if i.getInputValue("file") == "t_textures/albedo.png"]
     assert img.getInput("file").getColorSpace() == "acescg"
     back = tmp_path / "back.json"
     r = cli("import", str(out), "-o", str(back))
     assert r.returncode == 0, r.stderr
     (tex,) = [nd for nd in load(back).graph.nodes.values()
-              if nd.kind == "texture_parameter" and nd.settings["path"] == "albedo.png"]
+              if nd.kind == "texture_parameter"
+              and nd.settings["path"] == "t_textures/albedo.png"]
     assert tex.settings["color_space"] == "ACEScg"
 
     d = load(src)
@@ -935,7 +1025,7 @@ def test_every_lobe_field_exports_to_standard_surface_and_imports_back(tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr
     out = tmp_path / "x" / "lobes.mtlx"
     out.parent.mkdir()
-    r = cli("export", str(src), "-o", str(out))
+    r = cli("export", str(src), "-o", str(out), "--surface", "standard_surface")
     assert r.returncode == 0, r.stderr
     doc = load_with_stdlib(out)
     ok, msg = doc.validate()
@@ -1005,6 +1095,8 @@ def test_a_varying_anisotropy_direction_is_refused_on_export_with_its_name(tmp_p
                   {"id": "out", "kind": "material_output"}],
         "links": [{"from": ["p", "position"], "to": ["make", "anisotropyDirection"]},
                   {"from": ["make", "attributes"], "to": ["out", "attributes"]}]}))
-    r = cli("export", str(src), "-o", str(tmp_path / "v.mtlx"))
-    assert r.returncode == 2, r.stdout + r.stderr
-    assert r.stderr.count("error:") == 1 and "anisotropyDirection" in r.stderr
+    for surface in ("standard_surface", "gltf_pbr"):
+        r = cli("export", str(src), "-o", str(tmp_path / "v.mtlx"), "--surface", surface)
+        assert r.returncode == 2, r.stdout + r.stderr
+        assert r.stderr.count("error:") == 1 and "anisotropyDirection" in r.stderr
+        assert not (tmp_path / "v.mtlx").exists()

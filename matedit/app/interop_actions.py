@@ -200,7 +200,8 @@ class InteropActions:
         except Exception as exc:
             return self._fail(title, exc)
         baked = f"; baked {', '.join(n for n, _ in result.baked)}" if result.baked else ""
-        return self._done(f"exported {out.name}{baked}")
+        said = "".join(f"; note: {n}" for n in result.notes)
+        return self._done(f"exported {out.name}{baked}{said}")
 
     def export_baked(self, folder: Path | None = None, size: int = 1024) -> bool:
         title = "Export baked textures"

@@ -3,11 +3,12 @@
 
 glTF 2.0: the preview mesh with tangents and a metallic-roughness material on maps baked
 on that mesh in UV space (matedit.interop.bake.bake_for_export, matedit.interop.gltf).
-MaterialX: a nodegraph reproducing the attribute graph feeding one standard_surface
-(matedit.interop.mtlx_export); subgraphs MaterialX cannot express are baked to EXR images
-beside the document, and reported. USD: the preview mesh bound to a Material with a
-UsdPreviewSurface network on the baked maps and the MaterialX export in the mtlx render
-context (matedit.interop.usd). `--check` measures the round trip's loss
+MaterialX: a nodegraph reproducing the attribute graph feeding one open_pbr_surface,
+standard_surface or gltf_pbr (matedit.interop.mtlx_export); subgraphs MaterialX cannot
+express are baked to images in OUT_textures/ beside the document, with copies of the
+textures the material reads, and reported (--zip: OUT.zip). USD: the preview mesh bound to
+a Material with a UsdPreviewSurface network on the baked maps and the MaterialX export in
+the mtlx render context (matedit.interop.usd). `--check` measures the round trip's loss
 (matedit.commands.export_check)."""
 
 from __future__ import annotations
@@ -25,9 +26,10 @@ def register(sub) -> None:
     p = sub.add_parser("export", help="export a material to glTF 2.0, MaterialX or USD",
                        description="Export a material as a glTF 2.0 asset (.gltf or .glb: "
                        "preview mesh, baked maps, metallic-roughness material) or as a "
-                       "MaterialX document (.mtlx: nodegraph and standard_surface) or as a USD "
-                       "asset (.usda with its textures beside it, or a .usdz package: preview "
-                       "mesh, UsdPreviewSurface on baked maps, MaterialX network).")
+                       "MaterialX document (.mtlx: nodegraph and a surface shader, with its baked "
+                       "maps and texture copies in OUT_textures/) or as a USD asset (.usda with "
+                       "its textures beside it, or a .usdz package: preview mesh, "
+                       "UsdPreviewSurface on baked maps, MaterialX network).")
     p.add_argument("file", metavar="FILE")
     p.add_argument("-o", "--output", required=True,
                    metavar="OUT.gltf|OUT.glb|OUT.mtlx|OUT.usda|OUT.usdz")
@@ -39,6 +41,15 @@ def register(sub) -> None:
                    "...) or an OBJ file (./sphere for a file of that name) (default: the file's "
                    "preview mesh, else sphere)")
     export_check.register(p)
+    p.add_argument("--surface", default="open_pbr_surface",
+                   choices=("open_pbr_surface", "standard_surface", "gltf_pbr"),
+                   help="MaterialX only: the surface shader (default open_pbr_surface, "
+                   "MaterialX 1.39's own)")
+    p.add_argument("--format", default="png", choices=("png", "exr"),
+                   help="MaterialX only: baked maps as 8-bit PNG (sRGB colour, linear "
+                   "data; default) or float EXR")
+    p.add_argument("--zip", action="store_true",
+                   help="MaterialX only: pack OUT.mtlx and its side files into OUT.zip")
     declare_inputs(p, file="document", mesh="mesh")
     p.set_defaults(run=run)
 
@@ -55,6 +66,10 @@ def run(args) -> int:
         if args.mesh:
             raise UsageError("--mesh applies to glTF and USD exports only")
         return _mtlx(args, out)
+    for flag, given in (("--surface", args.surface != "open_pbr_surface"),
+                        ("--format", args.format != "png"), ("--zip", args.zip)):
+        if given:
+            raise UsageError(f"{flag} applies to MaterialX (.mtlx) exports only")
     if kind in (".usda", ".usdz"):
         if args.check:
             raise UsageError("--check reads back .gltf, .glb and .mtlx exports; USD has no "
@@ -130,7 +145,8 @@ def _mtlx(args, out: Path) -> int:
     resolver = FileResolver()
     inputs = command_inputs(args, [doc], resolver)
     try:
-        result = mtlx_export.export(doc, resolver, out, size)
+        result = mtlx_export.export(doc, resolver, out, size, args.surface, args.format,
+                                    args.zip)
         refuse_overwrite([*result.files, *export_check.outputs(args)], inputs)
         mtlx_export.write(result)
     except CompileError as exc:
@@ -146,6 +162,8 @@ def _mtlx(args, out: Path) -> int:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
     for node, why in result.baked:
         report("note", f"{path}: node {node}: baked to an image ({why})")
+    for line in result.notes:
+        report("note", f"{path}: {line}")
     export_check.after_write(args, path, doc, out)
     return 0
 

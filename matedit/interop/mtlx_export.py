@@ -1,14 +1,13 @@
 """A material as a MaterialX 1.39 document: one nodegraph reproducing the attribute graph,
-feeding one `standard_surface` through a `surfacematerial`.
-
-Why standard_surface: it is the surface every MaterialX 1.39 code generator and renderer
-(GLSL, OSL, MDL, MSL; USD Hydra, Arnold, the MaterialX viewer) implements, and our model,
-Karis' metallic-roughness one, maps onto its inputs without approximation: base_color and
-metalness; specular_roughness (both square it into the GGX alpha); its default specular IOR
-1.5 is our 0.04 dielectric F0. Our cavity "multiplies all lighting": it becomes `base` (which
-scales the diffuse and, through base_color, the metal's reflectance) and `specular` (which
-scales the dielectric reflection). open_pbr_surface would do as well, but is newer and less
-widely implemented; the importer reads both.
+feeding one surface shader through a `surfacematerial`: `open_pbr_surface` by default
+(MaterialX 1.39's own), `standard_surface` or `gltf_pbr` (SURFACE_KINDS). Each attribute
+field goes to the surface's input of the same meaning (docs/materialx.md, Export, has the
+table): base_color and the metalness; specular_roughness (all three square it into the GGX
+alpha); IORs as ours. Our cavity "multiplies all lighting": it becomes the base and specular
+weights of OpenPBR and standard_surface (which scale the diffuse and, through base_color,
+the metal's reflectance, and the dielectric reflection) and gltf_pbr's occlusion. A field a
+surface carries only approximately or not at all is a line in `notes` (the command prints
+them as `note:` lines).
 
 The graph comes from the lowered IR (matedit.compiler.lower), before optimisation, so the
 nodes are ours, one for one where the catalogue has a mapping (NodeDef.mtlx, read through
@@ -16,16 +15,19 @@ matedit.interop.mtlx_map): material function calls are inlined (their nodes name
 CALL_NODE), layer stacks are their blends, parameters are the nodegraph's interface inputs,
 other unconnected inputs are values. What cannot be
 expressed (`BAKE` in the map) is evaluated by the CPU evaluator over UV space (the bake plane
-of matedit.interop.bake) into a float EXR beside the document, read by an `image` node on
+of matedit.interop.bake) into a map in OUT_textures/, read by an `image` node on
 texture coordinate 0, and reported; a baked node that reads the position, normal, view or
 time is exact on the bake plane only, and the report says so.
 
-Textures are referenced relative to the document's folder, each image's file with the
-texture's colour space (matedit.interop.mtlx_colorspace: `srgb_texture` for sRGB, `lin_rec709`
-for linear, the MaterialX name of an OpenColorIO space); the document's colour space is
-`lin_rec709`, so MaterialX decodes a texture as matedit does (an image not in lin_rec709 is
-read as color4, the type MaterialX converts, then made a vector4). Baked images are float EXR
-in lin_rec709.
+The export is self-contained: baked maps and copies of the textures the material reads go
+into OUT_textures/ beside OUT.mtlx (`side_folder`), named in the document by relative
+paths; `write` puts them in place with the document, or packs them all into OUT.zip. Each
+image's file carries its colour space (matedit.interop.mtlx_colorspace: `srgb_texture` for
+sRGB, `lin_rec709` for linear, the MaterialX name of an OpenColorIO space); the document's
+colour space is `lin_rec709`, so MaterialX decodes a texture as matedit does (an image not
+in lin_rec709 is read as a colour type, which MaterialX converts, then made a vector).
+Baked maps are 8-bit PNGs (a colour map sRGB-encoded, `srgb_texture`; a data map linear) or
+float EXRs in lin_rec709; `detail_notes` says which lose detail at the bake size.
 """
 
 from __future__ import annotations
@@ -55,14 +57,32 @@ from matedit.graph.nodes import (
 from matedit.graph.types import PortType
 from matedit.interop.mtlx_colorspace import WORKING, materialx_spaces, stdlib, to_materialx
 from matedit.interop.mtlx_map import BAKE, MxNode, MxRecipe, mapping
+from matedit.io.atomic import read_bounded
 
 MX_TYPE = {PortType.FLOAT: "float", PortType.VEC2: "vector2", PortType.VEC3: "vector3",
            PortType.VEC4: "vector4"}
 # The compiler's own ops that stand for a catalogue kind's mapping.
 IR_OP_ROLES = {ops.BLEND: Role.MASK_BLEND, ops.MASK: Role.COMPONENT_MASK}
 MTLX_VERSION = "1.39"
+# The surfaces the export writes (--surface); OpenPBR is MaterialX 1.39's own default.
+SURFACE_KINDS = ("open_pbr_surface", "standard_surface", "gltf_pbr")
+DEFAULT_SURFACE = "open_pbr_surface"
+FORMATS = ("png", "exr")
+# A texture the material reads is copied whole; larger files are refused.
+MAX_TEXTURE_BYTES = 1 << 30
+# The detail check: a band of this many rows of the bake is baked again at twice the size;
+# a map whose finer bake, box-filtered to the bake's texels, differs from it by an RMS above
+# DETAIL_RMS of the map's range has detail finer than its texels (the note says so).
+DETAIL_ROWS = 16
+DETAIL_RMS = 1.0 / 255.0
 # The thinnest part standard_surface's subsurface_scale = 1 / thickness stands for (metres).
 _MIN_THICKNESS = 1e-4
+
+
+def safe_name(name: str) -> str:
+    """A file or element name as text MaterialX can hold: bytes of a file name that are not
+    UTF-8 (Python's surrogate escapes) become '_'."""
+    return "".join("_" if 0xDC80 <= ord(c) <= 0xDCFF else c for c in name)
 
 
 class MtlxExportError(ValueError):
@@ -87,15 +107,26 @@ class V:
 
 
 @dataclass
+class BakedImage:
+    pixels: np.ndarray  # (N, N, C) float32 linear, row 0 = v = 0
+    colour: bool  # an 8-bit sRGB colour map (else linear data, or a float EXR)
+
+
+@dataclass
 class MtlxExport:
     out: Path
     text: str
-    images: dict[Path, np.ndarray] = field(default_factory=dict)
+    images: dict[Path, BakedImage] = field(default_factory=dict)
     baked: list[tuple[str, str]] = field(default_factory=list)
+    copies: dict[Path, Path] = field(default_factory=dict)  # side file -> texture it copies
+    notes: list[str] = field(default_factory=list)
+    zip: Path | None = None  # write one archive of the document and its side files instead
 
     @property
     def files(self) -> list[Path]:
-        return [self.out, *self.images]
+        if self.zip is not None:
+            return [self.zip]
+        return [self.out, *self.images, *self.copies]
 
 
 def _fmt(value, mxtype: str) -> str:
@@ -115,7 +146,9 @@ def _const(value, t: PortType) -> tuple:
 
 
 class _Exporter:
-    def __init__(self, ir: MaterialIR, size: int, folder: Path, stem: str) -> None:
+    def __init__(self, ir: MaterialIR, size: int, folder: Path, stem: str,
+                 kind: str = DEFAULT_SURFACE, fmt: str = "png", side: str = "",
+                 rows: tuple[int, int] | None = None) -> None:
         import MaterialX as mx
 
         from matedit.compiler.cpu_eval import Env
@@ -125,20 +158,26 @@ class _Exporter:
         self.ir = ir
         self.size = size
         self.folder = folder
-        self.stem = stem
+        self.stem = stem = safe_name(stem)
+        self.kind = kind
+        self.fmt = fmt
+        self.side = side  # the side-file folder, relative to the document's
+        self.rows = rows  # a band of rows only (the detail check's finer bake)
+        self.notes: list[str] = []
+        self.copies: dict[Path, Path] = {}  # side file -> the texture file it copies
         self.doc = mx.createDocument()
         self.doc.setVersionString(MTLX_VERSION)
         self.doc.setColorSpace(WORKING)  # images in other spaces are converted to it
         self.ng = self.doc.addNodeGraph(mx.createValidName(f"NG_{stem}"))
-        n = size * size
+        n = size * (size if rows is None else rows[1] - rows[0])
         uniforms = {u.name: u.default for u in ir.uniforms}
-        self.env = Env(surface(size), n, uniforms, load_textures(ir),
+        self.env = Env(surface(size, rows), n, uniforms, load_textures(ir),
                        {f.name: f for f in ir.functions})
         self.functions = {f.name: f for f in ir.functions}
         self.uniforms = {u.name: u for u in ir.uniforms}
         self.textures = {t.name: t for t in ir.textures}
         self.names: set[str] = set()
-        self.images: dict[Path, np.ndarray] = {}
+        self.images: dict[Path, BakedImage] = {}
         self.baked: list[tuple[str, str]] = []
         self._uv = None
         self._iface: dict[str, str] = {}
@@ -311,22 +350,70 @@ class _Exporter:
 
     # --- baking ----------------------------------------------------------------------------
     def bake(self, hint: str, port: str, num, t: PortType, geo: bool, kind: str) -> V:
+        """A baked node output: an image node reading its map (BakedImage: an 8-bit PNG,
+        sRGB for a colour map and linear for a data map, or a float EXR; a PNG map whose
+        values leave [0, 1] is an EXR, and the note says so)."""
         def make():
             name = self.name(f"{hint}_{port}_baked")
-            file = f"{self.stem}_{name}.exr"
-            arr = np.asarray(num, dtype=np.float32).reshape(self.size, self.size, -1)
-            self.images[self.folder / file] = arr
+            h = self.size if self.rows is None else self.rows[1] - self.rows[0]
+            arr = np.asarray(num, dtype=np.float32).reshape(h, self.size, -1)
+            fmt = self.fmt
+            if fmt == "png" and (not np.all(np.isfinite(arr)) or arr.min() < 0.0
+                                 or arr.max() > 1.0):
+                fmt = "exr"
+                self.note(f"node {hint}: its {port} leaves [0, 1] "
+                          f"({float(np.nanmin(arr)):.3g} to {float(np.nanmax(arr)):.3g}), so "
+                          "its map is a float EXR, not an 8-bit PNG")
+            d = nodes.get(kind)
+            colour = fmt == "png" and t in (PortType.VEC3, PortType.VEC4) and (
+                port == "color" or (d is not None and d.category == "Colour"))
+            rel = f"{self.side}/{name}.{fmt}" if self.side else f"{self.stem}_{name}.{fmt}"
+            k = 1
+            while self.folder / rel in self.copies:  # a copied texture of that name
+                k += 1
+                rel = f"{self.side}/{name}_{k}.{fmt}"
+            self.images[self.folder / rel] = BakedImage(arr, colour)
             why = f"{kind} has no MaterialX stdlib equivalent"
             if geo:
                 why += "; it reads position, normal, view or time, so the bake is exact on " \
                        "the flat bake plane only"
             self.baked.append((hint, why))
-            n = self.ng.addNode("image", name, MX_TYPE[t])
-            n.setInputValue("file", file, "filename")
-            n.getInput("file").setColorSpace(WORKING)  # float EXR, linear as evaluated
+            # MaterialX decodes colour-typed images only: an sRGB map is read as a colour
+            # and converted back to our vector type (as a texture in another space)
+            space = "srgb_texture" if colour else WORKING
+            itype = {PortType.VEC3: "color3", PortType.VEC4: "color4"}[t] if colour \
+                else MX_TYPE[t]
+            n = self.ng.addNode("image", name, itype)
+            n.setInputValue("file", rel, "filename")
+            n.getInput("file").setColorSpace(space)
             self.set_input(n, "texcoord", self.uv0(), "vector2")
+            if colour:
+                return self.node("convert", MX_TYPE[t], f"{name}_linear",
+                                 [("in", ("node", n, None), itype)])
             return ("node", n, None)
         return V(num, t, make, geo)
+
+    def texture_file(self, path: str) -> str:
+        """The document's reference to a texture the material reads: a copy in the side
+        folder (named as the file, numbered where two share a name), or, for a file that
+        does not exist, its path relative to the document's folder (and a note)."""
+        src = Path(path)
+        for dest, was in self.copies.items():
+            if was == src:
+                return dest.relative_to(self.folder).as_posix()
+        if not self.side or not src.is_file():
+            if self.side:
+                self.note(f"texture {src.name}: no such file; referenced, not copied")
+            return safe_name(Path(os.path.relpath(path, self.folder)).as_posix())
+        taken = {d.name.lower() for d in self.copies} | {
+            p.name.lower() for p in self.images}
+        name, k = safe_name(src.name), 1
+        while name.lower() in taken:
+            k += 1
+            name = safe_name(f"{src.stem}_{k}{src.suffix}")
+        dest = self.folder / self.side / name
+        self.copies[dest] = src
+        return dest.relative_to(self.folder).as_posix()
 
     def _extract(self, r: tuple, t: PortType, i: int, hint: str) -> tuple:
         n = self.ng.addNode("extract", self.name(f"{hint}_{'xyzw'[i]}"), "float")
@@ -371,9 +458,8 @@ class _Exporter:
                 decoded = space != WORKING
                 n = self.ng.addNode("image", self.name(hint), "color4" if decoded else "vector4")
                 if info.path:
-                    rel = self.texture_files.get(info.name) or os.path.relpath(info.path,
-                                                                               self.folder)
-                    n.setInputValue("file", Path(rel).as_posix(), "filename")
+                    n.setInputValue("file", self.texture_files.get(info.name)
+                                    or self.texture_file(info.path), "filename")
                     n.getInput("file").setColorSpace(space)
                 self.set_input(n, "texcoord", args[1].ref(), "vector2")
                 shared["n"] = ("node", n, None)
@@ -496,47 +582,24 @@ class _Exporter:
 
     # --- the surface -----------------------------------------------------------------------
     def surface(self, attrs: V) -> None:
+        """The surface shader (`self.kind`, SURFACE_KINDS) reading the attributes, and the
+        surfacematerial; `notes` gets a line for each field that surface carries only
+        approximately or not at all (docs/materialx.md, Export: the three surfaces)."""
         mx = self.mx
         f = attrs.fields
-        shader = self.doc.addNode("standard_surface", mx.createValidName(f"SR_{self.stem}"),
+        shader = self.doc.addNode(self.kind, mx.createValidName(f"SR_{self.stem}"),
                                   "surfaceshader")
-        outputs: list[tuple[str, str, tuple]] = []
-
-        def color(v: V) -> tuple:
-            r = v.ref()
-            if r[0] == "value":
-                return r
-            return self.node("convert", "color3", "to_color3", [("in", r, MX_TYPE[v.type])])
-
-        outputs.append(("base", "float", f["cavity"].ref()))
-        outputs.append(("base_color", "color3", color(f["baseColor"])))
-        outputs.append(("metalness", "float", f["metallic"].ref()))
-        outputs.append(("specular", "float", f["cavity"].ref()))
-        outputs.append(("specular_roughness", "float", f["roughness"].ref()))
         written = set(self.ir.attributes)
-        if "normal" in written:
-            nm = self.normal_map(f["normal"], "normal")
-            if nm is not None:
-                outputs.append(("normal", "vector3", nm))
-        if "emissive" in written:
-            e = f["emissive"].ref()
-            if not (e[0] == "value" and not any(e[1])):
-                shader.setInputValue("emission", 1.0, "float")
-                outputs.append(("emission_color", "color3", color(f["emissive"])))
-        if "opacity" in written:
-            o = f["opacity"].ref()
-            if not (o[0] == "value" and o[1] == 1.0):
-                c = o if o[0] == "value" else self.node("convert", "color3", "to_opacity",
-                                                        [("in", o, "float")])
-                if c[0] == "value":
-                    c = ("value", (c[1],) * 3)
-                outputs.append(("opacity", "color3", c))
-        outputs += self.lobes(f, written, color)
-        if THIN_WALLED_DEFINE in self.ir.defines:  # the Material Output's setting
-            shader.setInputValue("thin_walled", True)
+        build = {"standard_surface": self._standard, "open_pbr_surface": self._open_pbr,
+                 "gltf_pbr": self._gltf}[self.kind]
+        outputs = build(f, written)
         for name, t, r in outputs:
             inp = shader.addInput(name, t)
-            if r[0] == "value":
+            if t == "boolean":
+                inp.setValueString("true" if r[1] else "false")
+            elif t == "integer":
+                inp.setValueString(str(int(r[1])))
+            elif r[0] == "value":
                 inp.setValueString(_fmt(r[1], t))
             elif r[0] == "iface":
                 # A parameter straight into the surface: route it through a dot node.
@@ -547,24 +610,117 @@ class _Exporter:
         mat = self.doc.addMaterialNode(mx.createValidName(f"M_{self.stem}"), shader)
         del mat
 
-    def normal_map(self, v: V, hint: str) -> tuple | None:
-        """A tangent-space normal as standard_surface's world normal: encoded to [0, 1] into
-        a normalmap node; None for the constant +Z (the surface's own normal)."""
-        n = v.ref()
-        if n[0] == "value" and tuple(n[1]) == (0.0, 0.0, 1.0):
-            return None
-        enc = self.node("add", "vector3", f"{hint}_encode", [
-            ("in1", self.node("multiply", "vector3", f"{hint}_half",
-                              [("in1", n, "vector3"), ("in2", ("value", 0.5), "float")]),
-             "vector3"), ("in2", ("value", 0.5), "float")])
-        return self.node("normalmap", "vector3", f"{hint}_map", [("in", enc, "vector3")])
+    def color(self, v: V) -> tuple:
+        r = v.ref()
+        if r[0] == "value":
+            return r
+        return self.node("convert", "color3", "to_color3", [("in", r, MX_TYPE[v.type])])
 
-    def lobes(self, f: dict, written: set, color) -> list[tuple[str, str, tuple]]:
+    def note(self, text: str) -> None:
+        if text not in self.notes:
+            self.notes.append(text)
+
+    def _is(self, v: V, value) -> bool:
+        r = v.ref()
+        return r[0] == "value" and bool(np.allclose(np.ravel(r[1]), np.ravel(value)))
+
+    def _common(self, f: dict, written: set, names: dict[str, str]) -> list:
+        """The talk's inputs, by this surface's names (None: not carried)."""
+        out: list[tuple[str, str, tuple]] = [
+            (names["baseColor"], "color3", self.color(f["baseColor"])),
+            (names["metallic"], "float", f["metallic"].ref()),
+            (names["roughness"], "float", f["roughness"].ref())]
+        if "normal" in written:
+            nm = self.normal_map(f["normal"], "normal")
+            if nm is not None:
+                out.append((names["normal"], "vector3", nm))
+        return out
+
+    def _emission(self, f: dict, written: set, color_in: str, weight_in: str,
+                  weight: float) -> list:
+        if "emissive" not in written or self._is(f["emissive"], (0.0, 0.0, 0.0)):
+            return []
+        return [(weight_in, "float", ("value", weight)),
+                (color_in, "color3", self.color(f["emissive"]))]
+
+    def _opacity(self, f: dict, written: set, name: str, t: str) -> list:
+        if "opacity" not in written or self._is(f["opacity"], 1.0):
+            return []
+        o = f["opacity"].ref()
+        if t == "float":
+            return [(name, "float", o)]
+        c = o if o[0] == "value" else self.node("convert", "color3", "to_opacity",
+                                                [("in", o, "float")])
+        if c[0] == "value":
+            c = ("value", (c[1],) * 3)
+        return [(name, "color3", c)]
+
+    def direction_angle(self, f: dict) -> float:
+        """The constant anisotropy direction's angle from the tangent (radians)."""
+        d = f["anisotropyDirection"].ref()
+        if d[0] != "value":
+            raise MtlxExportError(
+                f"anisotropyDirection: {self.kind} takes the anisotropy direction as a "
+                "rotation from the tangent; a varying direction cannot be exported (use a "
+                "constant)")
+        return math.atan2(float(d[1][1]), float(d[1][0]))
+
+    def _anisotropy_note(self, written: set, theirs: str) -> None:
+        if "anisotropy" in written:
+            self.note(f"anisotropy: written as {self.kind}'s {theirs}, which stretches the "
+                      "roughness by its own rule (ours: alpha x (1 + a) along the direction, "
+                      "alpha x (1 - a) across); approximated")
+
+    def _cavity_note(self, f: dict, written: set, lobes: tuple[str, ...]) -> None:
+        if "cavity" in written and not self._is(f["cavity"], 1.0):
+            others = [x for x in lobes if x in written]
+            if others:
+                self.note(f"cavity: our cavity darkens the {', '.join(others)} lobe too, "
+                          f"which {self.kind}'s base and specular weights do not; "
+                          "approximated")
+
+    def _transmission(self, f: dict, written: set, weight: str, color: str,
+                      depth: str) -> list:
+        """standard_surface's and OpenPBR's rule (docs/materialx.md, Transmission)."""
+        out: list[tuple[str, str, tuple]] = []
+        if "transmission" in written:
+            out.append((weight, "float", f["transmission"].ref()))
+        if "attenuationDistance" in written:
+            out.append((depth, "float", f["attenuationDistance"].ref()))
+            out.append((color, "color3", self.color(f["attenuationColor"])))
+            if "transmissionColor" in written:
+                self.note(f"transmissionColor: {self.kind}'s transmission_color is the "
+                          "absorption colour at transmission_depth when a depth is set; the "
+                          "surface tint has no counterpart then; dropped")
+        elif "transmissionColor" in written:
+            out.append((color, "color3", self.color(f["transmissionColor"])))
+        elif "attenuationColor" in written:
+            self.note("attenuationColor: without attenuationDistance it changes nothing; "
+                      "not written")
+        return out
+
+    def _standard(self, f: dict, written: set) -> list:
+        out = [("base", "float", f["cavity"].ref())]
+        out += self._common(f, written, {"baseColor": "base_color", "metallic": "metalness",
+                                         "roughness": "specular_roughness",
+                                         "normal": "normal"})
+        out.append(("specular", "float", f["cavity"].ref()))
+        out += self._emission(f, written, "emission_color", "emission", 1.0)
+        out += self._opacity(f, written, "opacity", "color3")
+        out += self.lobes(f, written)
+        if THIN_WALLED_DEFINE in self.ir.defines:  # the Material Output's setting
+            out.append(("thin_walled", "boolean", ("value", True)))
+        self._anisotropy_note(written, "specular_anisotropy")
+        self._cavity_note(f, written, ("coat", "sheenColor", "subsurface", "transmission"))
+        return out
+
+    def lobes(self, f: dict, written: set) -> list[tuple[str, str, tuple]]:
         """standard_surface inputs for the lobes beyond the talk the material writes: the
         same meanings (coat colour a transmittance tint, sheen a weighted colour, IORs), the
         tangent-space coat normal through a normalmap like the base's, and the anisotropy
         direction as standard_surface's rotation (a fraction of a turn from the tangent),
         which MaterialX can only take here from a constant direction."""
+        color = self.color
         out: list[tuple[str, str, tuple]] = []
         plain = (("specularColor", "specular_color", "color3"), ("ior", "specular_IOR", "float"),
                  ("coat", "coat", "float"), ("coatRoughness", "coat_roughness", "float"),
@@ -591,12 +747,7 @@ class _Exporter:
             if nm is not None:
                 out.append(("coat_normal", "vector3", nm))
         if "anisotropyDirection" in written:
-            d = f["anisotropyDirection"].ref()
-            if d[0] != "value":
-                raise MtlxExportError(
-                    "anisotropyDirection: standard_surface takes the anisotropy direction as "
-                    "a rotation; a varying direction cannot be exported (use a constant)")
-            turn = math.atan2(float(d[1][1]), float(d[1][0])) / (2.0 * math.pi)
+            turn = self.direction_angle(f) / (2.0 * math.pi)
             out.append(("specular_rotation", "float", ("value", turn % 1.0)))
         if "subsurface" in written and "subsurfaceColor" not in written:
             # standard_surface's subsurface_color default is 0.8; ours is white
@@ -606,17 +757,172 @@ class _Exporter:
             out.append(("thin_film_IOR", "float", ("value", 1.3)))
         if "thickness" in written:
             out.append(("subsurface_scale", "float", self.inverse_thickness(f["thickness"])))
-        if "transmission" in written:
-            out.append(("transmission", "float", f["transmission"].ref()))
-        if "attenuationDistance" in written:
-            # standard_surface's transmission_color is the absorption colour reached at
-            # transmission_depth where the depth is above 0 (then our transmissionColor has
-            # no counterpart), a surface tint at depth 0 (docs/materialx.md, Transmission)
-            out.append(("transmission_depth", "float", f["attenuationDistance"].ref()))
-            out.append(("transmission_color", "color3", color(f["attenuationColor"])))
-        elif "transmissionColor" in written:
-            out.append(("transmission_color", "color3", color(f["transmissionColor"])))
+        out += self._transmission(f, written, "transmission", "transmission_color",
+                                  "transmission_depth")
         return out
+
+    def _open_pbr(self, f: dict, written: set) -> list:
+        """OpenPBR: the names of standard_surface's meanings (as the importer reads them),
+        emission in nits (1000 is our emissive 1), the film in micrometres with weight 1,
+        the mean free path as subsurface_radius_scale x subsurface_radius (1 / thickness),
+        the anisotropy direction as the tangent rotated about the normal (a constant)."""
+        out = [("base_weight", "float", f["cavity"].ref())]
+        out += self._common(f, written, {"baseColor": "base_color",
+                                         "metallic": "base_metalness",
+                                         "roughness": "specular_roughness",
+                                         "normal": "geometry_normal"})
+        out.append(("specular_weight", "float", f["cavity"].ref()))
+        out += self._emission(f, written, "emission_color", "emission_luminance", 1000.0)
+        out += self._opacity(f, written, "geometry_opacity", "float")
+        plain = (("specularColor", "specular_color", "color3"),
+                 ("ior", "specular_ior", "float"),
+                 ("anisotropy", "specular_roughness_anisotropy", "float"),
+                 ("coat", "coat_weight", "float"), ("coatColor", "coat_color", "color3"),
+                 ("coatRoughness", "coat_roughness", "float"),
+                 ("subsurface", "subsurface_weight", "float"),
+                 ("subsurfaceColor", "subsurface_color", "color3"),
+                 ("thinFilmIor", "thin_film_ior", "float"))
+        for ours, theirs, t in plain:
+            if ours in written:
+                out.append((theirs, t, self.color(f[ours]) if t == "color3" else f[ours].ref()))
+        if "coat" in written and "coatIor" not in written:
+            out.append(("coat_ior", "float", ("value", 1.5)))  # OpenPBR's default is 1.6
+        if "coatIor" in written:
+            out.append(("coat_ior", "float", f["coatIor"].ref()))
+        if "coatNormal" in written:
+            nm = self.normal_map(f["coatNormal"], "coat_normal")
+            if nm is not None:
+                out.append(("geometry_coat_normal", "vector3", nm))
+        if "sheenColor" in written:
+            out.append(("fuzz_weight", "float", ("value", 1.0)))
+            out.append(("fuzz_color", "color3", self.color(f["sheenColor"])))
+        if "sheenColor" in written or "sheenRoughness" in written:  # its default is 0.5
+            out.append(("fuzz_roughness", "float", f["sheenRoughness"].ref()))
+            self.note("sheenColor: written as OpenPBR's fuzz, whose lobe is its own (a "
+                      "layer that also dims what is under it); approximated")
+        if "subsurface" in written and "subsurfaceColor" not in written:
+            out.append(("subsurface_color", "color3", ("value", [1.0, 1.0, 1.0])))
+        if "subsurface" in written or "subsurfaceRadius" in written or "thickness" in written:
+            # the mean free path radius x scale against our thickness 1: the shading reads
+            # radius / thickness only (docs/shading.md, Subsurface)
+            out.append(("subsurface_radius_scale", "color3", self.color(f["subsurfaceRadius"])))
+            out.append(("subsurface_radius", "float", self.inverse_thickness(f["thickness"])))
+            if "thickness" in written:
+                self.note("thickness: OpenPBR has no part thickness; folded into "
+                          "subsurface_radius (1 / thickness), which keeps radius / thickness, "
+                          "all our shading reads; the thickness itself reads back as 1")
+        if "thinFilmThickness" in written:
+            out.append(("thin_film_weight", "float", ("value", 1.0)))
+            out.append(("thin_film_thickness", "float", self.scaled(
+                f["thinFilmThickness"], 1e-3, "thin_film_um")))
+            if "thinFilmIor" not in written:  # OpenPBR's default is 1.4, ours 1.3
+                out.append(("thin_film_ior", "float", ("value", 1.3)))
+        if "anisotropyDirection" in written:
+            out.append(("geometry_tangent", "vector3", self.rotated_tangent(f)))
+        out += self._transmission(f, written, "transmission_weight", "transmission_color",
+                                  "transmission_depth")
+        if THIN_WALLED_DEFINE in self.ir.defines:
+            out.append(("geometry_thin_walled", "boolean", ("value", True)))
+        self._anisotropy_note(written, "specular_roughness_anisotropy")
+        self._cavity_note(f, written, ("coat", "sheenColor", "subsurface", "transmission"))
+        return out
+
+    def _gltf(self, f: dict, written: set) -> list:
+        """glTF's PBR (KHR_materials_* as MaterialX's gltf_pbr): cavity as occlusion, the
+        clearcoat, sheen, specular, transmission and volume, iridescence (nm, weight 1) and
+        anisotropy (rotation in radians); no subsurface, coat colour or coat IOR."""
+        out = self._common(f, written, {"baseColor": "base_color", "metallic": "metallic",
+                                        "roughness": "roughness", "normal": "normal"})
+        if "cavity" in written:
+            out.append(("occlusion", "float", f["cavity"].ref()))
+            if not self._is(f["cavity"], 1.0):
+                self.note("cavity: written as gltf_pbr's occlusion, which darkens indirect "
+                          "light only (ours all lighting); approximated")
+        out += self._emission(f, written, "emissive", "emissive_strength", 1.0)
+        op = self._opacity(f, written, "alpha", "float")
+        if op:
+            out += op + [("alpha_mode", "integer", ("value", 2))]  # BLEND
+        plain = (("specularColor", "specular_color", "color3"), ("ior", "ior", "float"),
+                 ("coat", "clearcoat", "float"), ("coatRoughness", "clearcoat_roughness", "float"),
+                 ("sheenColor", "sheen_color", "color3"),
+                 ("anisotropy", "anisotropy_strength", "float"),
+                 ("transmission", "transmission", "float"),
+                 ("attenuationColor", "attenuation_color", "color3"),
+                 ("attenuationDistance", "attenuation_distance", "float"),
+                 ("thinFilmIor", "iridescence_ior", "float"))
+        for ours, theirs, t in plain:
+            if ours in written:
+                out.append((theirs, t, self.color(f[ours]) if t == "color3" else f[ours].ref()))
+        if "sheenColor" in written or "sheenRoughness" in written:  # its default is 0
+            out.append(("sheen_roughness", "float", f["sheenRoughness"].ref()))
+        if "coatNormal" in written:
+            nm = self.normal_map(f["coatNormal"], "coat_normal")
+            if nm is not None:
+                out.append(("clearcoat_normal", "vector3", nm))
+        if "thinFilmThickness" in written:
+            out.append(("iridescence", "float", ("value", 1.0)))
+            out.append(("iridescence_thickness", "float", f["thinFilmThickness"].ref()))
+        if "anisotropyDirection" in written:
+            out.append(("anisotropy_rotation", "float", ("value", self.direction_angle(f))))
+        if THIN_WALLED_DEFINE in self.ir.defines:  # glTF's thin-walled: thickness 0
+            out.append(("thickness", "float", ("value", 0.0)))
+        elif "thickness" in written or "transmission" in written:
+            out.append(("thickness", "float", f["thickness"].ref()))  # 0 would be thin
+        for ours in ("coatColor", "coatIor", "subsurface", "subsurfaceColor",
+                     "subsurfaceRadius", "transmissionColor"):
+            if ours in written and not (ours == "coatIor" and self._is(f[ours], 1.5)):
+                self.note(f"{ours}: gltf_pbr has no counterpart; dropped")
+        if "thickness" in written and "subsurface" in written:
+            self.note("thickness: written as gltf_pbr's volume thickness; its subsurface "
+                      "meaning is dropped with the subsurface")
+        self._anisotropy_note(written, "anisotropy_strength")
+        return out
+
+    def scaled(self, v: V, k: float, hint: str) -> tuple:
+        r = v.ref()
+        if r[0] == "value":
+            return ("value", float(np.ravel(r[1])[0]) * k)
+        return self.node("multiply", "float", hint, [("in1", r, "float"),
+                                                     ("in2", ("value", k), "float")])
+
+    def rotated_tangent(self, f: dict) -> tuple:
+        """OpenPBR's geometry_tangent for the tangent-space anisotropy direction: for a
+        constant, the world tangent rotated about the world normal by its angle (degrees,
+        rotate3d's unit; MaterialX's rotate3d turns clockwise about its axis, so the amount
+        is negated); for a varying one, the direction in world space, normalize(T x +
+        B y + N z) of the world tangent, bitangent and normal."""
+        t = self.node("tangent", "vector3", "tangent", strings=[("space", "world")])
+        n = self.node("normal", "vector3", "normal_axis", strings=[("space", "world")])
+        d = f["anisotropyDirection"]
+        if d.ref()[0] != "value":
+            b = self.node("bitangent", "vector3", "bitangent", strings=[("space", "world")])
+            terms = [self.node("multiply", "vector3", f"aniso_{axis}",
+                               [("in1", g, "vector3"),
+                                ("in2", self._extract(d.ref(), PortType.VEC3, i, "aniso"),
+                                 "float")])
+                     for i, (axis, g) in enumerate(zip("tbn", (t, b, n)))]
+            tb = self.node("add", "vector3", "aniso_tb", [("in1", terms[0], "vector3"),
+                                                          ("in2", terms[1], "vector3")])
+            s = self.node("add", "vector3", "aniso_tbn", [("in1", tb, "vector3"),
+                                                          ("in2", terms[2], "vector3")])
+            return self.node("normalize", "vector3", "anisotropy_tangent",
+                             [("in", s, "vector3")])
+        deg = -math.degrees(self.direction_angle(f))
+        return self.node("rotate3d", "vector3", "anisotropy_tangent",
+                         [("in", t, "vector3"), ("amount", ("value", deg), "float"),
+                          ("axis", n, "vector3")])
+
+    def normal_map(self, v: V, hint: str) -> tuple | None:
+        """A tangent-space normal as standard_surface's world normal: encoded to [0, 1] into
+        a normalmap node; None for the constant +Z (the surface's own normal)."""
+        n = v.ref()
+        if n[0] == "value" and tuple(n[1]) == (0.0, 0.0, 1.0):
+            return None
+        enc = self.node("add", "vector3", f"{hint}_encode", [
+            ("in1", self.node("multiply", "vector3", f"{hint}_half",
+                              [("in1", n, "vector3"), ("in2", ("value", 0.5), "float")]),
+             "vector3"), ("in2", ("value", 0.5), "float")])
+        return self.node("normalmap", "vector3", f"{hint}_map", [("in", enc, "vector3")])
 
     def inverse_thickness(self, v: V) -> tuple:
         """Our thickness as standard_surface's subsurface_scale, 1 / thickness: the shading
@@ -734,11 +1040,23 @@ def validate(text: str) -> tuple[bool, str]:
     return bool(ok), msg
 
 
-def export_ir(ir: MaterialIR, out: Path, size: int, stem: str,
-              texture_files: dict[str, str] | None = None) -> MtlxExport:
+def side_folder(out: Path) -> str:
+    """The folder of an export's side files (baked maps, texture copies), beside OUT.mtlx:
+    OUT_textures."""
+    return safe_name(f"{Path(out).stem}_textures")
+
+
+def export_ir(ir: MaterialIR, out: Path, size: int, stem: str, kind: str = DEFAULT_SURFACE,
+              fmt: str = "png", zip_it: bool = False, texture_files: dict[str, str] | None = None,
+              side: str | None = None) -> MtlxExport:
     """`texture_files`: texture name -> the file value its image nodes get (where a caller
-    copies the texture beside the document under another name)."""
-    ex = _Exporter(ir, size, Path(out).parent, stem)
+    copies the texture itself, under another name); `side`: the folder of the side files
+    beside OUT ("" for none: beside it; default OUT_textures)."""
+    if kind not in SURFACE_KINDS:
+        raise MtlxExportError(f"surface {kind!r}: not one of {', '.join(SURFACE_KINDS)}")
+    out = Path(out)
+    ex = _Exporter(ir, size, out.parent, stem, kind, fmt,
+                   side_folder(out) if side is None else side)
     ex.texture_files = dict(texture_files or {})
     try:
         (attrs,) = ex.scope(ir.main, {}, "")
@@ -752,27 +1070,102 @@ def export_ir(ir: MaterialIR, out: Path, size: int, stem: str,
     if not ok:
         raise MtlxExportError(f"{out}: the MaterialX document does not validate: "
                               f"{' '.join(msg.split())[:300]}")
-    return MtlxExport(Path(out), text, ex.images, ex.baked)
+    notes = list(ex.notes)
+    if ex.images:
+        notes.append(f"{len(ex.images)} baked map(s) at {size} x {size} texels "
+                     f"({', '.join(sorted({p.suffix[1:].upper() for p in ex.images}))}; "
+                     "--size N to change)")
+        notes += detail_notes(ir, ex, size, stem, kind, fmt)
+    return MtlxExport(out, text, ex.images, ex.baked, ex.copies, notes,
+                      out.with_suffix(".zip") if zip_it else None)
 
 
-def export(doc, resolver, out: Path, size: int = 512) -> MtlxExport:
+def detail_notes(ir: MaterialIR, ex: _Exporter, size: int, stem: str, kind: str,
+                 fmt: str) -> list[str]:
+    """A note per baked map with detail finer than its texels: a band of DETAIL_ROWS rows
+    in the middle is baked again at 2 x size; where that finer bake, averaged over each
+    texel's 2 x 2 sub-texels, differs from the bake by an RMS above DETAIL_RMS of the map's
+    range, the bake has lost (or aliased) detail, and --size 2N is suggested."""
+    rows = min(size, DETAIL_ROWS)
+    j0 = (size - rows) // 2
+    fine = _Exporter(ir, 2 * size, ex.folder, stem, kind, "exr", ex.side,
+                     rows=(2 * j0, 2 * (j0 + rows)))
+    (attrs,) = fine.scope(ir.main, {}, "")
+    fine.surface(attrs)  # makes the same images, in the same order, under the same names
+    out = []
+    by_name = {p.with_suffix("").name: img for p, img in fine.images.items()}
+    for path, img in ex.images.items():
+        f = by_name.get(path.with_suffix("").name)
+        if f is None:
+            continue
+        coarse = img.pixels[j0:j0 + rows].astype(np.float64)
+        x = f.pixels.astype(np.float64)
+        down = x.reshape(rows, 2, size, 2, -1).mean(axis=(1, 3))
+        span = float(np.nanmax(img.pixels) - np.nanmin(img.pixels))
+        rms = float(np.sqrt(np.nanmean((down - coarse) ** 2)))
+        if rms > DETAIL_RMS * max(span, 1e-6):
+            out.append(f"{path.name}: detail finer than its {size} x {size} texels (a 2x "
+                       f"bake differs by RMS {rms / max(span, 1e-6):.2%} of its range); "
+                       f"try --size {2 * size}")
+    return out
+
+
+def export(doc, resolver, out: Path, size: int = 512, kind: str = DEFAULT_SURFACE,
+           fmt: str = "png", zip_it: bool = False) -> MtlxExport:
     """The MaterialX export of a material document (raises CompileError, MtlxExportError)."""
     from matedit.compiler.lower import lower_document
     from matedit.interop.export import stem_of
 
     ir = lower_document(doc, resolver)
-    return export_ir(ir, Path(out), size, stem_of(doc))
+    return export_ir(ir, Path(out), size, stem_of(doc), kind, fmt, zip_it)
+
+
+def _encode(path: Path, img: BakedImage) -> None:
+    """One baked map: an 8-bit PNG (sRGB-encoded for a colour map) or a float EXR."""
+    from matedit.interop.bake import BakedMap, encode_file, linear_to_srgb
+
+    px = img.pixels.astype(np.float64)
+    encode_file(path, BakedMap(path.stem, linear_to_srgb(px) if img.colour else px,
+                               img.colour))
 
 
 def write(result: MtlxExport) -> None:
-    """The document and its baked images, together or not at all (the document last)."""
-    from matedit.interop.bake import BakedMap, encode_file
-    from matedit.io.atomic import atomic_write_text, staged_outputs
+    """The document and its side files (baked maps, texture copies) in OUT_textures, the
+    document last, each folder's files together or none; or, with `zip`, one archive of
+    them all by their relative names (written whole or not at all)."""
+    from matedit.io.atomic import atomic_write_bytes, atomic_write_text, staged_outputs
 
-    if not result.images:
-        atomic_write_text(result.out, result.text)
+    out = result.out
+    folder = out.parent
+    if result.zip is not None:
+        import io
+        import tempfile
+        import zipfile
+
+        buf = io.BytesIO()
+        with tempfile.TemporaryDirectory() as tmp, \
+                zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+            z.writestr(safe_name(out.name), result.text)
+            for path, img in result.images.items():
+                staged = Path(tmp) / path.name
+                _encode(staged, img)
+                z.writestr(path.relative_to(folder).as_posix(), staged.read_bytes())
+            for dest, src in result.copies.items():
+                z.writestr(dest.relative_to(folder).as_posix(),
+                           read_bounded(src, MAX_TEXTURE_BYTES))
+        atomic_write_bytes(result.zip, buf.getvalue())
         return
-    with staged_outputs(result.out.parent) as stage:
-        for path, arr in result.images.items():
-            encode_file(stage.path(path), BakedMap(path.stem, arr, False))
-        stage.write_text(result.out, result.text)
+    side = [*result.images, *result.copies]
+    if not side:
+        atomic_write_text(out, result.text)
+        return
+    side_dir = side[0].parent
+    with staged_outputs(folder) as stage:
+        stage.write_text(out, result.text)  # written first, moved into place last
+        if side_dir.is_symlink():  # a link planted at the folder's name is replaced
+            side_dir.unlink()
+        with staged_outputs(side_dir) as files:
+            for path, img in result.images.items():
+                _encode(files.path(path), img)
+            for dest, src in result.copies.items():
+                files.write_bytes(dest, read_bounded(src, MAX_TEXTURE_BYTES))

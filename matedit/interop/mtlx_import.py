@@ -92,6 +92,8 @@ LOBES: dict[str, dict[str, tuple[str, str | None]]] = {
         "coatNormal": ("geometry_coat_normal", None), "sheenColor": ("fuzz_color", "fuzz_weight"),
         "sheenRoughness": ("fuzz_roughness", None),
         "anisotropy": ("specular_roughness_anisotropy", None),
+        # the tangent rotated about the normal by a constant angle (our export's)
+        "anisotropyDirection": ("geometry_tangent", None),
         # the mean free path subsurface_radius x subsurface_radius_scale, at our thickness 1
         "subsurface": ("subsurface_weight", None), "subsurfaceColor": ("subsurface_color", None),
         "subsurfaceRadius": ("subsurface_radius_scale", "subsurface_radius"),
@@ -1217,6 +1219,12 @@ class _Importer:
             if attr == "coatNormal":
                 self.normal(shader, inp, cat in WORLD_NORMAL, make, "coatNormal")
                 continue
+            if inp == "geometry_tangent":
+                d = self.tangent_direction(shader, inp)
+                if d is not None:  # else not read: the rule warns it dropped
+                    self.mapped.add(inp)
+                    self.connect(d, make, attr)
+                continue
             src = self.surface_input(shader, inp)
             if src is None:
                 continue
@@ -1259,6 +1267,76 @@ class _Importer:
                     self.connect(src, mul, "a")
                     src = Src(mul, "result", width=src.width)
             self.connect(src, make, attr)
+
+    def tangent_direction(self, shader, name: str) -> Src | None:
+        """OpenPBR's geometry_tangent as our export writes it (`tangent_rotation` for a
+        constant direction; normalize(T x + B y + N z) of the world tangent, bitangent and
+        normal for a varying one, whose x, y, z extract one source: that source, our
+        tangent-space direction); None for any other tangent."""
+        angle = self.tangent_rotation(shader, name)
+        if angle is not None:
+            return Src(value=[math.cos(angle), math.sin(angle), 0.0], width=3)
+        inp = shader.getInput(name)
+        ng = self.mxdoc.getNodeGraph(inp.getNodeGraphString()) if inp is not None and \
+            inp.getNodeGraphString() else None
+        o = ng.getOutput(inp.getOutputString()) if ng is not None else None
+        up = ng.getNode(o.getNodeName()) if o is not None and o.getNodeName() else None
+
+        def node(n, port):
+            i = n.getInput(port) if n is not None else None
+            return i.getConnectedNode() if i is not None else None
+
+        if up is None or up.getCategory() != "normalize":
+            return None
+        tbn = node(up, "in")
+        tb = node(tbn, "in1")
+        terms = [node(tb, "in1"), node(tb, "in2"), node(tbn, "in2")]
+        if tbn is None or tb is None or tbn.getCategory() != "add" or tb.getCategory() != "add":
+            return None
+        sources = []
+        for i, (term, geo) in enumerate(zip(terms, ("tangent", "bitangent", "normal"))):
+            g, ex = node(term, "in1"), node(term, "in2")
+            if term is None or term.getCategory() != "multiply" or g is None or \
+                    g.getCategory() != geo or g.getInputValue("space") not in (None, "world") \
+                    or ex is None or ex.getCategory() != "extract" or \
+                    self.index(ex, f"node {self.name_of(ex)}") != i:
+                return None
+            sources.append(node(ex, "in"))
+        if sources[0] is None or any(s != sources[0] for s in sources):
+            return None
+        return self.input_src(terms[0].getInput("in2").getConnectedNode(), "in", 1)
+
+    def tangent_rotation(self, shader, name: str) -> float | None:
+        """OpenPBR's geometry_tangent as our export writes it, the world tangent rotated
+        about the world normal by a constant angle (a rotate3d node, which turns clockwise
+        about its axis): our anisotropy direction's angle, anticlockwise from the tangent, in
+        radians; None for any other tangent."""
+        inp = shader.getInput(name)
+        up = None
+        if inp is not None and inp.getNodeGraphString():
+            ng = self.mxdoc.getNodeGraph(inp.getNodeGraphString())
+            o = ng.getOutput(inp.getOutputString()) if ng is not None else None
+            up = ng.getNode(o.getNodeName()) if o is not None and o.getNodeName() else None
+        if up is None or up.getCategory() != "rotate3d":
+            return None
+
+        def source(port: str) -> str:
+            i = up.getInput(port)
+            n = i.getConnectedNode() if i is not None else None
+            if n is None or n.getInputValue("space") not in (None, "world"):
+                return ""
+            return n.getCategory()
+
+        amount = up.getInput("amount")
+        if source("in") != "tangent" or source("axis") != "normal" or amount is None \
+                or connected(amount):
+            return None
+        try:
+            deg = _floats(amount.getValueString(), f"node {self.name_of(up)}: input amount")
+        except ValueError as exc:
+            self.err(str(exc))
+            return None
+        return -math.radians(deg[0])  # rotate3d turns clockwise about its axis
 
     def normal(self, shader, name: str, world: bool, make: str, port: str = "normal") -> None:
         inp = shader.getInput(name)

@@ -92,8 +92,9 @@ def document() -> str:
         "",
         "Generated from the node catalogue (`NodeDef.mtlx` in matedit/nodes/) by",
         "`docs/materialx.py`; a test fails when it is out of date. `matedit export OUT.mtlx`",
-        "(see [cli.md](cli.md)) writes a MaterialX 1.39 nodegraph feeding one",
-        "`standard_surface`. Each kind is exported one of three ways:",
+        "(see [cli.md](cli.md)) writes a MaterialX 1.39 nodegraph feeding one surface",
+        "shader (`open_pbr_surface` by default, `standard_surface` or `gltf_pbr`: see",
+        "Export, below). Each kind is exported one of three ways:",
         "",
         "- **maps**: one stdlib node (its inputs named, ours→MaterialX's) or a recipe, a few",
         "  stdlib nodes that compute the same thing (written beside the kind in its category",
@@ -102,7 +103,8 @@ def document() -> str:
         "  tests/test_interop_mtlx.py. A kind with no mapping the exporter can write is",
         "  refused by name.",
         "- **bakes**: not expressible node for node; the export evaluates its outputs over UV",
-        "  space into EXR images read by `image` nodes, and reports each baked node.",
+        "  space into maps in `OUT_textures/` (8-bit PNG, sRGB for a colour map, or float",
+        "  EXR) read by `image` nodes, and reports each baked node.",
         "- **lowered**: never reaches the exporter; the compiler turns it into interface",
         "  inputs (parameters), values (constants), inlined calls and blends.",
         "",
@@ -124,9 +126,74 @@ def document() -> str:
     lines += [", ".join(f"`{k}`" for k in baked), ""]
     lines += ["## Kinds lowered before export", ""]
     lines += [", ".join(f"`{k}`" for k in lowered), ""]
+    lines += _EXPORT_TEXT
     lines += _TRANSMISSION_TEXT
     return "\n".join(lines)
 
+
+# Each attribute field on the three surfaces the export writes (matedit.interop.mtlx_export;
+# tests/test_interop_mtlx_surfaces.py holds the round trip to it).
+_EXPORT_TEXT = [
+    "## Export: the three surfaces",
+    "",
+    "`--surface` picks the surface shader. Every field goes to the input of the same",
+    "meaning (a lobe's inputs only where the graph writes the lobe), and the import reads it",
+    "back within 1e-6, except where the table says otherwise; each such field is a `note:`",
+    "line on export. The anisotropy's roughness stretch is each surface's own on all three",
+    "(ours: α (1 + a) along the direction, α (1 − a) across), noted as approximated.",
+    "",
+    "| field | open_pbr_surface | standard_surface | gltf_pbr |",
+    "|---|---|---|---|",
+    "| baseColor | `base_color` | `base_color` | `base_color` |",
+    "| metallic | `base_metalness` | `metalness` | `metallic` |",
+    "| roughness | `specular_roughness` | `specular_roughness` | `roughness` |",
+    "| cavity | `base_weight` and `specular_weight` | `base` and `specular` | `occlusion`"
+    " (indirect light only: noted) |",
+    "| normal | `geometry_normal` (a `normalmap`) | `normal` (a `normalmap`) | `normal`"
+    " (a `normalmap`) |",
+    "| emissive | `emission_color`, `emission_luminance` 1000 | `emission_color`,"
+    " `emission` 1 | `emissive` |",
+    "| opacity | `geometry_opacity` | `opacity` (grey) | `alpha`, `alpha_mode` 2 (BLEND) |",
+    "| specularColor | `specular_color` | `specular_color` | `specular_color` |",
+    "| ior | `specular_ior` | `specular_IOR` | `ior` |",
+    "| coat, coatRoughness | `coat_weight`, `coat_roughness` | `coat`, `coat_roughness` |"
+    " `clearcoat`, `clearcoat_roughness` |",
+    "| coatColor | `coat_color` | `coat_color` | none: noted, dropped |",
+    "| coatIor | `coat_ior` (1.5 written, its default 1.6) | `coat_IOR` | none (glTF's"
+    " is 1.5): noted unless 1.5 |",
+    "| coatNormal | `geometry_coat_normal` | `coat_normal` | `clearcoat_normal` |",
+    "| sheenColor, sheenRoughness | `fuzz_color` (`fuzz_weight` 1), `fuzz_roughness`:"
+    " noted (OpenPBR's fuzz is its own lobe) | `sheen_color` (`sheen` 1), `sheen_roughness`"
+    " | `sheen_color`, `sheen_roughness` |",
+    "| anisotropy | `specular_roughness_anisotropy` | `specular_anisotropy` |"
+    " `anisotropy_strength` |",
+    "| anisotropyDirection | `geometry_tangent`: a constant as the world tangent turned"
+    " about the normal by its angle (`rotate3d`), a varying one as normalize(T x + B y +"
+    " N z) | `specular_rotation` (turns; a constant) | `anisotropy_rotation` (radians; a"
+    " constant) |",
+    "| subsurface, subsurfaceColor | `subsurface_weight`, `subsurface_color` |"
+    " `subsurface`, `subsurface_color` | none: noted, dropped |",
+    "| subsurfaceRadius, thickness | `subsurface_radius_scale` = radius,"
+    " `subsurface_radius` = 1 / thickness: radius / thickness kept, the thickness reads"
+    " back as 1 (noted) | `subsurface_radius`, `subsurface_scale` = 1 / thickness |"
+    " radius none (noted); `thickness` (the volume's; 0 where thin-walled) |",
+    "| thinFilmThickness | `thin_film_thickness` in µm, `thin_film_weight` 1 |"
+    " `thin_film_thickness` (nm) | `iridescence_thickness` (nm), `iridescence` 1 |",
+    "| thinFilmIor | `thin_film_ior` | `thin_film_IOR` | `iridescence_ior` |",
+    "| transmission | `transmission_weight` | `transmission` | `transmission` |",
+    "| transmissionColor | `transmission_color` (no depth) | `transmission_color`"
+    " (no depth) | none: noted, dropped |",
+    "| attenuationColor, attenuationDistance | `transmission_color`,"
+    " `transmission_depth` | `transmission_color`, `transmission_depth` |"
+    " `attenuation_color`, `attenuation_distance` |",
+    "| thin_walled (the output's) | `geometry_thin_walled` | `thin_walled` | `thickness` 0 |",
+    "",
+    "A varying anisotropy direction is refused by name on standard_surface and gltf_pbr",
+    "(their rotation inputs take a constant here). Baked maps and copies",
+    "of the textures the material reads go into `OUT_textures/` beside the document,",
+    "named by relative paths (docs/cli.md, export).",
+    "",
+]
 
 # The surface inputs of the transmission lobe (matedit.interop.mtlx_export / mtlx_import).
 _TRANSMISSION_TEXT = [
@@ -215,7 +282,11 @@ _TRANSMISSION_TEXT = [
     "  `fuzz_color`, `fuzz_roughness`, `emission_luminance` (1000 nits is our emissive 1),",
     "  `geometry_opacity`, `geometry_normal`, `geometry_coat_normal`, `subsurface_weight`,",
     "  `subsurface_radius` × `subsurface_radius_scale`, `thin_film_thickness` (µm) ×",
-    "  `thin_film_weight` (0 or 1), `thin_film_ior`).",
+    "  `thin_film_weight` (0 or 1), `thin_film_ior`, and `geometry_tangent` where it is",
+    "  our export's: the world tangent turned about the world normal by a constant",
+    "  `rotate3d`, whose amount turns clockwise, or normalize(T x + B y + N z) of the world",
+    "  tangent, bitangent and normal, read as the anisotropy direction; any other tangent",
+    "  warns, dropped).",
     "- **gltf_pbr**: `base_color`, `metallic`, `roughness`, `normal`, `emissive` ×",
     "  `emissive_strength`, `alpha` under `alpha_mode` 2 (BLEND), `ior`, `specular_color`,",
     "  `transmission`, `thickness` (0: thin-walled where it transmits),",
@@ -251,7 +322,8 @@ _TRANSMISSION_TEXT = [
     "`coat_roughness_anisotropy`), `subsurface_anisotropy`",
     "(`subsurface_scatter_anisotropy`), `transmission_dispersion`,",
     "`transmission_extra_roughness`, `transmission_scatter` and its anisotropy, OpenPBR's",
-    "`transmission_dispersion_scale` and `_abbe_number`, `tangent`; gltf_pbr's `alpha`",
+    "`transmission_dispersion_scale` and `_abbe_number`, `tangent` (OpenPBR's",
+    "`geometry_tangent` but the rotation above); gltf_pbr's `alpha`",
     "under `alpha_mode` 0 (OPAQUE ignores it) and",
     "`dispersion`; UsdPreviewSurface's `useSpecularWorkflow`, `specularColor`,",
     "`opacityThreshold`, `displacement`; a `surfacematerial`'s `displacementshader`; a",

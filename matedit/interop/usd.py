@@ -470,8 +470,9 @@ def export_baked(doc, resolver, attrs: dict[str, np.ndarray], ir, mesh, out: Pat
     mtlx = None
     try:
         copies = texture_copies(lowered, out)
-        mx = mtlx_export.export_ir(lowered, out, size, file_stem(out),
-                                   {name: file for name, (file, _) in copies.items()})
+        mx = mtlx_export.export_ir(  # its bakes as EXR beside the layer, like the copies
+            lowered, out, size, file_stem(out), "standard_surface", "exr",
+            texture_files={name: file for name, (file, _) in copies.items()}, side="")
         mtlx = MtlxPart(mx.text, {p.name: a for p, a in mx.images.items()},
                         dict(copies.values()))
         notes += [f"node {node}: baked to an image for the MaterialX network ({why})"
