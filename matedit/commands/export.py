@@ -65,6 +65,9 @@ def run(args) -> int:
     if kind == ".mtlx":
         if args.mesh:
             raise UsageError("--mesh applies to glTF and USD exports only")
+        if args.zip and args.check:
+            raise UsageError("--check reads back the .mtlx it wrote; with --zip there is "
+                             "none: export without --zip to check it")
         return _mtlx(args, out)
     for flag, given in (("--surface", args.surface != "open_pbr_surface"),
                         ("--format", args.format != "png"), ("--zip", args.zip)):
