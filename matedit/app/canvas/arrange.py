@@ -18,6 +18,7 @@ functions, and tests/test_sample_layouts.py checks them with `layout_problems`.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterable
 from graphlib import TopologicalSorter
 
@@ -32,6 +33,7 @@ V_GAP = 36.0  # between nodes in a column
 LANE = 22.0  # the height a wire crossing a column reserves there
 GRID = 10.0  # positions are rounded to this
 REPAIR_LIMIT = 400  # moves tried by `repair` before it gives up
+REPAIR_SECONDS = 2.0  # and the time it may take (a large imported graph)
 
 NODE_MARGIN = 6.0  # scene units kept clear around each node's bounding rect (ports included)
 WIRE_STEPS = 200  # samples along each wire
@@ -58,11 +60,16 @@ def layout_problems(scene, ids: Iterable[str] | None = None) -> list[str]:
     lo, hi = int(END_ALLOWANCE * WIRE_STEPS), int((1 - END_ALLOWANCE) * WIRE_STEPS)
     for link, wire in sorted(scene.wire_items.items(), key=lambda kv: str(kv[0])):
         path = wire.mapToScene(wire.path())
+        box = path.boundingRect()  # only the bodies the wire's box reaches can be crossed
+        near = [(nid, body) for nid, body in bodies.items()
+                if nid not in (link.src, link.dst) and body.intersects(box)]
+        if not near:
+            continue
         hit = set()
         for k in range(lo, hi + 1):
             pt = path.pointAtPercent(k / WIRE_STEPS)
-            for nid, body in bodies.items():
-                if nid not in (link.src, link.dst) and body.contains(pt):
+            for nid, body in near:
+                if body.contains(pt):
                     hit.add(nid)
         for nid in sorted(hit):
             if nid in keep or link.src in keep or link.dst in keep:
@@ -223,7 +230,10 @@ def repair(scene, col: dict[str, int], limit: int = REPAIR_LIMIT) -> list[str]:
             items[n].setPos(items[n].pos().x(), items[n].pos().y() - dy)
 
     problems = layout_problems(scene, ids)
+    deadline = time.perf_counter() + REPAIR_SECONDS
     for _ in range(limit):
+        if time.perf_counter() > deadline:  # a large graph: what is left stays, reported
+            break
         candidates = []
         for problem in problems:
             candidates = _candidates(problem, items, links, ids)
