@@ -361,10 +361,10 @@ class _GltfImporter(_Importer):
     def transform(self, offset, rotation: float, scale) -> Src:
         """KHR_texture_transform in our UVs: glTF's v runs down the image, ours up (v_gltf =
         1 - v), so uv' = F(T R S F(uv)) with F the flip (u, 1 - v): Tiling and Offset (scale,
-        folded with the first flip), Rotate UV (glTF turns by -rotation in our frame) and
-        Tiling and Offset (the offset, folded with the second flip)."""
+        folded with the first flip: a Texture Coordinate's tiling and offset), Rotate UV (glTF
+        turns by -rotation in our frame) and Multiply Add (the offset, with the second flip)."""
         sx, sy = scale
-        first = self.add("uv_scale", _kind("multiply_then_add"),
+        first = self.add("uv_scale", _kind("tiled_texcoord"),
                          values={"tiling": [sx, -sy], "offset": [0.0, sy]}, depth=4)
         src = Src(first, "uv", width=2)
         if rotation != 0.0:
@@ -374,10 +374,9 @@ class _GltfImporter(_Importer):
             self.connect(src, rot, "uv")
             src = Src(rot, "uv", width=2)
         last = self.add("uv_offset", _kind("multiply_then_add"),
-                        values={"tiling": [1.0, -1.0], "offset": [offset[0], 1.0 - offset[1]]},
-                        depth=4)
-        self.connect(src, last, "uv")
-        return Src(last, "uv", width=2)
+                        values={"b": [1.0, -1.0], "c": [offset[0], 1.0 - offset[1]]}, depth=4)
+        self.connect(src, last, "a")
+        return Src(last, "result", width=2)
 
     def sampler(self, index: Any, where: str) -> None:
         if index is None:
@@ -797,12 +796,12 @@ class _GltfImporter(_Importer):
             return
         # the texture's direction 2 rg - 1, turned by the rotation, in the tangent plane
         dec = self.add("anisotropy_decode", _kind("multiply_then_add"),
-                       values={"tiling": [2.0, 2.0], "offset": [-1.0, -1.0]}, depth=1)
+                       values={"b": [2.0, 2.0], "c": [-1.0, -1.0]}, depth=1)
         rg = self.add("anisotropy_rg", kind_for(Role.COMPONENT_MASK), {"channels": "xy"},
                       depth=1)
         self.connect(Src(sample, "rgb", width=3), rg, "value")
-        self.connect(Src(rg, "result", width=2), dec, "uv")
-        src = Src(dec, "uv", width=2)
+        self.connect(Src(rg, "result", width=2), dec, "a")
+        src = Src(dec, "result", width=2)
         if rotation != 0.0:
             rot = self.add("anisotropy_rotate", _kind("rotate_about_pivot"),
                            values={"angle": math.degrees(rotation), "pivot": [0.0, 0.0]},
