@@ -45,8 +45,8 @@ def register(sub) -> None:
                    help="one material to OUT.json, or every material (or the one named) to "
                    "DIR/NAME.json")
     p.add_argument("--material", metavar="NAME",
-                   help="the surfacematerial (or glTF material) to import (required for OUT.json when the "
-                   "document holds several)")
+                   help="the surfacematerial (or glTF material) to import (required for "
+                   "OUT.json when the document holds several)")
     p.add_argument("--overwrite", action="store_true",
                    help="with -o DIR: replace DIR/NAME.json files that exist already "
                    "(without it they are an error and nothing is written)")

@@ -52,6 +52,7 @@ MAX_TEXTURES = 4096
 SHEEN_MIN_ROUGHNESS = 0.3  # where our sheen clamps its roughness (docs/shading.md, Sheen)
 
 _kind = mtlx_map.kind_mapped_to
+_ARITH = mtlx_map.arithmetic()
 # The samplers the renderer uses for every texture (matedit/render/textures.py).
 _SUPPORTED_SAMPLER = {"magFilter": (None, g.LINEAR),
                       "minFilter": (None, g.LINEAR_MIPMAP_LINEAR),
@@ -340,7 +341,7 @@ class _GltfImporter(_Importer):
         tex = textures[index]
         self.unknown_keys(tex, {"sampler", "source", "name", "extensions"},
                           f"{where}: texture {index}: ")
-        for name, ext in (tex.get("extensions") or {}).items():
+        for name in tex.get("extensions") or {}:
             self.err(f"material {self.material}: {where}: texture {index}: extension {name} "
                      "(an image format matedit does not read) is not supported")
         self.sampler(tex.get("sampler"), f"{where}: texture {index}: ")
@@ -548,7 +549,7 @@ class _GltfImporter(_Importer):
         src = Src(sample, port, width=width)
         if all(f == 1.0 for f in factor):
             return src
-        mul = self.add(f"{where.split('.')[-1]}_factor", _kind("multiply"),
+        mul = self.add(f"{where.split('.')[-1]}_factor", _ARITH.multiply,
                        values={"b": factor[0] if width == 1 else list(factor)}, depth=1)
         self.connect(src, mul, "a")
         return Src(mul, "result", width=width)
@@ -562,10 +563,10 @@ class _GltfImporter(_Importer):
         sample = self.texture(info, where, False, {"scale"})
         if sample is None:
             return
-        two = self.add(f"{port}_decode", _kind("multiply"),
+        two = self.add(f"{port}_decode", _ARITH.multiply,
                        values={"b": [2.0 * s, 2.0 * s, 2.0]}, depth=1)
         self.connect(Src(sample, "rgb", width=3), two, "a")
-        one = self.add(f"{port}_map", _kind("subtract"), values={"b": [s, s, 1.0]}, depth=1)
+        one = self.add(f"{port}_map", _ARITH.subtract, values={"b": [s, s, 1.0]}, depth=1)
         self.connect(Src(two, "result", width=3), one, "a")
         self.connect(Src(one, "result", width=3), self.make, port)
 
@@ -672,9 +673,9 @@ class _GltfImporter(_Importer):
                   "approximated")
         src = Src(sample, "r")
         if s != 1.0:  # 1 + s (r - 1) = r s + (1 - s)
-            mul = self.add("occlusion_strength", _kind("multiply"), values={"b": s}, depth=1)
+            mul = self.add("occlusion_strength", _ARITH.multiply, values={"b": s}, depth=1)
             self.connect(src, mul, "a")
-            add = self.add("occlusion", _kind("add"), values={"b": 1.0 - s}, depth=1)
+            add = self.add("occlusion", _ARITH.add, values={"b": 1.0 - s}, depth=1)
             self.connect(Src(mul, "result"), add, "a")
             src = Src(add, "result")
         self.set("cavity", src)
@@ -772,7 +773,7 @@ class _GltfImporter(_Importer):
             return None
         if a.node is None and b.node is None:
             return Src(value=[v * b.value[0] for v in a.value], width=a.width)
-        mul = self.add(hint, _kind("multiply"), depth=1)
+        mul = self.add(hint, _ARITH.multiply, depth=1)
         self.connect(a, mul, "a")
         self.connect(b, mul, "b")
         return Src(mul, "result", width=max(a.width, b.width))
