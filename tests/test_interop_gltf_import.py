@@ -619,3 +619,31 @@ def test_the_output_may_not_be_the_asset(tmp_path):
     os.symlink(src, tmp_path / "link.json")
     line = only_one_error(*cli("import", src, "-o", tmp_path / "link.json")[::2])
     assert "glTF asset" in line, line
+
+
+def test_an_image_linked_from_outside_the_folder_is_refused(tmp_path):
+    (tmp_path / "sub").mkdir()
+    secret = tmp_path / "secret.png"
+    secret.write_bytes(png_bytes(np.zeros((1, 1, 3), np.uint8)))
+    os.symlink(secret, tmp_path / "sub" / "inside.png")
+    src = write_json(tmp_path / "sub" / "l.gltf", asset(
+        [{"name": "l", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        [{"uri": "inside.png"}]))
+    line = only_one_error(*cli("import", src, "-o", tmp_path / "sub" / "o.json")[::2])
+    assert "leaves the folder" in line and "inside.png" in line, line
+
+
+@pytest.mark.parametrize("buffer,needle", [
+    ({"byteLength": 1 << 40}, "byteLength"),
+    ({"byteLength": 64, "uri": "data:application/octet-stream;base64,AAAA"}, "but 3 bytes"),
+    ({"byteLength": 8, "uri": "missing.bin"}, "cannot read"),
+    ({"byteLength": 8, "uri": "data:application/octet-stream;base64,!!!!"}, "base64"),
+], ids=["huge", "short", "missing", "bad base64"])
+def test_bad_buffers_are_one_error(tmp_path, buffer, needle):
+    src = write_json(tmp_path / "b.gltf", asset(
+        [{"name": "b", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        [{"bufferView": 0, "mimeType": "image/png"}], buffers=[buffer],
+        bufferViews=[{"buffer": 0, "byteLength": 8}]))
+    line = only_one_error(*cli("import", src, "-o", tmp_path / "o.json")[::2])
+    assert needle in line and "b.gltf" in line, line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.gltf"]
