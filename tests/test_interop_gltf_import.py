@@ -749,3 +749,37 @@ def test_bad_buffers_are_one_error(tmp_path, buffer, needle):
     line = only_one_error(*cli("import", src, "-o", tmp_path / "o.json")[::2])
     assert needle in line and "b.gltf" in line, line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["b.gltf"]
+
+
+def _png_pixels(raw: bytes) -> np.ndarray:
+    """An 8-bit RGBA PNG without filters' pixels, decoded here (filter type 0 rows only)."""
+    import struct
+    import zlib
+
+    at, idat, w = 8, b"", 0
+    while at < len(raw):
+        (n,) = struct.unpack(">I", raw[at:at + 4])
+        kind = raw[at + 4:at + 8]
+        if kind == b"IHDR":
+            w = struct.unpack(">I", raw[at + 8:at + 12])[0]
+        if kind == b"IDAT":
+            idat += raw[at + 8:at + 8 + n]
+        at += 12 + n
+    rows = zlib.decompress(idat)
+    stride = 1 + 4 * w
+    assert all(rows[i] == 0 for i in range(0, len(rows), stride))  # unfiltered rows
+    return np.frombuffer(bytes(b for i, b in enumerate(rows) if i % stride), np.uint8)
+
+
+def test_rgba_maps_are_written_and_read_with_straight_alpha(tmp_path):
+    """glTF's base colour is not premultiplied: the exporter's RGBA PNG stores the colour as
+    given, and matedit reads a PNG's colour as stored (OpenImageIO would otherwise divide
+    on writing and multiply on reading)."""
+    from matedit.io.images import read_image
+
+    px = np.array([[[0.8, 0.4, 0.2, 0.5]]])
+    bake.encode_file(tmp_path / "m.png", bake.BakedMap("m", px, False))
+    assert list(_png_pixels((tmp_path / "m.png").read_bytes())) == [204, 102, 51, 128]
+    (tmp_path / "p.png").write_bytes(png_bytes(np.array([[[255, 228, 34, 121]]], np.uint8)))
+    np.testing.assert_allclose(read_image(tmp_path / "p.png").pixels[0, 0] * 255,
+                               [255, 228, 34, 121], atol=1e-3)
