@@ -30,6 +30,7 @@ import math
 import os
 import struct
 import urllib.parse
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -294,7 +295,7 @@ class _GltfImporter(_Importer):
                 self.warn(f"{where}{k} {shown(v)} is not a property matedit reads; dropped")
 
     # textures ----------------------------------------------------------------------------
-    def texture(self, info: Any, where: str, srgb: bool, extra: set[str] = frozenset()
+    def texture(self, info: Any, where: str, srgb: bool, extra: Collection[str] = ()
                 ) -> str | None:
         """The Texture Sample node of a textureInfo (None after an error)."""
         if not isinstance(info, dict):
@@ -345,7 +346,7 @@ class _GltfImporter(_Importer):
             self.err(f"material {self.material}: {where}: texture {index}: extension {name} "
                      "(an image format matedit does not read) is not supported")
         self.sampler(tex.get("sampler"), f"{where}: texture {index}: ")
-        path = self.image(tex.get("source"), f"{where}: texture {index}")
+        path = self.image_path(tex.get("source"), f"{where}: texture {index}")
         if path is None:
             return None
         pname = self.new_id(f"{where.split('.')[-1]}_{'srgb' if srgb else 'data'}")
@@ -398,7 +399,7 @@ class _GltfImporter(_Importer):
                           "supported (matedit samples with REPEAT and LINEAR_MIPMAP_LINEAR / "
                           "LINEAR); approximated")
 
-    def image(self, index: Any, where: str) -> str | None:
+    def image_path(self, index: Any, where: str) -> str | None:
         """The path, relative to the output's folder, of image `index`: an external file as it
         lies, an embedded one extracted beside the output (`self.images`)."""
         images = _items(self.asset, "images", MAX_TEXTURES)
@@ -538,7 +539,7 @@ class _GltfImporter(_Importer):
 
     # terms ---------------------------------------------------------------------------------
     def term(self, factor: list[float], info: Any, port: str, where: str, srgb: bool,
-             extra: set[str] = frozenset()) -> Src | None:
+             extra: Collection[str] = ()) -> Src | None:
         """factor x texture channel(s) `port` (glTF's rule), or the factor alone."""
         width = len(factor)
         if info is None:
@@ -575,7 +576,7 @@ class _GltfImporter(_Importer):
             self.connect(src, self.make, attr)
 
     # the material ----------------------------------------------------------------------------
-    def build(self, m: dict) -> MaterialDocument:  # type: ignore[override]
+    def build(self, m: dict) -> MaterialDocument:
         self.make = self.add("make", kind_for(Role.MAKE_ATTRIBUTES))
         self.out_node = self.add("out", kind_for(Role.MATERIAL_OUTPUT))
         self.connect(Src(self.make, "attributes"), self.out_node, "attributes")
@@ -621,7 +622,7 @@ class _GltfImporter(_Importer):
                 read[name] = {k: self.prop(ext, k, d, f"extensions.{name}.")
                               for k, d in EXTENSIONS[name].items()}
         self.emissive(m, read.get("KHR_materials_emissive_strength"))
-        self.lobes(read, base)
+        self.extension_lobes(read, base)
         if m.get("doubleSided") not in (None, False):
             self.warn(f"doubleSided {shown(m.get('doubleSided'))}: the preview shades the "
                       "front faces as glTF does; back faces are not shaded with flipped "
@@ -697,7 +698,7 @@ class _GltfImporter(_Importer):
             return
         self.set("emissive", self.term(factor, et, "rgb", "emissiveTexture", True))
 
-    def lobes(self, e: dict[str, dict], base: Src | None) -> None:
+    def extension_lobes(self, e: dict[str, dict], base: Src | None) -> None:
         x = "extensions."
         if "KHR_materials_ior" in e:
             ior = e["KHR_materials_ior"]["ior"]
