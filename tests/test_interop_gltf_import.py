@@ -644,8 +644,12 @@ def test_hostile_image_references_are_one_error(tmp_path, case):
     ('{"asset": {"version": "2.0"}, "materials": [{"alphaMode": "SOMETIMES"}]}', "alphaMode"),
     ('{"asset": {"version": "2.0"}, "extensionsRequired": ["KHR_draco_mesh_compression"]}',
      "KHR_draco_mesh_compression"),
+    ("[" * 100000 + "]" * 100000, "nest more than 64 deep"),
+    ('{"asset": {"version": "2.0"}, "asset": {}}', "appears twice"),
+    ('{"asset": {"version": "2.0"}, "materials": [{"emissiveFactor": [NaN, 0, 0]}]}',
+     "bad JSON"),
 ], ids=["truncated", "array", "version", "materials", "string", "overflow", "alpha",
-        "required"])
+        "required", "deep", "duplicate key", "NaN"])
 def test_malformed_documents_are_one_error(tmp_path, text, needle):
     src = tmp_path / "bad.gltf"
     src.write_text(text)

@@ -173,11 +173,13 @@ def _parse_glb(path: Path, raw: bytes) -> tuple[dict, bytes | None]:
 
 
 def _parse_json(path: Path, raw: bytes) -> dict:
+    """The asset's JSON under matedit's JSON rules (matedit.io.jsontext: UTF-8, no duplicate
+    keys, no NaN, at most 64 levels deep, numbers a 64-bit float holds)."""
+    from matedit.io.jsontext import JSONTextError, parse_json
+
     try:
-        doc = json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
-    except UnicodeDecodeError:
-        raise GltfImportError([f"{path}: not UTF-8 text"]) from None
-    except (ValueError, RecursionError) as exc:
+        doc = parse_json(raw)
+    except JSONTextError as exc:
         msg = " ".join(str(exc).split())[:160]
         raise GltfImportError([f"{path}: not a glTF document (bad JSON: {msg})"]) from None
     if not isinstance(doc, dict) or not isinstance(doc.get("asset"), dict):
@@ -187,10 +189,6 @@ def _parse_json(path: Path, raw: bytes) -> dict:
         raise GltfImportError([f"{path}: asset version {version!r} is not supported (glTF "
                                "2.x only)"])
     return doc
-
-
-def _no_constant(name: str):
-    raise ValueError(f"{name} is not JSON")
 
 
 def load_asset(path: Path) -> Asset:
