@@ -414,6 +414,10 @@ class _GltfImporter(_Importer):
             if target is None:
                 return None
             self.reads.add(target)
+            if not os.path.isfile(target):
+                self.warn(f"{where}: image {index}: uri {uri[:80]!r}: no such file beside "
+                          f"{self.asset.path.name}; the material refers to it (the preview "
+                          "shows a checker)")
             return Path(os.path.relpath(os.path.abspath(target),
                                         os.path.abspath(self.out.parent))).as_posix()
         if isinstance(uri, str):
@@ -622,9 +626,8 @@ class _GltfImporter(_Importer):
         self.emissive(m, read.get("KHR_materials_emissive_strength"))
         self.extension_lobes(read, base)
         if m.get("doubleSided") not in (None, False):
-            self.warn(f"doubleSided {shown(m.get('doubleSided'))}: the preview shades the "
-                      "front faces as glTF does; back faces are not shaded with flipped "
-                      "normals; approximated")
+            self.warn(f"doubleSided {shown(m.get('doubleSided'))} is not supported (a matedit "
+                      "material has no back-face setting); dropped")
         layout(self.mat)
         return self.mat
 
