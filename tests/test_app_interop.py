@@ -20,7 +20,7 @@ def test_file_menu_offers_the_interop_entries(qtbot):
     i = texts.index("&Export Shaders…")
     # HLSL and MSL are targets of Export Shaders, not an entry of their own
     assert texts[i + 1:i + 5] == ["Export &glTF…", "Export &MaterialX…",
-                                  "Export &Baked Textures…", "&Import MaterialX…"]
+                                  "Export &Baked Textures…", "&Import MaterialX or glTF…"]
 
 
 def test_editor_exports_and_imports(qtbot, tmp_path):
@@ -48,6 +48,20 @@ def test_editor_exports_and_imports(qtbot, tmp_path):
     from matedit.app.canvas.arrange import layout_problems
 
     assert [p for p in layout_problems(w.canvas.scene()) if p.startswith("nodes ")] == []
+
+
+def test_editor_imports_gltf_with_its_embedded_images(qtbot, tmp_path):
+    w = make_window(qtbot, SAMPLE)
+    ia = w.menus.interop
+    assert ia.export_gltf(tmp_path / "m.glb", size=16), ia.last_message
+    assert ia.import_mtlx(tmp_path / "m.glb", tmp_path / "back.json"), ia.last_message
+    assert w.controller.document.path == tmp_path / "back.json"
+    written = sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("back"))
+    assert written == ["back.json", "back_image0.png", "back_image1.png", "back_image2.png"]
+    from matedit.app.canvas.arrange import layout_problems
+
+    assert layout_problems(w.canvas.scene()) == []
+    assert any("occlusionTexture" in p.message for p in w.problems.imported)
 
 
 def test_editor_import_error_names_the_node(qtbot, tmp_path, monkeypatch):

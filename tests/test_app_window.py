@@ -264,7 +264,7 @@ def test_the_file_menu_is_composed_by_action_ids(qtbot):
     i = ids.index("file.export")
     assert texts[texts.index("&Export Shaders…") + 1:][:4] == [
         "Export &glTF…", "Export &MaterialX…", "Export &Baked Textures…",
-        "&Import MaterialX…"]
+        "&Import MaterialX or glTF…"]
     assert ids[i + 4] == "|" and ids[-2:] == ["|", "file.quit"]
     assert ids.index("file.save_image") > ids.index("file.export")
     assert w.menus.help.title() == "&Help" and w.menus.help.menuAction() in \

@@ -418,7 +418,8 @@ def _input_tree(tmp, at=None):
     defaults = {"texture": "albedo.png", "function": "f.json", "preview_mesh": "pm.obj",
                 "preview_face": "penv/sky_px.hdr", "mesh": "mesh.obj",
                 "env_face": "env/sky_px.hdr", "env_file": "env.hdr", "rig": "rig.json",
-                "mtlx": "a.mtlx", "mtlx_image": "mx.png"}
+                "mtlx": "a.mtlx", "mtlx_image": "mx.png", "gltf": "a.gltf",
+                "gltf_bin": "a.bin"}
     p = {k: at.get(k, src / v) for k, v in defaults.items()}
     for f in p.values():
         f.parent.mkdir(parents=True, exist_ok=True)
@@ -437,6 +438,16 @@ def _input_tree(tmp, at=None):
         if p["env_file"].suffix == ".hdr" else p["env_file"].write_bytes(b"environment")
     write(p["rig"], {"format": "matedit.lightrig", "version": 1, "lights": []})
     p["mtlx"].write_text(_mtlx_text(_rel(p["mtlx_image"], p["mtlx"].parent)))
+    png = p["mtlx_image"].read_bytes()  # a glTF asset whose .bin embeds the image
+    p["gltf_bin"].write_bytes(png)
+    write(p["gltf"], {"asset": {"version": "2.0"},
+                      "buffers": [{"uri": _rel(p["gltf_bin"], p["gltf"].parent),
+                                   "byteLength": len(png)}],
+                      "bufferViews": [{"buffer": 0, "byteLength": len(png)}],
+                      "images": [{"bufferView": 0, "mimeType": "image/png"}],
+                      "textures": [{"source": 0}],
+                      "materials": [{"name": "mat", "pbrMetallicRoughness": {
+                          "baseColorTexture": {"index": 0}}}]})
     raw = base_material()
     raw["nodes"] += [
         {"id": "tex", "kind": "texture_parameter", "position": [0, 300],
@@ -517,6 +528,9 @@ COMMAND_CASES = {
                lambda p, o, kind: ["import", p["mtlx"], "-o", o]),
     "import .json": (("mtlx", "mtlx_image"), lambda kind: "mat.json",
                      lambda p, o, kind: ["import", p["mtlx"], "-o", o / "mat.json"]),
+    # a glTF's embedded image, extracted beside the material, over the asset or its .bin
+    "import .gltf": (("gltf", "gltf_bin"), lambda kind: "mat_image0.png",
+                     lambda p, o, kind: ["import", p["gltf"], "-o", o / "mat.json"]),
 }
 # Commands that write no file: their declaration must say they read nothing to protect, or
 # only documents (validate).
@@ -525,8 +539,8 @@ NO_OUTPUT = {"validate", "nodes", "brdf-lut", "stats"}  # stats prints, writes n
 
 def _direct_ok(command, kind, name) -> bool:
     """Whether the input can itself sit at the output name and still be read as that kind."""
-    if kind in ("document", "parent"):
-        return False  # a document's outputs are named after it
+    if kind in ("document", "parent", "gltf", "gltf_bin"):
+        return False  # a document's outputs are named after it; an asset's by its suffix
     if kind.endswith("face"):
         return name.rsplit(".", 1)[0].endswith("_px")
     return True
@@ -538,8 +552,9 @@ def _cases():
             for how in ("direct", "symlink", "hardlink", "read through a link"):
                 if how == "direct" and not _direct_ok(command, kind, name(kind)):
                     continue
-                if how == "read through a link" and kind == "parent":
-                    continue  # an instance reads its parent's references from the real file
+                if how == "read through a link" and kind in ("parent", "gltf_bin"):
+                    continue  # an instance reads its parent's references from the real file;
+                    # a .bin linked from outside the asset's folder is refused as leaving it
                 yield pytest.param(command, kind, how, id=f"{command}-{kind}-{how}")
 
 

@@ -1,5 +1,5 @@
 """File › Export and File › Import entries for the interchange formats: glTF 2.0 (.gltf/.glb),
-MaterialX (.mtlx), baked texture maps, HLSL/MSL, and importing a .mtlx.
+MaterialX (.mtlx), baked texture maps, HLSL/MSL, and importing a .mtlx, .gltf or .glb.
 
 The work is the command line's (matedit.interop), on the document in
 the editor, with its outputs checked against its inputs the same way. Baking needs a GL
@@ -83,7 +83,7 @@ class InteropActions:
         self.act_mtlx.triggered.connect(lambda: self.export_mtlx())
         self.act_bake = QAction("Export &Baked Textures…", w)
         self.act_bake.triggered.connect(lambda: self.export_baked())
-        self.act_import = QAction("&Import MaterialX…", w)
+        self.act_import = QAction("&Import MaterialX or glTF…", w)
         self.act_import.triggered.connect(lambda: self.import_mtlx())
         self.actions = [self.act_gltf, self.act_mtlx, self.act_bake]
 
@@ -224,11 +224,10 @@ class InteropActions:
         """(go on, the material to import): with several in the document, the one picked
         from a list; None when there is only one (or the file cannot be read: the import
         then reports why)."""
-        from matedit.interop.mtlx_import import MtlxImportError, material_names
-
+        material_names, failure = _reader(src)
         try:
             names = material_names(src)
-        except MtlxImportError:
+        except failure:
             return True, None
         if len(names) < 2:
             return True, None
@@ -241,13 +240,14 @@ class InteropActions:
         """The file proposed for an imported material: its MaterialX name (else the .mtlx's
         stem) as a file stem, made unique in the folder with _2, _3...: never a file that
         exists, so never the open document's."""
-        from matedit.interop.mtlx_import import MtlxImportError, file_stem, material_names
+        from matedit.interop.mtlx_import import file_stem
 
+        material_names, failure = _reader(src)
         name = material
         if name is None:
             try:
                 names = material_names(src)
-            except MtlxImportError:
+            except failure:
                 names = []
             name = names[0] if len(names) == 1 else None
         stem = file_stem(name) if name else (file_stem(src.stem) or "imported")
@@ -261,17 +261,20 @@ class InteropActions:
 
     def import_mtlx(self, src: Path | None = None, out: Path | None = None,
                     material: str | None = None) -> bool:
-        """Import one material of a .mtlx (`material`, else the only one, else the one the
-        artist picks), save it as a new file and open it. The name proposed is a new one
+        """Import one material of a .mtlx, .gltf or .glb (`material`, else the only one, else
+        the one the artist picks), save it (and a glTF's embedded images, beside it) as a new
+        file and open it. The name proposed is a new one
         (`_import_name`); a file picked that exists is replaced only after the file dialog's
         own confirmation, and a document open in the editor never is (refused, saying why)."""
-        title = "Import MaterialX"
+        title = "Import MaterialX or glTF"
         if src is None:
             path, _ = file_dialogs.open_file(self.window, title, self._start_dir(),
-                                             "MaterialX (*.mtlx)")
+                                             "MaterialX or glTF (*.mtlx *.gltf *.glb);;"
+                                             "MaterialX (*.mtlx);;glTF (*.gltf *.glb)")
             if not path:
                 return False
             src = Path(path)
+        gltf = _is_gltf(src)
         if material is None:
             go, material = self._choose_material(src, title)
             if not go:
@@ -292,20 +295,36 @@ class InteropActions:
             self.last_message = text
             return False
 
+        from matedit.interop.gltf_import import GltfImportError, import_gltf
         from matedit.interop.mtlx_import import MtlxImportError, import_mtlx
-        from matedit.io.atomic import atomic_write_text
+        from matedit.io.atomic import atomic_write_text, staged_outputs
         from matedit.io.document import dumps
         from matedit.io.inputs import refuse_overwrite
 
         warnings: list[str] = []
         try:
-            refuse_overwrite([out], {Path(os.path.realpath(src)): "the MaterialX document"})
-            doc = import_mtlx(src, out, material, warnings)
+            inputs = {Path(os.path.realpath(src)): "the glTF asset" if gltf
+                      else "the MaterialX document"}
+            refuse_overwrite([out], inputs)
+            images: dict[Path, bytes] = {}
+            if gltf:  # its embedded images are written beside the material, with it
+                result = import_gltf(src, out, material, warnings)
+                doc, images = result.document, result.images
+                inputs.update({_real(p): "a file the glTF asset reads" for p in result.reads})
+                refuse_overwrite(list(images), inputs)
+            else:
+                doc = import_mtlx(src, out, material, warnings)
             _arrange(doc)  # the importer's own columns, made readable
             if not self.host.actions.maybe_save():
                 return False
-            atomic_write_text(out, dumps(doc))
-        except MtlxImportError as exc:
+            if images:
+                with staged_outputs(out.parent) as stage:
+                    for p, data in images.items():
+                        stage.write_bytes(p, data)
+                    stage.write_text(out, dumps(doc))
+            else:
+                atomic_write_text(out, dumps(doc))
+        except (MtlxImportError, GltfImportError) as exc:
             text = "\n".join(exc.messages[:20])
             QMessageBox.critical(self.window, title, f"Cannot import {src.name}:\n{text}")
             self.last_message = text
@@ -328,7 +347,7 @@ class InteropActions:
             shown = "\n".join(warnings[:20])
             more = f"\n… and {len(warnings) - 20} more (see Diagnostics)" \
                 if len(warnings) > 20 else ""
-            box = QMessageBox(QMessageBox.Icon.Warning, "Import MaterialX",
+            box = QMessageBox(QMessageBox.Icon.Warning, "Import",
                               f"Imported {src.name}. {len(warnings)} of what it sets "
                               f"{'is' if len(warnings) == 1 else 'are'} not represented "
                               f"exactly (also listed in Diagnostics):\n\n{shown}{more}",
@@ -337,6 +356,21 @@ class InteropActions:
             box.show()
             self.import_report = box
         return True
+
+
+def _is_gltf(src: Path) -> bool:
+    return src.suffix.lower() in (".gltf", ".glb")
+
+
+def _reader(src: Path):
+    """(material_names, its error type) of the importer for `src`'s format."""
+    if _is_gltf(src):
+        from matedit.interop import gltf_import
+
+        return gltf_import.material_names, gltf_import.GltfImportError
+    from matedit.interop import mtlx_import
+
+    return mtlx_import.material_names, mtlx_import.MtlxImportError
 
 
 def _arrange(doc) -> None:

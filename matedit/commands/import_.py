@@ -1,5 +1,5 @@
-"""`matedit import FILE.mtlx -o OUT.json|DIR [--material NAME]`: MaterialX materials as
-matedit materials.
+"""`matedit import FILE.mtlx|FILE.gltf|FILE.glb -o OUT.json|DIR [--material NAME]`: MaterialX
+or glTF 2.0 materials as matedit materials (the file's suffix chooses the reader).
 
 `-o OUT.json` writes one material: the document's only one, or the one `--material` names.
 `-o DIR` (any output not ending in .json; created if missing) writes every material, or the
@@ -16,7 +16,12 @@ does not represent exactly (dropped, approximated, clamped) is a `warning:` line
 file, material, node, input and value; `--strict` makes each an `error:` line instead (exit
 2, nothing written).
 No output may replace the MaterialX document or an image a material reads. See
-matedit.interop.mtlx_import for what is read."""
+matedit.interop.mtlx_import for what is read.
+
+glTF (matedit.interop.gltf_import) follows the same rules; images the asset embeds (in a
+.glb, a .bin or a data: URI) are written beside each material as STEM_imageN.png|jpg, with
+it (all or nothing); under -o DIR an existing one is refused like DIR/NAME.json. No output
+may replace the asset, a .bin it reads or an image it names."""
 
 from __future__ import annotations
 
@@ -29,17 +34,19 @@ from matedit.io.inputs import declare_inputs
 
 
 def register(sub) -> None:
-    p = sub.add_parser("import", help="import MaterialX materials",
+    p = sub.add_parser("import", help="import MaterialX or glTF materials",
                        description="Convert a MaterialX document's materials (standard_surface,"
                        " open_pbr_surface, gltf_pbr or UsdPreviewSurface, with nodegraphs of "
-                       "stdlib nodes matedit has) into matedit materials.")
-    p.add_argument("file", metavar="FILE.mtlx")
+                       "stdlib nodes matedit has), or a glTF 2.0 asset's materials (.gltf or "
+                       ".glb: metallic-roughness and the KHR_materials_* lobes), into matedit "
+                       "materials.")
+    p.add_argument("file", metavar="FILE.mtlx|FILE.gltf|FILE.glb")
     p.add_argument("-o", "--output", required=True, metavar="OUT.json|DIR",
                    help="one material to OUT.json, or every material (or the one named) to "
                    "DIR/NAME.json")
     p.add_argument("--material", metavar="NAME",
-                   help="the surfacematerial to import (required for OUT.json when the "
-                   "document holds several)")
+                   help="the surfacematerial (or glTF material) to import (required for "
+                   "OUT.json when the document holds several)")
     p.add_argument("--overwrite", action="store_true",
                    help="with -o DIR: replace DIR/NAME.json files that exist already "
                    "(without it they are an error and nothing is written)")
@@ -68,6 +75,8 @@ def refuse_existing(targets, overwrite: bool) -> None:
 
 
 def run(args) -> int:
+    if Path(args.file).suffix.lower() in (".gltf", ".glb"):
+        return run_gltf(args)
     from matedit.interop.mtlx_import import MtlxImportError, import_all, import_mtlx, output_paths
     from matedit.io.atomic import atomic_write_text, staged_outputs
     from matedit.io.document import dumps
@@ -119,4 +128,67 @@ def run(args) -> int:
                          f"{exc.strerror or exc}") from None
     if sys.stderr.isatty():
         print(f"imported {path} into {', '.join(str(p) for p in docs)}", file=sys.stderr)
+    return 0
+
+
+def run_gltf(args) -> int:
+    """`import FILE.gltf|glb`: as the MaterialX import, with each material's embedded images
+    written beside it."""
+    from matedit.interop.gltf_import import GltfImportError, import_all, import_gltf
+    from matedit.interop.mtlx_import import output_paths
+    from matedit.io.atomic import staged_outputs
+    from matedit.io.document import dumps
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
+
+    path = Path(args.file)
+    out = Path(args.output)
+    to_folder = out.suffix.lower() != ".json"
+    if to_folder:
+        if out.exists() and not out.is_dir():
+            raise UsageError(f"{out}: exists and is not a folder (a single material's output "
+                             "must end in .json)")
+    elif not out.parent.is_dir():
+        raise UsageError(f"{out}: folder {out.parent} does not exist")
+    inputs = {p: ("the glTF asset" if w == "the MaterialX document" else w)
+              for p, w in command_inputs(args).items()}
+    if not to_folder:
+        try:
+            refuse_overwrite([out], inputs)
+        except OverwriteError as exc:
+            raise UsageError(str(exc)) from None
+    warnings: list[str] = []
+    try:
+        if to_folder and args.material is None:
+            results = import_all(path, out, warnings)
+        else:
+            target = out
+            if to_folder:
+                target = output_paths([args.material], out)[args.material]
+            results = {target: import_gltf(path, target, args.material, warnings)}
+    except GltfImportError as exc:
+        raise _fail(exc) from None
+    if warnings and args.strict:
+        raise _fail(GltfImportError([f"{w} (--strict)" for w in warnings])) from None
+    for w in warnings:
+        report("warning", w)
+    files: dict[Path, bytes] = {}
+    for target, result in results.items():
+        files.update(result.images)
+        files[target] = dumps(result.document).encode("utf-8")  # after its images
+        for p in result.reads:
+            inputs.setdefault(Path(os.path.realpath(p)), "a file the glTF asset reads")
+    try:
+        refuse_overwrite(list(files), inputs)
+        if to_folder:
+            refuse_existing(files, args.overwrite)
+        with staged_outputs(out if to_folder else out.parent) as stage:  # all, or none
+            for target, data in files.items():
+                stage.write_bytes(target, data)
+    except OverwriteError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"{getattr(exc, 'filename', None) or out}: cannot write: "
+                         f"{exc.strerror or exc}") from None
+    if sys.stderr.isatty():
+        print(f"imported {path} into {', '.join(str(p) for p in results)}", file=sys.stderr)
     return 0

@@ -378,6 +378,8 @@ def encode_file(path: Path, m: BakedMap) -> None:
         return
     h, w, c = pixels.shape
     spec = oiio.ImageSpec(w, h, c, "uint8")
+    if c == 4:  # colour and alpha stored as given (glTF's base colour is not premultiplied)
+        spec.attribute("oiio:UnassociatedAlpha", 1)
     if m.srgb:
         spec.attribute("oiio:ColorSpace", "sRGB")
     write_oiio(path, spec, np.clip(np.rint(pixels * 255.0), 0, 255).astype(np.uint8))

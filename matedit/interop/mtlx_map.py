@@ -18,6 +18,8 @@ This module only reads the catalogue for the exporter and the importer.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from matedit.graph import nodes
 from matedit.graph.nodes import BAKE, LOWERED, MxNode, MxRecipe
 
@@ -334,3 +336,17 @@ _TRANSMISSION_TEXT = [
     "does not read warns the same way: the list is what the rule found, not what it checks.",
     "",
 ]
+
+
+@dataclass(frozen=True)
+class Arithmetic:
+    """Our kinds of MaterialX's multiply, add and subtract: what an importer of another
+    format (matedit.interop.gltf_import) builds factors and offsets with."""
+
+    multiply: str
+    add: str
+    subtract: str
+
+
+def arithmetic() -> Arithmetic:
+    return Arithmetic(*(kind_mapped_to(c) for c in ("multiply", "add", "subtract")))

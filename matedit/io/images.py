@@ -164,13 +164,20 @@ def read_image(path: str | os.PathLike) -> ImageData:
         raise ImageError(f"{name}: not an image file matedit reads (the name must end in "
                          f"{', '.join(sorted(READ_FORMATS))})")
     with oiio_name(p) as oname:
-        inp = oiio.ImageInput.open(oname)
+        inp = oiio.ImageInput.open(oname, _STRAIGHT_ALPHA)
         if inp is None:
             raise ImageError(f"{name}: cannot read image: {_oiio_error()}")
         try:
             return _read_opened(inp, name)
         finally:
             inp.close()
+
+
+# Colour and alpha as the file stores them: OpenImageIO would otherwise premultiply the
+# colour of a PNG (or TIFF) with unassociated alpha by its alpha on reading. A texture's
+# colour is read as painted (glTF's base colour and alpha are independent channels).
+_STRAIGHT_ALPHA = oiio.ImageSpec()
+_STRAIGHT_ALPHA.attribute("oiio:UnassociatedAlpha", 1)
 
 
 def _read_opened(inp, name: str) -> ImageData:
