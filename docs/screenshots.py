@@ -167,6 +167,20 @@ def main() -> int:
     w.compiler.set_preview(None)
     pump(1.0)
 
+    # 8b. View > A/B Split: the rust mask bypassed (B) against the material before it (A).
+    canvas.select_nodes(["mask"])
+    before = w.compiler.current
+    canvas.toggle_bypass()
+    w.controller.flush()
+    wait(lambda: w.compiler.current is not before, what="the bypassed material")
+    w.viewport.set_comparing(True)
+    pump(1.5)
+    save(w.panels.viewport_dock, "viewport-ab-split.png")
+    w.viewport.set_comparing(False)
+    w.controller.undo_stack.undo()
+    w.controller.flush()
+    pump(1.0)
+
     # 9. Zoomed out: titles stay readable, port labels hide.
     canvas.frame_all()
     canvas.resetTransform()

@@ -229,7 +229,8 @@ def _mx_doc(name: str, out: Path):
 
     ir = lower_document(load_material(MATERIALS / f"{name}.json"), FileResolver())
     copies = {name: file for name, (file, _) in texture_copies(ir, out).items()}
-    result = mtlx_export.export_ir(ir, out, SIZE, file_stem(out), copies)
+    result = mtlx_export.export_ir(ir, out, SIZE, file_stem(out), "standard_surface", "exr",
+                                   texture_files=copies, side="")
     doc = mx.createDocument()
     mx.readFromXmlString(doc, result.text)
     own = [n.getName() for n in doc.getNodeGraphs()], [n.getName() for n in doc.getNodes()]

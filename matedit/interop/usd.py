@@ -473,7 +473,7 @@ def export_baked(doc, resolver, attrs: dict[str, np.ndarray], ir, mesh, out: Pat
         mx = mtlx_export.export_ir(  # its bakes as EXR beside the layer, like the copies
             lowered, out, size, file_stem(out), "standard_surface", "exr",
             texture_files={name: file for name, (file, _) in copies.items()}, side="")
-        mtlx = MtlxPart(mx.text, {p.name: a for p, a in mx.images.items()},
+        mtlx = MtlxPart(mx.text, {p.name: a.pixels for p, a in mx.images.items()},
                         dict(copies.values()))
         notes += [f"node {node}: baked to an image for the MaterialX network ({why})"
                   for node, why in mx.baked]
