@@ -11,6 +11,7 @@ from graphs_util import EDITOR_SAMPLE
 from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
 from test_app_viewport import frame
 
+from matedit.graph.commands import MoveNodes
 from matedit.resources import graphs_dir
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
@@ -134,6 +135,10 @@ def test_images_dropped_on_the_canvas_become_wired_textures_with_a_guessed_colou
         assert Path(tp.settings["path"]).name == name
         assert g.incoming(ts.id, "texture").src == tp.id
         assert w.controller.undo_stack.count() == steps + 1  # one undo step
+        # out of the way: an image dropped on a node fills that node's texture slot instead
+        # (tests/test_app_texture_slot.py)
+        w.controller.push(MoveNodes({n: (g.nodes[n].position[0] - 3000.0,
+                                         g.nodes[n].position[1]) for n in new}))
     settle(qtbot, w)
     assert w.compiler.current is not None
 

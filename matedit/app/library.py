@@ -32,6 +32,8 @@ KIND_ROLE = Qt.ItemDataRole.UserRole + 1
 SECTIONS = (("Materials", "materials", "material"), ("Layers", "layers", "layer"),
             ("Functions", "functions", "function"))
 USER_FOLDERS_KEY = "library/folders"
+# folders of the built-in library that hold matedit's own templates, not samples for artists
+INTERNAL = frozenset({"interop"})
 
 
 def classify(path: Path) -> tuple[str, str, str] | None:
@@ -139,6 +141,8 @@ class LibraryPanel(QWidget):
             if not root.is_dir():
                 continue
             for path in sorted(root.rglob("*.json")):
+                if not origin and path.relative_to(root).parts[0] in INTERNAL:
+                    continue
                 info = classify(path)
                 if info is None:
                     continue

@@ -93,6 +93,10 @@ class ViewportPanel(QWidget):
                                         Qt.ItemDataRole.ToolTipRole)
         self.view_combo.setToolTip("What the viewport shows: the lit material, some of its "
                                    "lobes only, or one of its fields")
+        # as wide as its short names; the popup lists the long ones in full
+        self.view_combo.setSizeAdjustPolicy(
+            QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+        self.view_combo.setMinimumContentsLength(9)
         self.view = ViewportWidget()
         self.environment = EnvironmentChoice(self.view, self, self)
         self.env_combo = environment_combo(self.environment)
@@ -101,7 +105,7 @@ class ViewportPanel(QWidget):
         self.exposure.setRange(-60, 60)  # tenths of EV: the arrow keys step 0.1 EV
         self.exposure.setSingleStep(1)
         self.exposure.setPageStep(10)
-        self.exposure.setMinimumWidth(100)
+        self.exposure.setMinimumWidth(140)
         self.exposure.setToolTip("Exposure (EV); arrow keys step 0.1 EV, Page Up/Down 1 EV")
         self.exposure_spin = QDoubleSpinBox()
         self.exposure_spin.setRange(-6.0, 6.0)
@@ -120,7 +124,8 @@ class ViewportPanel(QWidget):
         self.diff_label.setToolTip("Reference and difference modes: samples a pixel so far, "
                                    "and the mean difference from the split-sum image")
         # View › Follow Selection, and its button on the bar
-        self.follow_action = QAction(icon("follow"), "&Follow Selection in Viewport", self)
+        # (no icon on the action: it would be drawn instead of the menu's check mark)
+        self.follow_action = QAction("&Follow Selection in Viewport", self)
         self.follow_action.setObjectName("view.follow_selection")
         self.follow_action.setCheckable(True)
         self.follow_action.setToolTip("Follow the selection: the viewport previews the node you "
@@ -129,7 +134,11 @@ class ViewportPanel(QWidget):
         self.follow_action.toggled.connect(self._follow_toggled)
         self.follow_button = QToolButton()
         self.follow_button.setObjectName("followSelection")
-        self.follow_button.setDefaultAction(self.follow_action)
+        self.follow_button.setIcon(icon("follow"))
+        self.follow_button.setCheckable(True)
+        self.follow_button.setToolTip(self.follow_action.toolTip())
+        self.follow_button.toggled.connect(self.follow_action.setChecked)
+        self.follow_action.toggled.connect(self.follow_button.setChecked)
         # View › A/B Split, and its button: the material before the last structural edit
         # (A, left of the divider) against the material now (B)
         self.ab_action = QAction("A/B &Split: Before the Last Edit", self)
