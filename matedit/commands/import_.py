@@ -74,15 +74,11 @@ def refuse_existing(targets, overwrite: bool) -> None:
                              "import into another folder")
 
 
-def run(args) -> int:
-    if Path(args.file).suffix.lower() in (".gltf", ".glb"):
-        return run_gltf(args)
-    from matedit.interop.mtlx_import import MtlxImportError, import_all, import_mtlx, output_paths
-    from matedit.io.atomic import atomic_write_text, staged_outputs
-    from matedit.io.document import dumps
-    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
+def _output(args, inputs) -> tuple[Path, bool]:
+    """OUT and whether it is a folder, checked: a folder that is not one, a missing parent,
+    or an input at OUT's name is an error."""
+    from matedit.io.inputs import OverwriteError, refuse_overwrite
 
-    path = Path(args.file)
     out = Path(args.output)
     to_folder = out.suffix.lower() != ".json"
     if to_folder:
@@ -93,24 +89,46 @@ def run(args) -> int:
         raise UsageError(f"{out}: folder {out.parent} does not exist")
     if not to_folder:
         try:
-            refuse_overwrite([out], command_inputs(args))
+            refuse_overwrite([out], inputs)
         except OverwriteError as exc:
             raise UsageError(str(exc)) from None
+    return out, to_folder
+
+
+def _imported(args, path: Path, out: Path, to_folder: bool, import_all, import_one, error):
+    """target -> what the format's importer made of `path` (every material into a folder,
+    or the one asked for), its warnings reported; --strict makes them errors."""
+    from matedit.interop.mtlx_import import output_paths
+
     warnings: list[str] = []
     try:
         if to_folder and args.material is None:
-            docs = import_all(path, out, warnings)
+            made = import_all(path, out, warnings)
         else:
             target = out
             if to_folder:
                 target = output_paths([args.material], out)[args.material]
-            docs = {target: import_mtlx(path, target, args.material, warnings)}
-    except MtlxImportError as exc:
+            made = {target: import_one(path, target, args.material, warnings)}
+    except error as exc:
         raise _fail(exc) from None
     if warnings and args.strict:
-        raise _fail(MtlxImportError([f"{w} (--strict)" for w in warnings])) from None
+        raise _fail(error([f"{w} (--strict)" for w in warnings])) from None
     for w in warnings:
         report("warning", w)
+    return made
+
+
+def run(args) -> int:
+    if Path(args.file).suffix.lower() in (".gltf", ".glb"):
+        return run_gltf(args)
+    from matedit.interop.mtlx_import import MtlxImportError, import_all, import_mtlx
+    from matedit.io.atomic import atomic_write_text, staged_outputs
+    from matedit.io.document import dumps
+    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
+
+    path = Path(args.file)
+    out, to_folder = _output(args, command_inputs(args))
+    docs = _imported(args, path, out, to_folder, import_all, import_mtlx, MtlxImportError)
     try:  # the MaterialX document, and every image an imported material reads
         refuse_overwrite(list(docs), command_inputs(args, written=docs.values()))
         if to_folder:  # every material, or none
@@ -135,42 +153,15 @@ def run_gltf(args) -> int:
     """`import FILE.gltf|glb`: as the MaterialX import, with each material's embedded images
     written beside it."""
     from matedit.interop.gltf_import import GltfImportError, import_all, import_gltf
-    from matedit.interop.mtlx_import import output_paths
     from matedit.io.atomic import staged_outputs
     from matedit.io.document import dumps
     from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
 
     path = Path(args.file)
-    out = Path(args.output)
-    to_folder = out.suffix.lower() != ".json"
-    if to_folder:
-        if out.exists() and not out.is_dir():
-            raise UsageError(f"{out}: exists and is not a folder (a single material's output "
-                             "must end in .json)")
-    elif not out.parent.is_dir():
-        raise UsageError(f"{out}: folder {out.parent} does not exist")
     inputs = {p: ("the glTF asset" if w == "the MaterialX document" else w)
               for p, w in command_inputs(args).items()}
-    if not to_folder:
-        try:
-            refuse_overwrite([out], inputs)
-        except OverwriteError as exc:
-            raise UsageError(str(exc)) from None
-    warnings: list[str] = []
-    try:
-        if to_folder and args.material is None:
-            results = import_all(path, out, warnings)
-        else:
-            target = out
-            if to_folder:
-                target = output_paths([args.material], out)[args.material]
-            results = {target: import_gltf(path, target, args.material, warnings)}
-    except GltfImportError as exc:
-        raise _fail(exc) from None
-    if warnings and args.strict:
-        raise _fail(GltfImportError([f"{w} (--strict)" for w in warnings])) from None
-    for w in warnings:
-        report("warning", w)
+    out, to_folder = _output(args, inputs)
+    results = _imported(args, path, out, to_folder, import_all, import_gltf, GltfImportError)
     files: dict[Path, bytes] = {}
     for target, result in results.items():
         files.update(result.images)
