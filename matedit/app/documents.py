@@ -133,7 +133,10 @@ class DocumentTabs(QObject):
                                self.actions.untitled_key, self.actions._autosaved_index)
 
     def _watch(self, stack: QUndoStack) -> None:
-        stack.cleanChanged.connect(lambda _c: self.retitle())
+        stack.cleanChanged.connect(self._clean_changed)  # a slot: Qt disconnects it with us
+
+    def _clean_changed(self, _clean: bool) -> None:
+        self.retitle()
 
     def _park(self, index: int) -> None:
         """The state of material tab `index`, shown until now, back into its session;
@@ -209,7 +212,7 @@ class DocumentTabs(QObject):
             self.pages.window().show()
         session = DocumentSession(None, editor.undo_stack, editor=editor)
         self._watch(editor.undo_stack)
-        editor.dirtyChanged.connect(lambda _d: self.retitle())
+        editor.dirtyChanged.connect(self._clean_changed)
         self._insert(session)
         return session
 

@@ -79,7 +79,7 @@ class InstanceEditor(QWidget):
         self.compile_count = 0
         self.dirty = False
         self.undo_stack = QUndoStack(self)  # the main window's Edit › Undo, in its tab
-        self.undo_stack.cleanChanged.connect(lambda clean: self._set_dirty(not clean))
+        self.undo_stack.cleanChanged.connect(self._clean_changed)  # a slot: Qt disconnects it
         self.panel = ParameterPanel()
         self.view = ViewportWidget()
         self.chain_label = QLabel()
@@ -145,6 +145,9 @@ class InstanceEditor(QWidget):
             self.dirty = dirty
             self.dirtyChanged.emit(dirty)
         self.setWindowTitle(self._title())
+
+    def _clean_changed(self, clean: bool) -> None:
+        self._set_dirty(not clean)
 
     def _re_resolve(self) -> None:
         self.resolved = resolve(self.doc)
