@@ -548,7 +548,7 @@ def test_materialx_round_trip(tmp_path, values, thin):
     pytest.importorskip("MaterialX")
     src = _material(tmp_path / "glass.json", values, thin)
     out = tmp_path / "glass.mtlx"
-    r = _cli("export", str(src), "-o", str(out))
+    r = _cli("export", str(src), "-o", str(out), "--surface", "standard_surface")
     assert r.returncode == 0, r.stderr
     from tests.test_interop_mtlx import load_with_stdlib
 
