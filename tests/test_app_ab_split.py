@@ -5,22 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from graphs_util import EDITOR_SAMPLE
-from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
-from test_app_viewport import frame
+from test_app_support import app_env, settle  # noqa: F401
+from test_app_viewport import frame, window  # noqa: F401, F811 - the shown sample
 
 from matedit.graph.commands import SetValue
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
-
-
-@pytest.fixture
-def window(qtbot, request):
-    request.getfixturevalue("app_env")
-    w = make_window(qtbot, EDITOR_SAMPLE, show=True)
-    wait_for_renderer(qtbot, w)
-    settle(qtbot, w)
-    return w
 
 
 def _edited(qtbot, w, edit):
@@ -33,7 +23,7 @@ def _edited(qtbot, w, edit):
     settle(qtbot, w, 50)
 
 
-def test_split_shows_the_material_before_the_last_edit_on_the_left(window, qtbot):
+def test_split_shows_the_material_before_the_last_edit_on_the_left(window, qtbot):  # noqa: F811
     w = window
     vp = w.viewport
     assert "view.ab_split" in [a.objectName() for a in w.menus.view.actions()]

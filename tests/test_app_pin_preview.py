@@ -4,19 +4,10 @@ artist selects, and a pinned preview stays while other nodes are selected."""
 from __future__ import annotations
 
 import pytest
-from graphs_util import EDITOR_SAMPLE
-from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
+from test_app_support import app_env, settle  # noqa: F401
+from test_app_viewport import window  # noqa: F401, F811 - the shown sample
 
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
-
-
-@pytest.fixture
-def window(qtbot, request):
-    request.getfixturevalue("app_env")
-    w = make_window(qtbot, EDITOR_SAMPLE, show=True)
-    wait_for_renderer(qtbot, w)
-    settle(qtbot, w)
-    return w
 
 
 def _target(w):
@@ -24,7 +15,7 @@ def _target(w):
     return None if t is None else (t.node_id, t.port)
 
 
-def test_follow_previews_each_selected_node_and_pin_keeps_one(window, qtbot):
+def test_follow_previews_each_selected_node_and_pin_keeps_one(window, qtbot):  # noqa: F811
     w = window
     canvas = w.tabs.material.canvas
     vp = w.viewport
