@@ -131,7 +131,8 @@ float anisotropicLobeTerms(AnisotropicLobe l, vec3 N, vec3 V, vec3 L, out float 
 vec3 anisotropicSpecularTowards(AnisotropicLobe l, vec3 N, vec3 V, float NoV, vec3 F0, vec3 L) {
     // Burley 2012 appendix B.2 eq 13 (D); Heitz 2014 eq 80 with Karis 2013 eq 4 (Vis); eq 5 (F)
     float NoL = saturate(dot(N, L));
-    if (NoL <= 0.0) return vec3(0.0);
+    vec3 h = L + V;  // L = -V: H undefined, nothing reflected (as lights.glsl)
+    if (NoL <= 0.0 || dot(h, h) < 1e-12) return vec3(0.0);
     float VoH, alphaV, alphaL;
     float D = anisotropicLobeTerms(l, N, V, L, VoH, alphaV, alphaL);
     float kV = k_AnalyticProjected(alphaV);
@@ -404,7 +405,8 @@ vec3 ggxAnisotropicSampleDirection(AnisotropicLobe l, vec3 N, vec3 V, vec2 Xi) {
 vec3 anisotropicBrdfCosineIBL(AnisotropicLobe l, vec3 N, vec3 V, vec3 F0, vec3 L) {
     // Burley 2012 B.2 eq 13; Heitz 2014 eq 80 with Karis 2013 eq 4 (k = alpha / 2); Schlick 1994
     float NoL = saturate(dot(N, L));
-    if (NoL <= 0.0) return vec3(0.0);
+    vec3 h = L + V;  // L = -V: H undefined, nothing reflected
+    if (NoL <= 0.0 || dot(h, h) < 1e-12) return vec3(0.0);
     float NoV = max(dot(N, V), 1e-4);
     float VoH, alphaV, alphaL;
     float D = anisotropicLobeTerms(l, N, V, L, VoH, alphaV, alphaL);

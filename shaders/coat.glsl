@@ -89,9 +89,9 @@ float coatSpecularTowards(CoatContext c, vec3 V, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4", eq 3-5 on the coat's normal and alpha;
     // Filament Materials documentation, "Clear coat specular BRDF": a second GGX lobe
     float NoL = saturate(dot(c.N, L));
-    if (NoL <= 0.0) return 0.0;
-    vec3 h = L + V;
-    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
+    vec3 h = L + V;  // L = -V: H undefined, nothing reflected (as lights.glsl)
+    if (NoL <= 0.0 || dot(h, h) < 1e-12) return 0.0;
+    vec3 H = h * inversesqrt(dot(h, h));
     float NoH = saturate(dot(c.N, H));
     float VoH = saturate(dot(V, H));
     vec3 NxH = cross(c.N, H);
@@ -135,9 +135,9 @@ float coatReferenceAlpha(CoatContext c) {
 float coatBrdfCosine(CoatContext c, vec3 V, vec3 L) {
     // Karis 2013, "Real Shading in Unreal Engine 4", SpecularIBL: D G F / (4 NoL NoV), k = a / 2
     float NoL = saturate(dot(c.N, L));
-    if (NoL <= 0.0) return 0.0;
-    vec3 h = L + V;
-    vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
+    vec3 h = L + V;  // L = -V: H undefined, nothing reflected (as lights.glsl)
+    if (NoL <= 0.0 || dot(h, h) < 1e-12) return 0.0;
+    vec3 H = h * inversesqrt(dot(h, h));
     float a = coatReferenceAlpha(c);
     float NoH = saturate(dot(c.N, H));
     float VoH = saturate(dot(V, H));

@@ -167,10 +167,10 @@ vec3 specularTowards(ShadingContext s, vec3 L) {
     return anisotropicSpecularTowards(s.aniso, s.N, s.V, s.NoV, s.F0, L) * s.specularScale;
 #endif
     float NoL = saturate(dot(s.N, L));
-    // Below the horizon nothing is reflected; this also skips L = -V, where H is undefined
-    // (a representative point behind the surface can land exactly there).
-    if (NoL <= 0.0) return vec3(0.0);
+    // Below the horizon nothing is reflected. Nor where L = -V (a view from behind the
+    // surface, a representative point straight behind the shading point): H is undefined.
     vec3 h = L + s.V;
+    if (NoL <= 0.0 || dot(h, h) < 1e-12) return vec3(0.0);
     vec3 H = h * inversesqrt(max(dot(h, h), 1e-30));
     float NoH = saturate(dot(s.N, H));
     float VoH = saturate(dot(s.V, H));

@@ -1514,6 +1514,7 @@ def _assert_lights_finite22(lights) -> None:
 @example(edits=[("element", "light 1 position", 1, _Raw22("9" * 400))])
 @example(edits=[("set", "light 0", "radius", _Raw22("1e308"))])
 @example(edits=[("duplicate", "light 1", "intensity", 5.0)])
+@example(edits=[("element", "light 1 position", 0, _Raw22("1e-7"))])  # L = -V behind a point
 def test_generated_rigs_load_cleanly_or_light_finitely(edits):
     """Mutated rigs (wrong types, huge, NaN and infinite numbers, 400-digit integers, deep
     nesting, duplicate and missing keys, unknown fields, unicode): the loader raises RigError

@@ -379,6 +379,64 @@ def test_light_building_blocks(ctx, rng):
     check("specularTowards", out["st"], st(**sv), slack=perturbation_spread(st, sv, rng))
 
 
+def test_lobes_reflect_nothing_where_the_light_is_straight_behind_the_view(ctx, rng):
+    """L = -V with N.L > 0 (a shading point seen from behind its surface, lit from in front:
+    a tube light's representative point can land exactly there) leaves H undefined; the
+    plain, coat and anisotropic lobes return exactly 0, not D(0) = inf, on the GPU and in
+    the twins. Near it (|L + V| = 1e-3) both stay finite and agree (float32 tolerance)."""
+    from matedit.shading import anisotropy, coat
+
+    n = 64
+    N = unit_vectors(rng, n)
+    L = N + 0.5 * unit_vectors(rng, n)
+    L = f32(L / np.linalg.norm(L, axis=1, keepdims=True))
+    L = np.where((np.sum(N * L, 1) <= 0.05)[:, None], N, L)
+    exact, near = f32(-L), -L + 1e-3 * np.cross(L, unit_vectors(rng, n))
+    near = f32(near / np.linalg.norm(near, axis=1, keepdims=True))
+    T = np.cross(N, unit_vectors(rng, n))
+    T = f32(T / np.linalg.norm(T, axis=1, keepdims=True))
+    B = f32(np.cross(N, T))
+    base = {"N": f32(N), "L": L, "T": T, "B": B, "rough": f32(rng.uniform(0.05, 1.0, n)),
+            "F0": f32(rng.uniform(0.02, 1.0, (n, 3)))}  # fmt: skip
+    body = """
+        ShadingContext s = makeShadingContext(vec3(0.0), N, V, vec3(0.5), F0, rough);
+        plain = specularTowards(s, L);
+        CoatContext c = makeCoatContext(N, V, 1.0, rough, 0.03, vec3(1.0), 1.5, 1.0);
+        coatd = vec2(coatSpecularTowards(c, V, L), coatBrdfCosine(c, V, L));
+    """
+    abody = """
+        AnisotropicLobe l = makeAnisotropicLobe(rough * rough, 0.8, vec3(1.0, 0.0, 0.0), T, B, N);
+        aniso = anisotropicSpecularTowards(l, N, V, max(dot(N, V), 1e-4), F0, L);
+        anisoIbl = anisotropicBrdfCosineIBL(l, N, V, F0, L);
+    """
+    for V, label in ((exact, "L = -V"), (near, "|L + V| = 1e-3")):
+        v = {**base, "V": V}
+        out = gpu_eval_many(ctx, body, v, {"plain": "vec3", "coatd": "vec2"},
+                            includes=["lights.glsl", "coat.glsl"], defines=("MATERIAL_HAS_COAT",))
+        aout = gpu_eval_many(ctx, abody, v, {"aniso": "vec3", "anisoIbl": "vec3"},
+                             includes=["lights.glsl"], defines=("MATERIAL_HAS_ANISOTROPY",))
+        s = lights.makeShadingContext(np.zeros(3), v["N"], V, np.full(3, 0.5), v["F0"],
+                                      v["rough"])
+        c = coat.makeCoatContext(v["N"], V, 1.0, v["rough"], 0.03, np.ones(3), 1.5)
+        lo = anisotropy.makeAnisotropicLobe(v["rough"] ** 2, 0.8, np.array([1.0, 0, 0]), T, B,
+                                            v["N"])
+        nov = np.maximum(np.sum(v["N"] * V, 1), 1e-4)
+        twins = {
+            "plain": lights.specularTowards(s, L),
+            "coatd": np.stack([coat.coatSpecularTowards(c, V, L),
+                               coat.coatBrdfCosine(c, V, L)], 1),
+            "aniso": anisotropy.anisotropicSpecularTowards(lo, v["N"], V, nov, v["F0"], L),
+            "anisoIbl": anisotropy.anisotropicBrdfCosineIBL(lo, v["N"], V, v["F0"], L),
+        }
+        for name, gpu in (("plain", out["plain"]), ("coatd", out["coatd"]),
+                          ("aniso", aout["aniso"]), ("anisoIbl", aout["anisoIbl"])):
+            assert np.isfinite(gpu).all() and np.isfinite(twins[name]).all(), (label, name)
+            if V is exact:
+                assert (gpu == 0).all() and (twins[name] == 0).all(), (label, name)
+            else:  # D is sharp here: float32 half vectors of nearly opposite unit vectors
+                assert np.allclose(gpu, twins[name], rtol=2e-2, atol=1e-3), (label, name)
+
+
 # --- lights_block.glsl, ibl_inputs.glsl, surface.glsl ------------------------------------
 
 

@@ -136,7 +136,9 @@ def anisotropicSpecularTowards(l: AnisotropicLobe, N, V, NoV, F0, L) -> np.ndarr
     D, VoH, alphaV, alphaL = anisotropicLobeTerms(l, N, V, L)
     with np.errstate(divide="ignore", invalid="ignore"):
         kV, kL = k_AnalyticProjected(alphaV), k_AnalyticProjected(alphaL)
-        lobe = np.where(NoL > 0.0, D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
+        h = f64(L) + f64(V)  # L = -V: H undefined, nothing reflected (as the GLSL)
+        lobe = np.where((NoL > 0.0) & (dot(h, h) >= 1e-12),
+                        D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
     return lobe[..., None] * F_Schlick(F0, VoH)
 
 
@@ -278,7 +280,9 @@ def anisotropicBrdfCosineIBL(l: AnisotropicLobe, N, V, F0, L) -> np.ndarray:
     D, VoH, alphaV, alphaL = anisotropicLobeTerms(l, N, V, L)
     with np.errstate(divide="ignore", invalid="ignore"):
         kV, kL = k_IBL(alphaV), k_IBL(alphaL)
-        lobe = np.where(NoL > 0.0, D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
+        h = f64(L) + f64(V)  # L = -V: H undefined, nothing reflected (as the GLSL)
+        lobe = np.where((NoL > 0.0) & (dot(h, h) >= 1e-12),
+                        D * V_SchlickSmithAnisotropic(NoV, NoL, kV, kL) * NoL, 0.0)
     return lobe[..., None] * F_SchlickExact(F0, VoH)
 
 

@@ -87,7 +87,8 @@ def coatSpecularTowards(c: CoatContext, V, L) -> np.ndarray:
     F = c.F0 + (1.0 - c.F0) * Fc_SphericalGaussian(VoH)
     with np.errstate(divide="ignore", invalid="ignore"):
         D = D_GGX(NoH, c.a, dot(NxH, NxH))
-        lobe = np.where(NoL > 0.0, D * V_SchlickSmith(c.NoV, NoL, c.k) * F * NoL, 0.0)
+        lobe = np.where((NoL > 0.0) & (dot(h, h) >= 1e-12),
+                        D * V_SchlickSmith(c.NoV, NoL, c.k) * F * NoL, 0.0)
     return lobe * c.weight * c.scale
 
 
@@ -129,7 +130,8 @@ def coatBrdfCosine(c: CoatContext, V, L) -> np.ndarray:
     F = c.F0 + (1.0 - c.F0) * Fc_Exact(VoH)
     with np.errstate(divide="ignore", invalid="ignore"):
         D = D_GGX(NoH, a, dot(NxH, NxH))
-        f = np.where(NoL > 0.0, D * V_SchlickSmith(c.NoV, NoL, k_IBL(a)) * F * NoL, 0.0)
+        f = np.where((NoL > 0.0) & (dot(h, h) >= 1e-12),
+                     D * V_SchlickSmith(c.NoV, NoL, k_IBL(a)) * F * NoL, 0.0)
     return f * c.weight * c.scale
 
 

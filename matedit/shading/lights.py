@@ -137,10 +137,11 @@ def specularTowards(s: ShadingContext, L) -> np.ndarray:
     NoH = saturate(dot(s.N, H))
     VoH = saturate(dot(s.V, H))
     NxH = np.cross(s.N, H)
-    # Masked where NoL = 0 (there H may be undefined and D infinite), as the GLSL returns 0.
+    # Masked where NoL = 0 or L = -V (H undefined, D infinite), as the GLSL returns 0.
     with np.errstate(divide="ignore", invalid="ignore"):
         D = D_GGX(NoH, s.a, dot(NxH, NxH))
-        lobe = np.where(NoL > 0.0, D * V_SchlickSmith(s.NoV, NoL, s.k) * NoL, 0.0)
+        lobe = np.where((NoL > 0.0) & (dot(h, h) >= 1e-12),
+                        D * V_SchlickSmith(s.NoV, NoL, s.k) * NoL, 0.0)
     return lobe[..., None] * filmOrFresnel(s.film, s.F0, VoH, F_Schlick) * f64(s.specularScale)
 
 
