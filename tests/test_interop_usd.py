@@ -487,3 +487,76 @@ def test_a_texture_the_material_reads_is_copied_beside_the_layer(tmp_path):
     assert r.returncode == 0, r.stderr
     with zipfile.ZipFile(tmp_path / "out" / "t.usdz") as z:
         assert z.read("t_texture0.png") == (src / "my albedo.png").read_bytes()
+
+
+# Apple's usdz profile (what AR Quick Look loads; the rules the older ComplianceChecker ran
+# with arkit=True, restated from the usdz specification and Apple's USDZ notes): the root
+# layer is the only USD layer and is binary (usdc), it comes first, entries are stored and
+# 64-byte aligned, files are only layers, PNG/JPEG images and audio, prims are of the
+# geometry, shading and skinning types the viewer knows, and shaders are only the
+# UsdPreviewSurface family.
+ARKIT_FILES = {".usdc", ".usda", ".usd", ".png", ".jpg", ".jpeg", ".m4a", ".mp3", ".wav"}
+ARKIT_PRIMS = {"", "Scope", "Xform", "Camera", "Shader", "NodeGraph", "Material", "Mesh",
+               "Sphere", "Cube", "Cylinder", "Cone", "Capsule", "GeomSubset", "Points",
+               "SkelRoot", "Skeleton", "SkelAnimation", "BlendShape", "SpatialAudio"}
+ARKIT_SHADERS = {"UsdPreviewSurface", "UsdUVTexture", "UsdTransform2d"} | {
+    f"UsdPrimvarReader_{t}" for t in ("float", "float2", "float3", "float4", "int", "string",
+                                      "normal", "point", "vector", "matrix")}
+
+
+def arkit_violations(path: Path) -> list[str]:
+    out = []
+    entries = _local_data_offsets(path)
+    names = list(entries)
+    layers = [n for n in names if Path(n).suffix.lower() in (".usdc", ".usda", ".usd")]
+    if not names or Path(names[0]).suffix.lower() != ".usdc":
+        out.append(f"the first entry {names[:1]} is not a usdc layer")
+    if len(layers) != 1:
+        out.append(f"the package holds {len(layers)} USD layers: {layers}")
+    for name, (offset, method) in entries.items():
+        if Path(name).suffix.lower() not in ARKIT_FILES:
+            out.append(f"{name}: a file type the profile does not allow")
+        if method != 0 or offset % 64:
+            out.append(f"{name}: compressed or not 64-byte aligned")
+    stage = Usd.Stage.Open(str(path))
+    for prim in stage.Traverse():
+        if prim.GetTypeName() not in ARKIT_PRIMS:
+            out.append(f"{prim.GetPath()}: prim type {prim.GetTypeName()}")
+        if prim.IsA(UsdShade.Shader):
+            sid = UsdShade.Shader(prim).GetIdAttr().Get()
+            if sid not in ARKIT_SHADERS:
+                out.append(f"{prim.GetPath()}: shader {sid}")
+            if sid == "UsdUVTexture":
+                file = UsdShade.Shader(prim).GetInput("file").Get()
+                if not file.resolvedPath or "[" not in file.resolvedPath:
+                    out.append(f"{prim.GetPath()}: {file.path} is not inside the package")
+    return out
+
+
+@pytest.mark.parametrize("name", ["velvet", "honey"])
+def test_arkit_usdz_follows_apples_profile(tmp_path, name):
+    out = tmp_path / f"{name}.usdz"
+    r = cli("export", MATERIALS / f"{name}.json", "-o", out, "--size", SIZE, "--arkit")
+    assert r.returncode == 0, r.stderr
+    assert "ARKit profile" in r.stderr and "MaterialX" in r.stderr, r.stderr
+    assert arkit_violations(out) == []
+    assert validation_errors(out) == []
+    stage = Usd.Stage.Open(str(out))
+    _, mat = _material(stage)
+    assert _preview(mat).GetInput("diffuseColor").HasConnectedSource()
+    assert os.fsencode(str(tmp_path)) not in out.read_bytes()
+
+
+def test_the_arkit_rules_see_the_full_usdz(tmp_path):
+    """The check can fail: the default usdz carries the MaterialX network (ND_* shaders)."""
+    out = tmp_path / "full.usdz"
+    r = cli("export", MATERIALS / "velvet.json", "-o", out, "--size", SIZE)
+    assert r.returncode == 0, r.stderr
+    problems = arkit_violations(out)
+    assert any("shader ND_" in p for p in problems), problems
+
+
+def test_arkit_is_for_usdz_only(tmp_path):
+    r = cli("export", MATERIALS / "velvet.json", "-o", tmp_path / "v.usda", "--arkit")
+    assert r.returncode == 2 and r.stderr.strip() == "error: --arkit applies to .usdz exports only"
+    assert list(tmp_path.iterdir()) == []

@@ -8,7 +8,8 @@ standard_surface or gltf_pbr (matedit.interop.mtlx_export); subgraphs MaterialX 
 express are baked to images in OUT_textures/ beside the document, with copies of the
 textures the material reads, and reported (--zip: OUT.zip). USD: the preview mesh bound to
 a Material with a UsdPreviewSurface network on the baked maps and the MaterialX export in
-the mtlx render context (matedit.interop.usd). `--check` measures the round trip's loss
+the mtlx render context (matedit.interop.usd; `--arkit`: Apple's usdz profile, the preview
+network alone). `--check` measures the round trip's loss
 (matedit.commands.export_check)."""
 
 from __future__ import annotations
@@ -50,6 +51,9 @@ def register(sub) -> None:
                    "data; default) or float EXR")
     p.add_argument("--zip", action="store_true",
                    help="MaterialX only: pack OUT.mtlx and its side files into OUT.zip")
+    p.add_argument("--arkit", action="store_true",
+                   help=".usdz only: Apple's usdz profile (AR Quick Look): the "
+                   "UsdPreviewSurface network on PNG maps, without the MaterialX network")
     declare_inputs(p, file="document", mesh="mesh")
     p.set_defaults(run=run)
 
@@ -62,6 +66,8 @@ def run(args) -> int:
     if not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
     export_check.validate(args, out)
+    if args.arkit and kind != ".usdz":
+        raise UsageError("--arkit applies to .usdz exports only")
     if kind == ".mtlx":
         if args.mesh:
             raise UsageError("--mesh applies to glTF and USD exports only")
@@ -202,7 +208,7 @@ def _usd(args, out: Path) -> int:
             attrs, ir, bake_notes = bake_for_export(
                 ctx, doc, resolver, size, None if is_plane_spec(mesh_spec) else mesh,
                 progress_printer("baking"))
-        result = usd.export_baked(doc, resolver, attrs, ir, mesh, out, size)
+        result = usd.export_baked(doc, resolver, attrs, ir, mesh, out, size, args.arkit)
         refuse_overwrite(result.files, inputs)
         usd.write(result)
     except CompileError as exc:

@@ -451,11 +451,13 @@ def build(out: Path, maps: list[BakedMap], mesh, name: str, emissive_max: float,
 
 
 def export_baked(doc, resolver, attrs: dict[str, np.ndarray], ir, mesh, out: Path,
-                 size: int) -> UsdExport:
+                 size: int, arkit: bool = False) -> UsdExport:
     """The asset of `doc` from its bake (`bake.bake_attributes`: the attributes and the
     optimised IR) on `mesh`: the MaterialX export (of the lowered document, its baked nodes
-    `size` texels wide) carried where it can be written, else a note says why not. Raises
-    CompileError, UsdExportError."""
+    `size` texels wide) carried where it can be written, else a note says why not. With
+    `arkit` (a .usdz for AR Quick Look and other viewers of Apple's usdz profile), the
+    preview network alone: that profile allows no other shader and no EXR file, and a note
+    says so. Raises CompileError, UsdExportError."""
     from matedit.compiler.lower import lower_document
     from matedit.interop import mtlx_export
     from matedit.interop.bake import maps_from
@@ -468,6 +470,10 @@ def export_baked(doc, resolver, attrs: dict[str, np.ndarray], ir, mesh, out: Pat
     lowered = lower_document(doc, resolver)
     notes: list[str] = []
     mtlx = None
+    if arkit:
+        notes.append("ARKit profile: UsdPreviewSurface on the baked PNG maps only (no "
+                     "MaterialX network: the profile allows no other shader)")
+        return build(out, maps, mesh, stem_of(doc), emax, lobe_stats(ir), None, notes)
     try:
         copies = texture_copies(lowered, out)
         mx = mtlx_export.export_ir(  # its bakes as EXR beside the layer, like the copies
