@@ -80,9 +80,6 @@ def run(args) -> int:
         if given:
             raise UsageError(f"{flag} applies to MaterialX (.mtlx) exports only")
     if kind in (".usda", ".usdz"):
-        if args.check:
-            raise UsageError("--check reads back .gltf, .glb and .mtlx exports; USD has no "
-                             "importer yet")
         return _usd(args, out)
     return _gltf(args, out)
 
@@ -195,7 +192,7 @@ def _usd(args, out: Path) -> int:
     mesh_spec = args.mesh or preview_spec(doc, "mesh", "sphere")
     inputs = command_inputs(args, [doc], resolver)
     try:
-        refuse_overwrite([out], inputs)
+        refuse_overwrite([out, *export_check.outputs(args)], inputs)
         mesh = mesh_from_spec(mesh_spec)
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
@@ -223,4 +220,5 @@ def _usd(args, out: Path) -> int:
         report("note", f"{path}: {note}")
     if sys.stderr.isatty():
         print(f"exported {path} to {', '.join(str(p) for p in result.files)}", file=sys.stderr)
+    export_check.after_write(args, path, doc, out, str(mesh_spec))
     return 0

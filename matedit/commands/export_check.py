@@ -9,8 +9,11 @@ format's re-import function (`REIMPORTERS`, by output suffix):
                (base colour and alpha, metallic-roughness and occlusion, normal, emissive, and
                the material's factors; KHR_materials_* lobe extensions are not read back, so
                their loss shows in the figure).
+  .usda/.usdz  the UsdPreviewSurface network on its own maps (matedit.interop.usd_readback:
+               the same template, its clearcoat and ior constants as lobe fields; the
+               MaterialX network and a separate opacity map are not read back).
 The original and the round trip are rendered alike (`matedit render`'s defaults: the studio
-environment, the default light rig, split-sum, exposure 0; the export's mesh for glTF, the
+environment, the default light rig, split-sum, exposure 0; the export's mesh for glTF and USD, the
 sphere for MaterialX; N x N pixels) and compared per pixel with CIEDE2000 on the display
 images (matedit.shading.color_difference) over the pixels the mesh covers; the command
 prints `note: FILE: round trip: mean ΔE X max ΔE Y (CIEDE2000 on the display image)`.
@@ -101,10 +104,22 @@ def reimport_gltf_maps(out: Path, work: Path):
         raise UsageError(f"--check: cannot read the export back: {exc}") from None
 
 
+def reimport_usd_preview(out: Path, work: Path):
+    """The USD asset's UsdPreviewSurface on its own maps (matedit.interop.usd_readback)."""
+    from matedit.interop.usd_readback import UsdReadbackError, read_material
+
+    try:
+        return read_material(out, work)
+    except UsdReadbackError as exc:
+        raise UsageError(f"--check: cannot read the export back: {exc}") from None
+
+
 REIMPORTERS: dict[str, Callable] = {
     ".mtlx": reimport_mtlx,
     ".gltf": reimport_gltf_maps,
     ".glb": reimport_gltf_maps,
+    ".usda": reimport_usd_preview,
+    ".usdz": reimport_usd_preview,
 }
 
 
