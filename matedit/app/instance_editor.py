@@ -375,6 +375,31 @@ class Instances:
         self._attach(library.files)  # the Library listed its files before this was connected
         library.instanceCreateRequested.connect(lambda p: self.new_instance_dialog(p))
 
+    def instances_of_open(self) -> list[tuple[str, Path]]:
+        """(name, file) of every instance whose parent is the open material's file, among the
+        Library's files and those beside the material (what the A/B split offers as A)."""
+        doc = self.host.actions.document
+        if doc is None or doc.path is None or doc.is_function:
+            return []
+        target = Path(doc.path).resolve()
+        candidates = list(self.library.files)
+        try:
+            candidates += sorted(Path(doc.path).parent.glob("*.json"))
+        except OSError:
+            pass
+        out: dict[Path, str] = {}
+        for f in candidates:
+            real = f.resolve()
+            if real in out or real == target or not is_instance_file(f):
+                continue
+            try:
+                inst = load_instance(f)
+                if inst.parent_path().resolve() == target:
+                    out[real] = inst.name or f.stem
+            except (FormatError, ValueError, OSError):
+                continue
+        return sorted(((name, path) for path, name in out.items()), key=lambda e: e[0].lower())
+
     def _attach(self, files: list[Path]) -> None:  # the Library's instances, under parents
         attach_instances(self.library.items("material"), files, PATH_ROLE, KIND_ROLE)
 

@@ -70,10 +70,12 @@ class MainWindow(QMainWindow):
         self.menus: Menus = install_menus(self, self, [*p.docks(), self.stats.dock])
         for a in (self.viewport.follow_action, self.viewport.ab_action):
             self.menus.view.insertAction(self.menus.snap, a)
+        self.menus.view.insertMenu(self.menus.snap, self.viewport.ab_menu)
         self._build_status()
         self._connect()
         # File › New Instance, the Parameters dock, the Library's instances
         self.instances = Instances(self, self, self.menus.file, p.library, p.inspector_dock)
+        self.viewport.instances_of = self.instances.instances_of_open
         self.actions.open_instance = self.open_instance
         self.layout_state = WindowLayout(self, self.viewport, self.lights, self.menus.snap)
         if restore_layout:

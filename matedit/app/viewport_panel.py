@@ -5,16 +5,18 @@ restarts and stored with documents."""
 
 from __future__ import annotations
 
+import copy
 import os
 from pathlib import Path
 
-from PySide6.QtCore import Qt, Signal
-from PySide6.QtGui import QAction
+from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtGui import QAction, QActionGroup
 from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
     QHBoxLayout,
     QLabel,
+    QMenu,
     QSlider,
     QToolButton,
     QVBoxLayout,
@@ -22,7 +24,12 @@ from PySide6.QtWidgets import (
 )
 
 from matedit.app import file_dialogs
-from matedit.app.compile_service import MaterialCompiler, uniform_values, uniforms_by_port
+from matedit.app.compile_service import (
+    VIEWPORT_TARGET,
+    MaterialCompiler,
+    uniform_values,
+    uniforms_by_port,
+)
 from matedit.app.controller import ValueChange
 from matedit.app.environment import ENVIRONMENTS, EnvironmentChoice, environment_combo
 from matedit.app.node_preview import PreviewTarget
@@ -146,12 +153,28 @@ class ViewportPanel(QWidget):
         self.ab_action.setCheckable(True)
         self.ab_action.setIconText("A/B")
         self.ab_action.setToolTip("A/B split: the material before the last structural edit on "
-                                  "the left, as it is now on the right (drag the divider)")
+                                  "the left, as it is now on the right (drag the divider; "
+                                  "right-click to compare with an instance instead)")
         self.ab_action.toggled.connect(self._ab_toggled)
         self.ab_button = QToolButton()
         self.ab_button.setObjectName("abSplit")
         self.ab_button.setDefaultAction(self.ab_action)
         self.ab_button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+        # what A is: the material before the last edit, or one of its instances (View ›
+        # A/B Split Against, and the button's right-click menu: no arrow widens the bar)
+        self.ab_menu = QMenu("A/B Split A&gainst", self)
+        self.ab_menu.setObjectName("abSourceMenu")
+        self.ab_menu.aboutToShow.connect(self._fill_ab_menu)
+        self.ab_button.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
+        self.ab_button.customContextMenuRequested.connect(
+            lambda pos: self.ab_menu.popup(self.ab_button.mapToGlobal(pos)))
+        # (name, path) of the instance files of the open material; set by the window
+        self.instances_of = lambda: []
+        self._ab_instance: tuple[str, Path] | None = None
+        self._ab_refresh = QTimer(self)  # an instance as A follows the material's edits
+        self._ab_refresh.setSingleShot(True)
+        self._ab_refresh.setInterval(250)
+        self._ab_refresh.timeout.connect(self._refresh_instance_compare)
         self.save_button = QToolButton()
         self.save_button.setIcon(icon("save"))
         self.save_button.setToolTip("Save the viewport image (PNG as shown, or linear EXR)")
@@ -245,7 +268,10 @@ class ViewportPanel(QWidget):
         self.view.set_material(compiled)
         self.push_values()
         if self.comparing:
-            self._apply_compare()
+            if self._ab_instance is not None:
+                self._ab_refresh.start()
+            else:
+                self._apply_compare()
 
     def _send_values(self, uniforms: dict, textures: dict) -> None:
         """Values to the view, kept as what it shows (the A side of a later A/B split)."""
@@ -290,6 +316,7 @@ class ViewportPanel(QWidget):
         self.view.clear_material()
         self._hide_failure()
         self._shown, self._before = [None, {}, {}], None  # another document: no "before"
+        self._ab_instance = None
         if self.comparing:
             self.ab_action.setChecked(False)
 
@@ -310,9 +337,68 @@ class ViewportPanel(QWidget):
             w.setVisible(on)
         self._place_banner()
 
+    def _fill_ab_menu(self) -> None:
+        """Before the last edit, and each instance of the open material, as A."""
+        self.ab_menu.clear()
+        group = QActionGroup(self.ab_menu)
+        entries: list[tuple[str, tuple[str, Path] | None]] = [("Before the Last Edit", None)]
+        entries += [(f"Against Instance \u2018{name}\u2019", (name, Path(path)))
+                    for name, path in self.instances_of()]
+        for text, source in entries:
+            act = self.ab_menu.addAction(text)
+            act.setCheckable(True)
+            act.setChecked(self.comparing and source == self._ab_instance)
+            group.addAction(act)
+            act.triggered.connect(lambda _c=False, s=source: self.compare_with(s))
+        if len(entries) == 1:
+            none = self.ab_menu.addAction("No instance of this material in the Library or "
+                                          "its folder")
+            none.setEnabled(False)
+
+    def compare_with(self, instance: tuple[str, Path] | None) -> None:
+        """A/B split with A the material before the last edit (None) or the instance
+        (name, file) of the open material, its overrides on the material as it is now."""
+        self._ab_instance = instance
+        if self.comparing:
+            self._apply_compare()
+        else:
+            self.ab_action.setChecked(True)
+
+    def _refresh_instance_compare(self) -> None:
+        if self.comparing and self._ab_instance is not None:
+            self._apply_compare()
+
+    def _instance_compare(self) -> bool:
+        """A: the instance's effective material on the open document (False: it cannot be
+        drawn; the status bar says why and the split falls back to before the last edit)."""
+        from matedit.compiler import compile_document
+        from matedit.io.instance import InstanceError, load_instance, resolve
+
+        assert self._ab_instance is not None
+        name, path = self._ab_instance
+        root = copy.copy(self.controller.document)
+        root.graph = root.graph.copy()  # without the editor's listeners
+        try:
+            r = resolve(load_instance(path), root=root)
+            if r.errors:
+                raise InstanceError(r.errors[0].file, r.errors[0].message,
+                                    r.errors[0].parameter)
+            compiled = compile_document(r.document, self.controller.resolver, VIEWPORT_TARGET)
+        except Exception as exc:  # noqa: BLE001 - the split is an aid: say why, keep drawing
+            self.statusMessage.emit(f"A/B split: instance {name}: {exc}")
+            self._ab_instance = None
+            return False
+        self.view.set_compare(compiled, {}, {})
+        self.a_label.setText(f"A \u00b7 instance {name}")
+        self.b_label.setText("B \u00b7 the material now")
+        self._place_banner()
+        return True
+
     def _apply_compare(self) -> None:
         """A: the material before the last structural edit (the material now, until there is
-        one), with the values it was drawn with."""
+        one), with the values it was drawn with; or an instance (compare_with)."""
+        if self._ab_instance is not None and self._instance_compare():
+            return
         before = self._before
         if before is None and self._shown[0] is not None:
             before = (self._shown[0], dict(self._shown[1]), dict(self._shown[2]))
@@ -382,6 +468,8 @@ class ViewportPanel(QWidget):
         if self._by_port[0] is not cm:
             self._by_port = (cm, uniforms_by_port(cm))
         uniforms = self._by_port[1].get((change.node, change.port))
+        if self.comparing and self._ab_instance is not None:
+            self._ab_refresh.start()  # the instance's values not overridden follow
         if uniforms:
             self._send_values(uniform_values(cm, self.controller.document, uniforms), {})
 

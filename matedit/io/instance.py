@@ -463,10 +463,12 @@ def _real(p: Path) -> Path:
     return Path(os.path.realpath(p))
 
 
-def resolve(inst: InstanceDocument) -> ResolvedInstance:
+def resolve(inst: InstanceDocument, root: MaterialDocument | None = None) -> ResolvedInstance:
     """Walk the parent chain and build the effective material. Raises InstanceError for a
     chain that cannot be followed (missing parent, cycle, a parent that is not a material or
-    an instance, an unreadable parent); parameter problems are collected in `problems`."""
+    an instance, an unreadable parent); parameter problems are collected in `problems`.
+    `root`: a material document standing for the file at its path (the editor's open, maybe
+    unsaved, material), read instead of that file where the chain reaches it."""
     chain_docs: list[InstanceDocument] = [inst]
     chain: list[Path] = [_real(inst.path) if inst.path else Path("<unsaved instance>")]
     current = inst
@@ -483,6 +485,12 @@ def resolve(inst: InstanceDocument) -> ResolvedInstance:
             loop = [*chain[chain.index(real):], real]
             raise InstanceError(inst.path, "instance parents form a cycle: "
                                 + " -> ".join(str(p) for p in loop), None)
+        if root is not None and root.path is not None and _real(root.path) == real:
+            if root.is_function:
+                raise InstanceError(here, f"parent {current.parent} is a material function; "
+                                    "an instance's parent is a material or another instance")
+            chain.append(real)
+            return _apply(inst, chain_docs, chain, root)
         try:
             text = read_document_text(ppath)
         except FormatError as exc:
