@@ -9,9 +9,10 @@ References, independent of the importer:
     (1e-5: float32 evaluation);
   - matedit's own export (`matedit export X.glb`): every field glTF holds comes back within
     1e-6 for factors and 1/255 for the 8-bit maps (compared encoded, as stored);
-  - three materials documents of the Khronos glTF-Sample-Assets (tests/data/gltf/README.md):
-    every property they set is either read exactly (the reference agrees) or named in a
-    `warning:` line.
+  - thirteen materials documents of the Khronos glTF-Sample-Assets (tests/data/gltf/README.md),
+    their images replaced by small random ones sampled at random UVs: every property they set
+    is either read exactly (the reference agrees, texture transforms included) or named in a
+    `warning:` line, and so is a primitive's COLOR_0 that multiplies a material's base colour.
 """
 
 from __future__ import annotations
@@ -249,18 +250,39 @@ def properties(obj, prefix: str = "") -> list[str]:
 # The properties the reference above compares (read exactly when the evaluation agrees); any
 # other property a file sets must be named by a warning.
 COMPARED = {
-    "name", "pbrMetallicRoughness.baseColorFactor", "pbrMetallicRoughness.metallicFactor",
-    "pbrMetallicRoughness.roughnessFactor", "pbrMetallicRoughness.baseColorTexture.index",
+    "name", "alphaMode", "pbrMetallicRoughness.baseColorFactor",
+    "pbrMetallicRoughness.metallicFactor", "pbrMetallicRoughness.roughnessFactor",
+    "pbrMetallicRoughness.baseColorTexture.index",
     "pbrMetallicRoughness.metallicRoughnessTexture.index", "normalTexture.index",
     "normalTexture.scale", "emissiveFactor", "emissiveTexture.index",
-    "extensions.KHR_materials_ior.ior", "extensions.KHR_materials_clearcoat.clearcoatFactor",
+    "extensions.KHR_materials_emissive_strength.emissiveStrength",
+    "extensions.KHR_materials_ior.ior",
+    "extensions.KHR_materials_specular.specularColorFactor",
+    "extensions.KHR_materials_specular.specularColorTexture.index",
+    "extensions.KHR_materials_clearcoat.clearcoatFactor",
     "extensions.KHR_materials_sheen.sheenColorFactor",
     "extensions.KHR_materials_sheen.sheenRoughnessFactor",
+    "extensions.KHR_materials_anisotropy.anisotropyStrength",
+    "extensions.KHR_materials_anisotropy.anisotropyRotation",
+    "extensions.KHR_materials_anisotropy.anisotropyTexture.index",
+    "extensions.KHR_materials_transmission.transmissionFactor",
+    "extensions.KHR_materials_transmission.transmissionTexture.index",
+    "extensions.KHR_materials_volume.thicknessFactor",
+    "extensions.KHR_materials_volume.thicknessTexture.index",
+    "extensions.KHR_materials_volume.attenuationDistance",
+    "extensions.KHR_materials_volume.attenuationColor",
     "extensions.KHR_materials_iridescence.iridescenceIor",
     "extensions.KHR_materials_iridescence.iridescenceTexture.index",
 }
+# KHR_texture_transform on any textureInfo: the reference samples through it (gltf_transform)
+TRANSFORM = ".extensions.KHR_texture_transform."
 SRGB_TEXTURES = {"baseColorTexture", "emissiveTexture", "sheenColorTexture",
                  "specularColorTexture"}
+
+
+def _compared(prop: str) -> bool:
+    return prop in COMPARED or (TRANSFORM in prop and prop.rsplit(".", 1)[-1] in
+                                {"offset", "rotation", "scale"})
 
 
 @pytest.mark.parametrize("path", KHRONOS, ids=lambda p: p.stem)
@@ -270,44 +292,62 @@ def test_khronos_sample_materials_import_with_every_property_mapped_or_warned(tm
     assert rc == 0, err
     assert not error_lines(err)
     warnings = [line for line in err.splitlines() if line.startswith("warning: ")]
+    # every image a small random texture (linear RGBA, row 0 the top), sampled at random UVs
+    # so that texture transforms are compared too
     rng = np.random.default_rng(7)
-    texel = {i: rng.uniform(0.05, 0.95, 4) for i in range(len(gltf["images"]))}
-    for m in gltf["materials"]:
+    images = {i: rng.uniform(0.05, 0.95, (4, 5, 4)) for i in range(len(gltf["images"]))}
+    uv_gltf = rng.uniform(-1.0, 2.0, (64, 2))
+    for index, m in enumerate(gltf["materials"]):
         stem = "".join(ch if ch.isalnum() else "_" for ch in m["name"])
         out = tmp_path / "out" / f"{stem}.json"
         assert out.is_file(), sorted(p.name for p in (tmp_path / "out").iterdir())
         doc = load(out)
         assert doc.name == stem
         # every texture parameter names the asset's image, relative to the output, in the
-        # colour space glTF gives its slot
-        params = {n.settings["path"]: n.settings["srgb"] for n in doc.graph.nodes.values()
+        # colour space glTF gives its slot (one image may be read in two spaces)
+        params = {(n.settings["path"], n.settings["srgb"]) for n in doc.graph.nodes.values()
                   if role_of(n.kind) is Role.TEXTURE_PARAMETER}
         uris = {os.path.relpath(path.parent / im["uri"], out.parent).replace(os.sep, "/")
                 for im in gltf["images"]}
-        assert set(params) <= uris
-        by_uri = {os.path.relpath(path.parent / gltf["images"][t["source"]]["uri"],
-                                  out.parent).replace(os.sep, "/"): i
-                  for i, t in enumerate(gltf["textures"])}
+        assert {p for p, _ in params} <= uris
         for prop in properties(m):
             if prop.endswith("Texture.index"):
                 slot = prop.split(".")[-2]
-                uri = next(u for u, i in by_uri.items() if i == _get(m, prop))
-                assert params[uri] is (slot in SRGB_TEXTURES), (prop, params)
+                image = gltf["images"][gltf["textures"][_get(m, prop)]["source"]]
+                uri = os.path.relpath(path.parent / image["uri"], out.parent).replace(
+                    os.sep, "/")
+                assert (uri, slot in SRGB_TEXTURES) in params, (prop, params)
 
-        # the spec's values with every image a constant texel, against our evaluation
-        got = _evaluate_with_texels(doc, path, gltf, texel)
-        want = reference(m, lambda info, srgb: texel[gltf["textures"][info["index"]][
-            "source"]].reshape(1, 4))
+        # the spec's values at random UVs, against our evaluation
+        got = _evaluate_with_images(doc, path, gltf, images, uv_gltf)
+
+        def sample(info, srgb):
+            t = info.get("extensions", {}).get("KHR_texture_transform")
+            return bilinear_gltf(images[gltf["textures"][info["index"]]["source"]],
+                                 gltf_transform(uv_gltf, t))
+
+        want = reference(m, sample)
         for attr, value in want.items():
             np.testing.assert_allclose(got[attr], np.broadcast_to(value, got[attr].shape),
                                        atol=1e-5, err_msg=f"{path.name} {m['name']} {attr}")
+        # KHR_materials_volume: a transmissive surface without thickness is thin-walled
+        ext = m.get("extensions", {})
+        if ext.get("KHR_materials_transmission", {}).get("transmissionFactor", 0.0):
+            thin = ext.get("KHR_materials_volume", {}).get("thicknessFactor", 0.0) == 0.0
+            outputs = [n for n in doc.graph.nodes.values()
+                       if role_of(n.kind) is Role.MATERIAL_OUTPUT]
+            assert [bool(n.settings.get("thin_walled")) for n in outputs] == [thin], m["name"]
         named = [w for w in warnings if f"material {m['name']}:" in w]
         for prop in properties(m):
-            if prop in COMPARED:
+            if _compared(prop):
                 continue
             leaf = prop.split(".")[-1] if not prop.endswith(".index") else prop.split(".")[-2]
             assert any(leaf in w for w in named), f"{path.name} {m['name']}: {prop} is " \
                 f"neither compared nor warned about: {named}"
+        # glTF multiplies the base colour by a primitive's COLOR_0: not ours, so a warning
+        if any(p.get("material") == index and "COLOR_0" in p.get("attributes", {})
+               for mesh in gltf.get("meshes", []) for p in mesh["primitives"]):
+            assert any("COLOR_0" in w for w in named), (m["name"], named)
 
 
 def _get(obj: dict, path: str):
@@ -316,15 +356,19 @@ def _get(obj: dict, path: str):
     return obj
 
 
-def _evaluate_with_texels(doc, src: Path, gltf: dict, texel: dict) -> dict:
-    """Our CPU evaluation at one point, each texture a 1 x 1 image of its image's texel."""
+def _evaluate_with_images(doc, src: Path, gltf: dict, images: dict, uv_gltf: np.ndarray
+                          ) -> dict:
+    """Our CPU evaluation at glTF UVs `uv_gltf`, each texture its image's pixels (given as
+    linear, in file order: row 0 the top, so flipped to our row 0 = v = 0)."""
     ir = lower_and_optimise(doc, FileResolver())
     index = {os.path.realpath(src.parent / im["uri"]): i for i, im in enumerate(gltf["images"])}
-    textures = {t.name: texel[index[os.path.realpath(t.path)]].reshape(1, 1, 4).astype("f4")
-                for t in ir.textures}
-    surf = SurfaceArrays(np.array([[0.3, 0.6]]), np.zeros((1, 3)), np.array([[0.0, 0, 1]]),
-                         np.array([[0.0, 0, 1]]))
-    result = {k: np.asarray(v, np.float64).reshape(1, -1)
+    textures = {t.name: np.ascontiguousarray(images[index[os.path.realpath(t.path)]][::-1],
+                                             "f4") for t in ir.textures}
+    n = len(uv_gltf)
+    uv = np.stack([uv_gltf[:, 0], 1.0 - uv_gltf[:, 1]], -1)
+    up = np.tile([0.0, 0.0, 1.0], (n, 1))
+    surf = SurfaceArrays(uv, np.zeros((n, 3)), up, up)
+    result = {k: np.asarray(v, np.float64).reshape(n, -1)
               for k, v in evaluate(ir, surf, textures=textures).items()}
     result["normal"] /= np.linalg.norm(result["normal"], axis=1, keepdims=True)
     return result
@@ -561,12 +605,16 @@ def test_every_dropped_or_approximated_value_is_a_warning_and_strict_refuses(tmp
                                                 "sheenRoughnessFactor": 0.1}}}
     src = _one(tmp_path, m, [{"uri": img}],
                samplers=[{"wrapS": 33071, "magFilter": 9728}],
-               textures=[{"source": 0, "sampler": 0}])
+               textures=[{"source": 0, "sampler": 0}],
+               meshes=[{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
+                       {"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1},
+                                        "material": 0}]}])
     rc, _, err = cli("import", src, "-o", tmp_path / "w.json")
     assert rc == 0, err
     for needle in ("texCoord 1", "doubleSided true", "extras", "KHR_materials_unlit",
                    "KHR_materials_dispersion", "specularFactor 0.5", "wrapS CLAMP_TO_EDGE",
-                   "magFilter NEAREST", "sheenRoughnessFactor 0.1"):
+                   "magFilter NEAREST", "sheenRoughnessFactor 0.1",
+                   "COLOR_0 of meshes[1].primitives[0]:"):
         assert any(needle in w and w.startswith("warning: a.gltf: material w: ")
                    for w in err.splitlines()), (needle, err)
     for p in tmp_path.glob("w*"):

@@ -631,6 +631,25 @@ class _GltfImporter(_Importer):
         layout(self.mat)
         return self.mat
 
+    def vertex_colors(self, index: int) -> None:
+        """Warn where a primitive draws this material with vertex colours: glTF multiplies
+        the base colour (and alpha) by COLOR_0, which a matedit material cannot carry. The
+        meshes are otherwise not read, so a malformed one is passed over."""
+        meshes = self.asset.json.get("meshes")
+        users = []
+        for i, mesh in enumerate(meshes if isinstance(meshes, list) else []):
+            prims = mesh.get("primitives") if isinstance(mesh, dict) else None
+            for j, prim in enumerate(prims if isinstance(prims, list) else []):
+                if (isinstance(prim, dict) and prim.get("material") == index
+                        and isinstance(prim.get("attributes"), dict)
+                        and "COLOR_0" in prim["attributes"]):
+                    users.append(f"meshes[{i}].primitives[{j}]")
+        if users:
+            more = f" (and {len(users) - 3} more)" if len(users) > 3 else ""
+            self.warn(f"COLOR_0 of {', '.join(users[:3])}{more}: glTF multiplies this "
+                      "material's base colour and alpha by that vertex colour, which a "
+                      "matedit material does not carry; dropped")
+
     def alpha(self, m: dict, alpha: float, bct: Any) -> None:
         mode = m.get("alphaMode", "OPAQUE")
         cutoff = self.prop(m, "alphaCutoff", 0.5, "")
@@ -909,6 +928,7 @@ def _import_one(asset: Asset, index: int, name: str, out: Path,
         raise GltfImportError([f"{asset.path.name}: material {index} is not an object"])
     imp = _GltfImporter(asset, out, name)
     imp.build(m)
+    imp.vertex_colors(index)
     if imp.errors:
         raise GltfImportError(imp.errors)
     if warnings is not None:
