@@ -1,5 +1,5 @@
 """The round-trip table of docs/materialx.md (`## Round trip`): `matedit export --check` of
-every sample in graphs/materials to .mtlx and to .glb, at the sizes below, its mean and max
+every sample in graphs/materials to .mtlx, .glb and .usda, at the sizes below, its mean and max
 CIEDE2000 per sample.
 
     python tools/roundtrip_table.py            # print the table
@@ -21,7 +21,7 @@ DOC = ROOT / "docs" / "materialx.md"
 HEADING = "## Round trip"
 BAKE_SIZE = 64
 RENDER_SIZE = 64
-FORMATS = (".mtlx", ".glb")
+FORMATS = (".mtlx", ".glb", ".usda")
 LINE = re.compile(r"round trip: mean ΔE ([\d.]+) max ΔE ([\d.]+)")
 
 
@@ -41,8 +41,8 @@ def measure(sample: Path, suffix: str, folder: Path) -> tuple[float, float] | st
 
 
 def table(samples: list[Path]) -> str:
-    rows = ["| sample | .mtlx mean | .mtlx max | .glb mean | .glb max |",
-            "|---|---|---|---|---|"]
+    rows = ["| sample | " + " | ".join(f"{s} {w}" for s in FORMATS for w in ("mean", "max"))
+            + " |", "|---" * (1 + 2 * len(FORMATS)) + "|"]
     refused = []
     with tempfile.TemporaryDirectory() as tmp:
         for s in samples:
@@ -66,18 +66,23 @@ def section(body: str) -> str:
     return f"""{HEADING}
 
 `matedit export FILE -o OUT --check` reads what it wrote back (MaterialX through the
-importer; glTF as its own baked maps on a metallic-roughness material), renders the original
-and the round trip alike and prints their CIEDE2000 difference on the display image, over the
-pixels the mesh covers (docs/cli.md, `export`). Every sample, exported at `--size
-{BAKE_SIZE}` and rendered at `--check-size {RENDER_SIZE}` (sphere, studio): mean and max ΔE00.
+importer; glTF as its own baked maps on a metallic-roughness material; USD as its
+UsdPreviewSurface on its own maps), renders the original and the round trip alike and prints
+their CIEDE2000 difference on the display image, over the pixels the mesh covers
+(docs/cli.md, `export`). Every sample, exported with the defaults (MaterialX:
+`open_pbr_surface`, PNG maps) at `--size {BAKE_SIZE}` and rendered at `--check-size
+{RENDER_SIZE}` (sphere, studio): mean and max ΔE00.
 Made by `python tools/roundtrip_table.py --write`; tests/test_export_check.py holds a few
 samples within 1.5 times their row.
 
 A mean ΔE00 under about 1 is a difference hard to see side by side. What the figures hold:
 the maps baked at {BAKE_SIZE} texels (a pattern finer than that is lost, in both formats
 where MaterialX bakes a node), what glTF has no place for (lobe fields that vary over the
-surface go out as their means, subsurface is dropped; the export's `note:` lines name them)
-and what the MaterialX importer approximates (its `note: ... round trip import:` lines).
+surface go out as their means, subsurface is dropped; the export's `note:` lines name them),
+what UsdPreviewSurface has no input for (every lobe but the coat and the IOR: the USD
+column is what a viewer of the preview network draws; the asset's MaterialX network
+carries the rest but is not read back) and what the MaterialX importer approximates (its
+`note: ... round trip import:` lines).
 The max is a few pixels, mostly at highlights and silhouettes.
 
 {body}
@@ -97,7 +102,8 @@ def read_table(text: str) -> dict[str, dict[str, tuple[float, float]]]:
     out = {}
     start = text.find(HEADING + "\n")
     for line in text[start:].splitlines():
-        m = re.match(r"\| `([\w-]+)` \|" + r" ([\d.]+|no export) \|" * 4, line)
+        m = re.match(r"\| `([\w-]+)` \|" + r" ([\d.]+|no export) \|" * (2 * len(FORMATS)),
+                     line)
         if m:
             v = [None if x == "no export" else float(x) for x in m.groups()[1:]]
             out[m.group(1)] = {suffix: (v[2 * i], v[2 * i + 1])
