@@ -86,3 +86,29 @@ def test_only_parameters_and_outputs_cannot_be_collapsed():
     doc = load(EDITOR_SAMPLE)
     with pytest.raises(CollapseError, match="nothing to collapse"):
         collapse(doc, analyse(doc, FileResolver()), ["amount", "out"], "f.json", "f")
+
+
+def test_a_selection_with_an_outside_node_between_its_nodes_is_refused(tmp_path):
+    """Collapsing nodes joined through an unselected node would wire the call into itself
+    (call -> e0 -> call): refused, naming the nodes in between, before anything is built;
+    with them selected too, the collapse draws the same (CPU evaluator, 1e-12)."""
+    from matedit.graph.collapse import between
+    from matedit.resources import graphs_dir
+
+    doc = load(graphs_dir() / "materials" / "rusty_painted_metal.json")
+    ids = ["mask_noise", "edge", "hi", "mask"]  # edge -> e0 -> mask: e0 (and e1) outside
+    assert between(doc, ids) == ["e0", "e1"]
+    before = doc.graph.snapshot()
+    with pytest.raises(CollapseError, match=r"^e0, e1 sit between selected nodes"):
+        collapse(doc, analyse(doc, FileResolver()), ids, "f.json", "F")
+    assert doc.graph.snapshot() == before
+    want = _render(doc)
+    save(doc, tmp_path / "mat.json")
+    doc = load(tmp_path / "mat.json")
+    fn, commands, _call = collapse(doc, analyse(doc, FileResolver()), [*ids, "e0", "e1"],
+                                   "f.json", "F")
+    save(fn, tmp_path / "f.json")
+    Macro(commands, text="collapse").apply(doc.graph)
+    got = _render(doc)
+    for key in want:
+        np.testing.assert_allclose(got[key], want[key], rtol=0, atol=1e-12)

@@ -44,6 +44,45 @@ def collapsible(doc: MaterialDocument, node_ids: list[str]) -> list[str]:
                   and role_of(doc.graph.nodes[nid].kind) not in STAYS)
 
 
+def between(doc: MaterialDocument, node_ids) -> list[str]:
+    """Nodes outside `node_ids` on a path from one of them to another (sorted): a collapse
+    would wire the call into itself through them, so it refuses while there are any."""
+    inside = set(node_ids)
+    links = doc.graph.links
+
+    def reach(start: set[str], forward: bool) -> set[str]:
+        seen, todo = set(), list(start)
+        while todo:
+            n = todo.pop()
+            for lk in links:
+                a, b = (lk.src, lk.dst) if forward else (lk.dst, lk.src)
+                if a == n and b not in seen:
+                    seen.add(b)
+                    todo.append(b)
+        return seen
+
+    return sorted((reach(inside, True) & reach(inside, False)) - inside)
+
+
+def _between_error(nodes: list[str]) -> CollapseError:
+    shown = ", ".join(nodes[:4]) + (f" and {len(nodes) - 4} more" if len(nodes) > 4 else "")
+    return CollapseError(f"{shown} {'sits' if len(nodes) == 1 else 'sit'} between selected "
+                         "nodes (a wire leaves the selection and comes back through "
+                         f"{'it' if len(nodes) == 1 else 'them'}): select "
+                         f"{'it' if len(nodes) == 1 else 'them'} too, or fewer nodes")
+
+
+def check_collapsible(doc: MaterialDocument, node_ids) -> None:
+    """Raises CollapseError naming what stands in the way of collapsing `node_ids`."""
+    inside = collapsible(doc, list(node_ids))
+    if not inside:
+        raise CollapseError("nothing to collapse: select nodes other than parameters and "
+                            "outputs")
+    stuck = between(doc, inside)
+    if stuck:
+        raise _between_error(stuck)
+
+
 def _unique(name: str, taken: set[str]) -> str:
     out, i = name, 2
     while out in taken:
@@ -57,10 +96,8 @@ def collapse(doc: MaterialDocument, analysis: Analysis, node_ids: list[str], fun
     """(the function document, the material's commands, the call's id). `function_ref` is
     how the material will refer to the function's file; `analysis` is the material's (for
     the concrete types of the cut wires)."""
+    check_collapsible(doc, node_ids)
     inside = set(collapsible(doc, node_ids))
-    if not inside:
-        raise CollapseError("nothing to collapse: select nodes other than parameters and "
-                            "outputs")
     g = doc.graph
     fn = MaterialDocument(kind=DocumentKind.FUNCTION, name=name)
     for nid in sorted(inside):

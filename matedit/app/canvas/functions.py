@@ -11,7 +11,13 @@ from typing import TYPE_CHECKING
 
 from matedit.app.canvas import placement
 from matedit.app.paths import reference_for
-from matedit.graph.collapse import CollapseError, collapse, collapsible, expand
+from matedit.graph.collapse import (
+    CollapseError,
+    check_collapsible,
+    collapse,
+    collapsible,
+    expand,
+)
 from matedit.graph.commands import AddNode, Macro
 from matedit.graph.nodes import Role, role_of
 from matedit.io import library
@@ -49,6 +55,11 @@ def collapse_selection(view: NodeCanvasView) -> str:
     analysis = controller.analysis
     if analysis is None or any(n not in analysis.out_types for n in ids):
         view.message.emit("The material has errors: fix them (Diagnostics) before collapsing")
+        return ""
+    try:  # before the file is asked for
+        check_collapsible(doc, ids)
+    except CollapseError as exc:
+        view.message.emit(f"Cannot collapse: {exc}")
         return ""
     folder = Path(doc.path).parent if doc.path else Path.cwd()
     if library.inside(folder):
