@@ -22,14 +22,15 @@ HEAVY = ("numpy", "jsonschema", "referencing", "networkx")
 PROBE = """
 import json, sys
 from matedit.cli import main
-rc = main(sys.argv[1:])
-print(json.dumps({"rc": rc, "loaded": sorted(m for m in %r if m in sys.modules)}))
-""" % (HEAVY,)
+heavy = sys.argv[1].split(",")
+rc = main(sys.argv[2:])
+print(json.dumps({"rc": rc, "loaded": sorted(m for m in heavy if m in sys.modules)}))
+"""
 
 
 def _probe(*args: str) -> dict:
     env = dict(os.environ, PYTHONPATH=str(ROOT), PYTHONDONTWRITEBYTECODE="1")
-    r = subprocess.run([sys.executable, "-c", PROBE, *args], cwd=ROOT, env=env,
+    r = subprocess.run([sys.executable, "-c", PROBE, ",".join(HEAVY), *args], cwd=ROOT, env=env,
                        capture_output=True, text=True, timeout=120)
     return json.loads(r.stdout.strip().splitlines()[-1])
 

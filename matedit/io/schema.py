@@ -45,7 +45,7 @@ def _schemas() -> dict[str, dict]:
 
 @cache
 def _subset_checker(fmt: str) -> SubsetChecker | None:
-    return compile_schemas(_schemas(), SCHEMA_FILES[fmt])
+    return compile_schemas(_schemas(), schema_path(fmt).name)
 
 
 @cache
@@ -55,7 +55,7 @@ def _validator(fmt: str):
 
     resources = [(c["$id"], Resource.from_contents(c)) for c in _schemas().values()]
     registry = Registry().with_resources(resources)
-    return Draft202012Validator(_schemas()[SCHEMA_FILES[fmt]], registry=registry)
+    return Draft202012Validator(_schemas()[schema_path(fmt).name], registry=registry)
 
 
 def _path_text(parts) -> str:
