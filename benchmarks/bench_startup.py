@@ -51,7 +51,7 @@ def validate_times(path: Path, repeat: int = 5) -> dict:
 IMPORTS_OF_INTEREST = ("matedit.commands", "matedit.commands.validate",
                        "matedit.commands.compile", "matedit.commands.render",
                        "matedit.commands.bake_ibl", "matedit.commands.brdf_lut",
-                       "matedit.graph.validate", "networkx", "numpy", "moderngl")
+                       "matedit.graph.validate", "networkx", "numpy", "jsonschema", "moderngl")
 
 
 def import_breakdown(path: Path) -> dict:

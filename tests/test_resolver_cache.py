@@ -157,3 +157,20 @@ def test_a_file_rewritten_at_once_with_the_same_size_is_read_again(sample, reads
     os.utime(rust, ns=(st.st_atime_ns, st.st_mtime_ns))  # the same size and mtime
     compile_document(doc, FileResolver())
     assert reads["read"] == ["rust.json"]
+
+
+def test_no_compile_or_validation_changes_a_cached_document(sample):
+    """The cache hands every resolver the same document objects: the compiler, validation and
+    the input listing must only read them (a change would leak into every later compile)."""
+    from matedit.commands.validate import problems
+    from matedit.graph.validate import analyse
+
+    doc = load(sample)
+    compile_document(doc, FileResolver())
+    cached = {p: document.dumps(d) for p, (_, d) in document._documents.items()}
+    assert len(cached) >= 3  # the layers, their blends and the function
+    for _ in range(2):
+        compile_document(doc, FileResolver())
+        analyse(doc, FileResolver())
+        assert problems(sample, FileResolver()) == []
+    assert {p: document.dumps(d) for p, (_, d) in document._documents.items()} == cached

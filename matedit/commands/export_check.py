@@ -25,10 +25,12 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.cli_support import UsageError, report
+
+if TYPE_CHECKING:  # numpy is imported where an export is checked, not for every command
+    import numpy as np
 
 DEFAULT_SIZE = 256
 COVER_THRESHOLD = 0.05  # display difference that marks a pixel as the mesh's (see `coverage`)
@@ -139,6 +141,8 @@ class RoundTrip:
                 "(CIEDE2000 on the display image)")
 
     def side_by_side(self) -> np.ndarray:
+        import numpy as np
+
         heat = np.repeat(np.clip(self.delta_e / 10.0, 0.0, 1.0)[..., None], 3, axis=2)
         return np.concatenate([self.original, self.round_trip, heat], axis=1)
 
@@ -146,6 +150,8 @@ class RoundTrip:
 def render_display(docs, resolver, size: int, mesh: str) -> list[np.ndarray]:
     """Display images (size x size, sRGB in [0, 1]) of each document, all under one
     renderer: `matedit render`'s defaults (studio, default rig, split-sum, exposure 0)."""
+    import numpy as np
+
     from matedit.commands.render import _renderer
     from matedit.compiler import CompileError, compile_document
     from matedit.render import MeshError, Renderer
@@ -204,6 +210,8 @@ def _probes():
 
 def measure(original, round_trip, resolver, size: int, mesh: str) -> RoundTrip:
     """Render both (and the two coverage probes) and compare (module notes)."""
+    import numpy as np
+
     from matedit.shading.color_difference import image_difference
 
     a, b, dark, glow = render_display([original, round_trip, *_probes()], resolver, size, mesh)

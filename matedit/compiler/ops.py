@@ -20,12 +20,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from matedit.compiler.ir import Op
 from matedit.graph.nodes import Role, get, kind_for, role_of
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 # The compiler's own op kinds (`Op.kind`); interop.mtlx_export and render.deferred read them.
 MASK = "mask"  # a component swizzle, op.data["channels"]

@@ -6,12 +6,18 @@ deterministic whatever the order of nodes in the file.
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, Op, Scope, Splat, Var
 from matedit.graph.nodes import is_impure
 from matedit.graph.types import PortType
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 # The compiler's own ops whose value depends on more than their operands; catalogue kinds
 # declare it (NodeDef.impure: geometry, time, textures, uniforms).
@@ -69,12 +75,12 @@ def remove_unused(scope: Scope) -> None:
 
 def _fold(op: Op) -> list[Lit] | None:
     """The op's outputs as literals when all its operands are literals (numpy evaluation)."""
-    from matedit.compiler import cpu_eval
-
     if (op.kind in IMPURE_OPS or is_impure(op.kind) or not op.args
             or not all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
             or not all(t.is_numeric for _, t in op.outs)):
         return None
+    from matedit.compiler import cpu_eval  # numpy: only when there is something to fold
+
     lit_args = [a for a in op.args if isinstance(a, Lit)]  # all of them (checked above)
     try:
         values = cpu_eval.eval_op(op, [_as_array(a) for a in lit_args], None)

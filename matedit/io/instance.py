@@ -43,6 +43,7 @@ from matedit.io import library
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import (
     FormatError,
+    check_saves,
     load,
     parse_json_text,
     read_document_text,
@@ -247,10 +248,7 @@ def from_dict(raw: Any, file: str | None = None, path: Path | None = None) -> In
                 f"'preview.{key}' must be a string (a built-in name or a file path)",
                 f"preview.{key}")
     doc.preview = dict(preview)
-    try:
-        dumps(doc)
-    except (TypeError, ValueError) as exc:
-        raise FormatError(file, f"holds a value that cannot be saved again: {exc}") from None
+    check_saves(to_dict(doc), file)
     from matedit.io.schema import check_document_shape
 
     check_document_shape(raw, file)  # the published JSON Schema, after the rules above

@@ -6,6 +6,10 @@ migrated to the current version) with the `jsonschema` library against the schem
 field where the problem is inside ``nodes[i]``. The schemas allow members they do not
 know, so files from a newer minor version keep loading; graph-level rules (known node
 kinds, port types, cycles) are validation's job, not the schema's.
+
+A valid document is recognised without importing `jsonschema` (matedit.io.schema_subset
+judges the few keywords the schemas use); the library is loaded only when that check does
+not say yes, to decide and to word the error.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from matedit.io.errors import FormatError
+from matedit.io.schema_subset import SubsetChecker, compile_schemas
 
 SCHEMA_DIR = Path(__file__).resolve().parent.parent / "schemas"
 SCHEMA_FILES = {
@@ -32,17 +37,25 @@ def schema_path(fmt: str) -> Path:
 
 
 @cache
+def _schemas() -> dict[str, dict]:
+    """Every schema file's contents by file name (read once)."""
+    return {name: json.loads((SCHEMA_DIR / name).read_text(encoding="utf-8"))
+            for name in (*_SHARED, *SCHEMA_FILES.values())}
+
+
+@cache
+def _subset_checker(fmt: str) -> SubsetChecker | None:
+    return compile_schemas(_schemas(), schema_path(fmt).name)
+
+
+@cache
 def _validator(fmt: str):
     from jsonschema import Draft202012Validator
     from referencing import Registry, Resource
 
-    resources = []
-    for name in (*_SHARED, *SCHEMA_FILES.values()):
-        contents = json.loads((SCHEMA_DIR / name).read_text(encoding="utf-8"))
-        resources.append((contents["$id"], Resource.from_contents(contents)))
+    resources = [(c["$id"], Resource.from_contents(c)) for c in _schemas().values()]
     registry = Registry().with_resources(resources)
-    schema = json.loads(schema_path(fmt).read_text(encoding="utf-8"))
-    return Draft202012Validator(schema, registry=registry)
+    return Draft202012Validator(_schemas()[schema_path(fmt).name], registry=registry)
 
 
 def _path_text(parts) -> str:
@@ -79,8 +92,11 @@ def check_document_shape(raw: Any, file: str | None = None) -> None:
     if not isinstance(fmt, str) or fmt not in SCHEMA_FILES:
         raise FormatError(file, f"'format' must be one of {', '.join(sorted(SCHEMA_FILES))}, "
                           f"got {fmt!r}", field="format")
+    subset = _subset_checker(fmt)
+    if subset is not None and subset.is_valid(raw):  # the usual case, without jsonschema
+        return
     validator = _validator(fmt)
-    if validator.is_valid(raw):  # the usual case: no error to rank
+    if validator.is_valid(raw):  # no error to rank
         return
     from jsonschema.exceptions import best_match
 

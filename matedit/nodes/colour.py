@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     BAKE,
@@ -24,6 +23,12 @@ from matedit.nodes.kind import (
 )
 from matedit.nodes.maths import positive_power
 from matedit.nodes.twin import _clamp, _col, _mix
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 LUMA_REC709 = (0.2126, 0.7152, 0.0722)
 
@@ -87,8 +92,8 @@ BLEND_MODES: dict[str, Callable] = {
     "difference": lambda a, b: np.abs(a - b),
     "dodge": _dodge,
     "burn": _burn,
-    "lighten": np.maximum,
-    "darken": np.minimum,
+    "lighten": lambda a, b: np.maximum(a, b),
+    "darken": lambda a, b: np.minimum(a, b),
 }
 
 

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import UNIT, Thumbnail, _fn, _i, _o
 from matedit.nodes.twin import _clamp, _col, _dot, _need, _smoothstep, derivatives
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 
 def _nov(ctx):

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from matedit.nodes.kind import (
     IOR_RANGE,
@@ -26,6 +24,12 @@ from matedit.nodes.kind import (
     role_of,
 )
 from matedit.nodes.twin import _X, _Z, Attributes, _col, _mix, _safe_normalize, _smoothstep
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 
 def _lobe(name, type_, default, doc, rng, group) -> InputDef:

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import math
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     UNIT,
@@ -20,6 +19,12 @@ from matedit.nodes.kind import (
     _un,
 )
 from matedit.nodes.twin import _clamp, _col, _dot, _mix, _smoothstep, _where, fwidth
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 # --- maths -----------------------------------------------------------------------------------
 _op("add", "Add", "({a} + {b})", [_i("a", T), _i("b", T)], "a + b, per component.",

@@ -5,7 +5,7 @@ Integer hashes are uint32 arithmetic and match the GPU bit for bit.
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     _FILTER,
@@ -22,6 +22,12 @@ from matedit.nodes.kind import (
     register,
 )
 from matedit.nodes.twin import _clamp, _col, _mix, filtered_step, fwidth
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 NOISE_MAX_OCTAVES = 6
 
@@ -56,7 +62,6 @@ def _noise_octave(p: np.ndarray, seed: int) -> np.ndarray:
     return _mix(_mix(v00, v10, u[:, 0]), _mix(v01, v11, u[:, 0]), u[:, 1])
 
 
-_U = np.uint32
 
 
 def _as_uint(cells: np.ndarray) -> np.ndarray:
@@ -74,9 +79,9 @@ def hash_cell3(cx, cy, cz, seed) -> np.ndarray:
     return pcg_hash(cx + pcg_hash(cy + pcg_hash(cz + np.asarray(seed, dtype=np.uint32))))
 
 
-def hash_unit(h: np.ndarray, dtype=np.float32) -> np.ndarray:
+def hash_unit(h: np.ndarray, dtype="float32") -> np.ndarray:
     """nodeHashUnit: the top 24 bits in [0, 1), exact in float32."""
-    return ((h >> _U(8)).astype(np.float32) * np.float32(1.0 / 16777216.0)).astype(dtype)
+    return ((h >> np.uint32(8)).astype(np.float32) * np.float32(1.0 / 16777216.0)).astype(dtype)
 
 
 def node_seed(seed) -> np.ndarray:
@@ -88,7 +93,7 @@ def _gradient2(h: np.ndarray, dtype) -> np.ndarray:
     d = np.float32(0.70710678)
     g = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [d, d], [-d, d], [d, -d], [-d, -d]],
                  dtype=np.float32)
-    return g[h >> _U(29)].astype(dtype)
+    return g[h >> np.uint32(29)].astype(dtype)
 
 
 def _fade(t):
@@ -101,16 +106,16 @@ def gradient_noise2(p: np.ndarray, seed) -> np.ndarray:
     f = p - i
     c = _as_uint(i)
     cx, cy = c[:, 0], c[:, 1]
-    one = _U(1)
+    one = np.uint32(1)
     dt = p.dtype
 
     def corner(ox, oy, hx, hy):
         g = _gradient2(hash_cell2(cx + hx, cy + hy, seed), dt)
         return g[:, 0] * (f[:, 0] - ox) + g[:, 1] * (f[:, 1] - oy)
 
-    n00 = corner(0.0, 0.0, _U(0), _U(0))
-    n10 = corner(1.0, 0.0, one, _U(0))
-    n01 = corner(0.0, 1.0, _U(0), one)
+    n00 = corner(0.0, 0.0, np.uint32(0), np.uint32(0))
+    n10 = corner(1.0, 0.0, one, np.uint32(0))
+    n01 = corner(0.0, 1.0, np.uint32(0), one)
     n11 = corner(1.0, 1.0, one, one)
     u = _fade(f)
     return _mix(_mix(n00, n10, u[:, 0]), _mix(n01, n11, u[:, 0]), u[:, 1]) * np.asarray(
@@ -118,7 +123,7 @@ def gradient_noise2(p: np.ndarray, seed) -> np.ndarray:
 
 
 def _grad_dot3(h, d):
-    k = h >> _U(28)
+    k = h >> np.uint32(28)
     u = np.where(k < 8, d[:, 0], d[:, 1])
     v = np.where(k < 4, d[:, 1], np.where((k == 12) | (k == 14), d[:, 0], d[:, 2]))
     return np.where((k & 1) == 0, u, -u) + np.where((k & 2) == 0, v, -v)
@@ -134,7 +139,8 @@ def gradient_noise3(p: np.ndarray, seed) -> np.ndarray:
     for ox in (0, 1):
         for oy in (0, 1):
             for oz in (0, 1):
-                h = hash_cell3(c[:, 0] + _U(ox), c[:, 1] + _U(oy), c[:, 2] + _U(oz), seed)
+                h = hash_cell3(c[:, 0] + np.uint32(ox), c[:, 1] + np.uint32(oy),
+                               c[:, 2] + np.uint32(oz), seed)
                 off = np.asarray([ox, oy, oz], dtype=p.dtype)
                 vals[ox, oy, oz] = _grad_dot3(h, f - off)
     x00 = _mix(vals[0, 0, 0], vals[1, 0, 0], u[:, 0])
@@ -159,7 +165,7 @@ def _octaves(noise, p, octaves, lacunarity, gain, seed, shape=None):
         w = _clamp(n - k, 0.0, 1.0) * amplitude
         if not np.any(w > 0.0):
             break
-        v = noise(q, seed + _U(k))
+        v = noise(q, seed + np.uint32(k))
         total = total + w * (shape(v) if shape else v)
         norm = norm + w
         amplitude = amplitude * gain
@@ -391,11 +397,12 @@ _fn("cell_hash", "Random per Cell", "Noise",
 
 
 def _domain_warp(ctx, uv, scale, strength, octaves, seed):
-    s = node_seed(seed) * _U(2)
+    s = node_seed(seed) * np.uint32(2)
     p = uv * _col(scale)
     two = np.full(len(uv), 2.0, dtype=uv.dtype)
     half = np.full(len(uv), 0.5, dtype=uv.dtype)
-    d = np.stack([fbm2(p, octaves, two, half, s), fbm2(p, octaves, two, half, s + _U(101))], -1)
+    d = np.stack([fbm2(p, octaves, two, half, s),
+                  fbm2(p, octaves, two, half, s + np.uint32(101))], -1)
     return (uv + _col(strength) * d,)
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     UNIT,
@@ -18,6 +18,12 @@ from matedit.nodes.kind import (
     register,
 )
 from matedit.nodes.twin import _Z, _col, _dot, _mix, _need, _safe_normalize, derivatives
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 
 def _unpack_normal(ctx, packed, strength):

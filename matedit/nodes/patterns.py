@@ -8,8 +8,7 @@ same footprint from the evaluator's pixel grid (`SurfaceArrays.grid`).
 from __future__ import annotations
 
 import math
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     _FILTER,
@@ -28,7 +27,7 @@ from matedit.nodes.kind import (
     _o,
     register,
 )
-from matedit.nodes.noise import _U, _as_uint, fbm2, hash_cell2, hash_unit, node_seed
+from matedit.nodes.noise import _as_uint, fbm2, hash_cell2, hash_unit, node_seed
 from matedit.nodes.twin import (
     _clamp,
     _col,
@@ -40,6 +39,12 @@ from matedit.nodes.twin import (
     filtered_step,
     fwidth,
 )
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 
 def _direction(angle):
@@ -55,7 +60,7 @@ def _waves(x):
 def _fbm_fixed(p, seed):
     n = len(p)
     dt = p.dtype
-    return fbm2(p, np.full(n, 3.0, dt), np.full(n, 2.0, dt), np.full(n, 0.5, dt), _U(seed))
+    return fbm2(p, np.full(n, 3.0, dt), np.full(n, 2.0, dt), np.full(n, 0.5, dt), np.uint32(seed))
 
 
 def _checker(ctx, uv, scale, color_a, color_b, filter_width):

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-import numpy as np
+import math
+import struct
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     MESH_UV,
@@ -16,6 +18,12 @@ from matedit.nodes.kind import (
     register,
 )
 from matedit.nodes.twin import _col
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 
 def sample_bilinear(tex: np.ndarray, uv: np.ndarray) -> np.ndarray:
@@ -136,18 +144,23 @@ register(NodeDef(
 
 
 # --- hex tiling (Mikkelsen 2022, as MaterialX's hextiledimage parameterises it) -------------
-_F32 = np.float32
-_SQRT3_2 = _F32(np.sqrt(3.0) * 2.0)  # the triangle grid's scale: keeps the image's fit
-_SKEW = _F32(1.15470054)  # 2 tan 30: skewed space's v, and its inverse
+def _to_f32(x: float) -> float:
+    """x rounded to the nearest float32, as a Python float (numpy is not needed for it)."""
+    return float(struct.unpack("<f", struct.pack("<f", x))[0])
+
+
+_SQRT3_2 = _to_f32(math.sqrt(3.0) * 2.0)  # the triangle grid's scale: keeps the image's fit
+_SKEW = _to_f32(1.15470054)  # 2 tan 30: skewed space's v, and its inverse
 
 
 def hex_hash(p: np.ndarray) -> np.ndarray:
     """Two uniform numbers in 0..1 per grid vertex (Dave Hoskins' hash without sine, the one
     hextiledimage uses), in float32 as the GPU computes it. p: (N, 2)."""
-    p = p.astype(_F32)
-    p3 = np.stack([p[:, 0], p[:, 1], p[:, 0]], -1) * np.asarray([0.1031, 0.1030, 0.0973], _F32)
+    f32 = np.float32
+    p = p.astype(f32)
+    p3 = np.stack([p[:, 0], p[:, 1], p[:, 0]], -1) * np.asarray([0.1031, 0.1030, 0.0973], f32)
     p3 = p3 - np.floor(p3)
-    d: np.ndarray = np.asarray(np.sum(p3 * (p3[:, [1, 2, 0]] + _F32(33.33)), -1, dtype=_F32))
+    d: np.ndarray = np.asarray(np.sum(p3 * (p3[:, [1, 2, 0]] + f32(33.33)), -1, dtype=f32))
     p3 = p3 + d[:, None]
     h = (p3[:, [0, 0]] + p3[:, [1, 2]]) * p3[:, [2, 1]]
     return h - np.floor(h)
@@ -165,7 +178,7 @@ def hex_tiles(coord: np.ndarray, rotation, rotation_range, scale, scale_range, o
     """The three hex tiles over each point: their lookup coordinates (each tile's own
     random rotation about its centre, scale and offset) and barycentric weights (N, 3)."""
     coord = coord.astype(np.float64)
-    st = coord * float(_SQRT3_2)
+    st = coord * _SQRT3_2
     sk = np.stack([st[:, 0] - 0.57735027 * st[:, 1], 1.15470054 * st[:, 1]], -1)
     frac = sk - np.floor(sk)
     z = 1.0 - frac[:, 0] - frac[:, 1]
@@ -179,9 +192,9 @@ def hex_tiles(coord: np.ndarray, rotation, rotation_range, scale, scale_range, o
     rr = np.radians(np.asarray(rotation_range, np.float64))
     coords = []
     for vid in ids:
-        g = vid / float(_SQRT3_2)
-        centre = np.stack([g[:, 0] + 0.5 * g[:, 1], g[:, 1] / float(_SKEW)], -1)
-        rand = hex_hash(vid + _F32(0.12345)).astype(np.float64)
+        g = vid / _SQRT3_2
+        centre = np.stack([g[:, 0] + 0.5 * g[:, 1], g[:, 1] / _SKEW], -1)
+        rand = hex_hash(vid + np.float32(0.12345)).astype(np.float64)
         angle = rr[..., 0] + (rr[..., 1] - rr[..., 0]) * rand[:, 0] * rotation
         c, sn = np.cos(angle), np.sin(angle)
         srange = np.asarray(scale_range, np.float64)

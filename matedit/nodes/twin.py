@@ -12,10 +12,16 @@ give float32 results within a few ulps of the GPU.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
 
-Attributes = dict[str, np.ndarray]
+
+
+Attributes = dict[str, "np.ndarray"]
 
 
 @dataclass

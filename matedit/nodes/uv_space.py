@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     _UV,
@@ -24,6 +24,12 @@ from matedit.nodes.kind import (
 from matedit.nodes.maths import multiply_then_add
 from matedit.nodes.textures import sample_bilinear
 from matedit.nodes.twin import SurfaceArrays, _col, _dot, _need, _turns
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 
 def surface_tangent(ctx) -> np.ndarray:

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from matedit.nodes.kind import (
     LOWERED,
@@ -22,6 +21,12 @@ from matedit.nodes.kind import (
     _o,
     register,
 )
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported at first use (matedit.nodes.lazy_numpy)
+    from matedit.nodes.lazy_numpy import np
+
 
 # Components of a MaterialX value type.
 _WIDTH = {"float": 1, "vector2": 2, "vector3": 3, "vector4": 4}
