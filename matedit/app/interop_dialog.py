@@ -317,6 +317,7 @@ class InteropDialog(QDialog):
         self.ok = True
         self._remember()
         self.lines = [*warnings, *(f"note: {n}" for n in notes)]
+        self.written.sort(key=lambda p: p != out)  # the export's own file first
         names = ", ".join(p.name for p in self.written[:8])
         more = f" and {len(self.written) - 8} more" if len(self.written) > 8 else ""
         where = out if not self.spec.suffixes else out.parent
