@@ -102,14 +102,18 @@ def in_background(fn: Callable[[], object]):
     return box.get("value")
 
 
+def _texels(n: int) -> str:
+    return f"{n} × {n} texels"
+
+
 def _key(kind: str, name: str) -> str:
     return f"interop/{kind}/{name}"
 
 
-def _combo(items, current) -> QComboBox:
+def _combo(items, current, label=str) -> QComboBox:
     box = QComboBox()
     for it in items:
-        box.addItem(str(it), it)
+        box.addItem(label(it), it)
     i = box.findData(current)
     box.setCurrentIndex(max(i, 0))
     return box
@@ -152,7 +156,7 @@ class InteropDialog(QDialog):
             form.addRow("Type", self.file_type)
         out = self.output()
         size = int(s.value(_key(kind, "size"), default_size(out) if out.suffix else 1024))
-        self.size = _combo(SIZES, size)
+        self.size = _combo(SIZES, size, _texels)
         self.set_size(size)
         self.size.setToolTip("Baked map width and height in texels (--size)")
         form.addRow("Bake size", self.size)
@@ -214,7 +218,7 @@ class InteropDialog(QDialog):
     def set_size(self, n: int) -> None:
         """The bake size (a size off the list is added to it, for scripts and tests)."""
         if self.size.findData(n) < 0:
-            self.size.addItem(str(n), n)
+            self.size.addItem(_texels(n), n)
         self.size.setCurrentIndex(self.size.findData(n))
 
     def _follow_suffix(self) -> None:
@@ -318,10 +322,14 @@ class InteropDialog(QDialog):
         self._remember()
         self.lines = [*warnings, *(f"note: {n}" for n in notes)]
         self.written.sort(key=lambda p: p != out)  # the export's own file first
-        names = ", ".join(p.name for p in self.written[:8])
-        more = f" and {len(self.written) - 8} more" if len(self.written) > 8 else ""
-        where = out if not self.spec.suffixes else out.parent
-        return self._show(f"Exported {names}{more} into {where}")
+        if self.spec.suffixes:
+            more = len(self.written) - 1
+            names = out.name + (f" and {more} more file{'s' if more > 1 else ''}"
+                                if more > 0 else "")
+        else:
+            names = ", ".join(p.name for p in self.written)
+        where = out.parent if self.spec.suffixes else out
+        return self._show(f"Exported {names} into {where}")
 
     def _show(self, head: str) -> bool:
         checked = [ln for ln in self.lines if "round trip:" in ln and "ΔE" in ln]
