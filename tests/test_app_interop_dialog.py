@@ -183,3 +183,19 @@ def test_baked_textures_in_exr(qtbot, tmp_path):
     assert ia.export_baked(tmp_path, size=8, format="exr"), ia.last_message
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "mossy_stone_base_color.exr", "mossy_stone_normal.exr", "mossy_stone_orm.exr"]
+
+
+def test_an_instance_whose_override_does_not_resolve_is_refused(qtbot, tmp_path):
+    import json
+
+    bad = tmp_path / "bad.json"
+    data = json.loads(INSTANCE.read_text())
+    data["parent"] = str((INSTANCE.parent / data["parent"]).resolve())
+    data["parameters"]["wear_amount"] = "lots"
+    bad.write_text(json.dumps(data))
+    w = make_window(qtbot, SAMPLE)
+    assert w.instances.open(str(bad)) is not None
+    ia = w.menus.interop
+    assert not ia.export_mtlx(tmp_path / "bad.mtlx", size=16)
+    assert w.shown_errors and "wear_amount" in w.shown_errors[-1][1], w.shown_errors
+    assert "wear_amount" in ia.last_message and not (tmp_path / "bad.mtlx").exists()
