@@ -154,8 +154,10 @@ class InteropActions:
             return None
         if self.dialog is not None:
             self.dialog.deleteLater()
-        self.dialog = InteropDialog(kind, target, stem_of(target.doc), self._start_dir(),
-                                    self._report, self.window)
+        start = str(QSettings().value(FOLDER_KEY, "") or "") or (
+            str(target.source.parent) if target.source.is_absolute() else "")
+        self.dialog = InteropDialog(kind, target, stem_of(target.doc), start, self._report,
+                                    self.window)
         return self.dialog
 
     def _report(self, lines: list[str]) -> None:
