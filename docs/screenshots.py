@@ -39,6 +39,22 @@ def reexec_under_xvfb() -> int:
         shutil.rmtree(home, ignore_errors=True)
 
 
+def shoot_interop_export(w, folder: Path, save) -> None:
+    """docs/images/interop-export.png: the MaterialX export dialog after exporting the
+    window's material into `folder` (gltf_pbr, PNG maps, 256 texels, round trip checked)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    dlg = w.menus.interop.export_dialog("mtlx")
+    dlg.set_output(folder / "rusty_painted_metal.mtlx")
+    dlg.size.setCurrentIndex(dlg.size.findData(256))
+    dlg.surface.setCurrentIndex(dlg.surface.findData("gltf_pbr"))
+    dlg.check.setChecked(True)
+    dlg.show()
+    if not dlg.run_export():
+        raise SystemExit(f"error: the MaterialX export failed: {dlg.result.toPlainText()}")
+    save(dlg, "interop-export.png")
+    dlg.close()
+
+
 def main() -> int:
     if not os.environ.get("MATEDIT_SHOTS_CHILD"):
         return reexec_under_xvfb()
@@ -150,6 +166,9 @@ def main() -> int:
     pump(0.5)
     save(dlg, "export.png")
     dlg.close()
+
+    # 7b. File > Export MaterialX's options, after an export with the round trip checked.
+    shoot_interop_export(w, graphs.parent / "exports", save)
 
     # 8. Preview in viewport: a noise node's value on the mesh, with the banner.
     from matedit.app.node_preview import PreviewTarget

@@ -19,7 +19,7 @@ def test_file_menu_offers_the_interop_entries(qtbot):
     texts = [a.text() for a in file_menu.actions() if not a.isSeparator()]
     i = texts.index("&Export Shaders…")
     # HLSL and MSL are targets of Export Shaders, not an entry of their own
-    assert texts[i + 1:i + 5] == ["Export &glTF…", "Export &MaterialX…",
+    assert texts[i + 1:i + 6] == ["Export &glTF…", "Export &MaterialX…", "Export &USD…",
                                   "Export &Baked Textures…", "&Import MaterialX or glTF…"]
 
 

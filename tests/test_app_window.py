@@ -262,10 +262,10 @@ def test_the_file_menu_is_composed_by_action_ids(qtbot):
     texts = [a.text() for a in w.menus.file.actions() if not a.isSeparator()]
     assert ids[:4] == ["file.new", "file.new_instance", "file.open", "file.recent"]
     i = ids.index("file.export")
-    assert texts[texts.index("&Export Shaders…") + 1:][:4] == [
-        "Export &glTF…", "Export &MaterialX…", "Export &Baked Textures…",
+    assert texts[texts.index("&Export Shaders…") + 1:][:5] == [
+        "Export &glTF…", "Export &MaterialX…", "Export &USD…", "Export &Baked Textures…",
         "&Import MaterialX or glTF…"]
-    assert ids[i + 4] == "|" and ids[-2:] == ["|", "file.quit"]
+    assert ids[i + 5] == "|" and ids[-2:] == ["|", "file.quit"]
     assert ids.index("file.save_image") > ids.index("file.export")
     assert w.menus.help.title() == "&Help" and w.menus.help.menuAction() in \
         w.menuBar().actions()

@@ -17,7 +17,7 @@ NODE_ROLE = Qt.ItemDataRole.UserRole
 
 @dataclass(frozen=True)
 class Problem:
-    severity: str  # "error" | "warning"
+    severity: str  # "error" | "warning" | "note" (an export's notes)
     message: str
     node_id: str = ""
     field: str = ""
@@ -61,7 +61,7 @@ class DiagnosticsPanel(QTreeWidget):
         order = {"error": 0, "warning": 1}
         for p in sorted(unique, key=lambda p: (order.get(p.severity, 2), p.node_id)):
             it = QTreeWidgetItem(self, ["", p.node_id, p.field, p.message])
-            it.setIcon(0, icon("error" if p.severity == "error" else "warning"))
+            it.setIcon(0, icon({"error": "error", "note": "export"}.get(p.severity, "warning")))
             it.setToolTip(3, f"{p.source}: {p.message}" if p.source else p.message)
             it.setData(0, NODE_ROLE, p.node_id)
 

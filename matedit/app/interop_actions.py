@@ -1,60 +1,34 @@
 """File › Export and File › Import entries for the interchange formats: glTF 2.0 (.gltf/.glb),
-MaterialX (.mtlx), baked texture maps, HLSL/MSL, and importing a .mtlx, .gltf or .glb.
+MaterialX (.mtlx), USD (.usda/.usdz), baked texture maps, and importing a .mtlx, .gltf or .glb.
 
-The work is the command line's (matedit.interop), on the document in
-the editor, with its outputs checked against its inputs the same way. Baking needs a GL
-context: it runs on a worker thread with its own headless EGL context, so the GUI thread's
-GLX context is never disturbed (GLVND refuses GLX on a thread with EGL current).
+Each export opens its options dialog (matedit.app.interop_dialog), which runs the command
+line's own export (`matedit export`, `matedit bake`) on the document tab in front: a material
+as edited, or an instance's resolved material named after the instance, with its outputs
+checked against its inputs the same way. Baking needs a GL context: it runs on a worker
+thread with its own headless EGL context, so the GUI thread's GLX context is never
+disturbed (GLVND refuses GLX on a thread with EGL current).
 """
 
 from __future__ import annotations
 
 import os
-import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
-from PySide6.QtCore import QSettings, Qt
+from PySide6.QtCore import QSettings
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QApplication, QInputDialog, QMessageBox, QWidget
+from PySide6.QtWidgets import QInputDialog, QMessageBox, QWidget
 
 from matedit.app import file_dialogs
 
 if TYPE_CHECKING:
     from matedit.app.controller import DocumentController
     from matedit.app.document_actions import DocumentActions
+    from matedit.app.documents import DocumentTabs
+    from matedit.app.interop_dialog import ExportTarget, InteropDialog
     from matedit.app.problems import ProblemsModel
 
 FOLDER_KEY = "interop/folder"
-
-
-def _in_worker(fn):
-    """Run `fn(ctx)` on a worker thread with a headless GL context made there (EGL must not
-    be current on the GUI thread, which uses GLX) and wait (the GUI shows a busy cursor);
-    re-raise its exception here."""
-    box: dict = {}
-
-    def run():
-        try:
-            from matedit.render.context import headless
-
-            with headless() as ctx:
-                box["value"] = fn(ctx)
-        except BaseException as exc:  # handed back to the GUI thread
-            box["error"] = exc
-
-    QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
-    try:
-        t = threading.Thread(target=run, name="matedit-interop", daemon=True)
-        t.start()
-        while t.is_alive():
-            t.join(0.05)
-            QApplication.processEvents()
-    finally:
-        QApplication.restoreOverrideCursor()
-    if "error" in box:
-        raise box["error"]
-    return box.get("value")
 
 
 class InteropHost(Protocol):
@@ -63,6 +37,7 @@ class InteropHost(Protocol):
     controller: DocumentController
     actions: DocumentActions
     problems: ProblemsModel
+    documents: DocumentTabs
 
     def status(self, text: str) -> None: ...
 
@@ -76,16 +51,19 @@ class InteropActions:
         self.host = host
         self.last_message = ""
         self.import_report: QMessageBox | None = None  # the last import's warnings, shown
+        self.dialog: InteropDialog | None = None  # the last export's dialog
         w = window
         self.act_gltf = QAction("Export &glTF…", w)
         self.act_gltf.triggered.connect(lambda: self.export_gltf())
         self.act_mtlx = QAction("Export &MaterialX…", w)
         self.act_mtlx.triggered.connect(lambda: self.export_mtlx())
+        self.act_usd = QAction("Export &USD…", w)
+        self.act_usd.triggered.connect(lambda: self.export_usd())
         self.act_bake = QAction("Export &Baked Textures…", w)
         self.act_bake.triggered.connect(lambda: self.export_baked())
         self.act_import = QAction("&Import MaterialX or glTF…", w)
         self.act_import.triggered.connect(lambda: self.import_mtlx())
-        self.actions = [self.act_gltf, self.act_mtlx, self.act_bake]
+        self.actions = [self.act_gltf, self.act_mtlx, self.act_usd, self.act_bake]
 
     def entries(self) -> list[QAction | None]:
         """The File menu's entries, in order (None: a separator)."""
@@ -111,22 +89,6 @@ class InteropActions:
             return str(saved)
         return str(Path(self.doc.path).parent) if self.doc.path else ""
 
-    def _ask_save(self, title: str, suffix_filter: str, default_name: str) -> Path | None:
-        path, _ = file_dialogs.save_file(self.window, title,
-                                         str(Path(self._start_dir()) / default_name),
-                                         suffix_filter)
-        if not path:
-            return None
-        QSettings().setValue(FOLDER_KEY, str(Path(path).parent))
-        return Path(path)
-
-    def _ask_folder(self, title: str) -> Path | None:
-        folder = file_dialogs.existing_folder(self.window, title, self._start_dir())
-        if not folder:
-            return None
-        QSettings().setValue(FOLDER_KEY, folder)
-        return Path(folder)
-
     def _fail(self, title: str, exc: Exception) -> bool:
         from matedit.compiler import CompileError
 
@@ -144,81 +106,102 @@ class InteropActions:
         self.host.status(text)
         return True
 
-    def _inputs(self):
+    # --- exports -------------------------------------------------------------------------
+    def export_target(self) -> ExportTarget:
+        """What File › Export works on: the document tab in front, a material as edited or
+        an instance's resolved material (named after the instance, as `matedit export`
+        reads an instance file; its warnings are the command's `warning:` lines). Raises
+        ValueError where there is nothing to export (an instance whose overrides do not
+        resolve, a material function)."""
+        from matedit.app.compile_worker import snapshot_document
+        from matedit.app.interop_dialog import ExportTarget
         from matedit.io.inputs import document_inputs
 
-        return document_inputs(self.doc, self.resolver)
+        session = self.host.documents.current
+        editor = session.editor
+        if editor is None:
+            doc = self.doc
+            if doc.is_function:
+                raise ValueError("a material function cannot be exported; export a material "
+                                 "that calls it")
+            source = Path(doc.path) if doc.path else Path(f"{self._stem()}.json")
+            return ExportTarget(snapshot_document(doc), self.resolver, source,
+                                document_inputs(doc, self.resolver))
+        resolved = editor.resolved
+        if resolved.errors:
+            raise ValueError(resolved.errors[0].format())
+        doc = resolved.document
+        inputs = document_inputs(doc, editor.resolver)
+        for i, p in enumerate(resolved.chain):  # the instance, its parents, the material
+            inputs.setdefault(_real(p), "the instance" if i == 0 else "a parent of the "
+                              "instance")
+        source = Path(editor.doc.path) if editor.doc.path else Path(f"{editor.name()}.json")
+        return ExportTarget(snapshot_document(doc), editor.resolver, source, inputs,
+                            [w.format() for w in resolved.warnings], instance=True)
 
-    # --- actions ---------------------------------------------------------------------------
-    def export_gltf(self, out: Path | None = None, size: int = 1024) -> bool:
-        title = "Export glTF"
-        out = out or self._ask_save(title, "glTF binary (*.glb);;glTF (*.gltf)",
-                                    f"{self._stem()}.glb")
+    def export_dialog(self, kind: str) -> InteropDialog | None:
+        """The options dialog of `kind` (gltf, mtlx, usd, baked) on the tab in front, not
+        shown; None (said why) where there is nothing to export."""
+        from matedit.app.interop_dialog import KINDS, InteropDialog
+        from matedit.interop.export import stem_of
+
+        try:
+            target = self.export_target()
+        except ValueError as exc:
+            text = f"Nothing to export: {exc}"
+            self.host.actions.show_error(KINDS[kind].title, text)
+            self.last_message = text
+            return None
+        if self.dialog is not None:
+            self.dialog.deleteLater()
+        start = str(QSettings().value(FOLDER_KEY, "") or "") or (
+            str(target.source.parent) if target.source.is_absolute() else "")
+        self.dialog = InteropDialog(kind, target, stem_of(target.doc), start, self._report,
+                                    self.window)
+        return self.dialog
+
+    def _report(self, lines: list[str]) -> None:
+        self.host.problems.set_export_report(lines)
+
+    def export(self, kind: str, out: Path | None = None, size: int | None = None,
+               **fields) -> bool:
+        """File › Export `kind`: with no `out`, the options dialog for the artist; with one,
+        the dialog's export run at once on `out` (`size` and `fields`: surface, format, zip,
+        check, set in it first; for scripts and tests)."""
+        dlg = self.export_dialog(kind)
+        if dlg is None:
+            return False
         if out is None:
-            return False
-        if out.suffix.lower() not in (".glb", ".gltf"):
-            out = out.with_suffix(".glb")
-        from matedit.interop import gltf
-        from matedit.interop.bake import bake_for_export, is_plane_spec, maps_from
-        from matedit.io.inputs import preview_spec, refuse_overwrite
-        from matedit.render.mesh import mesh_from_spec
+            dlg.exec()
+        else:
+            dlg.set_output(out)
+            if size is not None:
+                dlg.set_size(size)
+            for name, value in fields.items():
+                widget = getattr(dlg, "map_format" if name == "format" else name)
+                if isinstance(value, bool):
+                    widget.setChecked(value)
+                else:
+                    widget.setCurrentIndex(widget.findData(value))
+            dlg.run_export()
+        text = dlg.result.toPlainText()
+        self.last_message = text
+        if dlg.ok:
+            self.host.status(text.splitlines()[0] if text else "exported")
+        return dlg.ok
 
-        try:
-            mesh_spec = preview_spec(self.doc, "mesh", "sphere")  # builtin:cube, cube or a file
-            outs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
-            refuse_overwrite(outs, self._inputs())
-            mesh = mesh_from_spec(mesh_spec)
-            on = None if is_plane_spec(mesh_spec) else mesh  # baked on the mesh, as the CLI
-            attrs, ir, notes = _in_worker(lambda ctx: bake_for_export(
-                ctx, self.doc, self.resolver, size, on))
-            import numpy as np
+    def export_gltf(self, out: Path | None = None, size: int | None = None, **fields) -> bool:
+        return self.export("gltf", out, size, **fields)
 
-            emax = float(max(1.0, np.max(attrs["emissive"])))
-            attrs["emissive"] = attrs["emissive"] / emax
-            lobes = gltf.lobes_of(ir)
-            files = gltf.files_for(out, maps_from(attrs, ir.attributes), mesh, self._stem(),
-                                   emax, lobes)
-            gltf.write(files)
-        except Exception as exc:
-            return self._fail(title, exc)
-        said = "".join(f"; note: {n}" for n in [*notes, *lobes.notes])
-        return self._done(f"exported {', '.join(p.name for p in files)}{said}")
+    def export_mtlx(self, out: Path | None = None, size: int | None = None, **fields) -> bool:
+        return self.export("mtlx", out, size, **fields)
 
-    def export_mtlx(self, out: Path | None = None, size: int = 512) -> bool:
-        title = "Export MaterialX"
-        out = out or self._ask_save(title, "MaterialX (*.mtlx)", f"{self._stem()}.mtlx")
-        if out is None:
-            return False
-        out = out.with_suffix(".mtlx")
-        from matedit.interop import mtlx_export
-        from matedit.io.inputs import refuse_overwrite
+    def export_usd(self, out: Path | None = None, size: int | None = None, **fields) -> bool:
+        return self.export("usd", out, size, **fields)
 
-        try:
-            result = mtlx_export.export(self.doc, self.resolver, out, size)
-            refuse_overwrite(result.files, self._inputs())
-            mtlx_export.write(result)
-        except Exception as exc:
-            return self._fail(title, exc)
-        baked = f"; baked {', '.join(n for n, _ in result.baked)}" if result.baked else ""
-        said = "".join(f"; note: {n}" for n in result.notes)
-        return self._done(f"exported {out.name}{baked}{said}")
-
-    def export_baked(self, folder: Path | None = None, size: int = 1024) -> bool:
-        title = "Export baked textures"
-        folder = folder or self._ask_folder(title)
-        if folder is None:
-            return False
-        from matedit.interop.bake import MAP_NAMES, bake_document, map_paths, write_maps
-        from matedit.io.inputs import refuse_overwrite
-
-        try:
-            refuse_overwrite(map_paths(folder, self._stem(), MAP_NAMES, "png").values(),
-                             self._inputs())
-            maps, _ = _in_worker(lambda ctx: bake_document(ctx, self.doc, self.resolver, size))
-            paths = write_maps(folder, self._stem(), maps, "png")  # all, or none
-        except Exception as exc:
-            return self._fail(title, exc)
-        return self._done(f"baked {len(paths)} maps into {folder}")
+    def export_baked(self, folder: Path | None = None, size: int | None = None,
+                     **fields) -> bool:
+        return self.export("baked", folder, size, **fields)
 
     def _choose_material(self, src: Path, title: str) -> tuple[bool, str | None]:
         """(go on, the material to import): with several in the document, the one picked

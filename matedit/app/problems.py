@@ -42,6 +42,7 @@ class ProblemsModel(QObject):
         self.gl: list[Problem] = []
         self.budget: list[Problem] = []  # the cost budget's warnings (matedit.app.stats_dock)
         self.imported: list[Problem] = []  # the open material's import warnings
+        self.exported: list[Problem] = []  # the last File › Export's warning:/note: lines
         self.status = ""
         self.view = view
         compiler.compiled.connect(self._compiled)
@@ -59,6 +60,7 @@ class ProblemsModel(QObject):
         """Another document: the previous one's compiler, driver, budget and import reports
         are not its."""
         self.compile, self.gl, self.budget, self.imported, self.status = [], [], [], [], ""
+        self.exported = []
         self.changed.emit()
 
     def set_import_warnings(self, messages: list[str]) -> None:
@@ -66,6 +68,18 @@ class ProblemsModel(QObject):
         Import MaterialX's `warning:` lines): Diagnostics lists them until another document
         is opened."""
         self.imported = [Problem("warning", m, "", "", "import") for m in messages]
+        self.changed.emit()
+
+    def set_export_report(self, lines: list[str]) -> None:
+        """The last File › Export's `warning:`, `note:` and `error:` lines, as `matedit
+        export` prints them (the round trip's ΔE among the notes): Diagnostics lists them
+        until the next export or another document."""
+        out = []
+        for line in lines:
+            severity, _, text = line.partition(": ")
+            out.append(Problem(severity if severity in ("error", "warning") else "note", text,
+                               "", "", "export"))
+        self.exported = out
         self.changed.emit()
 
     def _shows_material(self) -> bool:
@@ -99,7 +113,7 @@ class ProblemsModel(QObject):
         out = [Problem(d.severity.value, d.message, d.node_id or "", d.port or "", "graph")
                for d in (analysis.diagnostics if analysis is not None else [])]
         if is_material:
-            out += self.compile + self.gl + self.budget + self.imported
+            out += self.compile + self.gl + self.budget + self.imported + self.exported
         return unique(out)
 
     def set_budget(self, problems: list[Problem]) -> None:

@@ -69,13 +69,8 @@ def compile_error(exc, path: Path) -> UsageError:
 
 
 def run(args) -> int:
-    from matedit.compiler import CompileError
-    from matedit.interop.bake import bake_document, map_paths, write_maps
-    from matedit.interop.export import stem_of
     from matedit.io.document import FileResolver
-    from matedit.io.images import ImageError
-    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
-    from matedit.render.context import headless
+    from matedit.io.inputs import command_inputs
 
     size = parse_size(args.size)
     path = Path(args.file)
@@ -84,27 +79,43 @@ def run(args) -> int:
         raise UsageError(f"{out}: exists and is not a folder")
     doc = load_material(path)
     resolver = FileResolver()
-    stem = stem_of(doc)
     inputs = command_inputs(args, [doc], resolver)
-    try:
-        from matedit.interop.bake import MAP_NAMES
+    paths = bake_to_folder(doc, resolver, path, out, size, args.format, inputs,
+                           progress_printer("baking"))
+    if sys.stderr.isatty():
+        print(f"baked {', '.join(p.name for p in paths)} into {out}", file=sys.stderr)
+    return 0
 
-        refuse_overwrite(map_paths(out, stem, MAP_NAMES, args.format).values(), inputs)
+
+def bake_to_folder(doc, resolver, path: Path, out: Path, size: int, fmt: str, inputs: dict,
+                   progress=None) -> list[Path]:
+    """Bake the material `doc` (read from `path`) into the folder `out` as STEM_*.`fmt`
+    (every map, or none), never over one of `inputs`; the files written. Raises UsageError
+    (one line) for anything that stops it; makes its own headless GL context. The editor's
+    File › Export Baked Textures runs this too."""
+    from matedit.compiler import CompileError
+    from matedit.interop.bake import MAP_NAMES, bake_document, map_paths, write_maps
+    from matedit.interop.export import stem_of
+    from matedit.io.images import ImageError
+    from matedit.io.inputs import OverwriteError, refuse_overwrite
+    from matedit.render.context import headless
+
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"{out}: exists and is not a folder")
+    stem = stem_of(doc)
+    try:
+        refuse_overwrite(map_paths(out, stem, MAP_NAMES, fmt).values(), inputs)
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
     try:
         with headless() as ctx:
-            maps, _ = bake_document(ctx, doc, resolver, size, progress_printer("baking"),
-                                    args.format)
+            maps, _ = bake_document(ctx, doc, resolver, size, progress, fmt)
     except CompileError as exc:
         raise compile_error(exc, path) from None
     try:
-        paths = write_maps(out, stem, maps, args.format)  # every map, or none
+        paths = write_maps(out, stem, maps, fmt)  # every map, or none
     except ImageError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    if sys.stderr.isatty():
-        print(f"baked {', '.join(p.name for p in paths.values())} into {out}",
-              file=sys.stderr)
-    return 0
+    return list(paths.values())

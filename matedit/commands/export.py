@@ -10,17 +10,57 @@ textures the material reads, and reported (--zip: OUT.zip). USD: the preview mes
 a Material with a UsdPreviewSurface network on the baked maps and the MaterialX export in
 the mtlx render context (matedit.interop.usd; `--arkit`: Apple's usdz profile, the preview
 network alone). `--check` measures the round trip's loss
-(matedit.commands.export_check)."""
+(matedit.commands.export_check).
+
+The editor's File › Export dialogs run the same functions (`validate`, `export_document`)
+on the document in the editor."""
 
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from matedit.cli_support import UsageError, report
 from matedit.commands import export_check
 from matedit.commands.bake import compile_error, load_material, parse_size, progress_printer
 from matedit.io.inputs import declare_inputs
+
+SUFFIXES = (".gltf", ".glb", ".mtlx", ".usda", ".usdz")
+SURFACES = ("open_pbr_surface", "standard_surface", "gltf_pbr")
+MAP_FORMATS = ("png", "exr")
+
+
+def default_size(out: Path) -> int:
+    """The bake size of an export to `out` when none is given: 512 for the MaterialX bakes,
+    1024 for glTF and USD."""
+    return 512 if out.suffix.lower() == ".mtlx" else 1024
+
+
+@dataclass
+class ExportOptions:
+    """What `matedit export` takes besides FILE and -o, by its options' names (`--format`
+    is `format`); the editor's Export dialog fills one in."""
+
+    size: str | None = None  # None: default_size
+    mesh: str | None = None
+    surface: str = "open_pbr_surface"
+    format: str = "png"
+    zip: bool = False
+    check: bool = False
+    check_image: str | None = None
+    check_size: str | None = None
+    arkit: bool = False
+
+
+@dataclass
+class Exported:
+    files: list[Path]  # what was written
+    round_trip: export_check.RoundTrip | None = None  # with --check
+
+
+Say = Callable[[str], None]  # takes each `note:` line's text (without "FILE: ") as it arises
 
 
 def register(sub) -> None:
@@ -60,50 +100,90 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = Path(args.output)
+    options = ExportOptions(args.size, args.mesh, args.surface, args.format, args.zip,
+                            args.check, args.check_image, args.check_size, args.arkit)
+    validate(options, out)
+    path = Path(args.file)
+    doc = load_material(path)
+    from matedit.io.document import FileResolver
+    from matedit.io.inputs import command_inputs
+
+    resolver = FileResolver()
+    inputs = command_inputs(args, [doc], resolver)
+    done = export_document(doc, resolver, path, out, options, inputs,
+                           lambda text: report("note", f"{path}: {text}"),
+                           progress_printer("baking"))
+    if sys.stderr.isatty() and out.suffix.lower() != ".mtlx":
+        print(f"exported {path} to {', '.join(str(p) for p in done.files)}", file=sys.stderr)
+    return 0
+
+
+def validate(options: ExportOptions, out: Path) -> None:
+    """Refuse (UsageError) an output or an option the export to `out` cannot take, before
+    anything is read or written."""
     kind = out.suffix.lower()
-    if kind not in (".gltf", ".glb", ".mtlx", ".usda", ".usdz"):
+    if kind not in SUFFIXES:
         raise UsageError(f"{out}: the output must end in .gltf, .glb, .mtlx, .usda or .usdz")
     if not out.parent.is_dir():
         raise UsageError(f"{out}: folder {out.parent} does not exist")
-    export_check.validate(args, out)
-    if args.arkit and kind != ".usdz":
+    export_check.validate(options, out)
+    if options.size is not None:
+        parse_size(options.size)
+    if options.arkit and kind != ".usdz":
         raise UsageError("--arkit applies to .usdz exports only")
     if kind == ".mtlx":
-        if args.mesh:
+        if options.mesh:
             raise UsageError("--mesh applies to glTF and USD exports only")
-        if args.zip and args.check:
+        if options.zip and options.check:
             raise UsageError("--check reads back the .mtlx it wrote; with --zip there is "
                              "none: export without --zip to check it")
-        return _mtlx(args, out)
-    for flag, given in (("--surface", args.surface != "open_pbr_surface"),
-                        ("--format", args.format != "png"), ("--zip", args.zip)):
+        return
+    for flag, given in (("--surface", options.surface != "open_pbr_surface"),
+                        ("--format", options.format != "png"), ("--zip", options.zip)):
         if given:
             raise UsageError(f"{flag} applies to MaterialX (.mtlx) exports only")
-    if kind in (".usda", ".usdz"):
-        return _usd(args, out)
-    return _gltf(args, out)
 
 
-def _gltf(args, out: Path) -> int:
+def export_document(doc, resolver, path: Path, out: Path, options: ExportOptions,
+                    inputs: dict, say: Say, progress=None) -> Exported:
+    """Export the material `doc` (read from `path`, or named so) to `out` with `options`
+    (`validate`d): never over one of `inputs`; each note to `say`. Raises UsageError (one
+    line, naming the file) for anything that stops it. Baking makes its own headless GL
+    context (on the calling thread)."""
+    kind = out.suffix.lower()
+    size = parse_size(options.size) if options.size is not None else default_size(out)
+    if kind == ".mtlx":
+        files = _mtlx(doc, resolver, path, out, options, inputs, say, size)
+        mesh = None
+    elif kind in (".usda", ".usdz"):
+        files = _usd(doc, resolver, path, out, options, inputs, say, size, progress)
+        mesh = _mesh_spec(doc, options)
+    else:
+        files, mesh = _gltf(doc, resolver, path, out, options, inputs, say, size, progress)
+    return Exported(files, export_check.after_write(options, doc, out, say, mesh))
+
+
+def _mesh_spec(doc, options: ExportOptions) -> str:
+    from matedit.io.inputs import preview_spec
+
+    return options.mesh or preview_spec(doc, "mesh", "sphere")
+
+
+def _gltf(doc, resolver, path: Path, out: Path, options: ExportOptions, inputs: dict,
+          say: Say, size: int, progress) -> tuple[list[Path], str]:
     import numpy as np
 
     from matedit.compiler import CompileError
     from matedit.interop import gltf
     from matedit.interop.bake import bake_for_export, is_plane_spec, maps_from
     from matedit.interop.export import stem_of
-    from matedit.io.document import FileResolver
-    from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
+    from matedit.io.inputs import OverwriteError, refuse_overwrite
     from matedit.render.context import headless
     from matedit.render.mesh import MeshError, mesh_from_spec
 
-    size = parse_size(args.size or "1024")
-    path = Path(args.file)
-    doc = load_material(path)
-    resolver = FileResolver()
-    mesh_spec = args.mesh or preview_spec(doc, "mesh", "sphere")
-    inputs = command_inputs(args, [doc], resolver)
+    mesh_spec = _mesh_spec(doc, options)
     outputs = [out] + ([out.with_suffix(".bin")] if out.suffix.lower() == ".gltf" else [])
-    outputs += export_check.outputs(args)
+    outputs += export_check.outputs(options)
     try:
         refuse_overwrite(outputs, inputs)
     except OverwriteError as exc:
@@ -118,7 +198,7 @@ def _gltf(args, out: Path) -> int:
         with headless() as ctx:
             attrs, ir, bake_notes = bake_for_export(
                 ctx, doc, resolver, size, None if is_plane_spec(mesh_spec) else mesh,
-                progress_printer("baking"))
+                progress)
     except CompileError as exc:
         raise compile_error(exc, path) from None
     emax = float(max(1.0, np.max(attrs["emissive"])))
@@ -131,29 +211,21 @@ def _gltf(args, out: Path) -> int:
     except OSError as exc:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
     for note in [*bake_notes, *lobes.notes]:
-        report("note", f"{path}: {note}")
-    if sys.stderr.isatty():
-        print(f"exported {path} to {', '.join(str(p) for p in files)}", file=sys.stderr)
-    export_check.after_write(args, path, doc, out, str(mesh_spec))
-    return 0
+        say(note)
+    return list(files), str(mesh_spec)
 
 
-def _mtlx(args, out: Path) -> int:
+def _mtlx(doc, resolver, path: Path, out: Path, options: ExportOptions, inputs: dict,
+          say: Say, size: int) -> list[Path]:
     from matedit.compiler import CompileError
     from matedit.interop import mtlx_export
-    from matedit.io.document import FileResolver
     from matedit.io.images import ImageError
-    from matedit.io.inputs import OverwriteError, command_inputs, refuse_overwrite
+    from matedit.io.inputs import OverwriteError, refuse_overwrite
 
-    size = parse_size(args.size or "512")
-    path = Path(args.file)
-    doc = load_material(path)
-    resolver = FileResolver()
-    inputs = command_inputs(args, [doc], resolver)
     try:
-        result = mtlx_export.export(doc, resolver, out, size, args.surface, args.format,
-                                    args.zip)
-        refuse_overwrite([*result.files, *export_check.outputs(args)], inputs)
+        result = mtlx_export.export(doc, resolver, out, size, options.surface, options.format,
+                                    options.zip)
+        refuse_overwrite([*result.files, *export_check.outputs(options)], inputs)
         mtlx_export.write(result)
     except CompileError as exc:
         raise compile_error(exc, path) from None
@@ -167,32 +239,26 @@ def _mtlx(args, out: Path) -> int:
     except OSError as exc:
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
     for node, why in result.baked:
-        report("note", f"{path}: node {node}: baked to an image ({why})")
+        say(f"node {node}: baked to an image ({why})")
     for line in result.notes:
-        report("note", f"{path}: {line}")
-    export_check.after_write(args, path, doc, out)
-    return 0
+        say(line)
+    return list(result.files)
 
 
-def _usd(args, out: Path) -> int:
+def _usd(doc, resolver, path: Path, out: Path, options: ExportOptions, inputs: dict,
+         say: Say, size: int, progress) -> list[Path]:
     """USD: the preview mesh bound to a Material with a UsdPreviewSurface network on the
     baked maps and the MaterialX export as a network in the mtlx render context."""
     from matedit.compiler import CompileError
     from matedit.interop import usd
     from matedit.interop.bake import bake_for_export, is_plane_spec
-    from matedit.io.document import FileResolver
-    from matedit.io.inputs import OverwriteError, command_inputs, preview_spec, refuse_overwrite
+    from matedit.io.inputs import OverwriteError, refuse_overwrite
     from matedit.render.context import headless
     from matedit.render.mesh import MeshError, mesh_from_spec
 
-    size = parse_size(args.size or "1024")
-    path = Path(args.file)
-    doc = load_material(path)
-    resolver = FileResolver()
-    mesh_spec = args.mesh or preview_spec(doc, "mesh", "sphere")
-    inputs = command_inputs(args, [doc], resolver)
+    mesh_spec = _mesh_spec(doc, options)
     try:
-        refuse_overwrite([out, *export_check.outputs(args)], inputs)
+        refuse_overwrite([out, *export_check.outputs(options)], inputs)
         mesh = mesh_from_spec(mesh_spec)
     except OverwriteError as exc:
         raise UsageError(str(exc)) from None
@@ -204,8 +270,8 @@ def _usd(args, out: Path) -> int:
         with headless() as ctx:  # on the mesh, as the glTF export bakes
             attrs, ir, bake_notes = bake_for_export(
                 ctx, doc, resolver, size, None if is_plane_spec(mesh_spec) else mesh,
-                progress_printer("baking"))
-        result = usd.export_baked(doc, resolver, attrs, ir, mesh, out, size, args.arkit)
+                progress)
+        result = usd.export_baked(doc, resolver, attrs, ir, mesh, out, size, options.arkit)
         refuse_overwrite(result.files, inputs)
         usd.write(result)
     except CompileError as exc:
@@ -217,8 +283,5 @@ def _usd(args, out: Path) -> int:
     except OSError as exc:
         raise UsageError(f"{exc.filename or out}: cannot write: {exc.strerror or exc}") from None
     for note in [*bake_notes, *result.notes]:
-        report("note", f"{path}: {note}")
-    if sys.stderr.isatty():
-        print(f"exported {path} to {', '.join(str(p) for p in result.files)}", file=sys.stderr)
-    export_check.after_write(args, path, doc, out, str(mesh_spec))
-    return 0
+        say(note)
+    return list(result.files)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from matedit.cli_support import UsageError, report
+from matedit.cli_support import UsageError
 
 if TYPE_CHECKING:  # numpy is imported where an export is checked, not for every command
     import numpy as np
@@ -222,23 +222,27 @@ def measure(original, round_trip, resolver, size: int, mesh: str) -> RoundTrip:
     return RoundTrip(float(de[covered].mean()), float(de[covered].max()), a, b, de, [])
 
 
-def after_write(args, path: Path, doc, out: Path, mesh: str | None = None) -> None:
-    """The export of `doc` (read from `path`) was written to `out`: with --check, measure the
-    round trip and report it (and write --check-image)."""
-    if not getattr(args, "check", False):
-        return
+def after_write(options, doc, out: Path, say: Callable[[str], None],
+                mesh: str | None = None) -> RoundTrip | None:
+    """The export of `doc` was written to `out`: with `options.check` (--check), measure the
+    round trip, give its notes and figure to `say` (the command prints them as `note:`
+    lines) and write --check-image; return it (None without --check)."""
+    if not getattr(options, "check", False):
+        return None
     from matedit.io.document import FileResolver
 
     resolver = FileResolver()
-    image = Path(args.check_image) if args.check_image else None
-    size = parse_render_size(args.check_size) if args.check_size else DEFAULT_SIZE
+    image = Path(options.check_image) if options.check_image else None
+    size = parse_render_size(options.check_size) if options.check_size else DEFAULT_SIZE
     with tempfile.TemporaryDirectory(prefix="matedit-check-") as tmp:
         back, notes = REIMPORTERS[out.suffix.lower()](out, Path(tmp))
         rt = measure(doc, back, resolver, size, mesh or "sphere")
+    rt.notes = list(notes)
     for note in notes:
-        report("note", f"{path}: {note}")
-    report("note", f"{path}: {rt.line()}")
+        say(note)
+    say(rt.line())
     if image is not None:
         from matedit.commands.render import write_png
 
         write_png(image, rt.side_by_side())
+    return rt
