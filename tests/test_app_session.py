@@ -1,16 +1,19 @@
 """A short artist session in the real window, driven by keyboard and mouse events under Xvfb:
 open a second document, go back to the first by its tab, collapse part of its graph into a
-material function, save, make an instance of it, override a layer parameter in the instance's
-tab by typing, export, and close everything with the save prompts answered. What the files
-hold afterwards is read back by the loaders the command line uses."""
+material function, save, make an instance of it, override a layer parameter in the
+instance's tab by typing, export it with the round-trip check from the options dialog, and
+close everything with the save prompts answered. What the files hold afterwards is read
+back by the loaders the command line uses."""
 
 from __future__ import annotations
 
 import json
+import re
 import shutil
 
+import pygltflib
 import pytest
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, QTimer
 from PySide6.QtTest import QTest
 from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
 
@@ -101,7 +104,37 @@ def test_an_artist_session_from_open_to_close_all(qtbot, tmp_path, monkeypatch):
     assert editor.value("rust_scale") == pytest.approx(21.5)
     assert docs.current.dirty
 
+    # File › Export glTF… on the instance's tab: the path typed, the round-trip check
+    # ticked and Export clicked in the options dialog, which is then closed with Escape
+    out = tmp_path / "out" / "rusty_blue.glb"
+    out.parent.mkdir()
+    seen: dict = {}
+
+    def drive() -> None:
+        dlg = w.menus.interop.dialog
+        dlg.path.setFocus()
+        QTest.keyClick(dlg.path, Qt.Key.Key_A, CTRL)
+        QTest.keyClicks(dlg.path, str(out))
+        dlg.size.setFocus()
+        while dlg.size.currentData() != 256:  # the smallest bake, by the arrow keys
+            QTest.keyClick(dlg.size, Qt.Key.Key_Up)
+        if not dlg.check.isChecked():
+            QTest.mouseClick(dlg.check, Qt.MouseButton.LeftButton,
+                             pos=dlg.check.rect().center())
+        QTest.mouseClick(dlg.export_button, Qt.MouseButton.LeftButton)
+        seen["text"], seen["ok"] = dlg.result.toPlainText(), dlg.ok
+        QTest.keyClick(dlg, Qt.Key.Key_Escape)
+
+    QTimer.singleShot(0, drive)
+    w.menus.interop.act_gltf.trigger()
+    assert seen.get("ok"), seen
+    assert re.search(r"round trip: mean ΔE \d+\.\d\d max ΔE", seen["text"]), seen["text"]
+    gltf = pygltflib.GLTF2().load(str(out))
+    assert gltf.materials[0].name == "rusty_blue"  # the instance's material, as it is named
+
     # close everything (Ctrl+Shift+W); every prompt is answered "save"
+    w.activateWindow()  # the closed dialog hands the keyboard back to the window
+    qtbot.waitUntil(w.isActiveWindow, timeout=5000)
     QTest.keyClick(w, Qt.Key.Key_W, CTRL | SHIFT)
     settle(qtbot, w)
     assert docs.count() == 1 and docs.current.untouched  # an empty, untitled material
