@@ -20,6 +20,11 @@ class _FirstFrame(QObject):
         view.frameDrawn.connect(self._drawn)
         QTimer.singleShot(FALLBACK_MS, self, self._run)
 
+    @property
+    def done(self) -> bool:
+        """Whether every step has run."""
+        return not self._steps
+
     def _drawn(self) -> None:
         self._view.frameDrawn.disconnect(self._drawn)
         QTimer.singleShot(0, self, self._run)  # not from inside paintGL
@@ -31,15 +36,8 @@ class _FirstFrame(QObject):
             QTimer.singleShot(0, self, self._run)  # the event loop between steps
 
 
-def after_first_frame(view, *steps: Callable[[], object]) -> QObject:
+def after_first_frame(view, *steps: Callable[[], object]) -> _FirstFrame:
     """Runs `steps` once `view` (a ViewportWidget) has drawn its first frame; the returned
-    object, a child of `view`, holds them."""
+    object, a child of `view`, holds them (`done` once they have run)."""
     return _FirstFrame(view, steps)
 
-
-def start_warm_up(compiler) -> None:
-    """The compile worker's warm-up child (matedit.render.warmup), so that the first
-    structural edit is warmed too; nothing without a worker or where it would not warm."""
-    worker = compiler.worker
-    if worker is not None and worker.warming and not worker.warm_up_started:
-        worker.prepare_warm_up()
