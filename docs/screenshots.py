@@ -99,7 +99,8 @@ def main() -> int:
     w.resize(1480, 900)
     w.show()
     view = w.viewport.view
-    wait(lambda: view.frames > 0 and w.compiler.current is not None, what="the first frame")
+    wait(lambda: view.frames > 0 and w.compiler.current is not None and view.environment_ready,
+         what="the first frame and the environment after it")
     canvas = w.tabs.material.canvas
     canvas.frame_all()
     pump(1.0)

@@ -84,8 +84,13 @@ def make_window(qtbot, path=None, *, sample: bool = False, show: bool = False,
 
 
 def wait_for_renderer(qtbot, window, timeout: int = 30000):
+    """The view's renderer, once it has the environment and the window has done what it
+    leaves until after the first frame (matedit.app.startup)."""
     view = window.viewport.view
-    qtbot.waitUntil(lambda: view.renderer is not None or bool(view.problem), timeout=timeout)
+    startup = getattr(window, "startup", None)
+    qtbot.waitUntil(lambda: (view.renderer is not None and view.environment_ready
+                             and (startup is None or startup.done))
+                    or bool(view.problem), timeout=timeout)
     assert view.renderer is not None, view.problem
     return view.renderer
 

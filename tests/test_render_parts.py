@@ -249,3 +249,17 @@ def test_gizmos_stand_where_the_lights_are(gl_ctx):
         assert not np.any(r.read_hdr())
     finally:
         r.release()
+
+
+def test_the_renderer_warm_up_frame_can_be_left_to_the_first_material(gl_ctx):
+    """`warm_up=False`: no constant material linked and drawn at start (the editor's viewport
+    passes it when its first material takes the deferred path)."""
+    cold = Renderer(gl_ctx, (32, 32), environment=None, warm_up=False)
+    warm = Renderer(gl_ctx, (32, 32), environment=None)
+    try:
+        assert cold.deferred and warm.deferred
+        assert cold.link_count == 0 and warm.link_count == 1
+        assert cold.environment_name == "" and cold.environment_warnings == []
+    finally:
+        cold.release()
+        warm.release()

@@ -372,7 +372,8 @@ class Instances:
         beside.raise_()
         library.instanceOpenRequested.connect(self.open)
         library.refreshed.connect(self._attach)
-        self._attach(library.files)  # the Library listed its files before this was connected
+        if library.listed:  # it listed its files before this was connected
+            self._attach(library.files)
         library.instanceCreateRequested.connect(lambda p: self.new_instance_dialog(p))
 
     def instances_of_open(self) -> list[tuple[str, Path]]:

@@ -106,7 +106,15 @@ class LibraryPanel(QWidget):
         self.tree.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
         self.tree.customContextMenuRequested.connect(self._context_menu)
         self.folder_dialog = file_dialogs.existing_folder  # tests replace it
-        self.refresh()
+        # the files are read (and the tree filled) by the first `refresh` or `ensure_listed`;
+        # the main window has it done once its viewport shows the first frame
+        self.files: list[Path] = []
+        self.listed = False
+
+    def ensure_listed(self) -> None:
+        """The tree filled, if no `refresh` has filled it yet."""
+        if not self.listed:
+            self.refresh()
 
     # --- folders ---------------------------------------------------------------------------
     def user_folders(self) -> list[Path]:
@@ -129,6 +137,7 @@ class LibraryPanel(QWidget):
 
     # --- tree ------------------------------------------------------------------------------
     def refresh(self) -> None:
+        self.listed = True
         self.tree.clear()
         sections = {}
         for title, _sub, kind in SECTIONS:
@@ -175,6 +184,7 @@ class LibraryPanel(QWidget):
             top.setHidden(bool(words) and shown == 0)
 
     def items(self, kind: str | None = None) -> list[QTreeWidgetItem]:
+        self.ensure_listed()
         out = []
         for i in range(self.tree.topLevelItemCount()):
             top = self.tree.topLevelItem(i)

@@ -33,6 +33,7 @@ from matedit.app.layout import WindowLayout
 from matedit.app.menus import Menus, install_menus
 from matedit.app.node_preview import PreviewTarget
 from matedit.app.problems import ProblemsModel
+from matedit.app.startup import after_first_frame
 from matedit.app.stats_dock import install_stats
 from matedit.resources import graphs_dir
 
@@ -92,6 +93,7 @@ class MainWindow(QMainWindow):
         self.actions.open_recovered_material = self.documents.open_recovered
         self.actions.open_function = lambda p: self.tabs.open_function(p, self.tabs.material)
         self.actions.preview_settings = self.viewport.document_preview
+        self.startup = after_first_frame(self.viewport.view, self.library.ensure_listed)
         if start:
             self.actions.start(path, sample_path() if sample else None)
             self.compiler.recompile()

@@ -72,6 +72,9 @@ class ViewportWidget(QOpenGLWidget):
         self._pending_textures: dict[str, Path | None] = {}
         self._mesh = "sphere"
         self._environment = "studio"
+        # the environment is baked (or loaded from the cache) after the first frame, so that
+        # the window shows at once; until then the view draws without image-based lighting
+        self._environment_pending = False
         self._mode = "splitsum"
         self._view = "lit"  # matedit.shading.views: lit, a lobe view or an attribute view
         self._exposure = 0.0
@@ -107,14 +110,14 @@ class ViewportWidget(QOpenGLWidget):
         dpr = self.devicePixelRatioF()
         size = (max(1, int(self.width() * dpr)), max(1, int(self.height() * dpr)))
         try:
-            try:  # bake the wanted environment once, not the default and then ours
-                self.renderer = cls(self.ctx, size=size, samples=4,
-                                    environment=self._environment)
-                env_done = True
-            except TypeError:
+            try:  # no environment yet: it follows the first frame (_load_environment)
+                self.renderer = cls(self.ctx, size=size, samples=4, environment=None,
+                                    warm_up=not self._first_frame_deferred())
+                self._environment_pending = True
+            except TypeError:  # a renderer class without the keyword bakes its default
                 self.renderer = cls(self.ctx, size=size, samples=4)
-                env_done = False
-            self._apply_view_state(set_environment=not env_done)
+                self._environment_pending = self._environment != "studio"
+            self._apply_view_state()
             # reference accumulation in bands of rows, a paint's worth at a time, so that
             # the event loop runs between them (matedit.render.slicing)
             from matedit.render.slicing import DEFAULT_BUDGET_MS
@@ -133,7 +136,21 @@ class ViewportWidget(QOpenGLWidget):
         if self._compare is not None:
             self._apply_compare()
 
-    def _apply_view_state(self, set_environment: bool = True) -> None:
+    def _first_frame_deferred(self) -> bool:
+        """Whether the material waiting for GL takes the deferred path: its first frame then
+        warms what the renderer's start-up frame of a constant material would."""
+        from matedit.render.deferred import wants_forward
+        from matedit.shading.views import is_attribute_view
+
+        cm = self._pending_material
+        if cm is None or is_attribute_view(self._view):
+            return False
+        try:
+            return not wants_forward(cm, self._pending_uniforms)
+        except Exception:  # whatever it is, the renderer warms itself as it always did
+            return False
+
+    def _apply_view_state(self) -> None:
         r = self.renderer
         r.set_mesh(self._mesh)
         r.mode = self._mode
@@ -144,8 +161,6 @@ class ViewportWidget(QOpenGLWidget):
             r.set_lights(list(self._lights))
         else:
             self._lights = list(r.lights)
-        if set_environment:
-            self._set_environment_now(self._environment, None)
 
     def resizeGL(self, w: int, h: int) -> None:  # noqa: N802 - Qt's name
         self._fbo = None
@@ -171,6 +186,8 @@ class ViewportWidget(QOpenGLWidget):
         self.frames += 1
         self.last_frame_time = time.perf_counter() - t0
         self._last_paint = time.perf_counter()
+        if self._environment_pending:
+            QTimer.singleShot(0, self, self._load_environment)
         self.frameDrawn.emit()
         if self.renderer.needs_redraw:  # reference mode accumulates until converged
             self._slicer.start()
@@ -219,7 +236,7 @@ class ViewportWidget(QOpenGLWidget):
         from matedit.render.warmup import ViewportState
 
         return ViewportState(samples=r.samples, deferred=r.deferred,
-                             environment=r.environment_name,
+                             environment=str(self._environment),  # the one it has or gets
                              mode=r.mode, mesh=r.mesh_name,
                              energy_compensation=r.energy_compensation,
                              show_background=r.show_background)
@@ -423,10 +440,32 @@ class ViewportWidget(QOpenGLWidget):
         """The environment the view is set to (baked at initializeGL if GL is not up yet)."""
         return self._environment
 
+    @property
+    def environment_ready(self) -> bool:
+        """Whether the renderer has the view's environment (False before GL is up and from
+        the first frame until the environment that follows it is in)."""
+        return self.renderer is not None and not self._environment_pending
+
+    def _load_environment(self) -> None:
+        """The environment at start-up, once the first frame is on screen."""
+        if not self._environment_pending or self.renderer is None:
+            return
+        self._environment_pending = False
+        self.makeCurrent()
+        try:
+            self._set_environment_now(self._environment, None)
+        except Exception as exc:  # as at start-up before: the view says what went wrong
+            self.problem = f"renderer failed to start: {type(exc).__name__}: {exc}"
+            self.renderer = None
+        finally:
+            self.doneCurrent()
+        self.update()
+
     def set_environment(self, spec: str, progress=None) -> None:
         """Bakes (or loads from cache) an environment; raises ValueError for a bad file."""
         self._environment = spec
         if self.renderer is not None:
+            self._environment_pending = False
             self.makeCurrent()
             try:
                 self._set_environment_now(spec, progress)

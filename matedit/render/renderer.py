@@ -40,7 +40,7 @@ class Renderer(PreviewSettings):
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int] = (512, 512),
                  samples: int = 4, environment: str | None = "studio",
-                 bake_settings=None, deferred: bool = True) -> None:
+                 bake_settings=None, deferred: bool = True, warm_up: bool = True) -> None:
         super().__init__()
         self.ctx, self.samples = ctx, samples
         # deferred preview (GBUFFER entry + one lighting pass) for opaque materials; forward
@@ -48,6 +48,8 @@ class Renderer(PreviewSettings):
         self.deferred = bool(deferred) and samples >= 2
         self.is_forward = True  # the current material's path
         self.bake_settings = bake_settings
+        self.environment_name = ""  # none until set_environment
+        self.environment_warnings: list[str] = []
         self._size = (0, 0)
         self._program: moderngl.Program | None = None
         self._mesh: GpuMesh | None = None
@@ -72,7 +74,7 @@ class Renderer(PreviewSettings):
         self.resize(*size)
         if environment is not None:
             self.set_environment(environment)
-        if self.deferred:
+        if self.deferred and warm_up:  # False: the first frame is a deferred material's
             self._warm_up()
 
     def _warm_up(self) -> None:
