@@ -61,11 +61,14 @@ LAYERS: tuple[Layer, ...] = (
           ("MaterialX", "pygltflib", "pxr", "OpenImageIO", "numpy", "moderngl")),
     # the preview renderer on any moderngl context
     Layer("render", ("matedit.render",), ("numpy", "moderngl")),
+    # the headless commands (validate, compile, render, bake, export, import ...) and their
+    # one-line reports: what the editor's dialogs run too (File › Export: commands.export)
+    Layer("commands", ("matedit.cli_support", "matedit.commands"),
+          ("numpy", "moderngl", "OpenImageIO")),
     # the PySide6 editor
     Layer("app", ("matedit.app",), ("PySide6", "shiboken6", "numpy", "moderngl")),
     # the matedit command: the editor, or a headless command
-    Layer("cli", ("matedit.cli_support", "matedit.commands", "matedit.cli", "matedit.__main__"),
-          ("numpy", "moderngl", "OpenImageIO")),
+    Layer("cli", ("matedit.cli", "matedit.__main__"), ("numpy",)),
 )
 
 
