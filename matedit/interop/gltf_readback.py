@@ -30,15 +30,36 @@ def _flat_png(path: Path, rgb) -> None:
     write_oiio(path, oiio.ImageSpec(1, 1, 3, "uint8"), px)
 
 
+def filled_template(paths: dict[str, str], values: dict, lobes: dict, opaque: bool,
+                    work: Path):
+    """The TEMPLATE material reading the images `paths` (texture parameter name -> file),
+    with its parameters set to `values` and its MaterialAttributes node's lobe fields to
+    `lobes`; `opaque`: its opacity input unwired. Named as if saved in `work`."""
+    from matedit.graph.nodes import Role, role_of
+    from matedit.io.document import load
+    from matedit.resources import graphs_dir
+
+    doc = load(graphs_dir().joinpath(*TEMPLATE))
+    for n in doc.graph.nodes.values():
+        name = n.settings.get("name")
+        if role_of(n.kind) == Role.TEXTURE_PARAMETER and name in paths:
+            n.settings["path"] = paths[name]
+        elif role_of(n.kind) == Role.MAKE_ATTRIBUTES:
+            n.values.update(lobes)
+        elif name in values:
+            n.values["value"] = values[name]
+    if opaque:
+        doc.graph.links = {lk for lk in doc.graph.links if lk.dst_port != "opacity"}
+    doc.path = work / "roundtrip.json"
+    return doc
+
+
 def read_material(out: Path, work: Path):
     """(the material document, its notes) of the asset `out`, its images written into the
     folder `work` (module notes); raises GltfReadbackError."""
     import pygltflib
 
-    from matedit.graph.nodes import Role, role_of
     from matedit.io.atomic import atomic_write_bytes
-    from matedit.io.document import load
-    from matedit.resources import graphs_dir
 
     try:
         g = pygltflib.GLTF2().load(str(out))
@@ -94,19 +115,9 @@ def read_material(out: Path, work: Path):
         "emissive_factor": list(mat.emissiveFactor or [0.0, 0.0, 0.0]),
         "emissive_strength": float(strength),
     }
-    doc = load(graphs_dir().joinpath(*TEMPLATE))
-    lobes = lobe_fields(mat.extensions or {})
-    for n in doc.graph.nodes.values():
-        name = n.settings.get("name")
-        if role_of(n.kind) == Role.TEXTURE_PARAMETER and name in paths:
-            n.settings["path"] = paths[name]
-        elif role_of(n.kind) == Role.MAKE_ATTRIBUTES:
-            n.values.update(lobes)
-        elif name in values:
-            n.values["value"] = values[name]
-    if mat.alphaMode in (None, "OPAQUE"):  # the template reads opacity from the alpha
-        doc.graph.links = {lk for lk in doc.graph.links if lk.dst_port != "opacity"}
-    doc.path = work / "roundtrip.json"
+    # the template reads opacity from the alpha
+    doc = filled_template(paths, values, lobe_fields(mat.extensions or {}),
+                          opaque=mat.alphaMode in (None, "OPAQUE"), work=work)
     unread = sorted(set(mat.extensions or {}) - set(LOBE_EXTENSIONS)
                     - {"KHR_materials_emissive_strength"})
     notes = []

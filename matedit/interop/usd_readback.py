@@ -84,12 +84,9 @@ def _texture_bytes(out: Path, asset) -> bytes:
 def read_material(out: Path, work: Path):
     """(the material document, its notes) of the USD asset `out`, its textures written into
     the folder `work` (module notes); raises UsdReadbackError."""
-    from matedit.graph.nodes import Role, role_of
-    from matedit.interop.gltf_readback import TEMPLATE, _flat_png
+    from matedit.interop.gltf_readback import _flat_png, filled_template
     from matedit.interop.usd import PREVIEW_LOBES
     from matedit.io.atomic import atomic_write_bytes
-    from matedit.io.document import load
-    from matedit.resources import graphs_dir
 
     out = Path(out)
     _stage, surf = _surface(out)  # the stage owns the shader's prim: keep it alive
@@ -126,19 +123,9 @@ def read_material(out: Path, work: Path):
         i = surf.GetInput(inp)
         if i and i.Get() is not None:
             lobes[field] = float(i.Get())
-    doc = load(graphs_dir().joinpath(*TEMPLATE))
-    for n in doc.graph.nodes.values():
-        name = n.settings.get("name")
-        if role_of(n.kind) == Role.TEXTURE_PARAMETER and name in paths:
-            n.settings["path"] = paths[name]
-        elif role_of(n.kind) == Role.MAKE_ATTRIBUTES:
-            n.values.update(lobes)
-        elif name in values:
-            n.values["value"] = values[name]
     # the template reads opacity from the base colour's alpha; the preview's opacity is a
     # map of its own, not read back
-    doc.graph.links = {lk for lk in doc.graph.links if lk.dst_port != "opacity"}
-    doc.path = work / "roundtrip.json"
+    doc = filled_template(paths, values, lobes, opaque=True, work=work)
     notes = ["round trip import: the UsdPreviewSurface network (what USD viewers draw); "
              "the MaterialX network is not read back"]
     if _texture_of(surf.GetInput("opacity")) is not None:
