@@ -165,10 +165,10 @@ class InteropDialog(QDialog):
         self.surface = self.map_format = None
         self.zip = self.check = self.arkit = None
         if self.spec.arkit:
-            self.arkit = QCheckBox("Apple's usdz profile (AR Quick Look): the preview network "
-                                   "on PNG maps, no MaterialX network")
+            self.arkit = QCheckBox("Apple's usdz profile (AR Quick Look)")
             self.arkit.setChecked(s.value(_key(kind, "arkit"), False, type=bool))
-            self.arkit.setToolTip("A .usdz package only (--arkit)")
+            self.arkit.setToolTip("A .usdz package only (--arkit): the preview network on PNG "
+                                  "maps, without the MaterialX network")
             form.addRow("Profile", self.arkit)
             self._follow_suffix()
         if self.spec.surface:
