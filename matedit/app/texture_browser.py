@@ -11,7 +11,8 @@ time and size: when the folder changes (a file watcher), only new or changed fil
 Dragging a thumbnail drags its file, as the file manager does, so the canvas takes it as a
 dropped image. Double-click (or Enter) uses the file: it fills the texture slot of the one
 node selected on the canvas when that node has one (as the Inspector's field does), else
-adds a Texture Parameter and a Texture Sample on it at the canvas's centre (as a drop there).
+adds a Texture Parameter and a Texture Sample on it at the canvas's centre (as an image
+dropped on empty canvas does).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from PySide6.QtCore import (
     QMimeData,
     QModelIndex,
     QObject,
+    QPointF,
     QRunnable,
     QSize,
     QSortFilterProxyModel,
@@ -499,7 +501,8 @@ class TextureBrowser(QWidget):
 
     def use_file(self, path: Path) -> list[str]:
         """The file into the canvas's selected texture slot (`texture_slot`), or a new
-        texture on it at the canvas's centre: the ids of the nodes filled or added."""
+        Texture Parameter and Texture Sample on it at the canvas's centre (as an image
+        dropped on empty canvas makes), selected: the ids of the nodes filled or added."""
         canvas = self.canvas_of()
         if canvas is None:
             return []
@@ -507,7 +510,10 @@ class TextureBrowser(QWidget):
         if slot is not None:
             return [slot[0]] if canvas.fill_texture_slot(slot[0], slot[1], path) else []
         centre = canvas.mapToScene(canvas.viewport().rect().center())
-        return canvas.drop_files([path], centre)
+        added = canvas.add_texture(path, centre - QPointF(115, 40))  # the pair, centred
+        if added:
+            canvas.select_nodes(added)
+        return added
 
     def shutdown(self) -> None:
         """No job waits or runs on: the window is closing."""
