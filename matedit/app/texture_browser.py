@@ -77,7 +77,7 @@ if TYPE_CHECKING:
     from matedit.app.controller import DocumentController
 
 THUMB = 96  # a thumbnail's longer side, pixels
-GRID = QSize(THUMB + 22, THUMB + 42)  # a thumbnail and two lines of text under it
+GRID = QSize(THUMB + 22, THUMB + 54)  # a thumbnail and two lines of text under it
 CACHE_SIZE = 1024  # thumbnails kept (at most 96x96 RGBA each: under 40 MB)
 WATCHED_FILES = 1000  # files watched for in-place rewrites (beyond: the folder only)
 PATH_ROLE = Qt.ItemDataRole.UserRole
@@ -293,8 +293,7 @@ class TextureBrowser(QWidget):
         self.view.setResizeMode(QListView.ResizeMode.Adjust)
         self.view.setIconSize(QSize(THUMB, THUMB))
         self.view.setGridSize(GRID)
-        self.view.setUniformItemSizes(True)
-        self.view.setWordWrap(False)
+        self.view.setWordWrap(True)  # (the name still elided in its middle)
         self.view.setTextElideMode(Qt.TextElideMode.ElideMiddle)
         self.view.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
