@@ -17,8 +17,10 @@ dropped on empty canvas does).
 
 from __future__ import annotations
 
+import atexit
 import bisect
 import os
+import weakref
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -28,6 +30,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shiboken6
 from PySide6.QtCore import (
+    QCoreApplication,
     QFileSystemWatcher,
     QMimeData,
     QModelIndex,
@@ -153,6 +156,19 @@ def make_thumb(path: Path, size: int = THUMB) -> Thumb:
     return Thumb(img, dims, f"{channels}, {storage} {data.format_name}")
 
 
+_POOLS: weakref.WeakSet[QThreadPool] = weakref.WeakSet()
+
+
+def _drain_pools() -> None:
+    for pool in list(_POOLS):
+        if shiboken6.isValid(pool):
+            pool.clear()
+            pool.waitForDone()
+
+
+atexit.register(_drain_pools)
+
+
 class _Results(QObject):
     done = Signal(object, object, object)  # path, (mtime, size), Thumb
 
@@ -251,6 +267,10 @@ class TextureBrowser(QWidget):
         # made before the results: destroyed first, it waits for the jobs still running
         self._pool = QThreadPool(self)
         self._pool.setMaxThreadCount(max(1, min(2, QThread.idealThreadCount() - 1)))
+        app = QCoreApplication.instance()
+        if app is not None:  # no job outlives the application's event loop
+            app.aboutToQuit.connect(self.shutdown)
+        _POOLS.add(self._pool)  # nor the interpreter, when it exits without an event loop
         self._results = _Results(self)
         self._results.done.connect(self._thumb_done)
         self._cache: OrderedDict[tuple[str, int, int], Thumb] = OrderedDict()
