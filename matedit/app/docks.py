@@ -1,6 +1,6 @@
 """The main window's dockable panels: which panel goes where, their default sizes, and the
 Lights dock's title (an '&' drawn as itself). The Textures browser is a tab beside the
-Library; a double-click there works on the window's active canvas (`window.canvas`).
+Library; a double-click there works on the window's active canvas (`CanvasHost.canvas`).
 
 `build_docks(window, compiler, controller, undo_group)` makes the panels and their docks on
 `window` and returns them as one typed `Panels`; the window keeps it and sets nothing else.
@@ -9,6 +9,7 @@ Library; a double-click there works on the window's active canvas (`window.canva
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol, cast
 
 import shiboken6
 from PySide6.QtCore import Qt, QTimer
@@ -26,6 +27,17 @@ from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
 from matedit.app.texture_browser import TextureBrowser
 from matedit.app.viewport_panel import ViewportPanel
+
+if TYPE_CHECKING:
+    from matedit.app.canvas import NodeCanvasView
+
+
+class CanvasHost(Protocol):
+    """What the Textures browser needs of the window: the canvas a double-click works on."""
+
+    @property
+    def canvas(self) -> NodeCanvasView: ...
+
 
 LIGHTS_TITLE = "Lights & Environment"
 # Default sizes at the default window size (1480x900): the viewport keeps a useful square,
@@ -111,7 +123,8 @@ def build_docks(w: QMainWindow, compiler: MaterialCompiler, controller: Document
     layers = LayersPanel(controller)
     library = LibraryPanel()
     textures = TextureBrowser(controller)
-    textures.canvas_of = lambda: getattr(w, "canvas", None)  # the window's active canvas
+    host = cast(CanvasHost, w)  # MainWindow: its `canvas` property
+    textures.canvas_of = lambda: host.canvas  # the window's active canvas, at the time
     lights = LightsPanel()
     code = CodeView(compiler)
     diagnostics = DiagnosticsPanel()
