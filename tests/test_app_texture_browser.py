@@ -145,7 +145,12 @@ def test_double_click_fills_the_selected_slot_or_adds_a_texture(qtbot, tmp_path)
 
     w.tabs.material.canvas.select_nodes([])
     settle(qtbot, w)
-    tb.view.activated.emit(green)
+    from PySide6.QtCore import Qt
+
+    tb.view.scrollTo(green)
+    at = tb.view.visualRect(green).center()
+    qtbot.mouseClick(tb.view.viewport(), Qt.MouseButton.LeftButton, pos=at)
+    qtbot.mouseDClick(tb.view.viewport(), Qt.MouseButton.LeftButton, pos=at)  # a real one
     settle(qtbot, w)
     added = set(graph.nodes) - before
     assert len(added) == 2
