@@ -23,6 +23,8 @@ _.paintGL
 _.textFromValue
 _.valueFromText
 _.fixup
+# QAbstractItemModel (matedit.app.texture_browser._FileModel: a drag copies, never moves)
+_.supportedDragActions
 
 # moderngl reads these attributes of its textures and contexts when they are set.
 _.repeat_x

@@ -1,5 +1,6 @@
 """The main window's dockable panels: which panel goes where, their default sizes, and the
-Lights dock's title (an '&' drawn as itself).
+Lights dock's title (an '&' drawn as itself). The Textures browser is a tab beside the
+Library; a double-click there works on the window's active canvas (`CanvasHost.canvas`).
 
 `build_docks(window, compiler, controller, undo_group)` makes the panels and their docks on
 `window` and returns them as one typed `Panels`; the window keeps it and sets nothing else.
@@ -8,6 +9,7 @@ Lights dock's title (an '&' drawn as itself).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol, cast
 
 import shiboken6
 from PySide6.QtCore import Qt, QTimer
@@ -23,7 +25,19 @@ from matedit.app.inspector import InspectorPanel
 from matedit.app.layers_panel import LayersPanel
 from matedit.app.library import LibraryPanel
 from matedit.app.lights_panel import LightsPanel
+from matedit.app.texture_browser import TextureBrowser
 from matedit.app.viewport_panel import ViewportPanel
+
+if TYPE_CHECKING:
+    from matedit.app.canvas import NodeCanvasView
+
+
+class CanvasHost(Protocol):
+    """What the Textures browser needs of the window: the canvas a double-click works on."""
+
+    @property
+    def canvas(self) -> NodeCanvasView: ...
+
 
 LIGHTS_TITLE = "Lights & Environment"
 # Default sizes at the default window size (1480x900): the viewport keeps a useful square,
@@ -70,11 +84,14 @@ class Panels:
     code_dock: QDockWidget
     diagnostics_dock: QDockWidget
     history_dock: QDockWidget
+    textures: TextureBrowser
+    textures_dock: QDockWidget
 
     def docks(self) -> list[QDockWidget]:
         """The docks in the order the View menu lists them."""
         return [self.viewport_dock, self.inspector_dock, self.layers_dock, self.library_dock,
-                self.lights_dock, self.code_dock, self.diagnostics_dock, self.history_dock]
+                self.textures_dock, self.lights_dock, self.code_dock, self.diagnostics_dock,
+                self.history_dock]
 
 
 def _lights_host(environment: EnvironmentPanel, lights: LightsPanel) -> QScrollArea:
@@ -105,6 +122,9 @@ def build_docks(w: QMainWindow, compiler: MaterialCompiler, controller: Document
     inspector = InspectorPanel(controller)
     layers = LayersPanel(controller)
     library = LibraryPanel()
+    textures = TextureBrowser(controller)
+    host = cast(CanvasHost, w)  # MainWindow: its `canvas` property
+    textures.canvas_of = lambda: host.canvas  # the window's active canvas, at the time
     lights = LightsPanel()
     code = CodeView(compiler)
     diagnostics = DiagnosticsPanel()
@@ -113,6 +133,7 @@ def build_docks(w: QMainWindow, compiler: MaterialCompiler, controller: Document
     environment = EnvironmentPanel(viewport.environment)
 
     library_dock = add_dock(w, "Library", "libraryDock", library, L, "folder-add")
+    textures_dock = add_dock(w, "Textures", "texturesDock", textures, L, "texture")
     layers_dock = add_dock(w, "Layers", "layersDock", layers, L, "layer")
     viewport_dock = add_dock(w, "Viewport", "viewportDock", viewport, R, "material")
     inspector_dock = add_dock(w, "Inspector", "inspectorDock", inspector, R)
@@ -127,6 +148,7 @@ def build_docks(w: QMainWindow, compiler: MaterialCompiler, controller: Document
     code_dock = add_dock(w, "GLSL", "codeDock", code, B)
     history_dock = add_dock(w, "History", "historyDock", history, B, "undo")
     w.splitDockWidget(library_dock, layers_dock, Qt.Orientation.Vertical)
+    _tab_when_shown(w, library_dock, textures_dock)
     w.splitDockWidget(viewport_dock, inspector_dock, Qt.Orientation.Vertical)
     w.tabifyDockWidget(inspector_dock, lights_dock)
     inspector_dock.raise_()
@@ -140,7 +162,26 @@ def build_docks(w: QMainWindow, compiler: MaterialCompiler, controller: Document
     w.resizeDocks([diagnostics_dock], [BOTTOM_HEIGHT], Qt.Orientation.Vertical)
     return Panels(viewport, inspector, layers, library, lights, environment, code, diagnostics,
                   history, viewport_dock, inspector_dock, layers_dock, library_dock,
-                  lights_dock, code_dock, diagnostics_dock, history_dock)
+                  lights_dock, code_dock, diagnostics_dock, history_dock, textures,
+                  textures_dock)
+
+
+def _tab_when_shown(w: QMainWindow, beside: QDockWidget, dock: QDockWidget) -> None:
+    """`dock` starts hidden and, shown the first time while still where it was added, is
+    tabbed beside `beside` and raised. (Tabbed from the start, the left column would be
+    laid out wider than the default window allows.)"""
+    dock.hide()
+
+    def shown(visible: bool) -> None:
+        if not visible or not shiboken6.isValid(w):
+            return
+        dock.visibilityChanged.disconnect(shown)
+        if not dock.isFloating() and not w.tabifiedDockWidgets(dock) and \
+                w.dockWidgetArea(dock) == w.dockWidgetArea(beside):
+            w.tabifyDockWidget(beside, dock)
+            QTimer.singleShot(0, dock, dock.raise_)
+
+    dock.visibilityChanged.connect(shown)
 
 
 def retitle_lights(w: QMainWindow, d: QDockWidget) -> None:

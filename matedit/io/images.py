@@ -22,6 +22,7 @@ import tempfile
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -143,8 +144,11 @@ def oiio_name(path: Path, *, folder: bool = False) -> Iterator[str]:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def read_image(path: str | os.PathLike) -> ImageData:
-    """Read the first subimage of `path` as float32 (H, W, C); raises ImageError."""
+@contextlib.contextmanager
+def _opened(path: str | os.PathLike) -> Iterator[tuple[Any, str, tuple[int, int, int]]]:
+    """(the open ImageInput, the file's name, its (width, height, channels)) once the file
+    is known to be a regular, non-empty file of `READ_FORMATS` whose header is safe to
+    read pixels from; closed afterwards. Raises ImageError."""
     p = Path(path)
     name = str(p)
     try:
@@ -168,9 +172,56 @@ def read_image(path: str | os.PathLike) -> ImageData:
         if inp is None:
             raise ImageError(f"{name}: cannot read image: {_oiio_error()}")
         try:
-            return _read_opened(inp, name)
+            yield inp, name, _checked_size(inp, name)
         finally:
             inp.close()
+
+
+def read_image(path: str | os.PathLike) -> ImageData:
+    """Read the first subimage of `path` as float32 (H, W, C); raises ImageError."""
+    with _opened(path) as (inp, name, _size):
+        return _read_opened(inp, name)
+
+
+def read_thumbnail(path: str | os.PathLike, size: int) -> tuple[ImageData, tuple[int, int]]:
+    """The first subimage of `path` shrunk to fit `size` x `size` pixels (each pixel the
+    mean of the file's pixels it covers; a smaller image is kept as it is), as float32,
+    and the file's own (width, height). The file is read a band of rows at a time, so a
+    large image is never held whole as floats. Raises ImageError as `read_image` does."""
+    with _opened(path) as (inp, name, (w, h, c)):
+        spec = inp.spec()
+        scale = min(1.0, size / max(w, h))
+        tw, th = max(1, round(w * scale)), max(1, round(h * scale))
+        row_of = np.arange(h) * th // h  # the thumbnail row of each file row, and column
+        col_starts = np.searchsorted(np.arange(w) * tw // w, np.arange(tw))
+        tile = int(spec.tile_height) if spec.tile_width > 0 else 0
+        band = max(1, (1 << 22) // (w * c))  # rows of about 16 MB of floats at a time
+        if tile:
+            band = max(tile, band // tile * tile)
+        acc = np.zeros((th, tw, c), np.float64)
+        for y0 in range(0, h, band):
+            y1 = min(h, y0 + band)
+            if tile:
+                rows = inp.read_tiles(0, 0, spec.x, spec.x + w, spec.y + y0, spec.y + y1,
+                                      spec.z, spec.z + 1, 0, c, "float")
+            else:
+                rows = inp.read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, 0, c,
+                                          "float")
+            err = inp.geterror() if inp.has_error else ""
+            if rows is None or err:
+                raise ImageError(f"{name}: corrupt or truncated image: "
+                                 f"{_oiio_error(inp) if not err else err}")
+            rows = np.asarray(rows, dtype=np.float32).reshape(y1 - y0, w, c)
+            sums = np.add.reduceat(rows, col_starts, axis=1, dtype=np.float64)
+            starts = np.flatnonzero(np.diff(row_of[y0:y1], prepend=-1))
+            acc[row_of[y0 + starts]] += np.add.reduceat(sums, starts, axis=0)
+        count = np.outer(np.bincount(row_of, minlength=th),
+                         np.diff(np.append(col_starts, w)))
+        pixels = (acc / count[:, :, None]).astype(np.float32)
+        return ImageData(pixels=pixels, path=name, format_name=inp.format_name(),
+                         is_ldr=spec.format.basetype in _LDR_BASETYPES,
+                         channel_names=tuple(spec.channelnames),
+                         is_8bit=spec.format.basetype in (oiio.UINT8, oiio.INT8)), (w, h)
 
 
 # Colour and alpha as the file stores them: OpenImageIO would otherwise premultiply the
@@ -180,8 +231,9 @@ _STRAIGHT_ALPHA = oiio.ImageSpec()
 _STRAIGHT_ALPHA.attribute("oiio:UnassociatedAlpha", 1)
 
 
-def _read_opened(inp, name: str) -> ImageData:
-    """The pixels of an open ImageInput, once its format and size are known to be safe."""
+def _checked_size(inp, name: str) -> tuple[int, int, int]:
+    """(width, height, channels) of an open ImageInput, once its format and size are known
+    to be safe to read."""
     fmt = inp.format_name()
     if fmt not in _READERS:
         raise ImageError(f"{name}: OpenImageIO reads it as {fmt!r}, not as an image format "
@@ -195,6 +247,14 @@ def _read_opened(inp, name: str) -> ImageData:
     if w * h > MAX_IMAGE_PIXELS or c > 64 or w * h * c > MAX_IMAGE_VALUES:
         raise ImageError(f"{name}: image is too large ({w}x{h}, {c} channels; at most "
                          f"{MAX_IMAGE_PIXELS} pixels and {MAX_IMAGE_VALUES} values)")
+    return w, h, c
+
+
+def _read_opened(inp, name: str) -> ImageData:
+    """The pixels of an open ImageInput whose size `_checked_size` has passed."""
+    fmt = inp.format_name()
+    spec = inp.spec()
+    w, h, c = spec.width, spec.height, spec.nchannels
     pixels = inp.read_image(0, 0, 0, c, "float")
     err = inp.geterror() if inp.has_error else ""
     if pixels is None or err:
