@@ -66,7 +66,7 @@ def test_an_artist_session_from_open_to_close_all(qtbot, tmp_path, monkeypatch):
 
     # collapse the rust mask's nodes into a function (Ctrl+G on the canvas)
     canvas = w.tabs.material.canvas
-    canvas.ask_function_path = lambda suggested: str(function)
+    canvas.ask_function_path = lambda _suggested: str(function)
     before = set(w.controller.document.graph.nodes)
     canvas.select_nodes(["mask_noise", "edge", "hi", "mask"])  # e0 and e1 sit between
     canvas.setFocus()
