@@ -14,6 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from test_app_support import app_env, make_window  # noqa: F401 - fixture
 
@@ -227,3 +228,39 @@ def test_usdz_in_apples_profile_with_its_round_trip(qtbot, tmp_path):
     want = FIGURE.search(r.stderr)
     assert r.returncode == 0 and want, r.stderr
     assert abs(float(got.group(1)) - float(want.group(1))) <= 0.01
+
+
+def test_the_mesh_choice_is_the_commands_mesh(qtbot, tmp_path):
+    """The dialog's Mesh (a built-in or an OBJ file) bakes on and ships the mesh `matedit
+    export --mesh` does: the same POSITION accessor (count, bounds within 1e-6)."""
+    import pygltflib
+
+    obj = tmp_path / "quad.obj"
+    obj.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                   "vn 0 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n")
+    w = make_window(qtbot, CHECKED)
+    ia = w.menus.interop
+
+    def positions(path):
+        g = pygltflib.GLTF2().load(str(path))
+        acc = g.accessors[g.meshes[0].primitives[0].attributes.POSITION]
+        return acc.count, np.array(acc.min), np.array(acc.max)
+
+    for spec, name in (("cube", "cube"), (str(obj), "quad")):
+        (tmp_path / name).mkdir()
+        dlg = ia.export_dialog("gltf")
+        assert dlg.mesh.itemText(0) == "The material's preview mesh"
+        dlg.set_mesh(spec)
+        assert dlg.options().mesh == spec
+        dlg.set_output(tmp_path / name / "gui.glb")
+        dlg.set_size(256)
+        assert dlg.run_export(), dlg.result.toPlainText()
+        r = cli("export", CHECKED, "-o", tmp_path / name / "cli.glb", "--size", "256",
+                "--mesh", spec)
+        assert r.returncode == 0, r.stderr
+        got, want = positions(tmp_path / name / "gui.glb"), positions(tmp_path / name /
+                                                                       "cli.glb")
+        assert got[0] == want[0]
+        np.testing.assert_allclose(got[1], want[1], atol=1e-6)
+        np.testing.assert_allclose(got[2], want[2], atol=1e-6)
+    assert positions(tmp_path / "quad" / "gui.glb")[0] == 4

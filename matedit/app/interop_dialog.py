@@ -38,8 +38,11 @@ from PySide6.QtWidgets import (
 
 from matedit.app import file_dialogs
 from matedit.commands.export import MAP_FORMATS, SURFACES, ExportOptions, default_size
+from matedit.render.mesh import BUILTIN_MESHES
 
 SIZES = (256, 512, 1024, 2048, 4096)
+OBJ_CHOICE = "OBJ file…"
+OBJ_FILTER = "Wavefront OBJ (*.obj)"
 
 
 @dataclass(frozen=True)
@@ -50,16 +53,18 @@ class Kind:
     map_format: bool = False  # baked maps' --format
     check: bool = False  # --check
     arkit: bool = False  # USD's --arkit (a .usdz only)
+    mesh: bool = False  # --mesh: the mesh baked on and shipped
 
 
 KINDS = {
     "gltf": Kind("Export glTF", ((".glb", "glTF binary (.glb: one file)"),
                                  (".gltf", "glTF (.gltf with a .bin and images)")),
-                 check=True),
+                 check=True, mesh=True),
     "mtlx": Kind("Export MaterialX", ((".mtlx", "MaterialX document (.mtlx)"),), surface=True,
                  check=True),
     "usd": Kind("Export USD", ((".usda", "USD text (.usda, textures beside it)"),
-                               (".usdz", "USD package (.usdz)")), check=True, arkit=True),
+                               (".usdz", "USD package (.usdz)")), check=True, arkit=True,
+                mesh=True),
     "baked": Kind("Export Baked Textures", (), map_format=True),
 }
 
@@ -163,7 +168,23 @@ class InteropDialog(QDialog):
         self.size.setToolTip("Baked map width and height in texels (--size)")
         form.addRow("Bake size", self.size)
         self.surface = self.map_format = None
-        self.zip = self.check = self.arkit = None
+        self.zip = self.check = self.arkit = self.mesh = None
+        if self.spec.mesh:
+            self.mesh = QComboBox()
+            self.mesh.addItem("The material's preview mesh", "")
+            for name in BUILTIN_MESHES:
+                self.mesh.addItem(name.capitalize(), name)
+            self.mesh.addItem(OBJ_CHOICE, OBJ_CHOICE)
+            kept = str(s.value(_key(kind, "mesh"), "") or "")
+            if kept and self.mesh.findData(kept) < 0 and Path(kept).is_file():
+                self.mesh.insertItem(self.mesh.count() - 1, Path(kept).name, kept)
+            self.mesh.setCurrentIndex(max(0, self.mesh.findData(kept)))
+            self._mesh_index = self.mesh.currentIndex()
+            self.mesh.activated.connect(self._mesh_chosen)
+            self.mesh.setToolTip("The mesh the maps are baked on and the asset carries "
+                                 "(--mesh): its positions, normals and tangents shape "
+                                 "position- and slope-dependent looks")
+            form.addRow("Mesh", self.mesh)
         if self.spec.arkit:
             self.arkit = QCheckBox("Apple's usdz profile (AR Quick Look)")
             self.arkit.setChecked(s.value(_key(kind, "arkit"), False, type=bool))
@@ -244,6 +265,44 @@ class InteropDialog(QDialog):
             self.path.setText(str(out.with_suffix(self.file_type.currentData())))
             self._follow_suffix()
 
+    def _mesh_chosen(self, index: int) -> None:
+        """An OBJ file joins the list (checked first: a file that is no mesh is said in the
+        result area, and the choice goes back)."""
+        assert self.mesh is not None
+        if self.mesh.itemData(index) != OBJ_CHOICE:
+            self._mesh_index = index
+            return
+        from matedit.render.mesh import MeshError, mesh_from_spec
+
+        path, _ = file_dialogs.open_file(self, "Bake on an OBJ mesh", "", OBJ_FILTER)
+        if path:
+            real = str(Path(path).resolve())
+            try:
+                mesh_from_spec(real)
+            except (MeshError, OSError) as exc:
+                self.result.setPlainText(f"{Path(path).name}: not a mesh: {exc}")
+                path = ""
+            else:
+                at = self.mesh.findData(real)
+                if at < 0:
+                    at = self.mesh.count() - 1
+                    self.mesh.insertItem(at, Path(real).name, real)
+                self.mesh.setCurrentIndex(at)
+                self._mesh_index = at
+                return
+        self.mesh.setCurrentIndex(self._mesh_index)
+
+    def set_mesh(self, spec: str) -> None:
+        """The mesh by its --mesh spec ("" for the preview mesh; an OBJ file's path joins
+        the list), for scripts and tests."""
+        assert self.mesh is not None
+        at = self.mesh.findData(spec)
+        if at < 0:
+            at = self.mesh.count() - 1
+            self.mesh.insertItem(at, Path(spec).name, spec)
+        self.mesh.setCurrentIndex(at)
+        self._mesh_index = at
+
     def _zip_toggled(self, on: bool) -> None:
         if self.check is not None:
             self.check.setEnabled(not on)
@@ -275,7 +334,8 @@ class InteropDialog(QDialog):
             format=self.map_format.currentData() if self.map_format is not None else "png",
             zip=zip_on,
             check=self.check is not None and self.check.isChecked() and not zip_on,
-            arkit=self.arkit is not None and self.arkit.isEnabled() and self.arkit.isChecked())
+            arkit=self.arkit is not None and self.arkit.isEnabled() and self.arkit.isChecked(),
+            mesh=(self.mesh.currentData() or None) if self.mesh is not None else None)
 
     def _remember(self) -> None:
         s = QSettings()
@@ -294,6 +354,8 @@ class InteropDialog(QDialog):
             s.setValue(_key(self.kind, "check"), self.check.isChecked())
         if self.arkit is not None:
             s.setValue(_key(self.kind, "arkit"), self.arkit.isChecked())
+        if self.mesh is not None:
+            s.setValue(_key(self.kind, "mesh"), o.mesh or "")
 
     # --- the export ------------------------------------------------------------------------
     def run_export(self) -> bool:
