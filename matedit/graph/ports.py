@@ -282,6 +282,48 @@ def _concrete_types(kind: str):
     return _CONCRETE[kind]
 
 
+# A kind's static ports, read once for the generic rule: those ports, the (name, default) of
+# its generic inputs, and (name, fixed type or None where generic) of its inputs and outputs.
+_GENERIC_PLANS: dict[str, tuple] = {}
+
+
+def _generic_plan(kind: str) -> tuple:
+    hit = _GENERIC_PLANS.get(kind)
+    if hit is None:
+        p = _static_ports(kind)
+        hit = _GENERIC_PLANS[kind] = (
+            p,
+            tuple((s.name, s.default) for s in p.inputs if s.type == GENERIC),
+            tuple((s.name, None if s.type == GENERIC else PortType(s.type)) for s in p.inputs),
+            tuple((s.name, None if s.type == GENERIC else PortType(s.type)) for s in p.outputs))
+    return hit
+
+
+def _generic_types(node: Node, plan: tuple, connected: dict[str, PortType]
+                   ) -> tuple[dict[str, PortType], dict[str, PortType]]:
+    """resolve_types of a kind with no ports rule: its generic inputs' widest type."""
+    _, generic_inputs, ins, outs = plan
+    widest: PortType | None = None
+    values = node.values
+    for name, default in generic_inputs:
+        t = connected.get(name)
+        if t is None:
+            t = _default_type(values.get(name, default))
+        if t == PortType.FLOAT:
+            continue
+        if not t.is_numeric:
+            raise ValueError(f"{name} takes a float or a vector, got {t}")
+        if widest is None:
+            widest = t
+        elif widest != t:
+            raise ValueError(
+                f"mixed vector sizes: {widest} and {t} ({name}); "
+                "use a Component Mask or Append node")
+    generic = widest or PortType.FLOAT
+    return ({name: generic if fixed is None else fixed for name, fixed in ins},
+            {name: generic if fixed is None else fixed for name, fixed in outs})
+
+
 def resolve_types(
     node: Node, ports: NodePorts, connected: dict[str, PortType]
 ) -> tuple[dict[str, PortType], dict[str, PortType]]:
@@ -295,6 +337,9 @@ def resolve_types(
         fixed = _concrete_types(node.kind)
         if fixed is not None:
             return fixed
+        plan = _generic_plan(node.kind)
+        if plan[0] is ports:
+            return _generic_types(node, plan, connected)
 
     def concrete(spec: Port) -> PortType | None:
         return None if spec.type == GENERIC else PortType(spec.type)
