@@ -182,12 +182,12 @@ def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = 
         from matedit.io.document import FileResolver
 
         resolver = FileResolver()
-    ir = ir if ir is not None else lower_and_optimise(doc, resolver)
-    if isinstance(doc.preview, dict) and doc.preview.get("energy_compensation") is True \
-            and ENERGY_COMPENSATION_DEFINE not in ir.defines:
-        ir.defines.append(ENERGY_COMPENSATION_DEFINE)  # the material's option (shading)
-    t = TARGETS[target]
-    with _no_gc():
+    with _no_gc():  # one pause for the whole compile: the collector runs once, after it
+        ir = ir if ir is not None else lower_and_optimise(doc, resolver)
+        if isinstance(doc.preview, dict) and doc.preview.get("energy_compensation") is True \
+                and ENERGY_COMPENSATION_DEFINE not in ir.defines:
+            ir.defines.append(ENERGY_COMPENSATION_DEFINE)  # the material's option (shading)
+        t = TARGETS[target]
         vert = vertex_source(t)
         frag, smap = fragment_source(ir, t, mode)
     return CompiledMaterial(target, vert, frag, smap, ir, structure_hash(vert.text, frag.text))

@@ -122,7 +122,11 @@ class _Lowerer:
     def arg(self, nid: str, port: str, t: PortType, default: Any) -> Expr:
         link = self.incoming[nid].get(port)
         if link is not None:
-            return convert(self.source(link.src, link.src_port), t)
+            src, src_port = link.src, link.src_port
+            e = self.alias.get((src, src_port))
+            if e is None:  # self.source, inlined: most operands are another op's output
+                e = Var(f"{src}.{src_port}", self.a.out_types[src][src_port])
+            return e if e.type == t else convert(e, t)
         node = self.doc.graph.nodes[nid]
         value = node.values.get(port, default)
         if value == MESH_UV:
@@ -176,16 +180,20 @@ class _Lowerer:
             self.ctx.uniforms[info.name] = info
 
     def emit(self, op: Op) -> Op:
-        self.scope.ops.append(op)
-        for port, _ in op.outs:
-            self.scope.sockets[(op.node, port)] = op.out(port)
+        scope = self.scope
+        scope.ops.append(op)
+        sockets, node = scope.sockets, op.node
+        for port, var in op.out_vars().items():
+            sockets[(node, port)] = var
         return op
 
     # --- nodes -------------------------------------------------------------------------------
     def lower(self) -> None:
+        gnodes = self.doc.graph.nodes
+        role_of = nodes.role_of
         for nid in self.a.order:
-            node = self.doc.graph.nodes[nid]
-            role = nodes.role_of(node.kind)
+            node = gnodes[nid]
+            role = role_of(node.kind)
             if node.muted and role == Role.LAYER_STACK:
                 # A bypassed stack is its base layer: every layer above it hidden.
                 layers = node.settings.get("layers")
@@ -224,20 +232,44 @@ class _Lowerer:
 
     def _inputs(self, nid: str) -> list[Expr]:
         ins = self.a.in_types[nid]
-        return [self.arg(nid, p.name, ins[p.name], p.default) for p in self.a.ports[nid].inputs]
+        arg = self.arg
+        return [arg(nid, p.name, ins[p.name], p.default) for p in self.a.ports[nid].inputs]
 
     def _generic(self, nid, node) -> None:
         d = nodes.REGISTRY[node.kind]
         role = d.role
+        a = self.a
         if role == Role.MAKE_ATTRIBUTES:
             # A field left at its default is compiled in as a literal, with no uniform.
             unwritten = self._unwritten_fields(nid, node)
-            ins = self.a.in_types[nid]
+            ins = a.in_types[nid]
             args = [literal(PortType(f.type), f.default) if f.name in unwritten
                     else self.arg(nid, f.name, ins[f.name], f.default) for f in ATTRIBUTE_FIELDS]
         else:
-            args = self._inputs(nid)
-        outs = [(p.name, self.a.out_types[nid][p.name]) for p in self.a.ports[nid].outputs]
+            # self._inputs, inlined: an operand wired from another op's output is that op's
+            # variable (its socket), made once when the op was emitted
+            ins = a.in_types[nid]
+            into = self.incoming[nid]
+            alias, sockets, types = self.alias, self.scope.sockets, a.out_types
+            args = []
+            for p in a.ports[nid].inputs:
+                name = p.name
+                t = ins[name]
+                link = into.get(name)
+                if link is None:
+                    args.append(self.arg(nid, name, t, p.default))
+                    continue
+                key = (link.src, link.src_port)
+                e = alias.get(key)
+                if e is None:
+                    var = f"{link.src}.{link.src_port}"
+                    src_type = types[link.src][link.src_port]
+                    e = sockets.get(key)
+                    if type(e) is not Var or e.name != var or e.type != src_type:
+                        e = Var(var, src_type)
+                args.append(e if e.type == t else convert(e, t))
+        out_types = a.out_types[nid]
+        outs = [(p.name, out_types[p.name]) for p in a.ports[nid].outputs]
         self.ctx.kinds.add(node.kind)
         op = self.emit(Op(nid, nid, node.kind, args, outs))
         if role == Role.MAKE_ATTRIBUTES:

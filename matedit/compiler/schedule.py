@@ -41,10 +41,16 @@ class Writer:
         self.map: dict[int, tuple[str, str]] = {}
 
     def add(self, text: str, node: str | None = None, file: str = "") -> None:
-        for line in text.split("\n"):
-            self.lines.append(line)
+        lines = self.lines
+        if "\n" not in text:  # most are one line
+            lines.append(text)
             if node is not None:
-                self.map[len(self.lines)] = (node, file)
+                self.map[len(lines)] = (node, file)
+            return
+        for line in text.split("\n"):
+            lines.append(line)
+            if node is not None:
+                self.map[len(lines)] = (node, file)
 
 
 _UNDERSCORES = re.compile(r"_+")
@@ -62,7 +68,10 @@ class LocalNames:
     def __call__(self, raw: str) -> str:
         if raw in self.taken:
             return self.taken[raw]
-        name = "l_" + _UNDERSCORES.sub("_", raw.replace(".", "_"))
+        stem = raw.replace(".", "_")
+        if "__" in stem:
+            stem = _UNDERSCORES.sub("_", stem)
+        name = "l_" + stem
         base, i = name, 2
         while name in self.used:
             name, i = f"{base}_{i}", i + 1
@@ -101,7 +110,8 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
     for op in scope.ops:
         for a in op.args:
             visit(a)
-        steps.append((op, [(names(op.out(p).name), t) for p, t in op.outs]))
+        out = op.out
+        steps.append((op, [(names(out(p).name), t) for p, t in op.outs]))
     for _, _, e in scope.outputs:
         names.visit(e)
     return ScopePlan(scope, main, names, steps)
