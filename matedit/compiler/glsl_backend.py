@@ -99,7 +99,8 @@ def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
     them through `out` parameters."""
     impl = ops.implementation(op.kind)
     d = nodes.get(op.kind)  # a catalogue kind's GLSL is its definition's
-    args = [expr(a, names) for a in op.args]
+    taken = names.taken
+    args = [taken[a.name] if type(a) is Var else expr(a, names) for a in op.args]
     template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
     if template is not None:
         (name, t), = outs
@@ -122,8 +123,14 @@ def _scope(w: Writer, plan: ScopePlan) -> None:
         params += [f"out {TYPE_NAMES[t]} out_{n}" for n, t, _ in scope.outputs]
         w.add(f"void {scope.name}({', '.join(params)}) {{")
         w.add(f"    // material function {scope.name}")
+    lines, line_nodes, source = w.lines, w.map, scope.source
     for op, outs in plan.steps:
-        w.add("    " + op_line(op, outs, names), op.node, scope.source)
+        text = "    " + op_line(op, outs, names)
+        if "\n" in text:
+            w.add(text, op.node, source)
+        else:  # w.add of one line
+            lines.append(text)
+            line_nodes[len(lines)] = (op.node, source)
     if plan.main:
         w.add(f"    return {expr(scope.outputs[0][2], names)};" if scope.outputs
               else "    return defaultMaterialAttributes();")

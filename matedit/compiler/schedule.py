@@ -106,10 +106,14 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
     for p, _ in scope.params:
         names.used.add(p)
     steps = []
-    visit = names.visit
+    visit, taken = names.visit, names.taken
     for op in scope.ops:
         for a in op.args:
-            visit(a)
+            if type(a) is Var:  # names.visit of the common operand
+                if a.name not in taken:
+                    names(a.name)
+            else:
+                visit(a)
         out = op.out
         steps.append((op, [(names(out(p).name), t) for p, t in op.outs]))
     for _, _, e in scope.outputs:
@@ -180,9 +184,9 @@ def schedule(ir: MaterialIR, mode: str | Entry = Entry.FORWARD,
     scopes.append(plan_scope(ir.main, main=True))
     # the library file of each node kind used, and those the compiler's own ops need
     needed = {f"nodes/{k}" for k in ir.node_kinds if nodes.REGISTRY[k].glsl}
-    for s in [ir.main, *ir.functions]:
-        for op in s.ops:
-            needed.update(ops.implementation(op.kind).units)
+    kinds = {op.kind for s in [ir.main, *ir.functions] for op in s.ops}
+    for kind in kinds:
+        needed.update(ops.implementation(kind).units)
     units = [*BASE_UNITS, *sorted(needed), *ENTRY_UNITS[entry]]
     if entry == Entry.FORWARD and any(d.partition("=")[0] == ATTRIBUTE_VIEW for d in defines):
         units.append("attribute_view")  # the viewport's attribute views (preview only)

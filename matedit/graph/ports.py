@@ -320,8 +320,18 @@ def _generic_types(node: Node, plan: tuple, connected: dict[str, PortType]
                 f"mixed vector sizes: {widest} and {t} ({name}); "
                 "use a Component Mask or Append node")
     generic = widest or PortType.FLOAT
-    return ({name: generic if fixed is None else fixed for name, fixed in ins},
+    # the same two dicts for every node of the kind that resolves to `generic` (callers only
+    # read them, as they do _concrete_types')
+    key = (node.kind, generic)
+    hit = _GENERIC_TYPES.get(key)
+    if hit is None:
+        hit = _GENERIC_TYPES[key] = (
+            {name: generic if fixed is None else fixed for name, fixed in ins},
             {name: generic if fixed is None else fixed for name, fixed in outs})
+    return hit
+
+
+_GENERIC_TYPES: dict[tuple[str, PortType], tuple[dict, dict]] = {}
 
 
 def resolve_types(

@@ -439,7 +439,11 @@ def _check_input_default(n, f) -> list[Diagnostic]:
 def function_refs(doc: MaterialDocument) -> list[tuple[str, str]]:
     """(node id, function file) for every function a document uses directly."""
     refs = []
-    for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
+    registry = nodes.REGISTRY
+    calling = (nodes.Role.FUNCTION_CALL, nodes.Role.LAYER_STACK)
+    users = [n for n in doc.graph.nodes.values()
+             if (d := registry.get(n.kind)) is not None and d.role in calling]
+    for n in sorted(users, key=attrgetter("id")):
         role = nodes.role_of(n.kind)
         if role == nodes.Role.FUNCTION_CALL and isinstance(n.settings.get("function"), str):
             refs.append((n.id, n.settings["function"]))
