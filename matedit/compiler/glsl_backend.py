@@ -89,11 +89,6 @@ def _format(template: str, op: Op) -> tuple[str, bool]:
     return hit
 
 
-def _fill(template: str, op: Op, args: list[str], t: PortType) -> str:
-    fmt, joined = _format(template, op)
-    return fmt.format(args, TYPE_NAMES[t], ", ".join(args) if joined else "", op.data)
-
-
 def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
     """One op as one line: a declaration of its value, or declarations and a call that fills
     them through `out` parameters."""
@@ -104,7 +99,10 @@ def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
     template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
     if template is not None:
         (name, t), = outs
-        line = f"{TYPE_NAMES[t]} {name} = {_fill(template, op, args, t)};"
+        fmt, joined = _format(template, op)
+        type_name = TYPE_NAMES[t]
+        value = fmt.format(args, type_name, ", ".join(args) if joined else "", op.data)
+        line = f"{type_name} {name} = {value};"
         if impl.assigns:
             sets = " ".join(f"{name}.{f} = {a};" for f, a in zip(op.data[impl.assigns], args[1:]))
             line += " " + sets
