@@ -111,12 +111,12 @@ def layer_entries(node: Node) -> list[dict]:
     return layers if isinstance(layers, list) else []
 
 
-_STATIC_RULES = (PortsRule.CHANNELS, PortsRule.COMPONENTS, PortsRule.CONCATENATION,
+STATIC_RULES = (PortsRule.CHANNELS, PortsRule.COMPONENTS, PortsRule.CONCATENATION,
                  PortsRule.PASSTHROUGH)
 _STATIC: dict[str, NodePorts] = {}
 
 
-def _static_ports(kind: str) -> NodePorts:
+def static_ports(kind: str) -> NodePorts:
     """Ports that depend on nothing but the kind, built once per kind (NodePorts is frozen)."""
     hit = _STATIC.get(kind)
     if hit is None:
@@ -133,8 +133,8 @@ def node_ports(
     if d is None:
         raise PortError(node.id, "kind", f"unknown node kind {node.kind!r}")
     rule = d.ports_rule
-    if rule is None or rule in _STATIC_RULES:
-        return _static_ports(node.kind)
+    if rule is None or rule in STATIC_RULES:
+        return static_ports(node.kind)
     ins = d.inputs
     outs = d.outputs
     s = {**d.setting_defaults(), **node.settings}
@@ -274,7 +274,7 @@ _CONCRETE: dict[str, tuple | None] = {}
 def _concrete_types(kind: str):
     """Types of a kind with no generic ports, computed once (callers only read them)."""
     if kind not in _CONCRETE:
-        p = _static_ports(kind)
+        p = static_ports(kind)
         specs = p.inputs + p.outputs
         _CONCRETE[kind] = None if any(s.type == GENERIC for s in specs) else (
             {s.name: PortType(s.type) for s in p.inputs},
@@ -290,7 +290,7 @@ _GENERIC_PLANS: dict[str, tuple] = {}
 def _generic_plan(kind: str) -> tuple:
     hit = _GENERIC_PLANS.get(kind)
     if hit is None:
-        p = _static_ports(kind)
+        p = static_ports(kind)
         hit = _GENERIC_PLANS[kind] = (
             p,
             tuple((s.name, s.default) for s in p.inputs if s.type == GENERIC),

@@ -26,12 +26,14 @@ from matedit.graph.model import Link, MaterialDocument
 from matedit.graph.names import identifier_problem
 from matedit.graph.numbers import gpu_number_problem
 from matedit.graph.ports import (
+    STATIC_RULES,
     FunctionResolver,
     NodePorts,
     PortError,
     layer_entries,
     node_ports,
     resolve_types,
+    static_ports,
 )
 from matedit.graph.types import PortType, coerce_value, conversion_reason
 
@@ -188,7 +190,9 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             diags.append(warning("no function chosen yet: the call does nothing until one is",
                                  nid, "function", f))
         try:
-            p = ports[nid] = node_ports(node, resolver, doc)
+            rule = d.ports_rule  # node_ports' fast path: most kinds' ports are the kind's own
+            p = ports[nid] = static_ports(node.kind) if rule is None or rule in STATIC_RULES \
+                else node_ports(node, resolver, doc)
             if node.values:
                 diags.extend(_limit_warnings(node, p, f))
         except PortError as exc:
@@ -208,12 +212,12 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             diags.append(error(f"link refers to missing node {missing!r}",
                                dst if dst in gnodes else None, dst_port, f))
             continue
-        p = ports.get(src)
-        if p is not None and p.output(src_port) is None:
+        src_ports = ports.get(src)
+        if src_ports is not None and src_ports.output(src_port) is None:
             diags.append(error(f"node {src} has no output {src_port!r}", src, src_port, f))
             continue
-        p = ports.get(dst)
-        if p is not None and p.input(dst_port) is None:
+        dst_ports = ports.get(dst)
+        if dst_ports is not None and dst_ports.input(dst_port) is None:
             diags.append(error(f"node {dst} has no input {dst_port!r}", dst, dst_port, f))
             continue
         into = incoming[dst]
@@ -237,9 +241,9 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
     in_types: dict[str, dict[str, PortType]] = {}
     out_types: dict[str, dict[str, PortType]] = {}
     for nid in order:
-        p = ports.get(nid)
-        if p is None:
+        if nid not in ports:
             continue
+        p = ports[nid]
         node = gnodes[nid]
         into = incoming[nid]
         connected: dict[str, PortType] = {}
