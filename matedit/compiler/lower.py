@@ -239,6 +239,7 @@ class _Lowerer:
         d = nodes.REGISTRY[node.kind]
         role = d.role
         a = self.a
+        sockets = self.scope.sockets
         if role == Role.MAKE_ATTRIBUTES:
             # A field left at its default is compiled in as a literal, with no uniform.
             unwritten = self._unwritten_fields(nid, node)
@@ -250,7 +251,7 @@ class _Lowerer:
             # variable (its socket), made once when the op was emitted
             ins = a.in_types[nid]
             into = self.incoming[nid]
-            alias, sockets, types = self.alias, self.scope.sockets, a.out_types
+            alias, types = self.alias, a.out_types
             args = []
             for p in a.ports[nid].inputs:
                 name = p.name
@@ -271,7 +272,10 @@ class _Lowerer:
         out_types = a.out_types[nid]
         outs = [(p.name, out_types[p.name]) for p in a.ports[nid].outputs]
         self.ctx.kinds.add(node.kind)
-        op = self.emit(Op(nid, nid, node.kind, args, outs))
+        op = Op(nid, nid, node.kind, args, outs)
+        self.scope.ops.append(op)  # self.emit(op), inlined
+        for port, v in op.out_vars().items():
+            sockets[(nid, port)] = v
         if role == Role.MAKE_ATTRIBUTES:
             self.written[op.out("attributes").key()] = ALL_FIELDS - unwritten
         elif role in (Role.MASK_BLEND, Role.HEIGHT_BLEND):

@@ -103,14 +103,18 @@ def fold_and_merge(scope: Scope) -> None:
     seen: dict[str, Op] = {}
     kept: list[Op] = []
     for op in scope.ops:
-        op.args = [table.get(a.name, a) if type(a) is Var else _subst(a, table)
-                   for a in op.args]
-        lits = _fold(op)
+        op.args = args = [table.get(a.name, a) if type(a) is Var else _subst(a, table)
+                          for a in op.args]
+        # _fold only where some operand is a literal (it wants all of them literals)
+        lits = _fold(op) if not args or any(type(a) is Lit for a in args) else None
         if lits is not None:
             for (port, _), lit in zip(op.outs, lits):
                 table[op.out(port).name] = lit
             continue
-        k = op.key()
+        if op.data or not all(type(a) is Var for a in args):
+            k = op.key()
+        else:  # op.key() of an op of Var operands and no data
+            k = f"{op.kind}||{','.join([a.name for a in args])}"
         first = seen.get(k)
         if first is not None and first.outs == op.outs:
             for port, _ in op.outs:

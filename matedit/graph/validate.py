@@ -5,9 +5,10 @@ mismatches, missing required links, cycles (inside a graph, and through
 function calls across files), calls to missing functions, and the document's
 output nodes. `check_connect` answers, before a link is made, whether it may be.
 
-The valid path orders the graph with the standard library's `graphlib`; networkx, whose
-import (with its backend scan) costs more than the rest of `matedit validate`, is loaded
-only to name a cycle that was found and for `check_connect`'s reachability question.
+The valid path orders the graph by its own in-degree counts (`stable_order`: the order
+graphlib's TopologicalSorter gives, with graphlib's CycleError); networkx, whose import (with
+its backend scan) costs more than the rest of `matedit validate`, is loaded only to name a
+cycle that was found and for `check_connect`'s reachability question.
 """
 
 from __future__ import annotations
@@ -149,7 +150,7 @@ def stable_order(vertices: Iterable[str], edges: Iterable[tuple[str, str]]) -> l
 def _cycle(vertices: Iterable[str], edges: Iterable[tuple[str, str]],
            source: str | None = None) -> list[tuple[str, str]]:
     """The edges of one cycle, named the way networkx's find_cycle walks it (only called
-    once graphlib has found that there is one)."""
+    once stable_order has found that there is one)."""
     import networkx as nx
 
     g = nx.DiGraph()
