@@ -89,17 +89,27 @@ def _format(template: str, op: Op) -> tuple[str, bool]:
     return hit
 
 
+# op kind -> (its definition, or None; its ops row; _format of its value template, or None
+# where it calls a function), kept while the kind's definition is the same object
+_ROWS: dict[str, tuple] = {}
+
+
 def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
     """One op as one line: a declaration of its value, or declarations and a call that fills
     them through `out` parameters."""
-    impl = ops.implementation(op.kind)
-    d = nodes.get(op.kind)  # a catalogue kind's GLSL is its definition's
+    kind = op.kind
+    d = nodes.REGISTRY.get(kind)  # a catalogue kind's GLSL is its definition's
+    row = _ROWS.get(kind)
+    if row is None or row[0] is not d:
+        impl = ops.implementation(kind)
+        template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
+        row = _ROWS[kind] = (d, impl, _format(template, op) if template is not None else None)
+    _, impl, formatted = row
     taken = names.taken
     args = [taken[a.name] if type(a) is Var else expr(a, names) for a in op.args]
-    template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
-    if template is not None:
+    if formatted is not None:
         (name, t), = outs
-        fmt, joined = _format(template, op)
+        fmt, joined = formatted
         type_name = TYPE_NAMES[t]
         value = fmt.format(args, type_name, ", ".join(args) if joined else "", op.data)
         line = f"{type_name} {name} = {value};"
