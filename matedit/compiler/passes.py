@@ -111,10 +111,11 @@ def fold_and_merge(scope: Scope) -> None:
             for (port, _), lit in zip(op.outs, lits):
                 table[op.out(port).name] = lit
             continue
-        if op.data or not all(type(a) is Var for a in args):
+        var_names = [a.name for a in args if type(a) is Var]
+        if op.data or len(var_names) != len(args):
             k = op.key()
         else:  # op.key() of an op of Var operands and no data
-            k = f"{op.kind}||{','.join([a.name for a in args])}"
+            k = f"{op.kind}||{','.join(var_names)}"
         first = seen.get(k)
         if first is not None and first.outs == op.outs:
             for port, _ in op.outs:
