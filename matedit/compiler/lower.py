@@ -109,9 +109,12 @@ class _Lowerer:
         self.ctx, self.doc, self.a, self.top, self.scope = ctx, doc, analysis, top, scope
         self.alias: dict[tuple[str, str], Expr] = {}
         self.written: dict[str, frozenset] = {}  # expr key -> fields written (MA values)
-        self.incoming: dict[str, dict[str, Link]] = {nid: {} for nid in doc.graph.nodes}
-        for l in doc.graph.links:
-            self.incoming[l.dst][l.dst_port] = l
+        # the analysis's: with no error, every link passed its checks (read, never changed)
+        self.incoming: dict[str, dict[str, Link]] = analysis.incoming
+        if len(self.incoming) != len(doc.graph.nodes):  # an Analysis made without them
+            self.incoming = {nid: {} for nid in doc.graph.nodes}
+            for l in doc.graph.links:
+                self.incoming[l.dst][l.dst_port] = l
 
     # --- operands --------------------------------------------------------------------------
     def source(self, nid: str, port: str) -> Expr:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 from graphlib import CycleError
 from operator import attrgetter
@@ -90,6 +90,9 @@ class Analysis:
     out_types: dict[str, dict[str, PortType]]
     order: list[str]
     diagnostics: list[Diagnostic]
+    # node id -> input port -> the link into it, of the links that passed the checks (every
+    # link, where there is no error)
+    incoming: dict[str, dict[str, Link]] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -319,7 +322,7 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
     diags.extend(_document_rules(doc, ports, f))
     if calls:
         diags.extend(_call_cycles(doc, resolver))
-    return Analysis(ports, in_types, out_types, order, diags)
+    return Analysis(ports, in_types, out_types, order, diags, incoming)
 
 
 def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
