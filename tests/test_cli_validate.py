@@ -63,7 +63,7 @@ def test_validate_reads_light_rigs(tmp_path):
 
 def test_the_valid_path_orders_the_graph_without_importing_networkx():
     """networkx's import (with its backend scan) was the largest part of `matedit validate`;
-    a valid file is ordered by graphlib, and networkx loads only to name a cycle."""
+    a valid file is ordered by validate.stable_order, and networkx loads only to name a cycle."""
     sample = graphs_dir() / "materials" / "rusty_painted_metal.json"
     probe = ("import sys\nfrom matedit.cli import main\n"
              "try:\n    main(['validate', sys.argv[1]])\nexcept SystemExit as e:\n"

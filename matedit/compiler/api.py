@@ -12,7 +12,7 @@ from typing import Any
 
 from matedit.compiler import ops
 from matedit.compiler.emit import Entry, SourceMap, fragment_source, std140_layout, vertex_source
-from matedit.compiler.ir import MaterialIR, Splat, Uni
+from matedit.compiler.ir import MaterialIR, Splat, Uni, Var
 from matedit.compiler.lower import CompileError, lower_document
 from matedit.compiler.passes import optimise
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, MATERIAL_BINDING, TARGETS
@@ -147,7 +147,8 @@ def prune(ir: MaterialIR) -> None:
         scope = todo.pop()
         for op in scope.ops:
             for a in op.args:
-                _uniforms_in(a, used)
+                if type(a) is not Var:  # another op's output names no uniform
+                    _uniforms_in(a, used)
             fn = op.data.get("function") if op.kind == ops.CALL else None
             if fn and fn not in called:
                 called.add(fn)
@@ -182,12 +183,12 @@ def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = 
         from matedit.io.document import FileResolver
 
         resolver = FileResolver()
-    ir = ir if ir is not None else lower_and_optimise(doc, resolver)
-    if isinstance(doc.preview, dict) and doc.preview.get("energy_compensation") is True \
-            and ENERGY_COMPENSATION_DEFINE not in ir.defines:
-        ir.defines.append(ENERGY_COMPENSATION_DEFINE)  # the material's option (shading)
-    t = TARGETS[target]
-    with _no_gc():
+    with _no_gc():  # one pause for the whole compile: the collector runs once, after it
+        ir = ir if ir is not None else lower_and_optimise(doc, resolver)
+        if isinstance(doc.preview, dict) and doc.preview.get("energy_compensation") is True \
+                and ENERGY_COMPENSATION_DEFINE not in ir.defines:
+            ir.defines.append(ENERGY_COMPENSATION_DEFINE)  # the material's option (shading)
+        t = TARGETS[target]
         vert = vertex_source(t)
         frag, smap = fragment_source(ir, t, mode)
     return CompiledMaterial(target, vert, frag, smap, ir, structure_hash(vert.text, frag.text))

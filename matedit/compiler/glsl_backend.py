@@ -89,21 +89,30 @@ def _format(template: str, op: Op) -> tuple[str, bool]:
     return hit
 
 
-def _fill(template: str, op: Op, args: list[str], t: PortType) -> str:
-    fmt, joined = _format(template, op)
-    return fmt.format(args, TYPE_NAMES[t], ", ".join(args) if joined else "", op.data)
+# op kind -> (its definition, or None; its ops row; _format of its value template, or None
+# where it calls a function), kept while the kind's definition is the same object
+_ROWS: dict[str, tuple] = {}
 
 
 def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
     """One op as one line: a declaration of its value, or declarations and a call that fills
     them through `out` parameters."""
-    impl = ops.implementation(op.kind)
-    d = nodes.get(op.kind)  # a catalogue kind's GLSL is its definition's
-    args = [expr(a, names) for a in op.args]
-    template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
-    if template is not None:
+    kind = op.kind
+    d = nodes.REGISTRY.get(kind)  # a catalogue kind's GLSL is its definition's
+    row = _ROWS.get(kind)
+    if row is None or row[0] is not d:
+        impl = ops.implementation(kind)
+        template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
+        row = _ROWS[kind] = (d, impl, _format(template, op) if template is not None else None)
+    _, impl, formatted = row
+    taken = names.taken
+    args = [taken[a.name] if type(a) is Var else expr(a, names) for a in op.args]
+    if formatted is not None:
         (name, t), = outs
-        line = f"{TYPE_NAMES[t]} {name} = {_fill(template, op, args, t)};"
+        fmt, joined = formatted
+        type_name = TYPE_NAMES[t]
+        value = fmt.format(args, type_name, ", ".join(args) if joined else "", op.data)
+        line = f"{type_name} {name} = {value};"
         if impl.assigns:
             sets = " ".join(f"{name}.{f} = {a};" for f, a in zip(op.data[impl.assigns], args[1:]))
             line += " " + sets
@@ -122,8 +131,14 @@ def _scope(w: Writer, plan: ScopePlan) -> None:
         params += [f"out {TYPE_NAMES[t]} out_{n}" for n, t, _ in scope.outputs]
         w.add(f"void {scope.name}({', '.join(params)}) {{")
         w.add(f"    // material function {scope.name}")
+    lines, line_nodes, source = w.lines, w.map, scope.source
     for op, outs in plan.steps:
-        w.add("    " + op_line(op, outs, names), op.node, scope.source)
+        text = "    " + op_line(op, outs, names)
+        if "\n" in text:
+            w.add(text, op.node, source)
+        else:  # w.add of one line
+            lines.append(text)
+            line_nodes[len(lines)] = (op.node, source)
     if plan.main:
         w.add(f"    return {expr(scope.outputs[0][2], names)};" if scope.outputs
               else "    return defaultMaterialAttributes();")

@@ -16,6 +16,10 @@ from matedit.graph.types import PortType
 
 
 class Expr:
+    """An operand. The frozen subclasses write their two fields into `__dict__` in their own
+    `__init__` (dataclass keeps a class's own): the generated one sets each through
+    `object.__setattr__`, twice the cost, and a large graph makes thousands of them."""
+
     type: PortType
 
     def key(self) -> str:
@@ -28,6 +32,11 @@ class Var(Expr):
     name: str
     type: PortType
 
+    def __init__(self, name: str, type: PortType) -> None:
+        d = self.__dict__  # frozen: the fields are set once, here
+        d["name"] = name
+        d["type"] = type
+
     def key(self) -> str:
         return self.name
 
@@ -36,6 +45,11 @@ class Var(Expr):
 class Param(Expr):
     name: str
     type: PortType
+
+    def __init__(self, name: str, type: PortType) -> None:
+        d = self.__dict__
+        d["name"] = name
+        d["type"] = type
 
     def key(self) -> str:
         return self.name
@@ -46,6 +60,11 @@ class Lit(Expr):
     value: Any  # float or tuple of floats, or None for MaterialAttributes defaults
     type: PortType
 
+    def __init__(self, value: Any, type: PortType) -> None:
+        d = self.__dict__
+        d["value"] = value
+        d["type"] = type
+
     def key(self) -> str:
         return f"lit:{self.type}:{self.value!r}"
 
@@ -54,6 +73,11 @@ class Lit(Expr):
 class Uni(Expr):
     name: str
     type: PortType
+
+    def __init__(self, name: str, type: PortType) -> None:
+        d = self.__dict__
+        d["name"] = name
+        d["type"] = type
 
     def key(self) -> str:
         return self.name
@@ -71,6 +95,11 @@ class SurfaceUV(Expr):
 class Splat(Expr):
     expr: Expr
     type: PortType
+
+    def __init__(self, expr: Expr, type: PortType) -> None:
+        d = self.__dict__
+        d["expr"] = expr
+        d["type"] = type
 
     def key(self) -> str:
         return f"{self.type}({self.expr.key()})"
@@ -92,19 +121,33 @@ class Op:
     outs: list[tuple[str, PortType]]
     data: dict[str, Any] = field(default_factory=dict)
 
+    def __init__(self, var: str, node: str, kind: str, args: list[Expr],
+                 outs: list[tuple[str, PortType]], data: dict[str, Any] | None = None) -> None:
+        # the generated __init__'s work, without its default-factory sentinel test
+        self.var, self.node, self.kind, self.args, self.outs = var, node, kind, args, outs
+        self.data = {} if data is None else data
+
     def out(self, port: str) -> Var:
         cache = self.__dict__.get("_out_vars")
         if cache is None:
-            cache = {name: Var(f"{self.var}.{name}", t) for name, t in self.outs}
-            self.__dict__["_out_vars"] = cache
+            cache = self.out_vars()
         return cache[port]
+
+    def out_vars(self) -> dict[str, Var]:
+        """Each output's variable, by port, in `outs` order (made once, then kept)."""
+        cache = self.__dict__.get("_out_vars")
+        if cache is None:
+            var = self.var
+            cache = {name: Var(f"{var}.{name}", t) for name, t in self.outs}
+            self.__dict__["_out_vars"] = cache
+        return cache
 
     def key(self) -> str:
         if not self.data:
             data = ""  # a registry kind's implementation follows from its kind
         else:
             data = repr(sorted((k, repr(v)) for k, v in self.data.items()))
-        return f"{self.kind}|{data}|{','.join(a.key() for a in self.args)}"
+        return f"{self.kind}|{data}|{','.join([a.key() for a in self.args])}"
 
 
 @dataclass

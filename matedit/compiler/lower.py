@@ -109,9 +109,12 @@ class _Lowerer:
         self.ctx, self.doc, self.a, self.top, self.scope = ctx, doc, analysis, top, scope
         self.alias: dict[tuple[str, str], Expr] = {}
         self.written: dict[str, frozenset] = {}  # expr key -> fields written (MA values)
-        self.incoming: dict[str, dict[str, Link]] = {nid: {} for nid in doc.graph.nodes}
-        for l in doc.graph.links:
-            self.incoming[l.dst][l.dst_port] = l
+        # the analysis's: with no error, every link passed its checks (read, never changed)
+        self.incoming: dict[str, dict[str, Link]] = analysis.incoming
+        if len(self.incoming) != len(doc.graph.nodes):  # an Analysis made without them
+            self.incoming = {nid: {} for nid in doc.graph.nodes}
+            for l in doc.graph.links:
+                self.incoming[l.dst][l.dst_port] = l
 
     # --- operands --------------------------------------------------------------------------
     def source(self, nid: str, port: str) -> Expr:
@@ -122,7 +125,11 @@ class _Lowerer:
     def arg(self, nid: str, port: str, t: PortType, default: Any) -> Expr:
         link = self.incoming[nid].get(port)
         if link is not None:
-            return convert(self.source(link.src, link.src_port), t)
+            src, src_port = link.src, link.src_port
+            e = self.alias.get((src, src_port))
+            if e is None:  # self.source, inlined: most operands are another op's output
+                e = Var(f"{src}.{src_port}", self.a.out_types[src][src_port])
+            return e if e.type == t else convert(e, t)
         node = self.doc.graph.nodes[nid]
         value = node.values.get(port, default)
         if value == MESH_UV:
@@ -176,16 +183,20 @@ class _Lowerer:
             self.ctx.uniforms[info.name] = info
 
     def emit(self, op: Op) -> Op:
-        self.scope.ops.append(op)
-        for port, _ in op.outs:
-            self.scope.sockets[(op.node, port)] = op.out(port)
+        scope = self.scope
+        scope.ops.append(op)
+        sockets, node = scope.sockets, op.node
+        for port, var in op.out_vars().items():
+            sockets[(node, port)] = var
         return op
 
     # --- nodes -------------------------------------------------------------------------------
     def lower(self) -> None:
+        gnodes = self.doc.graph.nodes
+        role_of = nodes.role_of
         for nid in self.a.order:
-            node = self.doc.graph.nodes[nid]
-            role = nodes.role_of(node.kind)
+            node = gnodes[nid]
+            role = role_of(node.kind)
             if node.muted and role == Role.LAYER_STACK:
                 # A bypassed stack is its base layer: every layer above it hidden.
                 layers = node.settings.get("layers")
@@ -224,22 +235,50 @@ class _Lowerer:
 
     def _inputs(self, nid: str) -> list[Expr]:
         ins = self.a.in_types[nid]
-        return [self.arg(nid, p.name, ins[p.name], p.default) for p in self.a.ports[nid].inputs]
+        arg = self.arg
+        return [arg(nid, p.name, ins[p.name], p.default) for p in self.a.ports[nid].inputs]
 
     def _generic(self, nid, node) -> None:
         d = nodes.REGISTRY[node.kind]
         role = d.role
+        a = self.a
+        sockets = self.scope.sockets
         if role == Role.MAKE_ATTRIBUTES:
             # A field left at its default is compiled in as a literal, with no uniform.
             unwritten = self._unwritten_fields(nid, node)
-            ins = self.a.in_types[nid]
+            ins = a.in_types[nid]
             args = [literal(PortType(f.type), f.default) if f.name in unwritten
                     else self.arg(nid, f.name, ins[f.name], f.default) for f in ATTRIBUTE_FIELDS]
         else:
-            args = self._inputs(nid)
-        outs = [(p.name, self.a.out_types[nid][p.name]) for p in self.a.ports[nid].outputs]
+            # self._inputs, inlined: an operand wired from another op's output is that op's
+            # variable (its socket), made once when the op was emitted
+            ins = a.in_types[nid]
+            into = self.incoming[nid]
+            alias, types = self.alias, a.out_types
+            args = []
+            for p in a.ports[nid].inputs:
+                name = p.name
+                t = ins[name]
+                link = into.get(name)
+                if link is None:
+                    args.append(self.arg(nid, name, t, p.default))
+                    continue
+                key = (link.src, link.src_port)
+                e = alias.get(key)
+                if e is None:
+                    var = f"{link.src}.{link.src_port}"
+                    src_type = types[link.src][link.src_port]
+                    e = sockets.get(key)
+                    if type(e) is not Var or e.name != var or e.type != src_type:
+                        e = Var(var, src_type)
+                args.append(e if e.type == t else convert(e, t))
+        out_types = a.out_types[nid]
+        outs = [(p.name, out_types[p.name]) for p in a.ports[nid].outputs]
         self.ctx.kinds.add(node.kind)
-        op = self.emit(Op(nid, nid, node.kind, args, outs))
+        op = Op(nid, nid, node.kind, args, outs)
+        self.scope.ops.append(op)  # self.emit(op), inlined
+        for port, v in op.out_vars().items():
+            sockets[(nid, port)] = v
         if role == Role.MAKE_ATTRIBUTES:
             self.written[op.out("attributes").key()] = ALL_FIELDS - unwritten
         elif role in (Role.MASK_BLEND, Role.HEIGHT_BLEND):

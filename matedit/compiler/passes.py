@@ -66,17 +66,27 @@ def remove_unused(scope: Scope) -> None:
         live.update(_vars(e))
     kept = []
     for op in reversed(scope.ops):
-        if any(op.out(p).name in live for p, _ in op.outs):
-            kept.append(op)
-            for a in op.args:
+        for v in op.out_vars().values():
+            if v.name in live:
+                break
+        else:
+            continue  # no output of it is read
+        kept.append(op)
+        for a in op.args:
+            if type(a) is Var:
+                live.add(a.name)
+            else:
                 live.update(_vars(a))
-    scope.ops = list(reversed(kept))
+    kept.reverse()
+    scope.ops = kept
 
 
 def _fold(op: Op) -> list[Lit] | None:
     """The op's outputs as literals when all its operands are literals (numpy evaluation)."""
-    if (op.kind in IMPURE_OPS or is_impure(op.kind) or not op.args
-            or not all(isinstance(a, Lit) and a.type.is_numeric for a in op.args)
+    args = op.args
+    # operands first: most ops read another op's output, and are rejected at once
+    if (not args or not all(isinstance(a, Lit) and a.type.is_numeric for a in args)
+            or op.kind in IMPURE_OPS or is_impure(op.kind)
             or not all(t.is_numeric for _, t in op.outs)):
         return None
     from matedit.compiler import cpu_eval  # numpy: only when there is something to fold
@@ -99,13 +109,19 @@ def fold_and_merge(scope: Scope) -> None:
     seen: dict[str, Op] = {}
     kept: list[Op] = []
     for op in scope.ops:
-        op.args = [_subst(a, table) for a in op.args]
-        lits = _fold(op)
+        op.args = args = [table.get(a.name, a) if type(a) is Var else _subst(a, table)
+                          for a in op.args]
+        # _fold only where some operand is a literal (it wants all of them literals)
+        lits = _fold(op) if not args or any(type(a) is Lit for a in args) else None
         if lits is not None:
             for (port, _), lit in zip(op.outs, lits):
                 table[op.out(port).name] = lit
             continue
-        k = op.key()
+        var_names = [a.name for a in args if type(a) is Var]
+        if op.data or len(var_names) != len(args):
+            k = op.key()
+        else:  # op.key() of an op of Var operands and no data
+            k = f"{op.kind}||{','.join(var_names)}"
         first = seen.get(k)
         if first is not None and first.outs == op.outs:
             for port, _ in op.outs:
@@ -115,7 +131,8 @@ def fold_and_merge(scope: Scope) -> None:
         kept.append(op)
     scope.ops = kept
     scope.outputs = [(n, t, _subst(e, table)) for n, t, e in scope.outputs]
-    scope.sockets = {k: _subst(e, table) for k, e in scope.sockets.items()}
+    scope.sockets = {k: table.get(e.name, e) if type(e) is Var else _subst(e, table)
+                     for k, e in scope.sockets.items()}
 
 
 def optimise(scope: Scope) -> None:

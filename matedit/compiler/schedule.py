@@ -41,10 +41,16 @@ class Writer:
         self.map: dict[int, tuple[str, str]] = {}
 
     def add(self, text: str, node: str | None = None, file: str = "") -> None:
-        for line in text.split("\n"):
-            self.lines.append(line)
+        lines = self.lines
+        if "\n" not in text:  # most are one line
+            lines.append(text)
             if node is not None:
-                self.map[len(self.lines)] = (node, file)
+                self.map[len(lines)] = (node, file)
+            return
+        for line in text.split("\n"):
+            lines.append(line)
+            if node is not None:
+                self.map[len(lines)] = (node, file)
 
 
 _UNDERSCORES = re.compile(r"_+")
@@ -62,7 +68,10 @@ class LocalNames:
     def __call__(self, raw: str) -> str:
         if raw in self.taken:
             return self.taken[raw]
-        name = "l_" + _UNDERSCORES.sub("_", raw.replace(".", "_"))
+        stem = raw.replace(".", "_")
+        if "__" in stem:
+            stem = _UNDERSCORES.sub("_", stem)
+        name = "l_" + stem
         base, i = name, 2
         while name in self.used:
             name, i = f"{base}_{i}", i + 1
@@ -97,11 +106,16 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
     for p, _ in scope.params:
         names.used.add(p)
     steps = []
-    visit = names.visit
+    visit, taken = names.visit, names.taken
     for op in scope.ops:
         for a in op.args:
-            visit(a)
-        steps.append((op, [(names(op.out(p).name), t) for p, t in op.outs]))
+            if type(a) is Var:  # names.visit of the common operand
+                if a.name not in taken:
+                    names(a.name)
+            else:
+                visit(a)
+        out = op.out
+        steps.append((op, [(names(out(p).name), t) for p, t in op.outs]))
     for _, _, e in scope.outputs:
         names.visit(e)
     return ScopePlan(scope, main, names, steps)
@@ -170,9 +184,9 @@ def schedule(ir: MaterialIR, mode: str | Entry = Entry.FORWARD,
     scopes.append(plan_scope(ir.main, main=True))
     # the library file of each node kind used, and those the compiler's own ops need
     needed = {f"nodes/{k}" for k in ir.node_kinds if nodes.REGISTRY[k].glsl}
-    for s in [ir.main, *ir.functions]:
-        for op in s.ops:
-            needed.update(ops.implementation(op.kind).units)
+    kinds = {op.kind for s in [ir.main, *ir.functions] for op in s.ops}
+    for kind in kinds:
+        needed.update(ops.implementation(kind).units)
     units = [*BASE_UNITS, *sorted(needed), *ENTRY_UNITS[entry]]
     if entry == Entry.FORWARD and any(d.partition("=")[0] == ATTRIBUTE_VIEW for d in defines):
         units.append("attribute_view")  # the viewport's attribute views (preview only)

@@ -77,6 +77,9 @@ class _Parsed:
 
 
 def _parse(text: str) -> _Parsed:
+    if "include" not in text:  # generated text: one chunk, no line to look at
+        lines = text.splitlines()
+        return _Parsed(("\n".join(lines) if lines else None,), ())
     chunks: list[str | None] = []
     includes: list[tuple[int, str]] = []
     run: list[str] = []

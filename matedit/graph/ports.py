@@ -111,12 +111,12 @@ def layer_entries(node: Node) -> list[dict]:
     return layers if isinstance(layers, list) else []
 
 
-_STATIC_RULES = (PortsRule.CHANNELS, PortsRule.COMPONENTS, PortsRule.CONCATENATION,
+STATIC_RULES = (PortsRule.CHANNELS, PortsRule.COMPONENTS, PortsRule.CONCATENATION,
                  PortsRule.PASSTHROUGH)
 _STATIC: dict[str, NodePorts] = {}
 
 
-def _static_ports(kind: str) -> NodePorts:
+def static_ports(kind: str) -> NodePorts:
     """Ports that depend on nothing but the kind, built once per kind (NodePorts is frozen)."""
     hit = _STATIC.get(kind)
     if hit is None:
@@ -133,8 +133,8 @@ def node_ports(
     if d is None:
         raise PortError(node.id, "kind", f"unknown node kind {node.kind!r}")
     rule = d.ports_rule
-    if rule is None or rule in _STATIC_RULES:
-        return _static_ports(node.kind)
+    if rule is None or rule in STATIC_RULES:
+        return static_ports(node.kind)
     ins = d.inputs
     outs = d.outputs
     s = {**d.setting_defaults(), **node.settings}
@@ -274,12 +274,64 @@ _CONCRETE: dict[str, tuple | None] = {}
 def _concrete_types(kind: str):
     """Types of a kind with no generic ports, computed once (callers only read them)."""
     if kind not in _CONCRETE:
-        p = _static_ports(kind)
+        p = static_ports(kind)
         specs = p.inputs + p.outputs
         _CONCRETE[kind] = None if any(s.type == GENERIC for s in specs) else (
             {s.name: PortType(s.type) for s in p.inputs},
             {s.name: PortType(s.type) for s in p.outputs})
     return _CONCRETE[kind]
+
+
+# A kind's static ports, read once for the generic rule: those ports, the (name, default) of
+# its generic inputs, and (name, fixed type or None where generic) of its inputs and outputs.
+_GENERIC_PLANS: dict[str, tuple] = {}
+
+
+def _generic_plan(kind: str) -> tuple:
+    hit = _GENERIC_PLANS.get(kind)
+    if hit is None:
+        p = static_ports(kind)
+        hit = _GENERIC_PLANS[kind] = (
+            p,
+            tuple((s.name, s.default) for s in p.inputs if s.type == GENERIC),
+            tuple((s.name, None if s.type == GENERIC else PortType(s.type)) for s in p.inputs),
+            tuple((s.name, None if s.type == GENERIC else PortType(s.type)) for s in p.outputs))
+    return hit
+
+
+def _generic_types(node: Node, plan: tuple, connected: dict[str, PortType]
+                   ) -> tuple[dict[str, PortType], dict[str, PortType]]:
+    """resolve_types of a kind with no ports rule: its generic inputs' widest type."""
+    _, generic_inputs, ins, outs = plan
+    widest: PortType | None = None
+    values = node.values
+    for name, default in generic_inputs:
+        t = connected.get(name)
+        if t is None:
+            t = _default_type(values.get(name, default))
+        if t == PortType.FLOAT:
+            continue
+        if not t.is_numeric:
+            raise ValueError(f"{name} takes a float or a vector, got {t}")
+        if widest is None:
+            widest = t
+        elif widest != t:
+            raise ValueError(
+                f"mixed vector sizes: {widest} and {t} ({name}); "
+                "use a Component Mask or Append node")
+    generic = widest or PortType.FLOAT
+    # the same two dicts for every node of the kind that resolves to `generic` (callers only
+    # read them, as they do _concrete_types')
+    key = (node.kind, generic)
+    hit = _GENERIC_TYPES.get(key)
+    if hit is None:
+        hit = _GENERIC_TYPES[key] = (
+            {name: generic if fixed is None else fixed for name, fixed in ins},
+            {name: generic if fixed is None else fixed for name, fixed in outs})
+    return hit
+
+
+_GENERIC_TYPES: dict[tuple[str, PortType], tuple[dict, dict]] = {}
 
 
 def resolve_types(
@@ -295,6 +347,9 @@ def resolve_types(
         fixed = _concrete_types(node.kind)
         if fixed is not None:
             return fixed
+        plan = _generic_plan(node.kind)
+        if plan[0] is ports:
+            return _generic_types(node, plan, connected)
 
     def concrete(spec: Port) -> PortType | None:
         return None if spec.type == GENERIC else PortType(spec.type)

@@ -5,18 +5,20 @@ mismatches, missing required links, cycles (inside a graph, and through
 function calls across files), calls to missing functions, and the document's
 output nodes. `check_connect` answers, before a link is made, whether it may be.
 
-The valid path orders the graph with the standard library's `graphlib`; networkx, whose
-import (with its backend scan) costs more than the rest of `matedit validate`, is loaded
-only to name a cycle that was found and for `check_connect`'s reachability question.
+The valid path orders the graph by its own in-degree counts (`stable_order`: the order
+graphlib's TopologicalSorter gives, with graphlib's CycleError); networkx, whose import (with
+its backend scan) costs more than the rest of `matedit validate`, is loaded only to name a
+cycle that was found and for `check_connect`'s reachability question.
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
-from graphlib import CycleError, TopologicalSorter
+from graphlib import CycleError
+from operator import attrgetter
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -25,12 +27,14 @@ from matedit.graph.model import Link, MaterialDocument
 from matedit.graph.names import identifier_problem
 from matedit.graph.numbers import gpu_number_problem
 from matedit.graph.ports import (
+    STATIC_RULES,
     FunctionResolver,
     NodePorts,
     PortError,
     layer_entries,
     node_ports,
     resolve_types,
+    static_ports,
 )
 from matedit.graph.types import PortType, coerce_value, conversion_reason
 
@@ -86,6 +90,9 @@ class Analysis:
     out_types: dict[str, dict[str, PortType]]
     order: list[str]
     diagnostics: list[Diagnostic]
+    # node id -> input port -> the link into it, of the links that passed the checks (every
+    # link, where there is no error)
+    incoming: dict[str, dict[str, Link]] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -109,23 +116,44 @@ def dependency_graph(doc: MaterialDocument) -> nx.DiGraph:
 def stable_order(vertices: Iterable[str], edges: Iterable[tuple[str, str]]) -> list[str]:
     """Topological order independent of the file's order: generation by generation (nodes
     whose inputs are all in earlier generations), ids sorted within each generation.
-    Raises graphlib.CycleError when the edges close a cycle."""
-    sorter: TopologicalSorter[str] = TopologicalSorter({v: () for v in vertices})
+    Raises graphlib.CycleError when the edges close a cycle.
+
+    Kahn's algorithm with in-degree counts (the order graphlib's TopologicalSorter gives when
+    each generation is marked done at once, at a fraction of its cost per edge)."""
+    succ: dict[str, list[str]] = {v: [] for v in vertices}
+    indeg = dict.fromkeys(succ, 0)
     for src, dst in edges:
-        sorter.add(dst, src)
-    sorter.prepare()
+        out = succ.get(src)
+        if out is None:
+            out = succ[src] = []
+            indeg[src] = 0
+        if dst not in indeg:
+            succ[dst] = []
+            indeg[dst] = 0
+        out.append(dst)
+        indeg[dst] += 1
+    generation = sorted([v for v, k in indeg.items() if k == 0])
     order: list[str] = []
-    while sorter.is_active():
-        generation = sorted(sorter.get_ready())
+    while generation:
         order.extend(generation)
-        sorter.done(*generation)
+        ready = []
+        for v in generation:
+            for w in succ[v]:
+                k = indeg[w] - 1
+                indeg[w] = k
+                if k == 0:
+                    ready.append(w)
+        ready.sort()
+        generation = ready
+    if len(order) != len(indeg):
+        raise CycleError("nodes are in a cycle")
     return order
 
 
 def _cycle(vertices: Iterable[str], edges: Iterable[tuple[str, str]],
            source: str | None = None) -> list[tuple[str, str]]:
     """The edges of one cycle, named the way networkx's find_cycle walks it (only called
-    once graphlib has found that there is one)."""
+    once stable_order has found that there is one)."""
     import networkx as nx
 
     g = nx.DiGraph()
@@ -147,23 +175,30 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
     ports: dict[str, NodePorts] = {}
 
     # Node kinds, settings and ports.
-    for nid in sorted(graph.nodes):
-        node = graph.nodes[nid]
-        if node.kind not in nodes.REGISTRY:
+    registry = nodes.REGISTRY
+    gnodes = graph.nodes
+    for nid in sorted(gnodes):
+        node = gnodes[nid]
+        d = registry.get(node.kind)
+        if d is None:
             diags.append(error(f"unknown node kind {node.kind!r}", nid, "kind", f))
             continue
-        for s in nodes.REGISTRY[node.kind].settings:  # ranges, curves: the float32 rule
-            if s.kind == "number" and s.name in node.settings:
-                why = gpu_number_problem(node.settings[s.name])
-                if why:
-                    diags.append(error(why, nid, s.name, f))
-        if nodes.role_of(node.kind) == nodes.Role.FUNCTION_CALL \
-                and node.settings.get("function") in (None, ""):
+        settings = node.settings
+        if settings:
+            for s in d.settings:  # ranges, curves: the float32 rule
+                if s.kind == "number" and s.name in settings:
+                    why = gpu_number_problem(settings[s.name])
+                    if why:
+                        diags.append(error(why, nid, s.name, f))
+        if d.role == nodes.Role.FUNCTION_CALL and settings.get("function") in (None, ""):
             diags.append(warning("no function chosen yet: the call does nothing until one is",
                                  nid, "function", f))
         try:
-            ports[nid] = node_ports(node, resolver, doc)
-            diags.extend(_limit_warnings(node, ports[nid], f))
+            rule = d.ports_rule  # node_ports' fast path: most kinds' ports are the kind's own
+            p = ports[nid] = static_ports(node.kind) if rule is None or rule in STATIC_RULES \
+                else node_ports(node, resolver, doc)
+            if node.values:
+                diags.extend(_limit_warnings(node, p, f))
         except PortError as exc:
             diags.append(error(str(exc), nid, exc.field, f))
         except LookupError as exc:
@@ -172,35 +207,37 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             diags.append(error(str(exc), nid, None, f))
 
     # Links: ends exist, ports exist, one link per input.
-    incoming: dict[str, dict[str, Link]] = {nid: {} for nid in graph.nodes}
+    incoming: dict[str, dict[str, Link]] = {nid: {} for nid in gnodes}
     good_links: list[Link] = []
     for link in sorted(graph.links):
-        if link.src not in graph.nodes or link.dst not in graph.nodes:
-            missing = link.src if link.src not in graph.nodes else link.dst
+        src, src_port, dst, dst_port = link
+        if src not in gnodes or dst not in gnodes:
+            missing = src if src not in gnodes else dst
             diags.append(error(f"link refers to missing node {missing!r}",
-                               link.dst if link.dst in graph.nodes else None, link.dst_port, f))
+                               dst if dst in gnodes else None, dst_port, f))
             continue
-        if link.src in ports and ports[link.src].output(link.src_port) is None:
-            diags.append(error(f"node {link.src} has no output {link.src_port!r}", link.src,
-                               link.src_port, f))
+        src_ports = ports.get(src)
+        if src_ports is not None and src_ports.output(src_port) is None:
+            diags.append(error(f"node {src} has no output {src_port!r}", src, src_port, f))
             continue
-        if link.dst in ports and ports[link.dst].input(link.dst_port) is None:
-            diags.append(error(f"node {link.dst} has no input {link.dst_port!r}", link.dst,
-                               link.dst_port, f))
+        dst_ports = ports.get(dst)
+        if dst_ports is not None and dst_ports.input(dst_port) is None:
+            diags.append(error(f"node {dst} has no input {dst_port!r}", dst, dst_port, f))
             continue
-        if link.dst_port in incoming[link.dst]:
-            diags.append(error("input has more than one link", link.dst, link.dst_port, f))
+        into = incoming[dst]
+        if dst_port in into:
+            diags.append(error("input has more than one link", dst, dst_port, f))
             continue
-        incoming[link.dst][link.dst_port] = link
+        into[dst_port] = link
         good_links.append(link)
 
     # Cycles.
     edges = [(l.src, l.dst) for l in good_links]
     order: list[str] = []
     try:
-        order = stable_order(graph.nodes, edges)
+        order = stable_order(gnodes, edges)
     except CycleError:
-        cycle = _cycle(graph.nodes, edges)
+        cycle = _cycle(gnodes, edges)
         path = " -> ".join([a for a, _ in cycle] + [cycle[0][0]])
         diags.append(error(f"cycle: {path}", cycle[0][0], None, f))
 
@@ -210,12 +247,14 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
     for nid in order:
         if nid not in ports:
             continue
-        node = graph.nodes[nid]
         p = ports[nid]
+        node = gnodes[nid]
+        into = incoming[nid]
         connected: dict[str, PortType] = {}
         blocked = False
-        for port, link in incoming[nid].items():
-            t = out_types.get(link.src, {}).get(link.src_port)
+        for port, link in into.items():
+            src_types = out_types.get(link.src)
+            t = src_types.get(link.src_port) if src_types is not None else None
             if t is None:
                 blocked = True  # upstream already reported
                 continue
@@ -227,62 +266,74 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             continue
         in_types[nid], out_types[nid] = ins, outs
         for port, t in connected.items():
-            reason = conversion_reason(t, ins[port])
-            if reason:
-                diags.append(error(reason, nid, port, f))
+            if t != ins[port]:  # an equal type always converts
+                reason = conversion_reason(t, ins[port])
+                if reason:
+                    diags.append(error(reason, nid, port, f))
+        values = node.values
+        d = registry[node.kind]
         for spec in p.inputs:
-            if spec.name in incoming[nid]:
+            name = spec.name
+            if name in into:
                 continue
-            t = ins.get(spec.name)
+            t = ins.get(name)
             if spec.required or (t is not None and not t.is_numeric):
                 if blocked:
                     continue
-                passes_on = nodes.role_of(node.kind) in _NO_DEFAULT
+                passes_on = d.role in _NO_DEFAULT
                 fallback = None if passes_on or t is None else _UNCONNECTED_DEFAULT.get(t)
                 if fallback is not None:  # the rest of the graph keeps compiling
-                    diags.append(warning(f"input {spec.name!r} ({t}) is not connected: it "
-                                         f"uses {fallback}", nid, spec.name, f))
+                    diags.append(warning(f"input {name!r} ({t}) is not connected: it "
+                                         f"uses {fallback}", nid, name, f))
                 else:
-                    diags.append(error(f"input {spec.name!r} ({t}) must be connected",
-                                       nid, spec.name, f))
+                    diags.append(error(f"input {name!r} ({t}) must be connected",
+                                       nid, name, f))
                 continue
-            if spec.name in node.values and t is not None:
+            if t is None:
+                continue
+            if name in values:
                 try:
-                    coerce_value(t, node.values[spec.name])
+                    coerce_value(t, values[name])
                 except ValueError as exc:
-                    diags.append(error(str(exc), nid, spec.name, f))
-            elif t is not None and t.is_numeric:  # a function file's default becomes a uniform
+                    diags.append(error(str(exc), nid, name, f))
+            elif t.is_numeric:  # a function file's default becomes a uniform
                 why = _default_number_problem(spec.default)
                 if why:
-                    diags.append(error(f"the default of input {spec.name!r}: {why}", nid,
-                                       spec.name, f))
-        d = nodes.REGISTRY[node.kind]
-        for vf in d.values:
-            if vf.name in node.values:
-                try:
-                    coerce_value(PortType(vf.type), node.values[vf.name])
-                except ValueError as exc:
-                    diags.append(error(str(exc), nid, vf.name, f))
+                    diags.append(error(f"the default of input {name!r}: {why}", nid,
+                                       name, f))
+        if d.values:
+            for vf in d.values:
+                if vf.name in values:
+                    try:
+                        coerce_value(PortType(vf.type), values[vf.name])
+                    except ValueError as exc:
+                        diags.append(error(str(exc), nid, vf.name, f))
         if d.role == nodes.Role.CONSTANT:
             try:
                 coerce_value(outs["value"], node.settings.get("value", 0.0))
             except ValueError as exc:
                 diags.append(error(str(exc), nid, "value", f))
-        for name in node.values:
-            if p.input(name) is None and d.values and not any(v.name == name for v in d.values):
-                diags.append(warning(f"stored value for unknown field {name!r} is ignored",
-                                     nid, name, f))
+        if d.values:
+            for name in values:
+                if p.input(name) is None and not any(v.name == name for v in d.values):
+                    diags.append(warning(f"stored value for unknown field {name!r} is ignored",
+                                         nid, name, f))
 
     diags.extend(_document_rules(doc, ports, f))
     if calls:
         diags.extend(_call_cycles(doc, resolver))
-    return Analysis(ports, in_types, out_types, order, diags)
+    return Analysis(ports, in_types, out_types, order, diags, incoming)
 
 
 def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
     diags = []
     R = nodes.Role
-    roles = [nodes.role_of(n.kind) for n in doc.graph.nodes.values()]
+    registry = nodes.REGISTRY
+    by_id = sorted(doc.graph.nodes.values(), key=attrgetter("id"))
+    # each node's definition (None: an unknown kind), in id order
+    defs = [(n, registry.get(n.kind)) for n in by_id]
+    roles = [d.role for _, d in defs if d is not None]
+    io_roles = (R.FUNCTION_INPUT, R.FUNCTION_OUTPUT)
     if doc.is_function:
         if R.FUNCTION_OUTPUT not in roles:
             diags.append(error("a material function needs at least one Function Output node",
@@ -291,8 +342,8 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
             diags.append(error("a material function cannot contain a Material Output node",
                                file=f))
         names: dict[tuple[str, str], str] = {}
-        for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
-            if nodes.role_of(n.kind) in (R.FUNCTION_INPUT, R.FUNCTION_OUTPUT):
+        for n, d in defs:
+            if d is not None and d.role in io_roles:
                 key = (n.kind, str(n.settings.get("name", "")))
                 if key in names:
                     diags.append(error(f"two {n.kind.replace('_', ' ')}s named {key[1]!r} "
@@ -301,21 +352,23 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                 why = identifier_problem(n.settings.get("name", ""))
                 if why:
                     diags.append(error(f"name {key[1]!r} {why}", n.id, "name", f))
-                if nodes.role_of(n.kind) == R.FUNCTION_INPUT:
+                if d.role == R.FUNCTION_INPUT:
                     diags.extend(_check_input_default(n, f))
     else:
-        outs = [n.id for n in doc.graph.nodes.values()
-                if nodes.role_of(n.kind) == R.MATERIAL_OUTPUT]
-        if len(outs) != 1:
+        outputs = roles.count(R.MATERIAL_OUTPUT)
+        if outputs != 1:
             diags.append(error(f"a material needs exactly one Material Output node, "
-                               f"found {len(outs)}", file=f))
-        for n in doc.graph.nodes.values():
-            if nodes.role_of(n.kind) in (R.FUNCTION_INPUT, R.FUNCTION_OUTPUT):
-                diags.append(error("function inputs and outputs belong in material functions",
-                                   n.id, None, f))
+                               f"found {outputs}", file=f))
+        if R.FUNCTION_INPUT in roles or R.FUNCTION_OUTPUT in roles:
+            for n in doc.graph.nodes.values():
+                if nodes.role_of(n.kind) in io_roles:
+                    diags.append(error("function inputs and outputs belong in material "
+                                       "functions", n.id, None, f))
     params: dict[str, str] = {}
-    for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
-        if nodes.role_of(n.kind) == R.TEXTURE_PARAMETER:
+    for n, d in defs:
+        if d is None:
+            continue
+        if d.role == R.TEXTURE_PARAMETER:
             tex = n.settings.get("path", "")
             if isinstance(tex, str) and tex:
                 base = Path(doc.path).parent if doc.path else Path.cwd()
@@ -335,7 +388,7 @@ def _document_rules(doc: MaterialDocument, ports, f) -> list[Diagnostic]:
                 if not found:
                     diags.append(warning(f"texture file {tex!r} not found; it shows as a checker",
                                          n.id, "path", f))
-        if nodes.is_value_parameter(n.kind):
+        if d.parameter is not None and d.role != R.STATIC_SWITCH:  # nodes.is_value_parameter
             name = str(n.settings.get("name", ""))
             why = identifier_problem(n.settings.get("name", ""))
             if why:
@@ -394,7 +447,11 @@ def _check_input_default(n, f) -> list[Diagnostic]:
 def function_refs(doc: MaterialDocument) -> list[tuple[str, str]]:
     """(node id, function file) for every function a document uses directly."""
     refs = []
-    for n in sorted(doc.graph.nodes.values(), key=lambda n: n.id):
+    registry = nodes.REGISTRY
+    calling = (nodes.Role.FUNCTION_CALL, nodes.Role.LAYER_STACK)
+    users = [n for n in doc.graph.nodes.values()
+             if (d := registry.get(n.kind)) is not None and d.role in calling]
+    for n in sorted(users, key=attrgetter("id")):
         role = nodes.role_of(n.kind)
         if role == nodes.Role.FUNCTION_CALL and isinstance(n.settings.get("function"), str):
             refs.append((n.id, n.settings["function"]))

@@ -1,0 +1,86 @@
+"""The graph -> GLSL step does work linear in the graph's size: Python function calls are
+counted (sys.setprofile) at two sizes, never timed (the time is benchmarks/bench_compile.py's
+`compile_ms`). A pass that revisits the graph once per node multiplies its calls by the size
+ratio squared, and fails here whatever machine runs it."""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+
+from matedit.compiler import compile_document
+from matedit.graph.model import DocumentKind, Link, MaterialDocument, Node
+
+_KINDS = ("add", "multiply", "lerp", "sin", "max", "subtract")
+_PORTS = {"add": ("a", "b"), "multiply": ("a", "b"), "subtract": ("a", "b"),
+          "max": ("a", "b"), "lerp": ("a", "b", "alpha"), "sin": ("value",)}
+
+
+def _material(n: int) -> MaterialDocument:
+    """About `n` maths nodes on the UVs, each fed by the one before it (so every node reaches
+    the output) and by one further back or a stored value (a uniform)."""
+    doc = MaterialDocument(kind=DocumentKind.MATERIAL)
+    g = doc.graph
+    g.nodes["uv"] = Node("uv", "texcoord")
+    g.nodes["split"] = Node("split", "split")
+    g.links.add(Link("uv", "uv", "split", "value"))
+    floats = [("split", "x"), ("split", "y")]
+    for i in range(n):
+        kind = _KINDS[i % len(_KINDS)]
+        nid = f"n{i}"
+        g.nodes[nid] = Node(nid, kind)
+        for k, port in enumerate(_PORTS[kind]):
+            if k == 0:
+                src = floats[-1]
+            elif (i + k) % 3:
+                src = floats[max(0, len(floats) - 1 - (i * 7 + k) % 9)]
+            else:
+                g.nodes[nid].values[port] = 0.25 + (i % 5) * 0.1
+                continue
+            g.links.add(Link(src[0], src[1], nid, port))
+        floats.append((nid, "result"))
+    g.nodes["make"] = Node("make", "make_attributes")
+    g.nodes["out"] = Node("out", "material_output")
+    g.links.add(Link(*floats[-1], "make", "roughness"))
+    g.links.add(Link("make", "attributes", "out", "attributes"))
+    return doc
+
+
+def _calls(doc: MaterialDocument) -> Counter:
+    """Python function calls of one compile, by (file, line, function)."""
+    compile_document(doc)  # warm: library files read, per-kind tables built
+    counts: Counter = Counter()
+
+    def profile(frame, event, arg):
+        if event == "call":
+            code = frame.f_code
+            counts[(code.co_filename, code.co_firstlineno, code.co_name)] += 1
+
+    sys.setprofile(profile)
+    try:
+        compile_document(doc)
+    finally:
+        sys.setprofile(None)
+    return counts
+
+
+def test_compile_calls_grow_linearly_with_the_graph():
+    small, large = _material(100), _material(1000)
+    ratio = len(large.graph.nodes) / len(small.graph.nodes)  # about 10
+    a, b = _calls(small), _calls(large)
+    # linear: the calls grow by the node ratio (plus a fixed part that does not grow); a
+    # quadratic pass would grow by ratio squared (about 100)
+    assert sum(b.values()) <= 1.2 * ratio * sum(a.values())
+    # and no single function grows faster than the graph (slack for a fixed few calls)
+    worst = {k: (a.get(k, 0), n) for k, n in b.items() if n > 1.2 * ratio * a.get(k, 0) + 20}
+    assert not worst, worst
+
+
+def test_one_validation_and_one_order_per_compile():
+    counts = _calls(_material(300))
+    by_name = Counter()
+    for (_, _, name), n in counts.items():
+        by_name[name] += n
+    assert by_name["analyse"] == 1  # the compiler validates the document once
+    # the node order, and the call graph's (a document with no functions: one vertex)
+    assert by_name["stable_order"] == 2
