@@ -153,6 +153,7 @@ class InteropDialog(QDialog):
         row.setContentsMargins(0, 0, 0, 0)
         form.addRow("Folder" if not self.spec.suffixes else "File", holder)
         self.file_type: QComboBox | None = None
+        self.arkit: QCheckBox | None = None  # made below; the type's choice enables it
         if len(self.spec.suffixes) > 1:
             self.file_type = QComboBox()
             for suffix, what in self.spec.suffixes:
@@ -168,7 +169,7 @@ class InteropDialog(QDialog):
         self.size.setToolTip("Baked map width and height in texels (--size)")
         form.addRow("Bake size", self.size)
         self.surface = self.map_format = None
-        self.zip = self.check = self.arkit = self.mesh = None
+        self.zip = self.check = self.mesh = None
         if self.spec.mesh:
             self.mesh = QComboBox()
             self.mesh.addItem("The material's preview mesh", "")
@@ -256,7 +257,7 @@ class InteropDialog(QDialog):
             i = self.file_type.findData(self.output().suffix.lower())
             if i >= 0:
                 self.file_type.setCurrentIndex(i)
-        if getattr(self, "arkit", None) is not None:
+        if self.arkit is not None:
             self.arkit.setEnabled(self.output().suffix.lower() == ".usdz")
 
     def _suffix_chosen(self, _i: int) -> None:
@@ -283,12 +284,7 @@ class InteropDialog(QDialog):
                 self.result.setPlainText(f"{Path(path).name}: not a mesh: {exc}")
                 path = ""
             else:
-                at = self.mesh.findData(real)
-                if at < 0:
-                    at = self.mesh.count() - 1
-                    self.mesh.insertItem(at, Path(real).name, real)
-                self.mesh.setCurrentIndex(at)
-                self._mesh_index = at
+                self.set_mesh(real)
                 return
         self.mesh.setCurrentIndex(self._mesh_index)
 

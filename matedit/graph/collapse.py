@@ -48,20 +48,23 @@ def between(doc: MaterialDocument, node_ids) -> list[str]:
     """Nodes outside `node_ids` on a path from one of them to another (sorted): a collapse
     would wire the call into itself through them, so it refuses while there are any."""
     inside = set(node_ids)
-    links = doc.graph.links
+    downstream: dict[str, set[str]] = {}
+    upstream: dict[str, set[str]] = {}
+    for lk in doc.graph.links:
+        downstream.setdefault(lk.src, set()).add(lk.dst)
+        upstream.setdefault(lk.dst, set()).add(lk.src)
 
-    def reach(start: set[str], forward: bool) -> set[str]:
-        seen, todo = set(), list(start)
+    def reach(start: set[str], edges: dict[str, set[str]]) -> set[str]:
+        seen: set[str] = set()
+        todo = list(start)
         while todo:
-            n = todo.pop()
-            for lk in links:
-                a, b = (lk.src, lk.dst) if forward else (lk.dst, lk.src)
-                if a == n and b not in seen:
+            for b in edges.get(todo.pop(), ()):
+                if b not in seen:
                     seen.add(b)
                     todo.append(b)
         return seen
 
-    return sorted((reach(inside, True) & reach(inside, False)) - inside)
+    return sorted((reach(inside, downstream) & reach(inside, upstream)) - inside)
 
 
 def _between_error(nodes: list[str]) -> CollapseError:
