@@ -107,7 +107,7 @@ def main() -> int:
     assert "bench_k" in g.nodes
 
     med = statistics.median
-    gpu = view.ctx.info.get("GL_RENDERER", "?")
+    gpu = view.gl_renderer()
     print(f"editor latency, sample layered material, viewport {size[0]}x{size[1]} px, {gpu}, "
           f"{os.cpu_count()} cores")
     print(f"  start-up to first frame            {startup * 1e3:8.0f} ms")

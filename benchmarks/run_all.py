@@ -707,7 +707,7 @@ def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
                      f"{r['latency_median_ms']:.0f}", f"{r['apply_median_ms']:.0f}",
                      f"{r['first_paint_median_ms']:.0f}", f"{r['plain_paint_median_ms']:.0f}"])
     rep.table(["", "UI block max (ms)", "UI block median (ms)", "edit → pixels median (ms)",
-               "UI-thread link (ms)", "first frame (ms)", "plain frame (ms)"], "lrrrrrr", rows)
+               "link, render thread (ms)", "first frame (ms)", "plain frame (ms)"], "lrrrrrr", rows)
     w = ub.get("warm", {})
     if "ui_block_max_ms" in w:
         rep.add(f"{w['edits']} edits each, viewport {w['viewport'][0]}×{w['viewport'][1]} px. "

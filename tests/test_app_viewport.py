@@ -7,6 +7,7 @@ import copy
 
 import numpy as np
 import pytest
+from broken_material import BrokenMaterial
 from graphs_util import EDITOR_SAMPLE
 from test_app_support import app_env, make_window, settle, wait_for_renderer  # noqa: F401
 
@@ -25,7 +26,7 @@ def frame(qtbot, view) -> np.ndarray:
     n = view.frames
     view.update()
     qtbot.waitUntil(lambda: view.frames > n, timeout=10000)
-    img = view.grabFramebuffer().convertToFormat(QImage.Format.Format_RGB888)
+    img = view.current_image().convertToFormat(QImage.Format.Format_RGB888)
     h, w, bpl = img.height(), img.width(), img.bytesPerLine()
     arr = np.frombuffer(img.constBits(), np.uint8, count=h * bpl).reshape(h, bpl)
     return arr[:, : w * 3].reshape(h, w, 3).astype(np.float32) / 255.0
@@ -75,20 +76,14 @@ def test_a_broken_edit_keeps_the_last_good_image(window, qtbot):
     settle(qtbot, window)
     good = frame(qtbot, view)
     cm = copy.copy(window.compiler.current)
-    broken = "#version 330 core\nvoid main() { this is not glsl; }\n"
-
-    class Broken(type(cm)):
-        fragment_text = property(lambda self: broken)
-
-        def variant(self, entry, defines=()):  # the renderer links entry variants
-            return self
-
-    cm.__class__ = Broken
+    cm.__class__ = BrokenMaterial  # sent to the render process as it is
+    cm.__dict__.pop("_variants", None)
     cm.structure_hash = "broken"
     errors = []
     view.glErrors.connect(errors.append)
     window.viewport.on_compiled(cm)
-    assert errors and errors[0]
+    qtbot.waitUntil(lambda: bool(errors), timeout=30000)  # the link is in the render process
+    assert errors[0]
     assert any(p.source == "GL" for p in window.diagnostics.problems)
     still = frame(qtbot, view)
     assert np.abs(still - good).max() < 2.5 / 255
@@ -101,6 +96,9 @@ def test_reference_mode_keeps_drawing_until_converged(window, qtbot):
     n = view.frames
     qtbot.waitUntil(lambda: view.frames >= n + 4, timeout=30000)
     qtbot.waitUntil(lambda: not view.renderer.needs_redraw, timeout=30000)
+    # the converged picture follows the renderer's state from the render process
+    qtbot.waitUntil(lambda: view.frame_info is not None and view.frame_info.converged,
+                    timeout=30000)
     assert "mean" in window.viewport.diff_label.text()
     window.viewport.mode_combo.setCurrentText("Split-sum")
 
@@ -210,15 +208,8 @@ def test_a_new_document_whose_glsl_fails_to_link_draws_nothing_of_the_last(windo
     view = window.viewport.view
     frame(qtbot, view)
     cm = copy.copy(window.compiler.current)
-    broken = "#version 330 core\nvoid main() { this is not glsl; }\n"
-
-    class Broken(type(cm)):
-        fragment_text = property(lambda self: broken)
-
-        def variant(self, entry, defines=()):
-            return self
-
-    cm.__class__ = Broken
+    cm.__class__ = BrokenMaterial  # sent to the render process as it is
+    cm.__dict__.pop("_variants", None)
     cm.structure_hash = "broken-new-document"
     window.actions.ask_save_changes = lambda _n: "discard"
     # The new document's first program is the broken one: the panel sees no other compile.
@@ -229,6 +220,8 @@ def test_a_new_document_whose_glsl_fails_to_link_draws_nothing_of_the_last(windo
         window.viewport.on_compiled(cm)  # and it fails in the driver
     finally:
         window.compiler.compiled.connect(window.viewport.on_compiled)
+    # the link fails in the render process: its reply comes back to the panel
+    qtbot.waitUntil(lambda: window.viewport.failure_message != "", timeout=30000)
     assert not view.renderer.has_material and not window.viewport.shows_material()
     assert window.viewport.failure_message.startswith("This material's GLSL does not build")
     assert any(p.source == "GL" for p in window.diagnostics.problems)

@@ -79,7 +79,7 @@ def quit_after_first_frame(setting: str) -> None:
 
         def on_frame() -> None:
             # A compiled material reaches the renderer before the frame after it is drawn.
-            if view.renderer is not None and window.compiler.current is not None:
+            if view.running and view.has_material and window.compiler.current is not None:
                 print(f"matedit: viewport frame drawn, {view.width()}x{view.height()}",
                       file=sys.stderr)
                 app.exit(0)

@@ -35,7 +35,7 @@ class _FirstFrame(QObject):
     def _fallback(self) -> None:
         if not self._waiting:
             return
-        if self._view.renderer is not None and not self._view.problem:
+        if self._view.running:
             QTimer.singleShot(FALLBACK_MS, self, self._fallback)  # GL is up: frames will come
             return
         self._stop_waiting()
@@ -44,7 +44,7 @@ class _FirstFrame(QObject):
         if self._waiting:
             self._waiting = False
             self._view.frameDrawn.disconnect(self._drawn)
-            QTimer.singleShot(0, self, self._run)  # not from inside paintGL
+            QTimer.singleShot(0, self, self._run)  # not from inside the paint
 
     def _run(self) -> None:
         if self._steps:

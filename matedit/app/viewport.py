@@ -1,10 +1,15 @@
-"""The 3D preview's GL widget: a QOpenGLWidget hosting `matedit.render.Renderer`.
+"""The 3D preview: a widget showing the pictures `matedit.render.Renderer` draws in a process
+of its own (matedit.render.server, through matedit.app.render_client), so that the UI thread
+never waits for the GL.
 
-The moderngl context is created once in `initializeGL` and every frame draws into
-Qt's framebuffer (`detect_framebuffer(defaultFramebufferObject())`). A structural
-edit arrives as a new `CompiledMaterial` (`set_material`): when it fails to link,
-the renderer keeps its last good program, and the errors, located on nodes, go
-out through `glErrors`. A value edit only sets uniforms and redraws.
+The render process starts when the widget is first shown, with a headless context of its
+own; every change (a new program, uniform values, the camera, the mesh, the environment...) is
+a message sent to it in order, and after the messages it draws a frame and sends the picture
+back, which `paintEvent` paints (scaled while a resize is under way). A structural edit arrives as
+a new `CompiledMaterial` (`set_material`): when it fails to link, the renderer keeps its last
+good program, and the errors, located on nodes, go out through `glErrors`. A value edit only
+sets uniforms and redraws. `renderer` (for tests and tools) reads the server's renderer, after
+the messages sent before; the editor itself never reads it.
 
 The last good program belongs to the document: another document clears it
 (`clear_material`), and until that document compiles and links the view draws the scene
@@ -14,14 +19,21 @@ without a material. The tool bar and the notices over the view are
 
 from __future__ import annotations
 
-import time
+import atexit
+import weakref
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from PySide6.QtCore import QPointF, Qt, QTimer, Signal
-from PySide6.QtGui import QColor, QPainter
-from PySide6.QtOpenGLWidgets import QOpenGLWidget
+from PySide6.QtCore import QCoreApplication, QEventLoop, QObject, QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QImage, QPainter
+from PySide6.QtWidgets import QWidget
+
+from matedit.app.render_client import RemoteRenderer, RenderProcess
+
+if TYPE_CHECKING:
+    from matedit.render.server import FrameInfo
 
 
 @dataclass(frozen=True)
@@ -37,16 +49,26 @@ class RenderSettings:
     energy_compensation: bool = False
 
 
-def _load_renderer_class():
-    """The renderer class, or the reason it cannot be had (shown in the viewport)."""
-    try:
-        from matedit.render import Renderer  # the lead's moderngl renderer
-    except ImportError as exc:
-        return None, f"renderer not available ({exc})"
-    return Renderer, ""
+_PROCESSES: weakref.WeakSet[RenderProcess] = weakref.WeakSet()
 
 
-class ViewportWidget(QOpenGLWidget):
+@atexit.register
+def _stop_render_processes() -> None:
+    """No render process outlives the editor."""
+    for process in list(_PROCESSES):
+        process.stop()
+
+
+class _Bridge(QObject):
+    """Carries what the render process says to the UI thread (queued: the slots run there)."""
+
+    frame = Signal(object, object, float)  # pixels, FrameInfo, the frame's GL ms
+    started = Signal(str, object)  # "" or the problem; the renderer's lights
+    ended = Signal(str)  # why the render process has gone
+    call = Signal(object)  # a callable to run on the UI thread
+
+
+class ViewportWidget(QWidget):
     """Orbit (left drag), zoom (wheel), pan (middle or shift+left drag)."""
 
     glErrors = Signal(list)  # [(node_id, message)] when a program fails to build
@@ -54,87 +76,133 @@ class ViewportWidget(QOpenGLWidget):
     frameDrawn = Signal()
     statusMessage = Signal(str)
     settingsChanged = Signal(object)  # the new RenderSettings
-    # GL work a paint does for reference accumulation (ms; None: the renderer's default,
-    # matedit.render.slicing.DEFAULT_BUDGET_MS); the next paint is queued behind the events
-    # that came meanwhile
+    viewRefused = Signal(str)  # a view whose program failed to link: the view still drawn
+    # GL work between two looks at the messages while reference mode accumulates (ms; None:
+    # matedit.render.server.BUDGET_MS)
     slice_budget_ms: float | None = None
-    DISPLAY_INTERVAL_S = 0.25  # reference accumulation shows its progress this often
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
         self.setMinimumSize(160, 120)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
-        self.ctx = None
-        self.renderer = None
+        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
         self.problem = ""
-        self._pending_material = None
+        self._bridge = _Bridge(self)
+        self._bridge.frame.connect(self._on_frame, Qt.ConnectionType.QueuedConnection)
+        self._bridge.started.connect(self._on_started, Qt.ConnectionType.QueuedConnection)
+        self._bridge.ended.connect(self._on_ended, Qt.ConnectionType.QueuedConnection)
+        self._bridge.call.connect(lambda fn: fn(), Qt.ConnectionType.QueuedConnection)
+        bridge = self._bridge
+        self._proc = RenderProcess(bridge.frame.emit, bridge.started.emit, bridge.ended.emit)
+        _PROCESSES.add(self._proc)
+        proc = self._proc
+        self.destroyed.connect(lambda *_: proc.stop())
+        self._running = False  # the renderer is up in its process
+        self._pending_material = None  # the last material posted (what the first frame shows)
+        self._has_material = False
         self._pending_uniforms: dict[str, Any] | None = None
-        self._pending_textures: dict[str, Path | None] = {}
         self._mesh = "sphere"
         self._environment = "studio"
         # the environment is baked (or loaded from the cache) after the first frame, so that
-        # the window shows at once; until then the view draws without image-based lighting
-        self._environment_pending = False
+        # the window shows at once; until then the view draws without image-based lighting:
+        # "pending" until the first frame is painted, "loading", then "ready"
+        self._environment_state = "pending"
         self._mode = "splitsum"
         self._view = "lit"  # matedit.shading.views: lit, a lobe view or an attribute view
         self._exposure = 0.0
-        self._lights = None
+        self._lights: list | None = None
         self._last = QPointF()
         self._button = Qt.MouseButton.NoButton
         self.frames = 0
         self.last_frame_time = 0.0
-        self._fbo = None
-        self._fbo_glo = -1
         self.settings = RenderSettings()
-        self._last_paint = 0.0
-        self._slicer = QTimer(self)  # reference accumulation between paints (_advance)
-        self._slicer.setSingleShot(True)
-        self._slicer.setInterval(0)
-        self._slicer.timeout.connect(self._advance)
+        self._image: QImage | None = None
+        self._new_frame = False
+        self.frame_info: FrameInfo | None = None  # what the last picture shows
         self._compare = None  # (compiled, uniforms, textures) of an A/B split's A side
         self._split = 0.5
 
-    # --- GL lifecycle ----------------------------------------------------------------------
-    def initializeGL(self) -> None:  # noqa: N802 - Qt's name
-        try:
-            import moderngl
-
-            self.ctx = moderngl.create_context()
-        except Exception as exc:
-            self.problem = f"no OpenGL 3.3 context: {exc}"
-            return
-        cls, why = _load_renderer_class()
-        if cls is None:
-            self.problem = why
-            return
+    # --- the render process -----------------------------------------------------------------
+    def _size_px(self) -> tuple[int, int]:
         dpr = self.devicePixelRatioF()
-        size = (max(1, int(self.width() * dpr)), max(1, int(self.height() * dpr)))
-        try:
-            try:  # no environment yet: it follows the first frame (_load_environment)
-                self.renderer = cls(self.ctx, size=size, samples=4, environment=None,
-                                    warm_up=not self._first_frame_deferred())
-                self._environment_pending = True
-            except TypeError:  # a renderer class without the keyword bakes its default
-                self.renderer = cls(self.ctx, size=size, samples=4)
-                self._environment_pending = self._environment != "studio"
-            self._apply_view_state()
-            # reference accumulation in bands of rows, a paint's worth at a time, so that
-            # the event loop runs between them (matedit.render.slicing)
-            from matedit.render.slicing import DEFAULT_BUDGET_MS
+        return max(1, int(self.width() * dpr)), max(1, int(self.height() * dpr))
 
-            self.renderer.slice_budget_ms = self.slice_budget_ms or DEFAULT_BUDGET_MS
-        except Exception as exc:
-            self.renderer = None
-            self.problem = f"renderer failed to start: {type(exc).__name__}: {exc}"
+    def showEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().showEvent(event)
+        if not self._proc.started:
+            s = self.settings
+            try:
+                self._proc.start({
+                    "size": self._size_px(), "warm_up": not self._first_frame_deferred(),
+                    "mesh": self._mesh, "mode": self._mode, "exposure": self._exposure,
+                    "view": self._view, "lights": self._lights, "budget_ms":
+                    self.slice_budget_ms,
+                    "settings": (s.environment_intensity, s.show_background,
+                                 s.background_blur, s.energy_compensation)})
+            except OSError as exc:
+                self._on_ended(f"the renderer could not start: {exc}")
+
+    def _on_started(self, problem: str, lights) -> None:
+        if problem:
+            self._on_ended(problem)
             return
-        if self._pending_material is not None:
-            cm, self._pending_material = self._pending_material, None
-            self._apply_material(cm)
-        self._flush_values()
-        if hasattr(self.renderer, "set_split"):
-            self.renderer.set_split(self._split)
-        if self._compare is not None:
-            self._apply_compare()
+        self._running = True
+        if self._lights is None:
+            self._lights = list(lights or [])
+
+    def _on_ended(self, problem: str) -> None:
+        self.problem = problem
+        self._running = False
+        super().update()
+
+    def _post(self, op: str, *args, then: Callable[[Any], None] | None = None,
+              failed: Callable[[BaseException], None] | None = None, frame: bool = True,
+              progress: Callable[[float], None] | None = None):
+        """Sends (op, args) to the render process; `then(reply)` or `failed(exception)` back
+        on the UI thread."""
+        future = self._proc.post(op, *args, frame=frame, progress=progress)
+        if then is not None or failed is not None:
+            bridge = self._bridge
+
+            def done(f) -> None:
+                exc = f.exception()
+                if exc is not None:
+                    if failed is not None:
+                        bridge.call.emit(lambda: failed(exc))
+                elif then is not None:
+                    bridge.call.emit(lambda: then(f.result()))
+
+            future.add_done_callback(done)
+        return future
+
+    def _do(self, path: str, *args, **kw):
+        """Calls the renderer's method at `path` (e.g. "camera.orbit") in the render process."""
+        return self._post("call", path, args, {}, **kw)
+
+    @property
+    def running(self) -> bool:
+        """Whether the renderer is up (False before the widget is shown and when it failed)."""
+        return self._running and not self.problem
+
+    @property
+    def renderer(self) -> RemoteRenderer | None:
+        """The render process's renderer, read and called after every message sent so far
+        (tests and tools); None while it starts or when it could not."""
+        if not self.running:
+            return None
+        try:
+            self.sync()
+        except RuntimeError:
+            return None
+        return RemoteRenderer(self._proc)
+
+    def sync(self) -> None:
+        """Waits until the render process has served every message sent so far."""
+        if self.running:
+            self._proc.sync()
+            # and the replies' handlers that came back meanwhile (a consistent point: what the
+            # panel shows follows what the renderer has)
+            QCoreApplication.sendPostedEvents(self._bridge)
 
     def _first_frame_deferred(self) -> bool:
         """Whether the material waiting for GL takes the deferred path: its first frame then
@@ -150,193 +218,130 @@ class ViewportWidget(QOpenGLWidget):
         except Exception:  # whatever it is, the renderer warms itself as it always did
             return False
 
-    def _apply_view_state(self) -> None:
-        r = self.renderer
-        r.set_mesh(self._mesh)
-        r.mode = self._mode
-        r.exposure = self._exposure
-        self._set_renderer_view(r, self._view)
-        self._apply_settings(r)
-        if self._lights is not None:
-            r.set_lights(list(self._lights))
-        else:
-            self._lights = list(r.lights)
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        self._do("resize", *self._size_px())
 
-    def resizeGL(self, w: int, h: int) -> None:  # noqa: N802 - Qt's name
-        self._fbo = None
-        if self.renderer is not None:
-            dpr = self.devicePixelRatioF()
-            self.renderer.resize(max(1, int(w * dpr)), max(1, int(h * dpr)))
+    def update(self, *args) -> None:
+        """A new frame from the render thread (and a repaint meanwhile)."""
+        if not args and self._proc.started:
+            self._post("get", "", frame=True)
+        super().update(*args)
 
-    def paintGL(self) -> None:  # noqa: N802 - Qt's name
-        t0 = time.perf_counter()
-        if self.renderer is None or self.ctx is None:
-            self._paint_message(self.problem or "starting the renderer…")
-            return
-        try:
-            glo = self.defaultFramebufferObject()
-            if self._fbo is None or self._fbo_glo != glo:  # Qt recreates it on resize
-                self._fbo, self._fbo_glo = self.ctx.detect_framebuffer(glo), glo
-            self.renderer.render(self._fbo)
-        except Exception as exc:  # keep the editor alive; show what went wrong
-            self.problem = f"render failed: {type(exc).__name__}: {exc}"
-            self.renderer = None
-            self._paint_message(self.problem)
-            return
-        self.frames += 1
-        self.last_frame_time = time.perf_counter() - t0
-        self._last_paint = time.perf_counter()
-        if self._environment_pending:
-            QTimer.singleShot(0, self, self._load_environment)
-        self.frameDrawn.emit()
-        if self.renderer.needs_redraw:  # reference mode accumulates until converged
-            self._slicer.start()
+    def _on_frame(self, pixels, info, ms: float) -> None:
+        h, w = pixels.shape[:2]
+        self._image = QImage(pixels.data, w, h, 4 * w, QImage.Format.Format_RGBA8888).copy()
+        self._image.setDevicePixelRatio(self.devicePixelRatioF())
+        self.frame_info = info
+        self.last_frame_time = ms / 1e3
+        self._new_frame = True
+        super().update()
 
-    def _advance(self) -> None:
-        """Reference accumulation between paints: one budget's worth of bands
-        (Renderer.advance), then the event loop; a paint when a frame is complete, or
-        DISPLAY_INTERVAL_S after the last one (the first frame shows as it is drawn)."""
-        r = self.renderer
-        if r is None or not r.needs_redraw:
-            return
-        frames = r.accumulated_frames
-        self.makeCurrent()
-        try:
-            bands = r.advance()
-        except Exception as exc:  # as paintGL: keep the editor alive, say what went wrong
-            self.problem = f"render failed: {type(exc).__name__}: {exc}"
-            self.renderer = None
-            self.update()
-            return
-        finally:
-            self.doneCurrent()
-        if not r.needs_redraw:  # converged: shown (and said) before anyone asks
-            self.repaint()
-        elif not bands or r.accumulated_frames != frames or \
-                time.perf_counter() - self._last_paint >= self.DISPLAY_INTERVAL_S:
-            self.update()
-        else:
-            self._slicer.start()
-
-    def _paint_message(self, text: str) -> None:
+    def paintEvent(self, event) -> None:  # noqa: N802 - Qt's name
         p = QPainter(self)
-        p.fillRect(self.rect(), QColor("#17191e"))
-        p.setPen(QColor("#8a91a0"))
-        p.drawText(self.rect().adjusted(12, 12, -12, -12),
-                   Qt.AlignmentFlag.AlignCenter | Qt.TextFlag.TextWordWrap, text)
+        if self._image is None:
+            p.fillRect(self.rect(), QColor("#17191e"))
+            p.setPen(QColor("#8a91a0"))
+            p.drawText(self.rect().adjusted(12, 12, -12, -12),
+                       Qt.AlignmentFlag.AlignCenter | Qt.TextFlag.TextWordWrap,
+                       self.problem or "starting the renderer…")
+            p.end()
+            return
+        p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform)
+        p.drawImage(QRectF(self.rect()), self._image)
+        if self.problem:
+            p.fillRect(self.rect().adjusted(0, self.height() - 28, 0, 0), QColor(23, 25, 30, 220))
+            p.setPen(QColor("#e0a0a0"))
+            p.drawText(self.rect().adjusted(8, 0, -8, -6),
+                       Qt.AlignmentFlag.AlignBottom | Qt.AlignmentFlag.AlignLeft, self.problem)
         p.end()
+        if self._new_frame:
+            self._new_frame = False
+            self.frames += 1
+            self.frameDrawn.emit()
+            if self._environment_state == "pending" and self.running:
+                self._load_environment()  # once the first frame is on screen
+
+    def current_image(self) -> QImage:
+        """The picture on screen (RGB888), a null image before the first frame."""
+        if self._image is None:
+            return QImage()
+        return self._image.convertToFormat(QImage.Format.Format_RGB888)
 
     # --- material and values ---------------------------------------------------------------
     def viewport_state(self):
         """What the compile worker needs to warm this view's programs (matedit.render.warmup),
         or None before the renderer runs."""
-        r = self.renderer
-        if r is None:
+        if not self.running:
             return None
         from matedit.render.warmup import ViewportState
 
-        return ViewportState(samples=r.samples, deferred=r.deferred,
+        cm = self._pending_material
+        forced = bool(cm is not None and getattr(cm, "preview", {}).get("energy_compensation"))
+        return ViewportState(samples=4, deferred=True,  # as the render process's renderer
                              environment=str(self._environment),  # the one it has or gets
-                             mode=r.mode, mesh=r.mesh_name,
-                             energy_compensation=r.energy_compensation,
-                             show_background=r.show_background)
+                             mode=self._mode, mesh=self._mesh,
+                             energy_compensation=self.settings.energy_compensation or forced,
+                             show_background=self.settings.show_background)
 
     @property
     def has_material(self) -> bool:
-        """Whether a material is drawn, or waits to be at initializeGL."""
-        if self.renderer is None:
+        """Whether a material is drawn, or waits to be when the renderer starts."""
+        if not self.running:
             return self._pending_material is not None
-        return bool(self.renderer.has_material)
+        return self._has_material
 
     def clear_material(self) -> None:
         """Draw no material (another document: the previous one's program is not its own)."""
         self._pending_material = None
-        self._pending_uniforms, self._pending_textures = None, {}
-        if self.renderer is not None:
-            self.makeCurrent()
-            try:
-                self.renderer.clear_material()
-            finally:
-                self.doneCurrent()
-            self.update()
+        self._pending_uniforms = None
+        self._has_material = False
+        self._do("clear_material")
 
-    def set_material(self, compiled) -> bool | None:
-        """A new program; None while GL is not up yet (applied at initializeGL)."""
-        if self.renderer is None:
-            self._pending_material = compiled
-            return None
-        return self._apply_material(compiled)
+    def set_material(self, compiled) -> None:
+        """A new program, linked on the render thread; `materialApplied` (and `glErrors` on a
+        failure) say how it went."""
+        self._pending_material = compiled
 
-    def _apply_material(self, compiled) -> bool:
-        self.makeCurrent()
-        try:
-            status = self.renderer.set_material(compiled)
-        except Exception as exc:
-            self.doneCurrent()
+        def applied(status) -> None:
+            ok = bool(status.ok)
+            if ok:
+                self._has_material = True
+            else:
+                self.glErrors.emit(list(status.errors or []))
+            self.materialApplied.emit(ok)
+
+        def failed(exc: BaseException) -> None:
             self.glErrors.emit([("", f"{type(exc).__name__}: {exc}")])
             self.materialApplied.emit(False)
-            return False
-        self.doneCurrent()
-        ok = bool(status.ok)
-        if not ok:
-            self.glErrors.emit(list(status.errors or []))
-        self.materialApplied.emit(ok)
-        self.update()
-        return ok
+
+        self._do("set_material", compiled, then=applied, failed=failed)
 
     def set_values(self, uniforms: dict[str, Any], textures: dict[str, Path | None]) -> None:
         self._pending_uniforms = uniforms
-        self._pending_textures = textures
-        if self.renderer is not None:
-            self._flush_values()
-            self.update()
-
-    def _flush_values(self) -> None:
-        if self.renderer is None:
-            return
-        self.makeCurrent()
-        try:
-            if self._pending_uniforms is not None:
-                self.renderer.set_uniforms(self._pending_uniforms)
-            for name, path in self._pending_textures.items():
-                try:
-                    self.renderer.set_texture(name, str(path) if path else None)
-                except ValueError as exc:
-                    self.statusMessage.emit(str(exc))
-            self._pending_textures = {}
-        finally:
-            self.doneCurrent()
+        self._post("values", uniforms, dict(textures),
+                   then=lambda problems: [self.statusMessage.emit(m) for m in problems])
 
     # --- A/B split -------------------------------------------------------------------------
     def set_compare(self, compiled, uniforms: dict[str, Any] | None = None,
-                    textures: dict[str, Path | None] | None = None) -> bool:
+                    textures: dict[str, Path | None] | None = None) -> None:
         """The A side of an A/B split (None: no split): `compiled` with these uniform values
         and texture files, left of the divider (Renderer.set_compare)."""
         self._compare = None if compiled is None else (compiled, dict(uniforms or {}),
                                                        dict(textures or {}))
-        return self._apply_compare()
+        self._apply_compare()
 
-    def _apply_compare(self) -> bool:
-        r = self.renderer
-        if r is None or not hasattr(r, "set_compare"):
-            return False
-        self.makeCurrent()
-        try:
-            if self._compare is None:
-                status = r.set_compare(None)
-            else:
-                cm, uniforms, textures = self._compare
-                status = r.set_compare(cm, uniforms, {k: str(v) if v else None
-                                                      for k, v in textures.items()})
-        except Exception as exc:  # noqa: BLE001 - the split is an aid: say it, keep drawing
+    def _apply_compare(self) -> None:
+        compare = self._compare or (None,)
+
+        def done(status) -> None:
+            if not status.ok:
+                self.statusMessage.emit("A/B split: the earlier material no longer builds")
+
+        def failed(exc: BaseException) -> None:  # the split is an aid: say it, keep drawing
             self.statusMessage.emit(f"A/B split: {type(exc).__name__}: {exc}")
-            return False
-        finally:
-            self.doneCurrent()
-        if not status.ok:
-            self.statusMessage.emit("A/B split: the earlier material no longer builds")
-        self.update()
-        return bool(status.ok)
+
+        self._post("compare", *compare, then=done, failed=failed)
 
     @property
     def split(self) -> float:
@@ -345,26 +350,20 @@ class ViewportWidget(QOpenGLWidget):
     def set_split(self, fraction: float) -> None:
         """The divider, as a fraction of the width from the left."""
         self._split = min(0.95, max(0.05, float(fraction)))
-        if self.renderer is not None and hasattr(self.renderer, "set_split"):
-            self.renderer.set_split(self._split)
-            self.update()
+        self._do("set_split", self._split)
 
     # --- view state ------------------------------------------------------------------------
     def set_mesh(self, name: str) -> None:
         self._mesh = name
-        if self.renderer is not None:
-            self.makeCurrent()
-            try:
-                self.renderer.set_mesh(name)
-            finally:
-                self.doneCurrent()
-            self.update()
+
+        def failed(exc: BaseException) -> None:
+            self.statusMessage.emit(f"mesh {Path(name).name}: {exc}")
+
+        self._do("set_mesh", name, failed=failed)
 
     def set_mode(self, mode: str) -> None:
         self._mode = mode
-        if self.renderer is not None:
-            self.renderer.mode = mode
-            self.update()
+        self._post("set", "mode", mode)
 
     @property
     def shading_view(self) -> str:
@@ -372,54 +371,34 @@ class ViewportWidget(QOpenGLWidget):
 
     def set_view(self, view: str) -> None:
         """The view chooser's view (matedit.shading.views): one relink the first time each
-        view is shown for a material (the programs are cached), a redraw after."""
-        self._view = view
-        if self.renderer is not None:
-            self.makeCurrent()
-            try:
-                self._set_renderer_view(self.renderer, view)
-            finally:
-                self.doneCurrent()
-            self.update()
+        view is shown for a material (the programs are cached), a redraw after. A view that
+        fails to link is said (`statusMessage`), and `viewRefused` names the view kept."""
+        old, self._view = self._view, view
 
-    def _set_renderer_view(self, r, view: str) -> None:
-        try:
-            r.set_view(view)
-        except Exception as exc:  # a link failure keeps the view the renderer had
-            self._view = r.view
+        def failed(exc: BaseException) -> None:
+            if self._view == view:
+                self._view = old
             self.statusMessage.emit(f"view {view}: {type(exc).__name__}: {exc}")
+            self.viewRefused.emit(self._view)
+
+        self._do("set_view", view, failed=failed)
 
     def set_exposure(self, ev: float) -> None:
         self._exposure = float(ev)
-        if self.renderer is not None:
-            self.renderer.exposure = float(ev)
-            self.update()
+        self._post("set", "exposure", self._exposure)
 
     def set_settings(self, settings: RenderSettings) -> None:
         """New render settings (background, blur, IBL intensity: a redraw; energy
-        compensation: a relink, in the widget's context)."""
+        compensation: a relink, on the render thread)."""
         if settings == self.settings:
             return
         self.settings = settings
-        if self.renderer is not None:
-            self.makeCurrent()
-            try:
-                self._apply_settings(self.renderer)
-            finally:
-                self.doneCurrent()
-            self.renderer.reset_accumulation()
-            self.update()
+        self._post("settings", settings.environment_intensity, settings.show_background,
+                   settings.background_blur, settings.energy_compensation)
         self.settingsChanged.emit(settings)
 
     def change_settings(self, **changes) -> None:
         self.set_settings(replace(self.settings, **changes))
-
-    def _apply_settings(self, r) -> None:
-        s = self.settings
-        r.environment_intensity = s.environment_intensity
-        r.show_background = s.show_background
-        r.background_blur = s.background_blur
-        r.set_energy_compensation(s.energy_compensation)
 
     @property
     def lights(self) -> list:
@@ -427,110 +406,95 @@ class ViewportWidget(QOpenGLWidget):
 
     def set_lights(self, lights: list) -> None:
         self._lights = list(lights)
-        if self.renderer is not None:
-            self.makeCurrent()
-            try:
-                self.renderer.set_lights(list(lights))
-            finally:
-                self.doneCurrent()
-            self.update()
+        self._do("set_lights", list(lights))
 
     @property
     def environment(self) -> str:
-        """The environment the view is set to (baked at initializeGL if GL is not up yet)."""
+        """The environment the view is set to (baked once the renderer's first frame is in)."""
         return self._environment
 
     @property
     def environment_ready(self) -> bool:
-        """Whether the renderer has the view's environment (False before GL is up and from
-        the first frame until the environment that follows it is in)."""
-        return self.renderer is not None and not self._environment_pending
+        """Whether the renderer has the view's environment (False before it runs and from the
+        first frame until the environment that follows it is in)."""
+        return self.running and self._environment_state == "ready"
 
     def _load_environment(self) -> None:
-        """The environment at start-up, once the first frame is on screen."""
-        if not self._environment_pending or self.renderer is None:
-            return
-        self._environment_pending = False
-        self.makeCurrent()
-        try:
-            self._set_environment_now(self._environment, None)
-        except Exception as exc:  # as at start-up before: the view says what went wrong
+        """The environment at start-up, once the first frame is on screen: baked (or loaded
+        from the cache) on the render thread."""
+        spec = self._environment
+        self._environment_state = "loading"
+
+        def done(_result) -> None:
+            if self._environment_state == "loading":
+                self._environment_state = "ready"
+
+        def failed(exc: BaseException) -> None:  # the view says what went wrong
+            self._environment_state = "ready"
             self.problem = f"renderer failed to start: {type(exc).__name__}: {exc}"
-            self.renderer = None
-        finally:
-            self.doneCurrent()
-        self.update()
+            super(ViewportWidget, self).update()
+
+        self._post("environment", spec, then=done, failed=failed)
 
     def set_environment(self, spec: str, progress=None) -> None:
-        """Bakes (or loads from cache) an environment; raises ValueError for a bad file."""
+        """Bakes (or loads from the cache) an environment on the render thread; the UI's event
+        loop runs meanwhile, `progress(fraction)` is called on the UI thread. Raises
+        ValueError (or OSError) for a bad file, the environment before it staying."""
         self._environment = spec
-        if self.renderer is not None:
-            self._environment_pending = False
-            self.makeCurrent()
-            try:
-                self._set_environment_now(spec, progress)
-            finally:
-                self.doneCurrent()
-            self.update()
+        if not self.running:
+            return
+        bridge = self._bridge
 
-    def _set_environment_now(self, spec: str, progress) -> None:
-        self.renderer.set_environment(spec, progress=progress)
+        def report(fraction: float) -> None:  # on the client's reader thread
+            if progress is not None:
+                bridge.call.emit(lambda: progress(fraction))
+
+        future = self._post("environment", spec, True, progress=report)
+        loop = QEventLoop()
+        future.add_done_callback(lambda _f: bridge.call.emit(loop.quit))
+        if not future.done():
+            loop.exec()
+        future.result()
+        self._environment_state = "ready"
 
     def gl_renderer(self) -> str:
         """The OpenGL renderer string ("" before GL is up)."""
-        if self.ctx is None:
+        if not self.running:
             return ""
+
         try:
-            info = self.ctx.info
-            return f"{info.get('GL_RENDERER', '?')} ({info.get('GL_VERSION', '?')})"
+            return str(self._proc.call("info"))
         except Exception:  # a context that cannot answer says nothing
             return ""
 
     def read_hdr(self):
         """(H, W, 3) scene-linear radiance of the last frame (before exposure and display
         transform), or None without a renderer."""
-        if self.renderer is None:
+        if not self.running:
             return None
-        self.makeCurrent()
-        try:
-            return self.renderer.read_hdr()
-        finally:
-            self.doneCurrent()
+        return self._proc.call("call", "read_hdr")
 
     def render_offscreen(self, width: int, height: int):
         """(display image, scene-linear radiance), each (H, W, 3) floats, of the view drawn
         at `width` x `height` (reference mode converged), then the view's own size again;
         None without a renderer."""
-        r = self.renderer
-        if r is None:
+        if not self.running:
             return None
-        self.makeCurrent()
-        size, budget = r.size, r.slice_budget_ms
-        try:
-            r.resize(int(width), int(height))
-            r.slice_budget_ms = None
-            r.reset_accumulation()
-            r.render_converged()
-            return r.read_image(), r.read_hdr()
-        finally:
-            r.slice_budget_ms = budget
-            r.resize(*size)
-            r.reset_accumulation()
-            self._fbo = None
-            self.doneCurrent()
-            self.update()
+
+        out = self._proc.call("offscreen", int(width), int(height))
+        self.update()
+        return out
 
     def read_image(self):
         """(H, W, 3) sRGB floats of the last frame, through the renderer."""
-        if self.renderer is None:
+        if not self.running:
             return None
-        self.makeCurrent()
-        try:
-            return self.renderer.read_image()
-        finally:
-            self.doneCurrent()
+        return self._proc.call("call", "read_image")
 
     # --- camera ----------------------------------------------------------------------------
+    def reset_camera(self) -> None:
+        self._do("camera.reset")
+
     def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt's name
         self._last = event.position()
         self._button = event.button()
@@ -539,31 +503,26 @@ class ViewportWidget(QOpenGLWidget):
             self._button = Qt.MouseButton.MiddleButton
 
     def mouseMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
-        if self.renderer is None:
+        if not self.running:
             return
         d = event.position() - self._last
         self._last = event.position()
-        cam = self.renderer.camera
+        dx, dy = d.x(), d.y()
         if self._button == Qt.MouseButton.LeftButton:
-            cam.orbit(-d.x() * 0.4, -d.y() * 0.4)
+            self._do("camera.orbit", -dx * 0.4, -dy * 0.4)
         elif self._button == Qt.MouseButton.MiddleButton:
             h = max(1, self.height())
-            cam.pan(-d.x() / h, d.y() / h)
-        else:
-            return
-        self.update()
+            self._do("camera.pan", -dx / h, dy / h)
 
     def mouseReleaseEvent(self, event) -> None:  # noqa: N802 - Qt's name
         self._button = Qt.MouseButton.NoButton
 
     def wheelEvent(self, event) -> None:  # noqa: N802 - Qt's name
-        if self.renderer is None:
+        if not self.running:
             return
         steps = event.angleDelta().y() / 120.0
-        self.renderer.camera.dolly(0.9 ** steps)
-        self.update()
+        self._do("camera.dolly", 0.9 ** steps)
 
     def mouseDoubleClickEvent(self, event) -> None:  # noqa: N802 - Qt's name
-        if self.renderer is not None:
-            self.renderer.camera.reset()
-            self.update()
+        if self.running:
+            self.reset_camera()

@@ -231,11 +231,11 @@ class ViewportPanel(QWidget):
         self.exposure_spin.valueChanged.connect(
             lambda ev: self.exposure.setValue(int(round(ev * 10))))
         self.environment.changed.connect(self.environmentChanged)
-        reset.clicked.connect(lambda: self.view.renderer and (self.view.renderer.camera.reset(),
-                                                              self.view.update()))
+        reset.clicked.connect(self.view.reset_camera)
         self.view.frameDrawn.connect(self._frame_drawn)
         self.view.statusMessage.connect(self.statusMessage)
         self.view.glErrors.connect(self.glErrors)
+        self.view.viewRefused.connect(self.set_view)  # a failed link: show what is drawn
         self.view.materialApplied.connect(self.materialApplied)
         compiler.compiled.connect(self.on_compiled)
         compiler.failed.connect(self._compile_failed)
@@ -462,7 +462,7 @@ class ViewportPanel(QWidget):
         cm = self.compiler.latest
         if cm is None:
             return
-        if change.many or change.setting or self.view.renderer is None:
+        if change.many or change.setting or not self.view.running:
             self.push_values()
             return
         if self._by_port[0] is not cm:
@@ -479,7 +479,7 @@ class ViewportPanel(QWidget):
 
     def renderer_lights(self) -> list | None:
         """The renderer's light rig once it runs; None while it starts; [] if it cannot."""
-        if self.view.renderer is not None:
+        if self.view.running:
             return self.view.lights
         return [] if self.view.problem else None
 
@@ -533,7 +533,7 @@ class ViewportPanel(QWidget):
             self.statusMessage.emit(f"{path.name} is a file the material reads: not "
                                     "overwritten")
             return False
-        if self.view.renderer is None:
+        if not self.view.running:
             self.statusMessage.emit("no image to save: the renderer is not running")
             return False
         try:
@@ -544,7 +544,7 @@ class ViewportPanel(QWidget):
 
                 write_image(path, self.view.read_hdr())
             else:
-                self._write_png(path, self.view.grabFramebuffer())
+                self._write_png(path, self.view.current_image())
         except (OSError, ValueError) as exc:
             self.statusMessage.emit(f"cannot save {path.name}: {exc}")
             return False
@@ -760,8 +760,6 @@ class ViewportPanel(QWidget):
         view = self.view_combo.itemData(index)
         if isinstance(view, str):  # not a separator
             self.view.set_view(view)
-            if self.view.shading_view != view:  # refused (a failed link): show what is drawn
-                self.set_view(self.view.shading_view)
 
     def set_view(self, view: str) -> None:
         """Chooses a view (matedit.shading.views name) as the chooser does."""
@@ -775,7 +773,7 @@ class ViewportPanel(QWidget):
         self.view.set_exposure(ev)
 
     def _frame_drawn(self) -> None:
-        r = self.view.renderer
+        r = self.view.frame_info  # read on the render thread when the frame was drawn
         if r is None or r.mode == "splitsum":
             return
         total = r.reference_frames * r.reference_samples

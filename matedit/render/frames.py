@@ -22,6 +22,7 @@ from collections.abc import Callable
 import moderngl
 import numpy as np
 
+from matedit.gl_wait import finish
 from matedit.render.deferred import GBuffer
 from matedit.render.fullscreen import FullscreenQuad, render_program, set_uniform
 from matedit.render.slicing import BandPlanner
@@ -210,7 +211,7 @@ class Accumulator:
                 scene(IBL_MODE_SPLIT_SUM, (0.0, 0.0), band)
             else:
                 scene(IBL_MODE_REFERENCE, r2_offset(self.frames), band)
-            self.ctx.finish()  # the band's real cost (the driver works asynchronously)
+            finish(self.ctx)  # the band's real cost (the driver works asynchronously)
             ms = (clock() - t0) * 1e3
             planner.record(band, ms)
             spent += ms

@@ -328,6 +328,13 @@ class Renderer(PreviewSettings):
         return self.accumulator.advance(self.mode, self.reference_frames, self._scene,
                                         self.targets.resolved, self.planner)
 
+    def display(self, target: moderngl.Framebuffer) -> None:
+        """The display pass alone into `target`: the frame as far as `advance` has drawn it
+        (split sum until the first reference frame is complete), no new bands."""
+        a = self.accumulator
+        a.display(target, "splitsum" if a.frames == 0 and self.mode != "splitsum" else
+                  self.mode, self.targets.resolved, self.exposure)
+
     @property
     def difference_mean(self) -> float | None:
         """Mean |split-sum - reference| of the last difference frame, linear HDR (read back

@@ -24,9 +24,7 @@ moderngl only, no Qt. One `Warmer` per thread: its context is current on the thr
 from __future__ import annotations
 
 import os
-import pickle
 import select
-import struct
 import subprocess
 import sys
 import threading
@@ -34,6 +32,9 @@ import time
 import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from matedit.render.pipe import recv as _recv
+from matedit.render.pipe import send as _send
 
 # Small: the variant key of llvmpipe's fragment shaders does not depend on the target's size
 # (measured: warmed at 16², 64² or the viewport's own size, the viewport's first draw of
@@ -130,24 +131,6 @@ class WarmReply:
     program: str = ""  # the structure hash of the variant drawn ("" when none)
     error: str = ""
     starting: bool = False  # not tried: the child is not ready yet (or would not start)
-
-
-# --- the pipe: 4-byte big-endian length, then a pickle -----------------------------------------
-def _send(stream, obj) -> None:
-    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
-    stream.write(struct.pack(">I", len(data)) + data)
-    stream.flush()
-
-
-def _recv(stream):
-    head = stream.read(4)
-    if len(head) < 4:
-        raise EOFError("warm-up pipe closed")
-    (n,) = struct.unpack(">I", head)
-    data = stream.read(n)
-    if len(data) < n:
-        raise EOFError("warm-up pipe closed")
-    return pickle.loads(data)  # noqa: S301 - our own child process, over its own pipe
 
 
 def shader_cache_enabled() -> bool:

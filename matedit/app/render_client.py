@@ -1,0 +1,201 @@
+"""The editor's side of the render server (matedit.render.server): a child process that owns
+the preview's GL context and renderer, so that no GL call, and no frame, ever runs in the
+editor's process (moderngl holds Python's interpreter lock through each of them).
+
+`RenderProcess.post(op, *args)` sends a message and returns a Future of its reply; messages
+go out in order from a writer thread (a busy server never blocks the UI thread's send), and a
+reader thread resolves the futures and hands frames, progress and the start-up report to the
+callbacks, on that thread (the viewport forwards them to the UI thread). `RemoteRenderer`
+reads and calls the server's renderer attribute by attribute (tests and tools; each is a round
+trip after the messages sent before it). No Qt here.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import queue
+import subprocess
+import sys
+import threading
+import weakref
+from collections.abc import Callable
+from concurrent.futures import Future
+from pathlib import Path
+from typing import Any
+
+from matedit.render.pipe import encode, recv, write
+from matedit.render.server import SERVER_ENV, Remote
+
+
+def _end(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        try:
+            proc.stdin.close()
+            proc.wait(timeout=5)
+        except (OSError, subprocess.TimeoutExpired):
+            proc.kill()
+
+
+class RenderProcess:
+    """The render server's client (the module docstring). `on_frame(pixels, info, ms)`,
+    `on_started(problem, lights)` and `on_ended(problem)` are called on the reader thread."""
+
+    def __init__(self, on_frame: Callable[..., None], on_started: Callable[..., None],
+                 on_ended: Callable[[str], None]) -> None:
+        self._on_frame, self._on_started, self._on_ended = on_frame, on_started, on_ended
+        self._ids = itertools.count(1)
+        self._lock = threading.Lock()
+        self._futures: dict[int, tuple[Future, Callable[[float], None] | None]] = {}
+        self._outbox: queue.Queue = queue.Queue()
+        self._proc: subprocess.Popen | None = None
+        self._closed = False
+
+    @property
+    def started(self) -> bool:
+        return self._proc is not None
+
+    @property
+    def alive(self) -> bool:
+        return self._proc is not None and self._proc.poll() is None and not self._closed
+
+    def start(self, init: dict) -> None:
+        """Starts the server with `init` (matedit.render.server.Server.start), then sends the
+        messages posted before."""
+        import matedit
+
+        env = dict(os.environ)
+        if getattr(sys, "frozen", False):  # a PyInstaller bundle: its entry point serves
+            cmd = [sys.executable]  # (packaging/matedit_entry.py)
+            env[SERVER_ENV] = "1"
+        else:
+            cmd = [sys.executable, "-m", "matedit.render.server"]
+            # the editor's own module path: what it sends unpickles there
+            root = str(Path(matedit.__file__).resolve().parent.parent)
+            env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(
+                [root, *filter(None, [env.get("PYTHONPATH")]), *filter(None, sys.path)]))
+        self._proc = proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                             env=env)
+        weakref.finalize(self, _end, proc)  # a client dropped without stop(): no orphan
+        pending = []
+        while True:
+            try:
+                pending.append(self._outbox.get_nowait())
+            except queue.Empty:
+                break
+        self._outbox.put(encode(("init", init)))
+        for message in pending:
+            self._outbox.put(message)
+        threading.Thread(target=self._write, args=(proc,), daemon=True,
+                         name="matedit-render-send").start()
+        threading.Thread(target=self._read, args=(proc,), daemon=True,
+                         name="matedit-render-receive").start()
+
+    def post(self, op: str, *args, frame: bool = True,
+             progress: Callable[[float], None] | None = None) -> Future:
+        """Sends (op, args); with `frame`, the server draws a frame after it. The Future has
+        the reply (or the server's exception)."""
+        future: Future = Future()
+        if self._closed or (self._proc is not None and self._proc.poll() is not None):
+            future.set_exception(RuntimeError("the renderer is not running"))
+            return future
+        mid = next(self._ids)
+        try:  # here, so that what cannot be sent fails its own future, not the pipe
+            message = encode((mid, op, args, frame))
+        except Exception as exc:  # noqa: BLE001 - pickle raises several kinds
+            future.set_exception(RuntimeError(f"cannot send {op} to the renderer: {exc}"))
+            return future
+        with self._lock:
+            self._futures[mid] = (future, progress)
+        self._outbox.put(message)
+        return future
+
+    def call(self, op: str, *args, timeout: float | None = 300.0) -> Any:
+        """post(...) without a frame, waited for (its exception raised here)."""
+        return self.post(op, *args, frame=False).result(timeout)
+
+    def sync(self, timeout: float | None = 300.0) -> None:
+        """Waits until the server has served every message sent so far."""
+        if self.alive:
+            self.call("get", "", timeout=timeout)
+
+    def stop(self) -> None:
+        """Ends the server (its stdin closes; it releases its context and exits)."""
+        self._closed = True
+        self._outbox.put(None)
+
+    # --- the threads ------------------------------------------------------------------------
+    def _write(self, proc: subprocess.Popen) -> None:
+        while True:
+            message = self._outbox.get()
+            try:
+                if message is None:
+                    proc.stdin.close()
+                    return
+                write(proc.stdin, message)
+            except (OSError, ValueError):  # the server has gone: the reader says so
+                return
+
+    def _read(self, proc: subprocess.Popen) -> None:
+        why = ""
+        while True:
+            try:
+                message = recv(proc.stdout)
+            except (EOFError, OSError):
+                break
+            except Exception as exc:  # noqa: BLE001 - a garbled reply: end, and say so
+                why = f"{type(exc).__name__}: {exc}"
+                break
+            kind = message[0]
+            if kind == "frame":
+                self._on_frame(*message[1:])
+            elif kind == "done":
+                _, mid, ok, value = message
+                with self._lock:
+                    future, _progress = self._futures.pop(mid, (None, None))
+                if future is not None:
+                    if ok:
+                        future.set_result(value)
+                    else:
+                        future.set_exception(value)
+            elif kind == "progress":
+                with self._lock:
+                    _future, progress = self._futures.get(message[1], (None, None))
+                if progress is not None:
+                    progress(message[2])
+            elif kind == "started":
+                self._on_started(message[1], message[2])
+        with self._lock:
+            futures, self._futures = list(self._futures.values()), {}
+        for future, _progress in futures:
+            future.set_exception(RuntimeError("the renderer has stopped"))
+        if not self._closed:
+            code = proc.wait()
+            self._closed = True
+            self._on_ended(why or f"the render process ended (exit status {code})")
+
+
+class RemoteRenderer:
+    """The server's renderer (or an object within it) read and called from the editor: data
+    attributes come back as values, objects as another RemoteRenderer, calls run there."""
+
+    def __init__(self, process: RenderProcess, path: str = "") -> None:
+        object.__setattr__(self, "_process", process)
+        object.__setattr__(self, "_path", path)
+
+    def _at(self, name: str) -> str:
+        return f"{self._path}.{name}" if self._path else name
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        value = self._process.call("get", self._at(name))
+        if isinstance(value, Remote):
+            return RemoteRenderer(self._process, value.path)
+        return value
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        self._process.call("set", self._at(name), value)
+
+    def __call__(self, *args, **kwargs) -> Any:
+        return self._process.call("call", self._path, args, kwargs)
