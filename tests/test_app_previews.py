@@ -36,8 +36,9 @@ def test_pattern_nodes_get_thumbnails_that_follow_value_edits(qtbot, app_env):  
     assert before != after
     canvas.select_nodes(["edge"])
     assert "edge" in previews.images()
-    previews.refresh()
-    assert canvas.scene().node_item("mask_noise")._preview is not None
+    previews.refresh()  # evaluated on the worker thread, shown when it is done
+    qtbot.waitUntil(lambda: canvas.scene().node_item("mask_noise")._preview is not None,
+                    timeout=30000)
 
 
 def test_preview_sphere_faces_the_viewer():

@@ -358,7 +358,8 @@ class LayersPanel(QWidget):
         self._timer.setInterval(0)
         self._timer.timeout.connect(self.rebuild)
         controller.changed.connect(self._on_change)
-        controller.documentReplaced.connect(self.rebuild)
+        controller.documentReplaced.connect(self._rebuild_all)
+        self._built: tuple | None = None  # what the rows were built from
         self.rebuild()
 
     # --- model -----------------------------------------------------------------------------
@@ -380,8 +381,25 @@ class LayersPanel(QWidget):
         elif event.kind == ChangeKind.VALUE and s is not None and s.node_id in event.node_ids:
             self.refresh_values()
 
+    def _rebuild_all(self) -> None:
+        """Another document: every row built again."""
+        self._built = None
+        self.rebuild()
+
     def rebuild(self) -> None:
+        """The rows, built again only when what they show has changed (the stack, its layers
+        or their settings: building a row's widgets costs ~15 ms, and a structural edit
+        anywhere in the graph comes here); opacity values are set in place."""
         s = self.stack
+        if s is not None:
+            node = self.controller.document.graph.nodes[s.node_id]
+            key = (s.node_id, repr(s.layers), repr(node.settings.get("layers", [])))
+            if key == self._built and self.list.count() == len(s.layers):
+                self.refresh_values()
+                return
+            self._built = key
+        else:
+            self._built = None
         selected = self.selected_layer()
         self.list.clear()
         self.empty.setVisible(s is None)
