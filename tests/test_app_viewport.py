@@ -188,6 +188,7 @@ def test_a_material_that_never_compiled_shows_no_other_documents_shader(window, 
     assert "cannot connect float to MaterialAttributes" in notice
     assert window.viewport.failure.isVisible()
     # The GLSL panel shows no other document's code, and says so; Diagnostics list the error.
+    window.code.ensure_current()  # what the panel shows when it is opened
     code = window.code.text.toPlainText()
     assert "does not compile" in window.code.info.text()
     assert "void main" not in code and "cannot connect float" in code

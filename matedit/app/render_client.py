@@ -169,8 +169,12 @@ class RenderProcess:
             futures, self._futures = list(self._futures.values()), {}
         for future, _progress in futures:
             future.set_exception(RuntimeError("the renderer has stopped"))
-        if not self._closed:
+        try:
+            code = proc.wait(timeout=10)  # reaped: no zombie left behind
+        except subprocess.TimeoutExpired:
+            proc.kill()
             code = proc.wait()
+        if not self._closed:
             self._closed = True
             self._on_ended(why or f"the render process ended (exit status {code})")
 
