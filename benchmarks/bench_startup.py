@@ -106,13 +106,12 @@ def editor_child(timeout_s: float = 90.0) -> int:
     def on_frame() -> None:
         now = time.monotonic()
         marks.setdefault("first_frame", now)
-        renderer = view.renderer
-        if renderer is not None and getattr(renderer, "_program", None) is not None:
+        info = view.frame_info  # what the picture painted shows, read as it was drawn
+        if info is not None and info.has_material:
             marks.setdefault("material_frame", now)
-            # a tree without deferred environments has it from the first frame
-            if getattr(view, "environment_ready", True) and "environment_frame" not in marks:
+            if info.environment_name and "environment_frame" not in marks:
                 marks["environment_frame"] = now
-                QTimer.singleShot(0, app.quit)  # not from inside paintGL
+                QTimer.singleShot(0, app.quit)  # not from inside the paint
 
     view.frameDrawn.connect(on_frame)
     QTimer.singleShot(int(timeout_s * 1000), app.quit)

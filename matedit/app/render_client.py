@@ -48,6 +48,7 @@ class RenderProcess:
         self._lock = threading.Lock()
         self._futures: dict[int, tuple[Future, Callable[[float], None] | None]] = {}
         self._outbox: queue.Queue = queue.Queue()
+        self._held: list[bytes] | None = []  # messages posted before `start`
         self._proc: subprocess.Popen | None = None
         self._closed = False
 
@@ -59,9 +60,11 @@ class RenderProcess:
     def alive(self) -> bool:
         return self._proc is not None and self._proc.poll() is None and not self._closed
 
-    def start(self, init: dict) -> None:
-        """Starts the server with `init` (matedit.render.server.Server.start), then sends the
-        messages posted before."""
+    def launch(self) -> None:
+        """Starts the server process without waiting: it imports and makes its GL context
+        while the editor builds its window; `start` then sends what it draws with."""
+        if self._proc is not None:
+            return
         import matedit
 
         env = dict(os.environ)
@@ -77,19 +80,23 @@ class RenderProcess:
         self._proc = proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                              env=env)
         weakref.finalize(self, _end, proc)  # a client dropped without stop(): no orphan
-        pending = []
-        while True:
-            try:
-                pending.append(self._outbox.get_nowait())
-            except queue.Empty:
-                break
-        self._outbox.put(encode(("init", init)))
-        for message in pending:
-            self._outbox.put(message)
         threading.Thread(target=self._write, args=(proc,), daemon=True,
                          name="matedit-render-send").start()
         threading.Thread(target=self._read, args=(proc,), daemon=True,
                          name="matedit-render-receive").start()
+
+    @property
+    def initialised(self) -> bool:
+        return self._held is None
+
+    def start(self, init: dict) -> None:
+        """Sends `init` (matedit.render.server.Server.start), launching the server first if
+        it is not running, then the messages posted before."""
+        self.launch()
+        held, self._held = self._held or [], None
+        self._outbox.put(encode(("init", init)))
+        for message in held:
+            self._outbox.put(message)
 
     def post(self, op: str, *args, frame: bool = True,
              progress: Callable[[float], None] | None = None) -> Future:
@@ -107,6 +114,9 @@ class RenderProcess:
             return future
         with self._lock:
             self._futures[mid] = (future, progress)
+            if self._held is not None:  # before `start`: sent after the init
+                self._held.append(message)
+                return future
         self._outbox.put(message)
         return future
 

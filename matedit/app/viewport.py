@@ -80,6 +80,10 @@ class ViewportWidget(QWidget):
     # GL work between two looks at the messages while reference mode accumulates (ms; None:
     # matedit.render.server.BUDGET_MS)
     slice_budget_ms: float | None = None
+    # start the render process when the widget is made, not when it is first shown (the
+    # editor's window: its start-up overlaps the window's; tests that never show a window
+    # set it off)
+    launch_early = True
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -97,6 +101,8 @@ class ViewportWidget(QWidget):
         _PROCESSES.add(self._proc)
         proc = self._proc
         self.destroyed.connect(lambda *_: proc.stop())
+        if self.launch_early:
+            proc.launch()  # imports and its GL context while the window is built
         self._running = False  # the renderer is up in its process
         self._pending_material = None  # the last material posted (what the first frame shows)
         self._has_material = False
@@ -129,7 +135,7 @@ class ViewportWidget(QWidget):
 
     def showEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().showEvent(event)
-        if not self._proc.started:
+        if not self._proc.initialised:
             s = self.settings
             try:
                 self._proc.start({
@@ -224,7 +230,7 @@ class ViewportWidget(QWidget):
 
     def update(self, *args) -> None:
         """A new frame from the render thread (and a repaint meanwhile)."""
-        if not args and self._proc.started:
+        if not args and self._proc.initialised:
             self._post("get", "", frame=True)
         super().update(*args)
 

@@ -125,12 +125,20 @@ class Server:
             send(self.out, ("done", message[1], False,
                             RuntimeError(f"cannot send the reply: {exc}")))
 
-    def start(self, init: dict) -> None:
+    def prepare(self) -> None:
+        """What needs no word from the editor, done while it builds its window: the imports
+        and the GL context."""
         from matedit.render.context import headless_context
+        from matedit.render.renderer import Renderer  # noqa: F401 - imported now, used at start
+
+        self.ctx = headless_context()
+
+    def start(self, init: dict) -> None:
         from matedit.render.renderer import Renderer
 
         self.budget_ms = float(init.get("budget_ms") or BUDGET_MS)
-        self.ctx = headless_context()
+        if self.ctx is None:
+            self.prepare()
         r = Renderer(self.ctx, size=tuple(init["size"]), samples=4, environment=None,
                      warm_up=bool(init.get("warm_up", True)))
         r.set_mesh(init.get("mesh", "sphere"))
@@ -145,6 +153,10 @@ class Server:
 
     def serve(self, inp) -> None:
         threading.Thread(target=self._read, args=(inp,), daemon=True).start()
+        try:
+            self.prepare()
+        except Exception:  # noqa: BLE001, S110 - tried again, and reported, at start
+            self.ctx = None
         init = self.inbox.get()
         if init is None:
             return
