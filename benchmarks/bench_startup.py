@@ -93,6 +93,9 @@ def editor_available() -> bool:
 def editor_child(timeout_s: float = 90.0) -> int:
     from PySide6.QtCore import QTimer
 
+    from matedit.app.render_client import prelaunch
+
+    prelaunch()  # as `matedit` does before it imports the editor
     from matedit.app.app import make_application
     from matedit.app.compile_service import MaterialCompiler
     from matedit.app.main_window import MainWindow

@@ -193,6 +193,9 @@ def open_editor(argv: list[str]) -> int:
             raise UsageError(str(exc)) from None
         if doc.is_function:
             raise UsageError(f"{path}: is a material function; open a material that uses it")
+    from matedit.app.render_client import prelaunch
+
+    prelaunch()  # the viewport's render process starts while the editor imports and builds
     from matedit.app.app import quit_after_first_frame, run
 
     if os.environ.get(QUIT_AFTER_FIRST_FRAME):

@@ -65,9 +65,10 @@ class CompileWorker(QObject):
 
     `warm_up` (default off: the viewport links and draws in its own render process, so a
     warm-up only moves the driver's JIT from one process to another; nothing is warmed while
-    MESA_SHADER_CACHE_DISABLE is set) has the viewport's programs warmed after each compile when `submit` is given the viewport's state
-    (asked from that thread, done in matedit.render.warmup's child process); `warmed` lists
-    (generation, asking thread, WarmReply), for tests."""
+    MESA_SHADER_CACHE_DISABLE is set) has the viewport's programs warmed after each compile
+    when `submit` is given the viewport's state (asked from that thread, done in
+    matedit.render.warmup's child process); `warmed` lists (generation, asking thread,
+    WarmReply), for tests."""
 
     finished = Signal(object)
     _done = Signal(object)  # emitted on the worker thread, delivered queued

@@ -25,7 +25,10 @@ from pathlib import Path
 from typing import Any
 
 from matedit.render.pipe import encode, recv, write
-from matedit.render.server import SERVER_ENV, Remote
+
+
+def _nothing(*_args) -> None:
+    """A callback not bound yet."""
 
 
 def _end(proc: subprocess.Popen) -> None:
@@ -41,9 +44,10 @@ class RenderProcess:
     """The render server's client (the module docstring). `on_frame(pixels, info, ms)`,
     `on_started(problem, lights)` and `on_ended(problem)` are called on the reader thread."""
 
-    def __init__(self, on_frame: Callable[..., None], on_started: Callable[..., None],
-                 on_ended: Callable[[str], None]) -> None:
-        self._on_frame, self._on_started, self._on_ended = on_frame, on_started, on_ended
+    def __init__(self, on_frame: Callable[..., None] | None = None,
+                 on_started: Callable[..., None] | None = None,
+                 on_ended: Callable[[str], None] | None = None) -> None:
+        self.bind(on_frame, on_started, on_ended)
         self._ids = itertools.count(1)
         self._lock = threading.Lock()
         self._futures: dict[int, tuple[Future, Callable[[float], None] | None]] = {}
@@ -51,6 +55,12 @@ class RenderProcess:
         self._held: list[bytes] | None = []  # messages posted before `start`
         self._proc: subprocess.Popen | None = None
         self._closed = False
+
+    def bind(self, on_frame, on_started, on_ended) -> None:
+        """The callbacks (before `start`: nothing comes back until the server has its init)."""
+        self._on_frame = on_frame or _nothing
+        self._on_started = on_started or _nothing
+        self._on_ended = on_ended or _nothing
 
     @property
     def started(self) -> bool:
@@ -66,6 +76,7 @@ class RenderProcess:
         if self._proc is not None:
             return
         import matedit
+        from matedit.render.server import SERVER_ENV
 
         env = dict(os.environ)
         if getattr(sys, "frozen", False):  # a PyInstaller bundle: its entry point serves
@@ -189,6 +200,30 @@ class RenderProcess:
             self._on_ended(why or f"the render process ended (exit status {code})")
 
 
+_SPARE: RenderProcess | None = None
+
+
+def prelaunch() -> None:
+    """Starts a render process now, before the editor imports Qt and builds its window, for
+    the first viewport to take (`take_prelaunched`): its imports and GL context overlap the
+    editor's own start-up."""
+    global _SPARE
+    if _SPARE is None:
+        spare = RenderProcess()
+        try:
+            spare.launch()
+        except OSError:  # the viewport starts its own, and says why if that fails too
+            return
+        _SPARE = spare
+
+
+def take_prelaunched() -> RenderProcess | None:
+    """The process `prelaunch` started (once), or None."""
+    global _SPARE
+    spare, _SPARE = _SPARE, None
+    return spare if spare is not None and spare.alive else None
+
+
 class RemoteRenderer:
     """The server's renderer (or an object within it) read and called from the editor: data
     attributes come back as values, objects as another RemoteRenderer, calls run there."""
@@ -203,6 +238,8 @@ class RemoteRenderer:
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__"):
             raise AttributeError(name)
+        from matedit.render.server import Remote
+
         value = self._process.call("get", self._at(name))
         if isinstance(value, Remote):
             return RemoteRenderer(self._process, value.path)

@@ -30,7 +30,7 @@ from PySide6.QtCore import QCoreApplication, QEventLoop, QObject, QPointF, QRect
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import QWidget
 
-from matedit.app.render_client import RemoteRenderer, RenderProcess
+from matedit.app.render_client import RemoteRenderer, RenderProcess, take_prelaunched
 
 if TYPE_CHECKING:
     from matedit.render.server import FrameInfo
@@ -97,7 +97,8 @@ class ViewportWidget(QWidget):
         self._bridge.ended.connect(self._on_ended, Qt.ConnectionType.QueuedConnection)
         self._bridge.call.connect(lambda fn: fn(), Qt.ConnectionType.QueuedConnection)
         bridge = self._bridge
-        self._proc = RenderProcess(bridge.frame.emit, bridge.started.emit, bridge.ended.emit)
+        self._proc = take_prelaunched() or RenderProcess()
+        self._proc.bind(bridge.frame.emit, bridge.started.emit, bridge.ended.emit)
         _PROCESSES.add(self._proc)
         proc = self._proc
         self.destroyed.connect(lambda *_: proc.stop())
