@@ -23,9 +23,8 @@ def frame(qtbot, view) -> np.ndarray:
     """The viewport's own framebuffer after one more frame, as (H, W, 3) floats in [0, 1]."""
     from PySide6.QtGui import QImage
 
-    n = view.frames
-    view.update()
-    qtbot.waitUntil(lambda: view.frames > n, timeout=10000)
+    serial = view.request_frame()  # a picture drawn after every change sent so far
+    qtbot.waitUntil(lambda: view.shown_serial >= serial > 0, timeout=30000)
     img = view.current_image().convertToFormat(QImage.Format.Format_RGB888)
     h, w, bpl = img.height(), img.width(), img.bytesPerLine()
     arr = np.frombuffer(img.constBits(), np.uint8, count=h * bpl).reshape(h, bpl)

@@ -118,6 +118,7 @@ class RenderProcess:
             future.set_exception(RuntimeError("the renderer is not running"))
             return future
         mid = next(self._ids)
+        future.mid = mid  # type: ignore[attr-defined]
         try:  # here, so that what cannot be sent fails its own future, not the pipe
             message = encode((mid, op, args, frame))
         except Exception as exc:  # noqa: BLE001 - pickle raises several kinds

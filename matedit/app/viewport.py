@@ -126,6 +126,7 @@ class ViewportWidget(QWidget):
         self._image: QImage | None = None
         self._new_frame = False
         self.frame_info: FrameInfo | None = None  # what the last picture shows
+        self.shown_serial = 0  # the serial of the picture painted last (request_frame)
         self._compare = None  # (compiled, uniforms, textures) of an A/B split's A side
         self._split = 0.5
 
@@ -230,10 +231,17 @@ class ViewportWidget(QWidget):
         self._do("resize", *self._size_px())
 
     def update(self, *args) -> None:
-        """A new frame from the render thread (and a repaint meanwhile)."""
-        if not args and self._proc.initialised:
-            self._post("get", "", frame=True)
+        """A new frame from the render process (and a repaint meanwhile)."""
+        if not args:
+            self.request_frame()
         super().update(*args)
+
+    def request_frame(self) -> int:
+        """Asks the render process for a frame; returns the serial number that the picture
+        painted after it reaches (`shown_serial`), 0 before the process has its init."""
+        if not self._proc.initialised:
+            return 0
+        return int(getattr(self._post("get", "", frame=True), "mid", 0))
 
     def _on_frame(self, pixels, info, ms: float) -> None:
         h, w = pixels.shape[:2]
@@ -265,6 +273,8 @@ class ViewportWidget(QWidget):
         if self._new_frame:
             self._new_frame = False
             self.frames += 1
+            if self.frame_info is not None:
+                self.shown_serial = self.frame_info.serial
             self.frameDrawn.emit()
             if self._environment_state == "pending" and self.running:
                 self._load_environment()  # once the first frame is on screen

@@ -53,6 +53,7 @@ class FrameInfo:
     has_material: bool
     environment_name: str
     size: tuple[int, int]
+    serial: int  # the last message served before the frame was drawn: it shows all up to it
 
 
 @dataclass(frozen=True)
@@ -229,7 +230,7 @@ class Server:
         info = FrameInfo(r.mode, int(r.accumulated_frames), int(r.reference_frames),
                          int(r.reference_samples), converged,
                          None if mean is None else float(mean), bool(r.has_material),
-                         str(r.environment_name), (w, h))
+                         str(r.environment_name), (w, h), self._message_id)
         self._last_shown = time.perf_counter()
         send(self.out, ("frame", np.ascontiguousarray(pixels), info,
                         (self._last_shown - t0) * 1e3))
