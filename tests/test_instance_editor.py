@@ -40,9 +40,8 @@ def _renderer(qtbot, editor):
 
 
 def _frame(qtbot, editor):
-    n = editor.view.frames
-    editor.view.update()
-    qtbot.waitUntil(lambda: editor.view.frames > n, timeout=20000)
+    serial = editor.view.request_frame()  # a picture after every change sent so far
+    qtbot.waitUntil(lambda: editor.view.shown_serial >= serial > 0, timeout=20000)
 
 
 def test_create_override_reset_switch_save_reopen(window, qtbot, tmp_path):

@@ -19,7 +19,8 @@ from matedit.resources import graphs_dir
 pytestmark = [pytest.mark.gui, pytest.mark.usefixtures("app_env")]
 
 SAMPLE = graphs_dir() / "materials" / "rusty_painted_metal.json"
-SLOW_S = 0.6  # each compile sleeps this long on the worker (time.sleep lets the UI run)
+SLOW_S = 2.0  # each compile sleeps this long on the worker (longer than a frame of the
+# render process on a loaded 2-core machine, so a frame is drawn meanwhile)
 
 
 @pytest.fixture
@@ -72,7 +73,7 @@ def test_a_slow_compile_never_blocks_the_ui_and_the_old_program_stays(window, qt
 
     view = window.viewport.view
     renderer = view.renderer
-    old = renderer._compiled
+    old = renderer._compiled.structure_hash  # the program drawn before the edit
     threads: list = []
     _slow_compiles(window, threads)
     delivered = []
@@ -85,17 +86,17 @@ def test_a_slow_compile_never_blocks_the_ui_and_the_old_program_stays(window, qt
     frames = view.frames
     _structural_edit(window, "renamed_for_test")
     assert window.compiler.worker.pending
-    assert renderer._compiled is old  # nothing swapped yet
+    assert renderer._compiled.structure_hash == old  # nothing swapped yet
     view.update()
     qtbot.waitUntil(lambda: view.frames > frames, timeout=5000)  # drawn meanwhile, old program
-    assert renderer._compiled is old
+    assert renderer._compiled.structure_hash == old
     qtbot.waitUntil(lambda: bool(delivered), timeout=10000)
     timer.stop()
     assert threads and all(t is not threading.main_thread() for t in threads)
     # the event loop ran throughout the compile (a blocked UI thread would tick ~once)
     assert len(ticks) >= 10
-    assert renderer._compiled is delivered[-1]
-    assert renderer._compiled.structure_hash != old.structure_hash
+    assert renderer._compiled.structure_hash == delivered[-1].structure_hash
+    assert renderer._compiled.structure_hash != old
     assert any(u.name == "p_renamed_for_test" for u in renderer._compiled.ir.uniforms)
 
 
@@ -111,7 +112,8 @@ def test_a_newer_edit_supersedes_a_pending_one(window, qtbot):
     assert len(delivered) == 1
     names = {u.name for u in delivered[0].ir.uniforms}
     assert "p_second_name" in names and "p_first_name" not in names
-    assert window.viewport.view.renderer._compiled is delivered[0]
+    assert window.viewport.view.renderer._compiled.structure_hash == \
+        delivered[0].structure_hash
     # reading `current` waits for nothing now, and is the delivered one
     assert window.compiler.current is delivered[0]
 
@@ -134,7 +136,7 @@ def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qt
 
     view = window.viewport.view
     renderer = view.renderer
-    old = renderer._compiled
+    old = renderer._compiled.structure_hash  # the program drawn before the edit
     threads: list = []
     _slow_compiles(window, threads, warm_up=True)
     order: list[str] = []
@@ -159,7 +161,7 @@ def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qt
     frames = view.frames
     view.update()
     qtbot.waitUntil(lambda: view.frames > frames, timeout=10000)
-    assert renderer._compiled is old  # drawn while warming: still the last good program
+    assert renderer._compiled.structure_hash == old  # drawn while warming: the last good one
     qtbot.waitUntil(lambda: "delivered" in order, timeout=120000)  # the child starts first
     timer.stop()
     assert order == ["warmed", "delivered"]  # swapped only once the warm-up was done
@@ -169,7 +171,7 @@ def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qt
     assert asking is not threading.main_thread()
     assert reply.ok, reply.error
     assert reply.pid not in (0, os.getpid())  # another process: no GIL shared with the UI
-    assert renderer._compiled is not old
+    assert renderer._compiled.structure_hash != old
     assert any(u.name == "p_warmed_name" for u in renderer._compiled.ir.uniforms)
     # the child drew the very program the viewport now draws
     assert reply.program == _viewport_program_hash(renderer)

@@ -239,15 +239,15 @@ class RemoteRenderer:
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__"):
             raise AttributeError(name)
-        from matedit.render.server import Remote
-
-        value = self._process.call("get", self._at(name))
-        if isinstance(value, Remote):
-            return RemoteRenderer(self._process, value.path)
-        return value
+        return self._wrap(self._process.call("get", self._at(name)))
 
     def __setattr__(self, name: str, value: Any) -> None:
         self._process.call("set", self._at(name), value)
 
     def __call__(self, *args, **kwargs) -> Any:
-        return self._process.call("call", self._path, args, kwargs)
+        return self._wrap(self._process.call("call", self._path, args, kwargs))
+
+    def _wrap(self, value: Any) -> Any:
+        from matedit.render.server import Remote
+
+        return RemoteRenderer(self._process, value.path) if isinstance(value, Remote) else value

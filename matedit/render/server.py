@@ -23,6 +23,7 @@ last one. The process ends when its stdin closes. No Qt here.
 
 from __future__ import annotations
 
+import itertools
 import pickle
 import queue
 import sys
@@ -37,6 +38,7 @@ from matedit.render.pipe import recv, send
 
 DISPLAY_INTERVAL_S = 0.25  # reference accumulation sends its progress this often
 BUDGET_MS = 40.0  # GL work between two looks at the messages while accumulating
+KEPT = 64  # objects returned by calls that the server keeps for the editor to read
 SERVER_ENV = "MATEDIT_RENDER_SERVER"  # set for a frozen bundle's child: serve, not the CLI
 
 
@@ -80,11 +82,31 @@ def _plain(value: Any) -> bool:
     return fields is not None and all(_plain(getattr(value, f)) for f in fields)
 
 
-def _resolve(root: Any, path: str) -> Any:
-    obj = root
+def _resolve(s: Server, path: str) -> Any:
+    """The renderer's attribute at a dotted path; a path that starts with `@N.` starts from
+    the object a call returned (kept by `_keep`)."""
+    head, _, rest = path.partition(".")
+    if head.startswith("@"):
+        obj, path = s.kept[int(head[1:])], rest
+    else:
+        obj = s.r
     for part in filter(None, path.split(".")):
         obj = getattr(obj, part)
     return obj
+
+
+def _keep(s: Server, value: Any, path: str) -> Any:
+    """`value` if it is data, else a Remote naming it (an object a call returned is kept, the
+    last KEPT of them, so that the editor can read it further)."""
+    if _plain(value):
+        return value
+    if not path.startswith("@") and "(" not in path:
+        return Remote(path, type(value).__name__)
+    key = next(s.keys)
+    s.kept[key] = value
+    while len(s.kept) > KEPT:
+        s.kept.pop(next(iter(s.kept)))
+    return Remote(f"@{key}", type(value).__name__)
 
 
 def apply_settings(r, intensity: float, background: bool, blur: float, energy: bool) -> None:
@@ -108,6 +130,8 @@ class Server:
         self._dirty = False
         self._last_shown = 0.0
         self._message_id = 0  # the message being served (its progress replies name it)
+        self.kept: dict[int, Any] = {}  # objects calls returned, read further by the editor
+        self.keys = itertools.count(1)
 
     # --- messages ---------------------------------------------------------------------------
     def _read(self, inp) -> None:
@@ -246,18 +270,17 @@ class Server:
 
 # --- the operations a message names: op(server, *args) -> a reply value ----------------------
 def _call(s: Server, path: str, args: tuple = (), kwargs: dict | None = None) -> Any:
-    value = _resolve(s.r, path)(*args, **(kwargs or {}))
-    return value if _plain(value) else None
+    value = _resolve(s, path)(*args, **(kwargs or {}))
+    return None if value is None else _keep(s, value, path + "()")
 
 
 def _get(s: Server, path: str) -> Any:
-    value = _resolve(s.r, path)
-    return value if _plain(value) else Remote(path, type(value).__name__)
+    return _keep(s, _resolve(s, path), path)
 
 
 def _set(s: Server, path: str, value: Any) -> None:
     head, _, name = path.rpartition(".")
-    setattr(_resolve(s.r, head), name, value)
+    setattr(_resolve(s, head), name, value)
 
 
 def _values(s: Server, uniforms: dict | None, textures: dict) -> list[str]:
