@@ -59,6 +59,14 @@ def _stop_render_processes() -> None:
         process.stop()
 
 
+def _emit(signal, *args) -> None:
+    """Emits from a thread of the render client; nothing when the viewport has gone."""
+    try:
+        signal.emit(*args)
+    except RuntimeError:  # its bridge was deleted with the viewport
+        pass
+
+
 class _Bridge(QObject):
     """Carries what the render process says to the UI thread (queued: the slots run there)."""
 
@@ -98,7 +106,8 @@ class ViewportWidget(QWidget):
         self._bridge.call.connect(lambda fn: fn(), Qt.ConnectionType.QueuedConnection)
         bridge = self._bridge
         self._proc = take_prelaunched() or RenderProcess()
-        self._proc.bind(bridge.frame.emit, bridge.started.emit, bridge.ended.emit)
+        self._proc.bind(lambda *a: _emit(bridge.frame, *a), lambda *a: _emit(bridge.started, *a),
+                        lambda *a: _emit(bridge.ended, *a))
         _PROCESSES.add(self._proc)
         proc = self._proc
         self.destroyed.connect(lambda *_: proc.stop())
@@ -174,11 +183,14 @@ class ViewportWidget(QWidget):
 
             def done(f) -> None:
                 exc = f.exception()
-                if exc is not None:
-                    if failed is not None:
-                        bridge.call.emit(lambda: failed(exc))
-                elif then is not None:
-                    bridge.call.emit(lambda: then(f.result()))
+                try:
+                    if exc is not None:
+                        if failed is not None:
+                            bridge.call.emit(lambda: failed(exc))
+                    elif then is not None:
+                        bridge.call.emit(lambda: then(f.result()))
+                except RuntimeError:  # the viewport has gone meanwhile: nobody to tell
+                    pass
 
             future.add_done_callback(done)
         return future
@@ -464,11 +476,14 @@ class ViewportWidget(QWidget):
 
         def report(fraction: float) -> None:  # on the client's reader thread
             if progress is not None:
-                bridge.call.emit(lambda: progress(fraction))
+                try:
+                    bridge.call.emit(lambda: progress(fraction))
+                except RuntimeError:  # the viewport has gone meanwhile
+                    pass
 
         future = self._post("environment", spec, True, progress=report)
         loop = QEventLoop()
-        future.add_done_callback(lambda _f: bridge.call.emit(loop.quit))
+        future.add_done_callback(lambda _f: _emit(bridge.call, loop.quit))
         if not future.done():
             loop.exec()
         future.result()
