@@ -29,9 +29,9 @@ print(json.dumps({"rc": rc, "loaded": sorted(m for m in heavy if m in sys.module
 """
 
 
-def _probe(*args: str) -> dict:
+def _probe(*args: str, heavy: str = ",".join(HEAVY)) -> dict:
     env = dict(os.environ, PYTHONPATH=str(ROOT), PYTHONDONTWRITEBYTECODE="1")
-    r = subprocess.run([sys.executable, "-c", PROBE, ",".join(HEAVY), *args], cwd=ROOT, env=env,
+    r = subprocess.run([sys.executable, "-c", PROBE, heavy, *args], cwd=ROOT, env=env,
                        capture_output=True, text=True, timeout=120)
     return json.loads(r.stdout.strip().splitlines()[-1])
 
@@ -66,6 +66,15 @@ def test_the_node_modules_do_not_read_numpy_at_import():
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
                        text=True, timeout=120)
     assert r.stdout.strip() == "ok", r.stderr
+
+
+def test_a_material_is_validated_without_the_instance_reader():
+    out = _probe("validate", str(ROOT / "graphs" / "materials" / "car_paint.json"),
+                 heavy="matedit.io.instance")
+    assert out["rc"] == 0 and out["loaded"] == []
+    out = _probe("validate", str(ROOT / "graphs" / "instances" / "worn_paint_red.json"),
+                 heavy="matedit.io.instance")
+    assert out["rc"] == 0 and out["loaded"] == ["matedit.io.instance"]
 
 
 def test_a_command_line_imports_only_its_commands_module():

@@ -28,6 +28,8 @@ from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
 
 FORMATS = {"matedit.material": DocumentKind.MATERIAL, "matedit.function": DocumentKind.FUNCTION}
 FORMAT_OF = {v: k for k, v in FORMATS.items()}
+INSTANCE_FORMAT = "matedit.instance"  # matedit.io.instance's files (named here for readers
+# that tell the kinds apart without importing that module)
 MAX_FILE_BYTES = 64 * 1024 * 1024
 
 
