@@ -34,7 +34,6 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import secrets
 import shutil
 import stat
 import zlib
@@ -114,6 +113,8 @@ def _host_tag() -> str:
 def temporary_name(name: str, kind: str = "tmp") -> str:
     """A fresh temporary name for `name`: `.<name>.<pid>-<host>.<random>.<kind>`, with at
     most `_NAME_KEPT` bytes of `name` (whole characters)."""
+    import secrets  # here: a reader of documents (matedit validate) never needs it
+
     kept = name[:_NAME_KEPT]
     while len(kept.encode("utf-8", "surrogateescape")) > _NAME_KEPT:
         kept = kept[:-1]
