@@ -194,17 +194,26 @@ class _Lowerer:
     def lower(self) -> None:
         gnodes = self.doc.graph.nodes
         role_of = nodes.role_of
+        handlers: dict[str, Any] = {}  # kind -> the method that lowers its nodes
         for nid in self.a.order:
             node = gnodes[nid]
+            if not node.muted:
+                handler = handlers.get(node.kind)
+                if handler is None:
+                    role = role_of(node.kind)
+                    special = getattr(self, f"_k_{role.name.lower()}", None) if role else None
+                    handler = handlers[node.kind] = special or self._generic
+                handler(nid, node)
+                continue
             role = role_of(node.kind)
-            if node.muted and role == Role.LAYER_STACK:
+            if role == Role.LAYER_STACK:
                 # A bypassed stack is its base layer: every layer above it hidden.
                 layers = node.settings.get("layers")
                 if isinstance(layers, list):
                     node = dataclasses.replace(node, settings={**node.settings, "layers": [
                         e if i == 0 or not isinstance(e, dict) else {**e, "visible": False}
                         for i, e in enumerate(layers)]})
-            elif node.muted and nodes.can_bypass(node.kind):
+            elif nodes.can_bypass(node.kind):
                 self._bypass(nid)
                 continue
             special = getattr(self, f"_k_{role.name.lower()}", None) if role else None
