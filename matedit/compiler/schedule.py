@@ -114,8 +114,8 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
                     names(a.name)
             else:
                 visit(a)
-        out = op.out
-        steps.append((op, [(names(out(p).name), t) for p, t in op.outs]))
+        out_vars = op.out_vars()  # op.out of each output, at once
+        steps.append((op, [(names(out_vars[p].name), t) for p, t in op.outs]))
     for _, _, e in scope.outputs:
         names.visit(e)
     return ScopePlan(scope, main, names, steps)

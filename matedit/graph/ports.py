@@ -24,11 +24,14 @@ class NodePorts:
     outputs: tuple[Port, ...]
     _by_input: dict[str, Port] = field(init=False, repr=False, compare=False)
     _by_output: dict[str, Port] = field(init=False, repr=False, compare=False)
+    # whether any input has hard bounds (Port.limits): values of the others are not checked
+    limited: bool = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # first match wins, as a linear scan would (duplicates are reported elsewhere)
         object.__setattr__(self, "_by_input", {p.name: p for p in reversed(self.inputs)})
         object.__setattr__(self, "_by_output", {p.name: p for p in reversed(self.outputs)})
+        object.__setattr__(self, "limited", any(p.limits is not None for p in self.inputs))
 
     def input(self, name: str) -> Port | None:
         return self._by_input.get(name)

@@ -200,7 +200,7 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             rule = d.ports_rule  # node_ports' fast path: most kinds' ports are the kind's own
             p = ports[nid] = static_ports(node.kind) if rule is None or rule in STATIC_RULES \
                 else node_ports(node, resolver, doc)
-            if node.values:
+            if node.values and p.limited:
                 diags.extend(_limit_warnings(node, p, f))
         except PortError as exc:
             diags.append(error(str(exc), nid, exc.field, f))
