@@ -68,9 +68,10 @@ def test_the_node_modules_do_not_read_numpy_at_import():
     assert r.stdout.strip() == "ok", r.stderr
 
 
-def test_a_material_is_validated_without_the_instance_reader():
+def test_a_material_is_validated_without_the_instance_reader_or_the_writers():
+    # nor the file writers (matedit.io.atomic) and the command-input checks (matedit.io.inputs)
     out = _probe("validate", str(ROOT / "graphs" / "materials" / "car_paint.json"),
-                 heavy="matedit.io.instance")
+                 heavy="matedit.io.instance,matedit.io.atomic,matedit.io.inputs")
     assert out["rc"] == 0 and out["loaded"] == []
     out = _probe("validate", str(ROOT / "graphs" / "instances" / "worn_paint_red.json"),
                  heavy="matedit.io.instance")

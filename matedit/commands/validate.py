@@ -7,7 +7,7 @@ from pathlib import Path
 from matedit.cli_support import report
 from matedit.graph.validate import Severity, analyse
 from matedit.io.document import INSTANCE_FORMAT, FileResolver, FormatError, load
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 
 def register(sub) -> None:
@@ -36,7 +36,7 @@ def empty_folders(files: list[str]) -> list[Path]:
 
 def _format_of(path: Path) -> str | None:
     """The `format` of a small JSON file, cheaply, to pick its reader; None if unknown."""
-    from matedit.io.atomic import read_bounded
+    from matedit.io.bounded import read_bounded
     from matedit.io.jsontext import parse_json
 
     try:

@@ -28,9 +28,9 @@ from matedit.graph.names import identifier_problem
 from matedit.graph.numbers import gpu_number_problem
 from matedit.graph.ports import (
     STATIC_RULES,
+    TYPE_PLANS,
     FunctionResolver,
     NodePorts,
-    TYPE_PLANS,
     PortError,
     generic_types,
     layer_entries,

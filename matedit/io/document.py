@@ -21,7 +21,7 @@ from typing import Any
 from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.nodes import Role, role_of
 from matedit.io import library
-from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
+from matedit.io.bounded import UnsafeFileError, read_bounded
 from matedit.io.errors import FormatError
 from matedit.io.jsontext import JSONTextError, check_json_value, parse_json
 from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
@@ -342,7 +342,7 @@ def save(doc: MaterialDocument, path: str | os.PathLike | None = None) -> Path:
     target = Path(path) if path is not None else doc.path
     if target is None:
         raise ValueError("no path to save to")
-    from matedit.io.atomic import saves_to_opened_path
+    from matedit.io.atomic import atomic_write_text, saves_to_opened_path
 
     follow = saves_to_opened_path(target, doc.path)
     rebase_references(doc, target)
