@@ -122,10 +122,13 @@ class Op:
     data: dict[str, Any] = field(default_factory=dict)
 
     def __init__(self, var: str, node: str, kind: str, args: list[Expr],
-                 outs: list[tuple[str, PortType]], data: dict[str, Any] | None = None) -> None:
+                 outs: list[tuple[str, PortType]], data: dict[str, Any] | None = None,
+                 out_vars: dict[str, Var] | None = None) -> None:
         # the generated __init__'s work, without its default-factory sentinel test
         self.var, self.node, self.kind, self.args, self.outs = var, node, kind, args, outs
         self.data = {} if data is None else data
+        if out_vars is not None:  # what out_vars() would make, made by the caller already
+            self.__dict__["_out_vars"] = out_vars
 
     def out(self, port: str) -> Var:
         cache = self.__dict__.get("_out_vars")

@@ -281,13 +281,18 @@ class _Lowerer:
                     if type(e) is not Var or e.name != var or e.type != src_type:
                         e = Var(var, src_type)
                 args.append(e if e.type == t else convert(e, t))
+        # the outputs, their variables (Op.out_vars) and sockets (self.emit), in one walk
         out_types = a.out_types[nid]
-        outs = [(p.name, out_types[p.name]) for p in a.ports[nid].outputs]
+        outs = []
+        out_vars: dict[str, Var] = {}
+        for p in a.ports[nid].outputs:
+            name = p.name
+            t = out_types[name]
+            outs.append((name, t))
+            out_vars[name] = sockets[(nid, name)] = Var(f"{nid}.{name}", t)
         self.ctx.kinds.add(node.kind)
-        op = Op(nid, nid, node.kind, args, outs)
-        self.scope.ops.append(op)  # self.emit(op), inlined
-        for port, v in op.out_vars().items():
-            sockets[(nid, port)] = v
+        op = Op(nid, nid, node.kind, args, outs, None, out_vars)
+        self.scope.ops.append(op)
         if role == Role.MAKE_ATTRIBUTES:
             self.written[op.out("attributes").key()] = ALL_FIELDS - unwritten
         elif role in (Role.MASK_BLEND, Role.HEIGHT_BLEND):
