@@ -141,8 +141,9 @@ def _scope(w: Writer, plan: ScopePlan) -> None:
     plain: dict[str, tuple | None] = {}  # kind -> (format, joined) where op_line is one format
     for op, outs in plan.steps:
         kind = op.kind
-        fast = plain.get(kind, 0)
-        if fast == 0:
+        if kind in plain:
+            fast = plain[kind]
+        else:
             _, impl, formatted = _row(op)
             fast = plain[kind] = formatted if not impl.assigns else None
         if fast is not None and len(outs) == 1:

@@ -114,17 +114,14 @@ def fold_and_merge(scope: Scope) -> None:
         # is a literal (then _fold, which wants all of them literals, is tried)
         args, var_names, some_lit = [], [], not op.args
         for a in op.args:
-            ta = type(a)
-            if ta is Var:
+            if type(a) is Var:
                 a = get(a.name, a)
-                ta = type(a)
-            elif ta is Splat:
+            elif type(a) is Splat:
                 a = _subst(a, table)
-                ta = type(a)
             args.append(a)
-            if ta is Var:
+            if type(a) is Var:
                 var_names.append(a.name)
-            elif ta is Lit:
+            elif type(a) is Lit:
                 some_lit = True
         op.args = args
         if some_lit:
