@@ -252,15 +252,28 @@ def _strip_preview_blocks(lines: list[str], defines: tuple[str, ...]) -> list[st
     return out
 
 
+# (entry file, defines) -> (mtime_ns, size, text): an entry file is read again only once
+# edited, as the library files are (matedit.glsl.include)
+_ENTRY_TEXTS: dict[tuple[str, tuple[str, ...]], tuple[int, int, str]] = {}
+
+
 def entry_text(entry: Entry, defines: tuple[str, ...] = ()) -> str:
     """The entry file's `main`, without its leading comment lines (the file's documentation)
     and without the preview blocks the caller's `defines` do not ask for."""
     from matedit.resources import shaders_dir
 
-    lines = (shaders_dir() / "entry" / f"{entry.value}.frag.glsl").read_text().split("\n")
+    path = shaders_dir() / "entry" / f"{entry.value}.frag.glsl"
+    st = path.stat()
+    key = (str(path), tuple(defines))
+    hit = _ENTRY_TEXTS.get(key)
+    if hit is not None and hit[0] == st.st_mtime_ns and hit[1] == st.st_size:
+        return hit[2]
+    lines = path.read_text().split("\n")
     while lines and lines[0].startswith("//"):
         lines.pop(0)
-    return "\n".join(_strip_preview_blocks(lines, tuple(defines))).rstrip("\n")
+    text = "\n".join(_strip_preview_blocks(lines, tuple(defines))).rstrip("\n")
+    _ENTRY_TEXTS[key] = (st.st_mtime_ns, st.st_size, text)
+    return text
 
 
 def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap]:
