@@ -77,7 +77,8 @@ def parse_json_text(text: str, file: str | None = None) -> Any:
 
 def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
     """Parse a document from JSON text (`path` anchors its relative references)."""
-    return from_dict(parse_json_text(text, file), file, path)
+    # parse_json checked depth and numbers already: from_dict's check, without its walk
+    return _from_dict(parse_json_text(text, file), file, path)
 
 
 def read_document_text(path: str | os.PathLike) -> str:
