@@ -27,7 +27,7 @@ class Expr:
         raise NotImplementedError
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Var(Expr):
     name: str
     type: PortType
@@ -41,7 +41,7 @@ class Var(Expr):
         return self.name
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Param(Expr):
     name: str
     type: PortType
@@ -55,7 +55,7 @@ class Param(Expr):
         return self.name
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Lit(Expr):
     value: Any  # float or tuple of floats, or None for MaterialAttributes defaults
     type: PortType
@@ -69,7 +69,7 @@ class Lit(Expr):
         return f"lit:{self.type}:{self.value!r}"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Uni(Expr):
     name: str
     type: PortType
@@ -91,7 +91,7 @@ class SurfaceUV(Expr):
         return "surface:uv"  # no `node.port` name has a colon
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Splat(Expr):
     expr: Expr
     type: PortType
@@ -105,7 +105,7 @@ class Splat(Expr):
         return f"{self.type}({self.expr.key()})"
 
 
-@dataclass
+@dataclass(init=False)  # its own __init__
 class Op:
     """One evaluation: a catalogue node kind, or one of the compiler's own ops.
 
