@@ -157,7 +157,9 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The whole command line's parser; with `only` (a command name), one holding that
+    command's parser alone: what parsing a command line that names it needs."""
     parser = _Parser(prog="matedit", description="Node-based material editor (Karis 2013). "
                      "`matedit [FILE]` opens the editor (no FILE: the built-in sample "
                      "layered material); the commands below run headless.")
@@ -166,8 +168,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
     from matedit import commands
 
-    for register in commands.REGISTRY:
-        register(sub)
+    commands.register(sub, only)
     return parser
 
 
@@ -207,9 +208,11 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     _hold_standard_fds()
     try:
-        parser = build_parser()
-        editor = not argv or (not argv[0].startswith("-") and argv[0] not in
-                              subcommand_names(parser))
+        from matedit.commands import COMMANDS
+
+        named = argv[0] if argv and argv[0] in COMMANDS else None
+        parser = build_parser(named)
+        editor = not argv or (not argv[0].startswith("-") and named is None)
     except Exception as exc:  # pragma: no cover - a broken command registry
         report("error", f"internal: {type(exc).__name__}: {exc}")
         return 1

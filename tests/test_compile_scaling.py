@@ -76,6 +76,17 @@ def test_compile_calls_grow_linearly_with_the_graph():
     assert not worst, worst
 
 
+def test_compile_calls_per_node_stay_low():
+    # Python function calls a node of a 1,000-node compile, the fixed part included: 39.6
+    # before issue 29's second pass (per-kind plans in analyse, fused operand and output
+    # walks, the common GLSL line written inline), 17.9 after it; a change that brings back
+    # per-node calls (a helper per operand, a per-node lookup through a function) fails here
+    # before a benchmark sees it
+    doc = _material(1000)
+    per_node = sum(_calls(doc).values()) / len(doc.graph.nodes)
+    assert per_node <= 20, per_node
+
+
 def test_one_validation_and_one_order_per_compile():
     counts = _calls(_material(300))
     by_name = Counter()

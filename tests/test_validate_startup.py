@@ -24,13 +24,14 @@ import json, sys
 from matedit.cli import main
 heavy = sys.argv[1].split(",")
 rc = main(sys.argv[2:])
-print(json.dumps({"rc": rc, "loaded": sorted(m for m in heavy if m in sys.modules)}))
+print(json.dumps({"rc": rc, "loaded": sorted(m for m in heavy if m in sys.modules),
+                  "commands": sorted(m for m in sys.modules if m.startswith("matedit.commands."))}))
 """
 
 
-def _probe(*args: str) -> dict:
+def _probe(*args: str, heavy: str = ",".join(HEAVY)) -> dict:
     env = dict(os.environ, PYTHONPATH=str(ROOT), PYTHONDONTWRITEBYTECODE="1")
-    r = subprocess.run([sys.executable, "-c", PROBE, ",".join(HEAVY), *args], cwd=ROOT, env=env,
+    r = subprocess.run([sys.executable, "-c", PROBE, heavy, *args], cwd=ROOT, env=env,
                        capture_output=True, text=True, timeout=120)
     return json.loads(r.stdout.strip().splitlines()[-1])
 
@@ -41,7 +42,7 @@ def _probe(*args: str) -> dict:
                                     "functions"])
 def test_the_valid_path_imports_no_heavy_module(sample):
     out = _probe("validate", str(ROOT / "graphs" / sample))
-    assert out == {"rc": 0, "loaded": []}
+    assert out == {"rc": 0, "loaded": [], "commands": ["matedit.commands.validate"]}
 
 
 def test_an_invalid_file_still_gets_the_librarys_error(tmp_path):
@@ -65,3 +66,40 @@ def test_the_node_modules_do_not_read_numpy_at_import():
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True,
                        text=True, timeout=120)
     assert r.stdout.strip() == "ok", r.stderr
+
+
+def test_a_material_is_validated_without_the_instance_reader_or_the_writers():
+    # nor the file writers (matedit.io.atomic) and the command-input checks (matedit.io.inputs)
+    out = _probe("validate", str(ROOT / "graphs" / "materials" / "car_paint.json"),
+                 heavy="matedit.io.instance,matedit.io.atomic,matedit.io.inputs")
+    assert out["rc"] == 0 and out["loaded"] == []
+    out = _probe("validate", str(ROOT / "graphs" / "instances" / "worn_paint_red.json"),
+                 heavy="matedit.io.instance")
+    assert out["rc"] == 0 and out["loaded"] == ["matedit.io.instance"]
+
+
+def test_a_command_line_imports_only_its_commands_module():
+    # the other subcommands' modules (and what they import) are no part of validate's start
+    out = _probe("validate", "--help")
+    assert out["commands"] == ["matedit.commands.validate"]
+    out = _probe("--help")  # the whole list: every command's module
+    from matedit.commands import COMMANDS
+
+    assert set(out["commands"]) >= {f"matedit.commands.{m}" for m in COMMANDS.values()}
+
+
+def test_the_command_table_is_the_parsers():
+    # COMMANDS names each command's module; a parser registered under another name, or a
+    # command missing from the table, fails here (and the order is the help's)
+    import argparse
+
+    from matedit.cli import build_parser
+    from matedit.commands import COMMANDS
+
+    def names(parser):
+        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+        return list(sub.choices)
+
+    assert names(build_parser()) == list(COMMANDS)
+    for name in COMMANDS:
+        assert names(build_parser(name)) == [name]

@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli_support import UsageError, report
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 
 def register(subparsers) -> None:

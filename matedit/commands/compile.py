@@ -11,7 +11,7 @@ from pathlib import Path
 
 from matedit.cli_support import UsageError, report
 from matedit.compiler.targets import CROSS_TARGETS, TARGETS
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 
 def register(sub) -> None:

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli_support import UsageError, one_line
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 MIN_SIZE = 16
 LABEL_BAND = 26  # pixels: the band under a tile that holds its name

@@ -25,7 +25,7 @@ from pathlib import Path
 from matedit.cli_support import UsageError, report
 from matedit.commands import export_check
 from matedit.commands.bake import compile_error, load_material, parse_size, progress_printer
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 SUFFIXES = (".gltf", ".glb", ".mtlx", ".usda", ".usdz")
 SURFACES = ("open_pbr_surface", "standard_surface", "gltf_pbr")

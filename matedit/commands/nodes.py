@@ -12,7 +12,7 @@ import sys
 from typing import Any
 
 from matedit.cli_support import UsageError
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 GLSL_TARGETS = ("glsl330", "glsl450", "essl300")
 SCHEMA_VERSION = 1

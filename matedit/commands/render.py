@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from matedit.cli_support import UsageError
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 # matedit.shading.views.VIEWS, spelled here so parsing the command line imports no numpy
 # (tests/test_views.py checks the two agree)

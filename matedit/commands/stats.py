@@ -23,7 +23,7 @@ from matedit.interop.stats import (
     over_budget,
     permutations,
 )
-from matedit.io.inputs import declare_inputs
+from matedit.io.input_kinds import declare_inputs
 
 OVER_BUDGET = 3  # the exit status of a material over a --budget-* budget (docs/cli.md)
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 from matedit.cli_support import report
 from matedit.graph.validate import Severity, analyse
-from matedit.io.document import FileResolver, FormatError, load
-from matedit.io.inputs import declare_inputs
+from matedit.io.document import INSTANCE_FORMAT, FileResolver, FormatError, load
+from matedit.io.input_kinds import declare_inputs
 
 
 def register(sub) -> None:
@@ -36,7 +36,7 @@ def empty_folders(files: list[str]) -> list[Path]:
 
 def _format_of(path: Path) -> str | None:
     """The `format` of a small JSON file, cheaply, to pick its reader; None if unknown."""
-    from matedit.io.atomic import read_bounded
+    from matedit.io.bounded import read_bounded
     from matedit.io.jsontext import parse_json
 
     try:
@@ -48,7 +48,8 @@ def _format_of(path: Path) -> str | None:
 
 def problems(path: Path, resolver: FileResolver) -> list[tuple[str, str]]:
     """(severity, message) lines for one file."""
-    if _format_of(path) == "matedit.lightrig":
+    fmt = _format_of(path)
+    if fmt == "matedit.lightrig":
         from matedit.io.rig import RigError
         from matedit.io.rig import load as load_rig
 
@@ -57,6 +58,13 @@ def problems(path: Path, resolver: FileResolver) -> list[tuple[str, str]]:
         except RigError as exc:
             return [("error", str(exc))]
         return []
+    if isinstance(fmt, str) and fmt != INSTANCE_FORMAT:
+        # read in full and not an instance: the instance reader is not needed (nor imported)
+        try:
+            doc = load(path)
+        except FormatError as exc:
+            return [("error", str(exc))]
+        return _document_problems(path, doc, resolver)
     from matedit.io.instance import InstanceError, is_instance_file, load_instance, resolve
 
     lines = []
@@ -71,6 +79,13 @@ def problems(path: Path, resolver: FileResolver) -> list[tuple[str, str]]:
             doc = load(path)
     except (FormatError, InstanceError) as exc:
         return [("error", str(exc))]
+    return lines + _document_problems(path, doc, resolver)
+
+
+def _document_problems(path: Path, doc, resolver: FileResolver) -> list[tuple[str, str]]:
+    """(severity, message) lines of a loaded material or function: its analysis, and for a
+    material without errors, its compile."""
+    lines = []
     diagnostics = analyse(doc, resolver).diagnostics
     for d in diagnostics:
         lines.append((d.severity.value, f"{d.file or path}: {d.format()}"))

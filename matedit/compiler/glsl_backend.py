@@ -94,9 +94,8 @@ def _format(template: str, op: Op) -> tuple[str, bool]:
 _ROWS: dict[str, tuple] = {}
 
 
-def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
-    """One op as one line: a declaration of its value, or declarations and a call that fills
-    them through `out` parameters."""
+def _row(op: Op) -> tuple:
+    """(definition or None, ops row, _format of its value template or None) of op's kind."""
     kind = op.kind
     d = nodes.REGISTRY.get(kind)  # a catalogue kind's GLSL is its definition's
     row = _ROWS.get(kind)
@@ -104,7 +103,13 @@ def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
         impl = ops.implementation(kind)
         template = impl.glsl if impl.glsl is not None else d.inline if d is not None else None
         row = _ROWS[kind] = (d, impl, _format(template, op) if template is not None else None)
-    _, impl, formatted = row
+    return row
+
+
+def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
+    """One op as one line: a declaration of its value, or declarations and a call that fills
+    them through `out` parameters."""
+    d, impl, formatted = _row(op)
     taken = names.taken
     args = [taken[a.name] if type(a) is Var else expr(a, names) for a in op.args]
     if formatted is not None:
@@ -132,8 +137,25 @@ def _scope(w: Writer, plan: ScopePlan) -> None:
         w.add(f"void {scope.name}({', '.join(params)}) {{")
         w.add(f"    // material function {scope.name}")
     lines, line_nodes, source = w.lines, w.map, scope.source
+    taken = names.taken
+    plain: dict[str, tuple | None] = {}  # kind -> (format, joined) where op_line is one format
     for op, outs in plan.steps:
-        text = "    " + op_line(op, outs, names)
+        kind = op.kind
+        if kind in plain:
+            fast = plain[kind]
+        else:
+            _, impl, formatted = _row(op)
+            fast = plain[kind] = formatted if not impl.assigns else None
+        if fast is not None and len(outs) == 1:
+            # op_line of a value template, inlined (most ops of a large graph)
+            args = [taken[a.name] if type(a) is Var else expr(a, names) for a in op.args]
+            (name, t), = outs
+            fmt, joined = fast
+            type_name = TYPE_NAMES[t]
+            value = fmt.format(args, type_name, ", ".join(args) if joined else "", op.data)
+            text = f"    {type_name} {name} = {value};"
+        else:
+            text = "    " + op_line(op, outs, names)
         if "\n" in text:
             w.add(text, op.node, source)
         else:  # w.add of one line
@@ -230,15 +252,28 @@ def _strip_preview_blocks(lines: list[str], defines: tuple[str, ...]) -> list[st
     return out
 
 
+# (entry file, defines) -> (mtime_ns, size, text): an entry file is read again only once
+# edited, as the library files are (matedit.glsl.include)
+_ENTRY_TEXTS: dict[tuple[str, tuple[str, ...]], tuple[int, int, str]] = {}
+
+
 def entry_text(entry: Entry, defines: tuple[str, ...] = ()) -> str:
     """The entry file's `main`, without its leading comment lines (the file's documentation)
     and without the preview blocks the caller's `defines` do not ask for."""
     from matedit.resources import shaders_dir
 
-    lines = (shaders_dir() / "entry" / f"{entry.value}.frag.glsl").read_text().split("\n")
+    path = shaders_dir() / "entry" / f"{entry.value}.frag.glsl"
+    st = path.stat()
+    key = (str(path), tuple(defines))
+    hit = _ENTRY_TEXTS.get(key)
+    if hit is not None and hit[0] == st.st_mtime_ns and hit[1] == st.st_size:
+        return hit[2]
+    lines = path.read_text().split("\n")
     while lines and lines[0].startswith("//"):
         lines.pop(0)
-    return "\n".join(_strip_preview_blocks(lines, tuple(defines))).rstrip("\n")
+    text = "\n".join(_strip_preview_blocks(lines, tuple(defines))).rstrip("\n")
+    _ENTRY_TEXTS[key] = (st.st_mtime_ns, st.st_size, text)
+    return text
 
 
 def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap]:

@@ -27,7 +27,7 @@ class Expr:
         raise NotImplementedError
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Var(Expr):
     name: str
     type: PortType
@@ -41,7 +41,7 @@ class Var(Expr):
         return self.name
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Param(Expr):
     name: str
     type: PortType
@@ -55,7 +55,7 @@ class Param(Expr):
         return self.name
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Lit(Expr):
     value: Any  # float or tuple of floats, or None for MaterialAttributes defaults
     type: PortType
@@ -69,7 +69,7 @@ class Lit(Expr):
         return f"lit:{self.type}:{self.value!r}"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Uni(Expr):
     name: str
     type: PortType
@@ -91,7 +91,7 @@ class SurfaceUV(Expr):
         return "surface:uv"  # no `node.port` name has a colon
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
 class Splat(Expr):
     expr: Expr
     type: PortType
@@ -105,7 +105,7 @@ class Splat(Expr):
         return f"{self.type}({self.expr.key()})"
 
 
-@dataclass
+@dataclass(init=False)  # its own __init__
 class Op:
     """One evaluation: a catalogue node kind, or one of the compiler's own ops.
 
@@ -122,10 +122,13 @@ class Op:
     data: dict[str, Any] = field(default_factory=dict)
 
     def __init__(self, var: str, node: str, kind: str, args: list[Expr],
-                 outs: list[tuple[str, PortType]], data: dict[str, Any] | None = None) -> None:
+                 outs: list[tuple[str, PortType]], data: dict[str, Any] | None = None,
+                 out_vars: dict[str, Var] | None = None) -> None:
         # the generated __init__'s work, without its default-factory sentinel test
         self.var, self.node, self.kind, self.args, self.outs = var, node, kind, args, outs
         self.data = {} if data is None else data
+        if out_vars is not None:  # what out_vars() would make, made by the caller already
+            self.__dict__["_out_vars"] = out_vars
 
     def out(self, port: str) -> Var:
         cache = self.__dict__.get("_out_vars")

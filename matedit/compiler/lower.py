@@ -194,17 +194,26 @@ class _Lowerer:
     def lower(self) -> None:
         gnodes = self.doc.graph.nodes
         role_of = nodes.role_of
+        handlers: dict[str, Any] = {}  # kind -> the method that lowers its nodes
         for nid in self.a.order:
             node = gnodes[nid]
+            if not node.muted:
+                handler = handlers.get(node.kind)
+                if handler is None:
+                    role = role_of(node.kind)
+                    special = getattr(self, f"_k_{role.name.lower()}", None) if role else None
+                    handler = handlers[node.kind] = special or self._generic
+                handler(nid, node)
+                continue
             role = role_of(node.kind)
-            if node.muted and role == Role.LAYER_STACK:
+            if role == Role.LAYER_STACK:
                 # A bypassed stack is its base layer: every layer above it hidden.
                 layers = node.settings.get("layers")
                 if isinstance(layers, list):
                     node = dataclasses.replace(node, settings={**node.settings, "layers": [
                         e if i == 0 or not isinstance(e, dict) else {**e, "visible": False}
                         for i, e in enumerate(layers)]})
-            elif node.muted and nodes.can_bypass(node.kind):
+            elif nodes.can_bypass(node.kind):
                 self._bypass(nid)
                 continue
             special = getattr(self, f"_k_{role.name.lower()}", None) if role else None
@@ -272,13 +281,18 @@ class _Lowerer:
                     if type(e) is not Var or e.name != var or e.type != src_type:
                         e = Var(var, src_type)
                 args.append(e if e.type == t else convert(e, t))
+        # the outputs, their variables (Op.out_vars) and sockets (self.emit), in one walk
         out_types = a.out_types[nid]
-        outs = [(p.name, out_types[p.name]) for p in a.ports[nid].outputs]
+        outs = []
+        out_vars: dict[str, Var] = {}
+        for p in a.ports[nid].outputs:
+            name = p.name
+            t = out_types[name]
+            outs.append((name, t))
+            out_vars[name] = sockets[(nid, name)] = Var(f"{nid}.{name}", t)
         self.ctx.kinds.add(node.kind)
-        op = Op(nid, nid, node.kind, args, outs)
-        self.scope.ops.append(op)  # self.emit(op), inlined
-        for port, v in op.out_vars().items():
-            sockets[(nid, port)] = v
+        op = Op(nid, nid, node.kind, args, outs, None, out_vars)
+        self.scope.ops.append(op)
         if role == Role.MAKE_ATTRIBUTES:
             self.written[op.out("attributes").key()] = ALL_FIELDS - unwritten
         elif role in (Role.MASK_BLEND, Role.HEIGHT_BLEND):

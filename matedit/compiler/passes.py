@@ -108,16 +108,28 @@ def fold_and_merge(scope: Scope) -> None:
     table: dict[str, Expr] = {}
     seen: dict[str, Op] = {}
     kept: list[Op] = []
+    get = table.get
     for op in scope.ops:
-        op.args = args = [table.get(a.name, a) if type(a) is Var else _subst(a, table)
-                          for a in op.args]
-        # _fold only where some operand is a literal (it wants all of them literals)
-        lits = _fold(op) if not args or any(type(a) is Lit for a in args) else None
-        if lits is not None:
-            for (port, _), lit in zip(op.outs, lits):
-                table[op.out(port).name] = lit
-            continue
-        var_names = [a.name for a in args if type(a) is Var]
+        # one walk over the operands: substituted, their variables' names, and whether any
+        # is a literal (then _fold, which wants all of them literals, is tried)
+        args, var_names, some_lit = [], [], not op.args
+        for a in op.args:
+            if type(a) is Var:
+                a = get(a.name, a)
+            elif type(a) is Splat:
+                a = _subst(a, table)
+            args.append(a)
+            if type(a) is Var:
+                var_names.append(a.name)
+            elif type(a) is Lit:
+                some_lit = True
+        op.args = args
+        if some_lit:
+            lits = _fold(op)
+            if lits is not None:
+                for (port, _), lit in zip(op.outs, lits):
+                    table[op.out(port).name] = lit
+                continue
         if op.data or len(var_names) != len(args):
             k = op.key()
         else:  # op.key() of an op of Var operands and no data

@@ -106,7 +106,7 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
     for p, _ in scope.params:
         names.used.add(p)
     steps = []
-    visit, taken = names.visit, names.taken
+    visit, taken, used = names.visit, names.taken, names.used
     for op in scope.ops:
         for a in op.args:
             if type(a) is Var:  # names.visit of the common operand
@@ -114,8 +114,21 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
                     names(a.name)
             else:
                 visit(a)
-        out = op.out
-        steps.append((op, [(names(out(p).name), t) for p, t in op.outs]))
+        out_vars = op.out_vars()  # op.out of each output, at once
+        outs = []
+        for p, t in op.outs:
+            raw = out_vars[p].name
+            name = taken.get(raw)
+            if name is None:
+                # names(raw), inlined for a name of no "__" not yet used (the common case)
+                name = "l_" + raw.replace(".", "_")
+                if "__" in name or name in used:
+                    name = names(raw)
+                else:
+                    used.add(name)
+                    taken[raw] = name
+            outs.append((name, t))
+        steps.append((op, outs))
     for _, _, e in scope.outputs:
         names.visit(e)
     return ScopePlan(scope, main, names, steps)

@@ -24,11 +24,14 @@ class NodePorts:
     outputs: tuple[Port, ...]
     _by_input: dict[str, Port] = field(init=False, repr=False, compare=False)
     _by_output: dict[str, Port] = field(init=False, repr=False, compare=False)
+    # whether any input has hard bounds (Port.limits): values of the others are not checked
+    limited: bool = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # first match wins, as a linear scan would (duplicates are reported elsewhere)
         object.__setattr__(self, "_by_input", {p.name: p for p in reversed(self.inputs)})
         object.__setattr__(self, "_by_output", {p.name: p for p in reversed(self.outputs)})
+        object.__setattr__(self, "limited", any(p.limits is not None for p in self.inputs))
 
     def input(self, name: str) -> Port | None:
         return self._by_input.get(name)
@@ -332,6 +335,29 @@ def _generic_types(node: Node, plan: tuple, connected: dict[str, PortType]
 
 
 _GENERIC_TYPES: dict[tuple[str, PortType], tuple[dict, dict]] = {}
+
+# kind -> (its fixed types or None, its generic plan or None): resolve_types' first steps,
+# once a kind, for a caller that resolves many nodes (matedit.graph.validate.analyse)
+TYPE_PLANS: dict[str, tuple] = {}
+
+
+def type_plan(kind: str) -> tuple:
+    """(fixed, plan): `fixed` the (inputs, outputs) types of a kind whose types follow from
+    the kind alone; else `plan` its _generic_plan when it has no ports rule (then, for a node
+    with the kind's own ports, `generic_types(node, plan, connected)` is resolve_types'
+    answer); (None, None) for a kind that has a ports rule."""
+    hit = TYPE_PLANS.get(kind)
+    if hit is None:
+        if nodes.REGISTRY[kind].ports_rule is not None:
+            hit = (None, None)
+        else:
+            fixed = _concrete_types(kind)
+            hit = (fixed, None if fixed is not None else _generic_plan(kind))
+        TYPE_PLANS[kind] = hit
+    return hit
+
+
+generic_types = _generic_types
 
 
 def resolve_types(

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from enum import Enum
 
-from matedit.graph.numbers import gpu_number_problem
+from matedit.graph.numbers import FLOAT32_MAX, gpu_number_problem
 
 
 class PortType(str, Enum):
@@ -70,7 +70,11 @@ def coerce_value(t: PortType, value: object) -> float | list[float]:
 
     Raises ValueError with a short reason; callers add the file, node and field.
     """
-    n = t.components
+    n = _COMPONENTS[t._value_]
+    if type(value) is float and n and -FLOAT32_MAX <= value <= FLOAT32_MAX:
+        # the common case, the rest's answer at once: a finite float in float32's range (NaN
+        # fails both comparisons and takes the path below, which words its error)
+        return value if n == 1 else [value] * n
     if n == 0:
         raise ValueError(f"a {t} port holds no value")
     if isinstance(value, bool) or value is None:

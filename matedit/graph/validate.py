@@ -28,13 +28,16 @@ from matedit.graph.names import identifier_problem
 from matedit.graph.numbers import gpu_number_problem
 from matedit.graph.ports import (
     STATIC_RULES,
+    TYPE_PLANS,
     FunctionResolver,
     NodePorts,
     PortError,
+    generic_types,
     layer_entries,
     node_ports,
     resolve_types,
     static_ports,
+    type_plan,
 )
 from matedit.graph.types import PortType, coerce_value, conversion_reason
 
@@ -197,7 +200,7 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             rule = d.ports_rule  # node_ports' fast path: most kinds' ports are the kind's own
             p = ports[nid] = static_ports(node.kind) if rule is None or rule in STATIC_RULES \
                 else node_ports(node, resolver, doc)
-            if node.values:
+            if node.values and p.limited:
                 diags.extend(_limit_warnings(node, p, f))
         except PortError as exc:
             diags.append(error(str(exc), nid, exc.field, f))
@@ -216,12 +219,13 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             diags.append(error(f"link refers to missing node {missing!r}",
                                dst if dst in gnodes else None, dst_port, f))
             continue
+        # NodePorts.output and .input, inlined (two lookups a link)
         src_ports = ports.get(src)
-        if src_ports is not None and src_ports.output(src_port) is None:
+        if src_ports is not None and src_port not in src_ports._by_output:
             diags.append(error(f"node {src} has no output {src_port!r}", src, src_port, f))
             continue
         dst_ports = ports.get(dst)
-        if dst_ports is not None and dst_ports.input(dst_port) is None:
+        if dst_ports is not None and dst_port not in dst_ports._by_input:
             diags.append(error(f"node {dst} has no input {dst_port!r}", dst, dst_port, f))
             continue
         into = incoming[dst]
@@ -259,8 +263,15 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
                 blocked = True  # upstream already reported
                 continue
             connected[port] = t
-        try:
-            ins, outs = resolve_types(node, p, connected)
+        kind = node.kind
+        fixed, plan = TYPE_PLANS.get(kind) or type_plan(kind)
+        try:  # resolve_types, its common cases inlined
+            if fixed is not None:
+                ins, outs = fixed
+            elif plan is not None and plan[0] is p:
+                ins, outs = generic_types(node, plan, connected)
+            else:
+                ins, outs = resolve_types(node, p, connected)
         except ValueError as exc:
             diags.append(error(str(exc), nid, None, f))
             continue

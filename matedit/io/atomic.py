@@ -24,9 +24,9 @@ folder first removes the leftovers there of a process of this user and host that
 (killed with SIGKILL, or a machine that lost power), matching that exact pattern only and
 never following a link (`remove_leftovers`).
 
-Reads (`read_bounded`, `check_readable_file`): only regular files, with the size limit
-checked while reading (so /dev/zero cannot exhaust memory), and opened non-blocking (so a
-FIFO cannot hang the reader).
+Reads (`read_bounded`, `check_readable_file`, in `matedit.io.bounded` and named here too):
+only regular files, with the size limit checked while reading (so /dev/zero cannot exhaust
+memory), and opened non-blocking (so a FIFO cannot hang the reader).
 """
 
 from __future__ import annotations
@@ -34,16 +34,19 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import secrets
 import shutil
 import stat
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
+# the reading half, its own module (what a reader of documents imports); named here too
+from matedit.io.bounded import UnsafeFileError as UnsafeFileError
+from matedit.io.bounded import check_readable_file as check_readable_file
+from matedit.io.bounded import read_bounded as read_bounded
+
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)
-_NONBLOCK = getattr(os, "O_NONBLOCK", 0)
 _DIRECTORY = getattr(os, "O_DIRECTORY", 0)
 
 # The part of a file name kept in a temporary name: enough to recognise it, short enough
@@ -51,10 +54,6 @@ _DIRECTORY = getattr(os, "O_DIRECTORY", 0)
 _NAME_KEPT = 96
 _LEFTOVER = re.compile(r"\..+\.(?P<pid>[1-9][0-9]{0,9})-(?P<host>[0-9a-f]{8})\.[0-9a-f]{16}"
                        r"\.(?P<kind>tmp|tmpdir)", re.DOTALL)  # the whole name (fullmatch)
-
-
-class UnsafeFileError(OSError):
-    """A path that is not a regular file, or a file larger than allowed."""
 
 
 def saves_to_opened_path(target: str | os.PathLike, opened: str | os.PathLike | None) -> bool:
@@ -114,6 +113,8 @@ def _host_tag() -> str:
 def temporary_name(name: str, kind: str = "tmp") -> str:
     """A fresh temporary name for `name`: `.<name>.<pid>-<host>.<random>.<kind>`, with at
     most `_NAME_KEPT` bytes of `name` (whole characters)."""
+    import secrets  # here: a reader of documents (matedit validate) never needs it
+
     kept = name[:_NAME_KEPT]
     while len(kept.encode("utf-8", "surrogateescape")) > _NAME_KEPT:
         kept = kept[:-1]
@@ -392,47 +393,3 @@ def staged_outputs(folder: str | os.PathLike) -> Iterator[OutputSet]:
             with contextlib.suppress(OSError):
                 os.rmdir(made)
         raise
-
-
-def check_readable_file(path: str | os.PathLike) -> Path:
-    """Raise UnsafeFileError unless `path` names a regular file (links followed)."""
-    p = Path(path)
-    try:
-        st = os.stat(p)
-    except FileNotFoundError:
-        raise
-    if stat.S_ISDIR(st.st_mode):
-        raise IsADirectoryError(f"{p}: is a folder, not a file")
-    if not stat.S_ISREG(st.st_mode):
-        raise UnsafeFileError(f"{p}: is not a regular file (a device, FIFO or socket)")
-    return p
-
-
-def read_bounded(path: str | os.PathLike, limit: int) -> bytes:
-    """The bytes of a regular file of at most `limit` bytes, counted while reading."""
-    p = Path(path)
-    fd = os.open(p, os.O_RDONLY | _NONBLOCK | _CLOEXEC)
-    try:
-        st = os.fstat(fd)
-        if stat.S_ISDIR(st.st_mode):
-            raise IsADirectoryError(f"{p}: is a folder, not a file")
-        if not stat.S_ISREG(st.st_mode):
-            raise UnsafeFileError(f"{p}: is not a regular file (a device, FIFO or socket)")
-        if _NONBLOCK:
-            os.set_blocking(fd, True)
-        chunks, total = [], 0
-        while True:
-            chunk = os.read(fd, min(1 << 20, limit + 1 - total))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            total += len(chunk)
-            if total > limit:
-                raise UnsafeFileError(f"{p}: file is larger than {_size(limit)}")
-        return b"".join(chunks)
-    finally:
-        os.close(fd)
-
-
-def _size(n: int) -> str:
-    return f"{n >> 20} MiB" if n >= 1 << 20 else f"{n} bytes"

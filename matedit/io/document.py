@@ -21,13 +21,15 @@ from typing import Any
 from matedit.graph.model import Comment, DocumentKind, Link, MaterialDocument, Node, valid_id
 from matedit.graph.nodes import Role, role_of
 from matedit.io import library
-from matedit.io.atomic import UnsafeFileError, atomic_write_text, read_bounded
+from matedit.io.bounded import UnsafeFileError, read_bounded
 from matedit.io.errors import FormatError
 from matedit.io.jsontext import JSONTextError, check_json_value, parse_json
 from matedit.io.migrations import CURRENT_VERSION, MigrationError, migrate
 
 FORMATS = {"matedit.material": DocumentKind.MATERIAL, "matedit.function": DocumentKind.FUNCTION}
 FORMAT_OF = {v: k for k, v in FORMATS.items()}
+INSTANCE_FORMAT = "matedit.instance"  # matedit.io.instance's files (named here for readers
+# that tell the kinds apart without importing that module)
 MAX_FILE_BYTES = 64 * 1024 * 1024
 
 
@@ -75,7 +77,8 @@ def parse_json_text(text: str, file: str | None = None) -> Any:
 
 def loads(text: str, file: str | None = None, path: Path | None = None) -> MaterialDocument:
     """Parse a document from JSON text (`path` anchors its relative references)."""
-    return from_dict(parse_json_text(text, file), file, path)
+    # parse_json checked depth and numbers already: from_dict's check, without its walk
+    return _from_dict(parse_json_text(text, file), file, path)
 
 
 def read_document_text(path: str | os.PathLike) -> str:
@@ -340,7 +343,7 @@ def save(doc: MaterialDocument, path: str | os.PathLike | None = None) -> Path:
     target = Path(path) if path is not None else doc.path
     if target is None:
         raise ValueError("no path to save to")
-    from matedit.io.atomic import saves_to_opened_path
+    from matedit.io.atomic import atomic_write_text, saves_to_opened_path
 
     follow = saves_to_opened_path(target, doc.path)
     rebase_references(doc, target)

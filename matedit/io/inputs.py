@@ -21,13 +21,15 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
+# The kinds of input a command argument may name, and the declaration of a command's inputs:
+# matedit.io.input_kinds (what every command's parser needs, without the rest of this module)
+from matedit.io.input_kinds import INPUT_KINDS as INPUT_KINDS
+from matedit.io.input_kinds import declare_inputs as declare_inputs
+
 BUILTIN_MESHES = ("sphere", "cube", "plane", "cylinder")
 BUILTIN_ENVIRONMENTS = ("studio", "sky")
 BUILTIN_PREFIX = "builtin:"
 _BUILTINS = {"mesh": BUILTIN_MESHES, "environment": BUILTIN_ENVIRONMENTS}
-
-# The kinds of input a command argument may name (see `declare_inputs`).
-INPUT_KINDS = ("document", "documents", "mesh", "environment", "rig", "mtlx")
 
 
 class OverwriteError(ValueError):
@@ -183,18 +185,6 @@ def document_inputs(doc, resolver=None, include_self: bool = True) -> dict[Path,
             for g in environment_files(f) if key == "environment" else [f]:
                 found.setdefault(_real(g), what_ if g == f else "a cube face of the environment")
     return found
-
-
-def declare_inputs(parser, **kinds: str) -> None:
-    """Record on a command's parser which arguments name inputs, and of which kind:
-    'document' (a loaded material or instance, passed to `command_inputs`), 'documents'
-    (the files or folders of several), 'mesh', 'environment', 'rig' (a light-rig file, or
-    default/none) or 'mtlx' (a MaterialX document). A command that reads nothing says so
-    explicitly: `declare_inputs(p)`."""
-    bad = [k for k in kinds.values() if k not in INPUT_KINDS]
-    if bad:
-        raise ValueError(f"unknown input kinds {bad} (known: {', '.join(INPUT_KINDS)})")
-    parser.set_defaults(inputs=dict(kinds))
 
 
 _KIND_WHAT = {"mesh": "the mesh", "environment": "the environment", "rig": "the light rig",

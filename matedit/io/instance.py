@@ -42,6 +42,7 @@ from matedit.graph.numbers import describe_number, gpu_number_problem, gpu_numbe
 from matedit.io import library
 from matedit.io.atomic import atomic_write_text
 from matedit.io.document import (
+    INSTANCE_FORMAT,
     FormatError,
     check_saves,
     load,
@@ -53,7 +54,7 @@ from matedit.io.document import (
 from matedit.io.jsontext import JSONTextError, parse_json
 from matedit.io.migrations import CURRENT_VERSION
 
-FORMAT = "matedit.instance"
+FORMAT = INSTANCE_FORMAT
 MAX_CHAIN = 64  # parents deep; far beyond any real use, it bounds a hostile chain
 TYPES = ("scalar", "vector", "color", "texture", "switch")
 # Parameter kinds and their instance types, from the catalogue (NodeDef.parameter).

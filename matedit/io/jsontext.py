@@ -49,11 +49,40 @@ def _no_constants(name: str) -> Any:
 
 def _check_value(raw: Any) -> None:
     """Depth and 64-bit numbers of a parsed value, with an explicit stack (no recursion)."""
+    if _plainly_fine(raw):
+        return
     try:
         _walk(raw)
     except JSONTextError as exc:
         exc.value = raw
         raise
+
+
+def _plainly_fine(raw: Any) -> bool:
+    """True when `raw` passes `_walk`, found without its paths: level by level, each of the
+    types JSON parses to checked by exact type. False when something fails, nests too deep
+    or is of another type (a tuple, a subclass): `_walk` then decides, and words the error."""
+    level: list = [raw]
+    depth = 0
+    while level:
+        below: list = []
+        for value in level:
+            t = type(value)
+            if t is dict or t is list:
+                if depth >= MAX_DEPTH:
+                    return False
+                below.extend(value.values() if t is dict else value)
+            elif t is float:
+                if value - value != 0.0:  # an infinity or NaN (finite: exactly 0.0)
+                    return False
+            elif t is int:
+                if not -MAX_FLOAT_INT <= value <= MAX_FLOAT_INT:
+                    return False
+            elif t is not str and t is not bool and value is not None:
+                return False
+        level = below
+        depth += 1
+    return True
 
 
 def _walk(raw: Any) -> None:
