@@ -45,3 +45,7 @@ _.__class__
 
 # written through a property (MaterialCompiler.last_compile_ms), which vulture does not follow
 _._last_compile_ms
+
+# the viewport calls the render process's camera by name (ViewportWidget._do("camera.orbit"))
+_.orbit
+_.dolly

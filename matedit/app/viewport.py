@@ -394,10 +394,6 @@ class ViewportWidget(QWidget):
         self._mode = mode
         self._post("set", "mode", mode)
 
-    @property
-    def shading_view(self) -> str:
-        return self._view
-
     def set_view(self, view: str) -> None:
         """The view chooser's view (matedit.shading.views): one relink the first time each
         view is shown for a material (the programs are cached), a redraw after. A view that
