@@ -200,29 +200,58 @@ def test_culling_back_faces_keeps_the_deferred_image(gl_ctx, monkeypatch):
     culling: each back face lies behind a front face, which the depth test keeps."""
     from matedit.ibl import BakeSettings
     from matedit.render import Renderer
-    from matedit.render.mesh import GpuMesh
 
     small = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
     r = Renderer(gl_ctx, (96, 80), samples=4, environment="studio", bake_settings=small)
     try:
-        r.set_material(compile_document(load(MATERIALS / "worn_painted_steel.json"),
-                                        FileResolver()))
-        assert not r.is_forward
-        for mesh in ("sphere", "cube", "cylinder"):
-            r.set_mesh(mesh)
-            for yaw, pitch in ((30.0, 15.0), (200.0, -60.0)):
-                r.camera.yaw, r.camera.pitch = yaw, pitch
-                assert r._mesh.closed and r._mesh.seen_from_outside(r.camera, 96 / 80)
-                r.render()
-                culled = r.read_linear().copy()
-                with monkeypatch.context() as m:
-                    m.setattr(GpuMesh, "closed", property(lambda self: False))
-                    r.render()
-                    both = r.read_linear().copy()
-                assert both.max() > 0.05
-                rel = np.abs(culled - both) / np.maximum(1.0, np.abs(both))
-                # exact but for a sample on a silhouette edge that the fill rule gives to the
-                # back face's triangle (seen: at most 2 pixels of 49,152 at 256 x 192)
-                assert (rel.max(axis=2) > 1e-6).sum() <= 2, (mesh, yaw, pitch)
+        _same_with_and_without_culling(r, "worn_painted_steel", False, monkeypatch)
+        # forward (lobes beyond the G-buffer's), opaque: blending replaces, culling is exact
+        _same_with_and_without_culling(r, "varnished_oak", True, monkeypatch)
     finally:
         r.release()
+
+
+def test_translucent_materials_draw_both_sides(gl_ctx):
+    from graphs_util import link, material, node
+
+    from matedit.ibl import BakeSettings
+    from matedit.render import Renderer
+
+    d = material()
+    node(d, "o", "scalar_parameter", {"name": "alpha"}, {"value": 0.5})
+    node(d, "make", "make_attributes", values={"baseColor": [0.8, 0.4, 0.2]})
+    node(d, "out", "material_output")
+    link(d, "o", "value", "make", "opacity")
+    link(d, "make", "attributes", "out", "attributes")
+    small = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
+    r = Renderer(gl_ctx, (32, 32), samples=4, environment="studio", bake_settings=small)
+    try:
+        r.set_material(compile_document(d))
+        assert r.is_forward and not r.material.opaque  # the back faces show through
+        r.set_uniforms({"p_alpha": 1.0})
+        assert r.material.opaque
+    finally:
+        r.release()
+
+
+def _same_with_and_without_culling(r, name, forward, monkeypatch):
+    from matedit.render.mesh import GpuMesh
+
+    r.set_material(compile_document(load(MATERIALS / f"{name}.json"), FileResolver()))
+    assert r.is_forward == forward and r.material.opaque
+    for mesh in ("sphere", "cube", "cylinder"):
+        r.set_mesh(mesh)
+        for yaw, pitch in ((30.0, 15.0), (200.0, -60.0)):
+            r.camera.yaw, r.camera.pitch = yaw, pitch
+            assert r._mesh.closed and r._mesh.seen_from_outside(r.camera, 96 / 80)
+            r.render()
+            culled = r.read_linear().copy()
+            with monkeypatch.context() as m:
+                m.setattr(GpuMesh, "closed", property(lambda self: False))
+                r.render()
+                both = r.read_linear().copy()
+            assert both.max() > 0.05
+            rel = np.abs(culled - both) / np.maximum(1.0, np.abs(both))
+            # exact but for a sample on a silhouette edge that the fill rule gives to the
+            # back face's triangle (seen: at most 2 pixels of 49,152 at 256 x 192)
+            assert (rel.max(axis=2) > 1e-6).sum() <= 2, (name, mesh, yaw, pitch)
