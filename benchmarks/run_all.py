@@ -59,6 +59,18 @@ GOALS = {
 }
 
 
+def code_lines(text: str) -> int:
+    """Lines of GLSL code in a shader text: not blank, not only a comment, not a `#line`."""
+    return sum(1 for line in text.splitlines()
+               if line.strip() and not line.lstrip().startswith(("//", "#line")))
+
+
+def jit_share(row: dict) -> float:
+    """The share of a structural edit's total that the first frame spends beyond a plain
+    frame (first frame - next frame, over the total): llvmpipe's JIT at the first draw."""
+    return max(0.0, row["first_frame"] - row["steady_frame"]) / row["total"]
+
+
 def ms(seconds: float, digits: int = 0) -> str:
     return f"{seconds * 1000:.{digits}f}"
 
@@ -121,6 +133,12 @@ def child_gl(quick: bool) -> dict:
                     med["describe"] = eq.describe(mode)
                     row["mx_" + mode] = med
         row["steady_frame"] = frame_time(r, ctx, frames=3)
+        # the fragment shader the preview linked (GBUFFER, or forward the split-sum FORWARD)
+        text = r.programs.drawn_variant(compile_document(doc, FileResolver()), r.is_forward,
+                                        r.energy_compensation, r.view).fragment_text
+        row["fragment_bytes"] = len(text.encode())
+        row["fragment_lines"] = code_lines(text)
+        row["path"] = "forward" if r.is_forward else "deferred"
         rows.append(row)
         print(f"  structural edit {path.stem}: matedit {ms(tot)} ms"
               + (f", MaterialX {ms(row['mx_shaders']['total'])} ms" if "mx_shaders" in row
@@ -445,6 +463,9 @@ def structural_section(rep: Report, gl: dict, goals: list) -> None:
         rows.append([
             r["sample"], str(r.get("layers", "?")), ms(r["compile"], 1), ms(r["link"]),
             ms(r["first_frame"]), f"**{ms(r['total'])}**", ms(r["steady_frame"]),
+            f"{100 * jit_share(r):.0f} %",
+            f"{r['fragment_lines']:,} / {r['fragment_bytes'] / 1024:.1f}"
+            if "fragment_bytes" in r else "–",
             f"{ms(mxs['generate'], 1)} / {ms(mxs['link'])} / {ms(mxs['first_frame'])}"
             if mxs else "–",
             f"**{ms(mxs['total'])}**" if mxs else "–",
@@ -453,10 +474,17 @@ def structural_section(rep: Report, gl: dict, goals: list) -> None:
             f"{mxi['total'] / r['total']:.1f}×" if mxi else "–",
         ])
     rep.table(["sample", "layers", "matedit compile (ms)", "link (ms)", "first frame (ms)",
-               "matedit total (ms)", "matedit next frame (ms)",
+               "matedit total (ms)", "matedit next frame (ms)", "JIT share of the total",
+               "fragment lines / KiB",
                "MaterialX per-layer gen / link / first frame (ms)",
                "MaterialX per-layer total (ms)", "ratio", "MaterialX mixed inputs total (ms)",
-               "ratio"], "lrrrrrrrrrrr", rows)
+               "ratio"], "lrrrrrrrrrrrrr", rows)
+    rep.add("*JIT share*: the first frame minus the next frame (a plain frame of the same "
+            "program), over the total: what llvmpipe's compile at the first draw takes of the "
+            "edit. *Fragment lines / KiB*: the fragment shader the preview linked (the GBUFFER "
+            "entry on the deferred path, the split-sum FORWARD entry on the forward path), "
+            "lines of code (no blank, comment-only or `#line` lines) and its size as linked.")
+    rep.add()
     mx_rows = [r for r in gl["structural"] if "mx_shaders" in r]
     if mx_rows:
         rep.add("MaterialX's steady frame (second draw of the same program), per-layer "
@@ -760,9 +788,15 @@ def results_json(results: dict, uiblock: dict, meta: dict, startup: dict | None 
     gl = results.get("gl", {})
     out["meta"]["gl_renderer"] = gl.get("gl_renderer")
     out["meta"]["mesa_shader_cache_disable"] = os.environ.get("MESA_SHADER_CACHE_DISABLE")
-    per = {"structural_edit_ms": {}, "materialx_per_layer_ms": {}, "materialx_mixed_ms": {}}
+    per: dict[str, dict] = {"structural_edit_ms": {}, "materialx_per_layer_ms": {},
+                            "materialx_mixed_ms": {}, "structural_jit_share": {},
+                            "fragment_lines": {}, "fragment_bytes": {}}
     for r in gl.get("structural", []):
         per["structural_edit_ms"][r["sample"]] = r["total"] * 1e3
+        per["structural_jit_share"][r["sample"]] = jit_share(r)
+        if "fragment_bytes" in r:
+            per["fragment_lines"][r["sample"]] = r["fragment_lines"]
+            per["fragment_bytes"][r["sample"]] = r["fragment_bytes"]
         if "mx_shaders" in r:
             per["materialx_per_layer_ms"][r["sample"]] = r["mx_shaders"]["total"] * 1e3
         if "mx_inputs" in r:

@@ -31,6 +31,8 @@ _.repeat_x
 _.repeat_y
 _.repeat_z
 _.blend_func
+_.front_face
+_.cull_face
 
 # pygltflib writes this material field; MaterialX's XmlReadOptions reads this option.
 _.emissiveFactor

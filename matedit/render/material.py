@@ -9,6 +9,7 @@ import moderngl
 
 from matedit.compiler.api import CompiledMaterial
 from matedit.glsl.layout import BINDINGS
+from matedit.render.deferred import may_be_translucent
 from matedit.render.fullscreen import set_uniform
 from matedit.render.textures import TextureCache
 
@@ -24,11 +25,13 @@ class MaterialResources:
         self.values: dict[str, Any] = {}
         self.textures = TextureCache(ctx)
         self._params: moderngl.Buffer | None = None
+        self._opaque: bool | None = None  # `opaque`, until the material or a value changes
 
     def load(self, compiled: CompiledMaterial, values: dict[str, Any]) -> None:
         """A newly compiled material with these uniform values: its buffer, its textures."""
         self.compiled = compiled
         self.values = dict(values)
+        self._opaque = None
         size = max(MIN_PARAMS_BYTES, len(compiled.pack_uniforms()))
         if self._params is None or self._params.size != size:
             if self._params is not None:
@@ -41,7 +44,18 @@ class MaterialResources:
         """Updates the material's uniforms among `values` (others are ignored) in the buffer."""
         known = {u.name for u in self.compiled.ir.uniforms}
         self.values.update({k: v for k, v in values.items() if k in known})
+        self._opaque = None
         self._params.write(self.compiled.pack_uniforms(self.values))
+
+    @property
+    def opaque(self) -> bool:
+        """Whether every fragment the material draws has opacity 1 with the current values
+        (matedit.render.deferred.may_be_translucent, conservative): then the nearest surface
+        alone shows, as in the G-buffer. False before the first material."""
+        if self._opaque is None:
+            self._opaque = self.compiled is not None and \
+                not may_be_translucent(self.compiled.ir, self.values)
+        return self._opaque
 
     def texture_space(self, name: str) -> str:
         """The colour space the material sets for texture `name` (srgb when it has none)."""

@@ -50,6 +50,54 @@ class MeshData:
     def radius(self) -> float:
         return float(np.max(np.linalg.norm(self.positions, axis=1))) if len(self.positions) else 1.0
 
+    def is_closed(self) -> bool:
+        """Whether the triangles bound a solid, wound counter-clockwise seen from outside:
+        with vertices welded by position (UV seams split them), every directed edge is used
+        exactly once and its reverse once (a closed, consistently oriented 2-manifold), and
+        the enclosed signed volume is positive. Then, seen from outside, every back-facing
+        point lies behind a front-facing one, and an opaque pass may cull back faces."""
+        return _is_closed(self.positions, self.indices)
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The axis-aligned bounding box (min, max corners) of the positions."""
+        if not len(self.positions):
+            return np.zeros(3), np.zeros(3)
+        p = np.asarray(self.positions, dtype=np.float64)
+        return p.min(axis=0), p.max(axis=0)
+
+
+def _is_closed(positions: np.ndarray, indices: np.ndarray) -> bool:
+    """MeshData.is_closed (vectorised; positions welded on a grid of 1e-6 of the mesh's size,
+    so that seams whose copies differ by rounding weld; degenerate triangles, such as a UV
+    sphere's at its poles, are left out)."""
+    p = np.asarray(positions, dtype=np.float64)
+    tri = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
+    if not len(p) or not len(tri):
+        return False
+    extent = float(np.max(p.max(axis=0) - p.min(axis=0)))
+    if not np.isfinite(extent) or extent <= 0.0:
+        return False
+    cells = np.round(p / (extent * 1e-6)).astype(np.int64)
+    _, weld = np.unique(cells, axis=0, return_inverse=True)
+    weld = weld.reshape(-1)
+    t = weld[tri]
+    t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 2] != t[:, 0])]
+    if not len(t):
+        return False
+    n = int(weld.max()) + 1
+    a = np.concatenate([t[:, 0], t[:, 1], t[:, 2]])
+    b = np.concatenate([t[:, 1], t[:, 2], t[:, 0]])
+    edges = np.sort(a * n + b)
+    if np.any(edges[1:] == edges[:-1]):  # a directed edge used twice: not a 2-manifold
+        return False
+    reverse = b * n + a
+    pos = np.searchsorted(edges, reverse)
+    if np.any(pos >= len(edges)) or np.any(edges[np.minimum(pos, len(edges) - 1)] != reverse):
+        return False  # an edge without its opposite: a border, or inconsistent winding
+    v0, v1, v2 = (p[tri[:, k]] for k in range(3))
+    volume = float(np.einsum("ij,ij->i", v0, np.cross(v1, v2)).sum()) / 6.0
+    return volume > 0.0
+
 
 def _normalize(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
@@ -517,6 +565,8 @@ class GpuMesh:
         self.vbo = ctx.buffer(data.interleaved().tobytes())
         self.ibo = ctx.buffer(data.indices.astype("u4").tobytes())
         self._vaos: dict[int, object] = {}
+        self._closed: bool | None = None
+        self._bounds: tuple[np.ndarray, np.ndarray] | None = None
 
     def vao(self, program):
         key = program.glo
@@ -533,6 +583,26 @@ class GpuMesh:
             self._vaos[key] = self.ctx.vertex_array(
                 program, [(self.vbo, " ".join(fmt), *used)], self.ibo)
         return self._vaos[key]
+
+    @property
+    def closed(self) -> bool:
+        """MeshData.is_closed, computed once (at the first frame that asks)."""
+        if self._closed is None:
+            self._closed = self.data.is_closed()
+        return self._closed
+
+    def seen_from_outside(self, camera, aspect: float) -> bool:
+        """Whether no point of the mesh's bounding box lies within the near plane's reach of
+        `camera` (an OrbitCamera: eye, fov, near) at this aspect: then the eye is outside
+        the mesh and nothing of it is clipped open by the near plane."""
+        lo, hi = self._bounds if self._bounds is not None else self.data.bounds()
+        self._bounds = (lo, hi)
+        eye = np.asarray(camera.eye, dtype=np.float64)
+        gap = float(np.linalg.norm(np.maximum(np.maximum(lo - eye, eye - hi), 0.0)))
+        tan = math.tan(math.radians(camera.fov) / 2.0)
+        # the farthest a point of the near plane's rectangle lies from the eye
+        reach = camera.near * math.sqrt(1.0 + tan * tan * (1.0 + aspect * aspect))
+        return gap > 2.0 * reach
 
     def forget(self, program) -> None:
         vao = self._vaos.pop(program.glo, None)

@@ -84,6 +84,11 @@ class ProgramCache:
             self.table[variant.structure_hash] = prog
         return prog, variant
 
+    def drawn_variant(self, compiled: CompiledMaterial, forward: bool,
+                      compensation: bool = False, view: str = "lit") -> CompiledMaterial:
+        """The entry variant `material` links for these settings (its text, for reports)."""
+        return compiled.variant(*self._variant(forward, compensation, view))
+
     def material(self, compiled: CompiledMaterial, forward: bool, compensation: bool = False,
                  view: str = "lit") -> moderngl.Program:
         """The program a material draws with (raises moderngl.Error): its GBUFFER entry, or

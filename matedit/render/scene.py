@@ -63,8 +63,18 @@ class ScenePass:
                 targets.begin_gbuffer()
             ctx.enable(moderngl.DEPTH_TEST | (0 if deferred else moderngl.BLEND))
             ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+            # An opaque surface (the G-buffer, or a forward material of opacity 1: blending
+            # then replaces) of a closed mesh seen from outside hides its back faces, which
+            # would only cost their fragments' material and lighting code (llvmpipe shades
+            # them before the depth test drops them): they are culled. Translucent materials
+            # and open meshes draw both sides.
+            cull = (deferred or material.opaque) and mesh.closed and mesh.seen_from_outside(
+                view.camera, targets.size[0] / max(1, targets.size[1]))
+            if cull:
+                ctx.front_face, ctx.cull_face = "ccw", "back"
+                ctx.enable(moderngl.CULL_FACE)
             mesh.render(program)
-            ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
             if deferred:
                 targets.begin_lighting()
                 compensation = view.energy_compensation or \

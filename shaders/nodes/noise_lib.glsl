@@ -34,17 +34,17 @@ highp uint nodeSeed(float seed) {
 
 vec2 nodeGradient2(highp uint h) {
     // Perlin 2002, "Improving Noise": gradients from a small fixed set, here the 8 unit
-    // directions of the axes and diagonals chosen by the hash's top 3 bits
+    // directions of the axes and diagonals chosen by the hash's top 3 bits:
+    // k = 0..3: (1, 0), (-1, 0), (0, 1), (0, -1); k = 4..7: (d, d), (-d, d), (d, -d), (-d, -d).
+    // Selects, not a ladder of returns: llvmpipe runs every branch of a divergent ladder
+    // (execution masks), and the selects JIT to less code; bit k & 1 is the sign of the
+    // first non-zero component, k & 2 that of the diagonal's y (the values are exactly the
+    // table's: +-1 * d is exact).
     highp uint k = h >> 29u;
+    float s = (k & 1u) == 0u ? 1.0 : -1.0;
     float d = 0.70710678;
-    if (k == 0u) return vec2(1.0, 0.0);
-    if (k == 1u) return vec2(-1.0, 0.0);
-    if (k == 2u) return vec2(0.0, 1.0);
-    if (k == 3u) return vec2(0.0, -1.0);
-    if (k == 4u) return vec2(d, d);
-    if (k == 5u) return vec2(-d, d);
-    if (k == 6u) return vec2(d, -d);
-    return vec2(-d, -d);
+    return k < 2u ? vec2(s, 0.0)
+                  : (k < 4u ? vec2(0.0, s) : vec2(s * d, (k & 2u) == 0u ? d : -d));
 }
 
 float nodeGradDot3(highp uint h, vec3 d) {
