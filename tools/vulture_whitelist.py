@@ -51,3 +51,4 @@ _._last_compile_ms
 # the viewport calls the render process's camera by name (ViewportWidget._do("camera.orbit"))
 _.orbit
 _.dolly
+_._stop_render_processes  # registered with atexit (matedit/app/viewport.py)
