@@ -6,8 +6,9 @@ optimises it and writes the GLSL of the viewport's entry variants (FORWARD, and 
 deferred preview). With `warm_up` on and the viewport's state
 (matedit.render.warmup.ViewportState) the worker then has that program linked and drawn once in
 a headless context of a helper process (matedit.render.warmup), so that the driver's compiled
-shaders are in Mesa's shader cache before the viewport's render process asks for them; it is
-off by default, since that process already keeps the link and the JIT off the UI thread.
+shaders are in Mesa's shader cache before the viewport's render process asks for them (the
+render process keeps the link and the JIT off the UI thread either way; with the warm-up the
+edit reaches the screen sooner: benchmarks/bench_ui_block.py measures both).
 The result comes back to the UI thread as a queued Qt signal; the viewport sends the program
 to its render process (matedit.render.server), which links it and swaps it in, drawing the
 last good program until then. Each request has a generation number: a newer request supersedes
@@ -63,16 +64,15 @@ def viewport_textures(cm, doc) -> dict:
 class CompileWorker(QObject):
     """One background thread; `finished(CompileResult)` arrives on the UI thread.
 
-    `warm_up` (default off: the viewport links and draws in its own render process, so a
-    warm-up only moves the driver's JIT from one process to another; nothing is warmed while
-    MESA_SHADER_CACHE_DISABLE is set) has the viewport's programs warmed after each compile
+    `warm_up` (default on; nothing is warmed while MESA_SHADER_CACHE_DISABLE is set) has the
+    viewport's programs warmed after each compile
     when `submit` is given the viewport's state (asked from that thread, done in
     matedit.render.warmup's child process); `warmed` lists (generation, asking thread,
     WarmReply), for tests."""
 
     finished = Signal(object)
     _done = Signal(object)  # emitted on the worker thread, delivered queued
-    warm_up = False  # per instance too (tests, benchmarks/bench_ui_block.py)
+    warm_up = True  # per instance too (tests, benchmarks/bench_ui_block.py)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
