@@ -65,10 +65,9 @@ class CompileWorker(QObject):
     """One background thread; `finished(CompileResult)` arrives on the UI thread.
 
     `warm_up` (default on; nothing is warmed while MESA_SHADER_CACHE_DISABLE is set) has the
-    viewport's programs warmed after each compile
-    when `submit` is given the viewport's state (asked from that thread, done in
-    matedit.render.warmup's child process); `warmed` lists (generation, asking thread,
-    WarmReply), for tests."""
+    viewport's programs warmed after each compile when `submit` is given the viewport's
+    state (asked from that thread, done in matedit.render.warmup's child process); `warmed`
+    lists (generation, asking thread, WarmReply), for tests."""
 
     finished = Signal(object)
     _done = Signal(object)  # emitted on the worker thread, delivered queued
