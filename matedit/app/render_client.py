@@ -13,7 +13,6 @@ trip after the messages sent before it). No Qt here.
 from __future__ import annotations
 
 import itertools
-import os
 import queue
 import subprocess
 import sys
@@ -21,23 +20,13 @@ import threading
 import weakref
 from collections.abc import Callable
 from concurrent.futures import Future
-from pathlib import Path
 from typing import Any
 
-from matedit.render.pipe import encode, recv, write
+from matedit.render.pipe import child_command, encode, end_child, recv, write
 
 
 def _nothing(*_args) -> None:
     """A callback not bound yet."""
-
-
-def _end(proc: subprocess.Popen) -> None:
-    if proc.poll() is None:
-        try:
-            proc.stdin.close()
-            proc.wait(timeout=5)
-        except (OSError, subprocess.TimeoutExpired):
-            proc.kill()
 
 
 class RenderProcess:
@@ -75,22 +64,14 @@ class RenderProcess:
         while the editor builds its window; `start` then sends what it draws with."""
         if self._proc is not None:
             return
-        import matedit
         from matedit.render.server import SERVER_ENV
 
-        env = dict(os.environ)
-        if getattr(sys, "frozen", False):  # a PyInstaller bundle: its entry point serves
-            cmd = [sys.executable]  # (packaging/matedit_entry.py)
-            env[SERVER_ENV] = "1"
-        else:
-            cmd = [sys.executable, "-m", "matedit.render.server"]
-            # the editor's own module path: what it sends unpickles there
-            root = str(Path(matedit.__file__).resolve().parent.parent)
-            env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(
-                [root, *filter(None, [env.get("PYTHONPATH")]), *filter(None, sys.path)]))
+        # the editor's own module path: what it sends unpickles there
+        cmd, env = child_command("matedit.render.server", SERVER_ENV,
+                                 [p for p in sys.path if p])
         self._proc = proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                              env=env)
-        weakref.finalize(self, _end, proc)  # a client dropped without stop(): no orphan
+        weakref.finalize(self, end_child, proc)  # a client dropped without stop(): no orphan
         threading.Thread(target=self._write, args=(proc,), daemon=True,
                          name="matedit-render-send").start()
         threading.Thread(target=self._read, args=(proc,), daemon=True,

@@ -31,8 +31,8 @@ import threading
 import time
 import weakref
 from dataclasses import dataclass, field
-from pathlib import Path
 
+from matedit.render.pipe import child_command, end_child
 from matedit.render.pipe import recv as _recv
 from matedit.render.pipe import send as _send
 
@@ -145,15 +145,6 @@ SERVER_ENV = "MATEDIT_WARMUP_SERVER"  # set for a frozen bundle's child: serve, 
 MAX_STARTS = 5
 
 
-def _end(proc: subprocess.Popen) -> None:
-    if proc.poll() is None:
-        try:
-            proc.stdin.close()
-            proc.wait(timeout=2)
-        except (OSError, subprocess.TimeoutExpired):
-            proc.kill()
-
-
 class WarmupClient:
     """The editor's side. `start()` starts the child without waiting; it makes its context and
     renderer and says it is ready (seconds: imports, the environment from the bake cache).
@@ -170,21 +161,12 @@ class WarmupClient:
         self.starts = 0  # children started (a crashed one is replaced, up to MAX_STARTS)
 
     def _start(self) -> subprocess.Popen:
-        import matedit
-
-        env = dict(os.environ)
-        if getattr(sys, "frozen", False):  # a PyInstaller bundle: its entry point serves
-            cmd = [sys.executable]  # (packaging/matedit_entry.py)
-            env[SERVER_ENV] = "1"
-        else:
-            cmd = [sys.executable, "-m", "matedit.render.warmup"]
-            root = str(Path(matedit.__file__).resolve().parent.parent)
-            env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
+        cmd, env = child_command("matedit.render.warmup", SERVER_ENV)
         self.starts += 1
         proc = subprocess.Popen(cmd,
                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env,
                                 stderr=subprocess.DEVNULL)
-        weakref.finalize(self, _end, proc)  # a client dropped without close(): no orphan
+        weakref.finalize(self, end_child, proc, 2.0)  # a client dropped without close()
         return proc
 
     def _ensure(self) -> subprocess.Popen | None:
