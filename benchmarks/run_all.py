@@ -637,7 +637,8 @@ def startup_section(rep: Report, st: dict, goals: list) -> None:
     v = st.get("validate")
     if v and "error" not in v:
         rep.add(f"`{v['command'].replace(str(ROOT) + '/', '')}` as a subprocess: median of 5 "
-                "after one warm-up run.")
+                "after one warm-up run, with Python's bytecode cache on (in a fresh folder the "
+                "warm-up run fills, as an installed matedit has its bytecode).")
         rep.add()
         rep.table(["command", "median (ms)", "runs (ms)"], "lrl",
                   [["matedit validate worn_painted_steel.json", ms(v["median"]),
@@ -671,8 +672,8 @@ def startup_section(rep: Report, st: dict, goals: list) -> None:
             "start-up figure), and the first frame with the environment's lighting (baked or "
             "loaded once the first frame is on screen). The launches share a fresh HOME and a "
             "fresh Mesa shader cache (MESA_SHADER_CACHE_DIR in it, the cache on): the first "
-            "launch bakes the studio IBL and compiles every shader into empty caches (cold), "
-            "the next ones have both cached (warm, median).")
+            "launch bakes the studio IBL, compiles every shader and writes Python's bytecode "
+            "into empty caches (cold), the next ones have them cached (warm, median).")
     rep.add()
     rows = []
     cold = e.get("cold", {})
