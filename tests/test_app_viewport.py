@@ -257,3 +257,24 @@ def test_a_value_edit_sets_the_uniforms_of_that_port_and_no_other(window, qtbot,
     assert len(sets) == 1 and sets[0][0] == sorted(u.name for u in cm.ir.uniforms)
     window.controller.undo_stack.undo()
     assert changes == [MANY_VALUES, MANY_VALUES]
+
+
+def test_a_render_process_that_dies_is_started_again_with_what_it_drew(window, qtbot):
+    """A driver crash takes the render process, not the editor: the viewport starts another
+    and sends it the material, its values and the environment; the picture comes back."""
+    import os
+    import signal
+
+    view = window.viewport.view
+    before = frame(qtbot, view)
+    said: list[str] = []
+    view.statusMessage.connect(said.append)
+    pid = view._proc._proc.pid
+    os.kill(pid, signal.SIGKILL)
+    qtbot.waitUntil(lambda: view.running and view._proc._proc.pid != pid, timeout=60000)
+    qtbot.waitUntil(lambda: view.environment_ready, timeout=60000)
+    after = frame(qtbot, view)
+    assert not view.problem and view.renderer.has_material
+    assert any("restarted" in m for m in said)
+    assert not any(p.source == "GL" for p in window.diagnostics.problems)
+    assert np.abs(after - before).mean() < 0.01  # the same material, values and lighting

@@ -25,6 +25,10 @@ from typing import Any
 from matedit.render.pipe import child_command, encode, end_child, recv, write
 
 
+class RendererStopped(RuntimeError):
+    """The render process is not running (any more): what was sent to it was not done."""
+
+
 def _nothing(*_args) -> None:
     """A callback not bound yet."""
 
@@ -96,7 +100,7 @@ class RenderProcess:
         the reply (or the server's exception)."""
         future: Future = Future()
         if self._closed or (self._proc is not None and self._proc.poll() is not None):
-            future.set_exception(RuntimeError("the renderer is not running"))
+            future.set_exception(RendererStopped("the renderer is not running"))
             return future
         mid = next(self._ids)
         future.mid = mid  # type: ignore[attr-defined]
@@ -171,7 +175,7 @@ class RenderProcess:
         with self._lock:
             futures, self._futures = list(self._futures.values()), {}
         for future, _progress in futures:
-            future.set_exception(RuntimeError("the renderer has stopped"))
+            future.set_exception(RendererStopped("the renderer has stopped"))
         try:
             code = proc.wait(timeout=10)  # reaped: no zombie left behind
         except subprocess.TimeoutExpired:

@@ -30,7 +30,12 @@ from PySide6.QtCore import QCoreApplication, QEventLoop, QObject, QPointF, QRect
 from PySide6.QtGui import QColor, QImage, QPainter
 from PySide6.QtWidgets import QWidget
 
-from matedit.app.render_client import RemoteRenderer, RenderProcess, take_prelaunched
+from matedit.app.render_client import (
+    RemoteRenderer,
+    RendererStopped,
+    RenderProcess,
+    take_prelaunched,
+)
 
 if TYPE_CHECKING:
     from matedit.render.server import FrameInfo
@@ -92,6 +97,7 @@ class ViewportWidget(QWidget):
     # editor's window: its start-up overlaps the window's; tests that never show a window
     # set it off)
     launch_early = True
+    MAX_RESTARTS = 3  # a render process that dies (a driver crash) is started again so often
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -104,16 +110,14 @@ class ViewportWidget(QWidget):
         self._bridge.started.connect(self._on_started, Qt.ConnectionType.QueuedConnection)
         self._bridge.ended.connect(self._on_ended, Qt.ConnectionType.QueuedConnection)
         self._bridge.call.connect(lambda fn: fn(), Qt.ConnectionType.QueuedConnection)
-        bridge = self._bridge
         self._proc = take_prelaunched() or RenderProcess()
-        self._proc.bind(lambda *a: _emit(bridge.frame, *a), lambda *a: _emit(bridge.started, *a),
-                        lambda *a: _emit(bridge.ended, *a))
-        _PROCESSES.add(self._proc)
-        proc = self._proc
-        self.destroyed.connect(lambda *_: proc.stop())
+        self._connect_process()
         if self.launch_early:
-            proc.launch()  # imports and its GL context while the window is built
+            self._proc.launch()  # imports and its GL context while the window is built
         self._running = False  # the renderer is up in its process
+        self._restarts = 0
+        self._uniforms: dict[str, Any] = {}  # every value sent, for a restarted process
+        self._textures: dict[str, Path | None] = {}
         self._pending_material = None  # the last material posted (what the first frame shows)
         self._has_material = False
         self._pending_uniforms: dict[str, Any] | None = None
@@ -147,17 +151,19 @@ class ViewportWidget(QWidget):
     def showEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().showEvent(event)
         if not self._proc.initialised:
-            s = self.settings
-            try:
-                self._proc.start({
-                    "size": self._size_px(), "warm_up": not self._first_frame_deferred(),
-                    "mesh": self._mesh, "mode": self._mode, "exposure": self._exposure,
-                    "view": self._view, "lights": self._lights, "budget_ms":
-                    self.slice_budget_ms,
-                    "settings": (s.environment_intensity, s.show_background,
-                                 s.background_blur, s.energy_compensation)})
-            except OSError as exc:
-                self._on_ended(f"the renderer could not start: {exc}")
+            self._send_init()
+
+    def _send_init(self) -> None:
+        s = self.settings
+        try:
+            self._proc.start({
+                "size": self._size_px(), "warm_up": not self._first_frame_deferred(),
+                "mesh": self._mesh, "mode": self._mode, "exposure": self._exposure,
+                "view": self._view, "lights": self._lights, "budget_ms": self.slice_budget_ms,
+                "settings": (s.environment_intensity, s.show_background, s.background_blur,
+                             s.energy_compensation)})
+        except OSError as exc:
+            self._on_ended(f"the renderer could not start: {exc}")
 
     def _on_started(self, problem: str, lights) -> None:
         if problem:
@@ -168,9 +174,37 @@ class ViewportWidget(QWidget):
             self._lights = list(lights or [])
 
     def _on_ended(self, problem: str) -> None:
+        """The render process has gone: started again with what it drew (MAX_RESTARTS times;
+        a process that fails to start is not retried), or the view says why."""
+        if self._running and self._restarts < self.MAX_RESTARTS:
+            self._restarts += 1
+            self.statusMessage.emit(f"the viewport's renderer stopped ({problem}); restarted")
+            self._restart()
+            return
         self.problem = problem
         self._running = False
         super().update()
+
+    def _restart(self) -> None:
+        self._running = False
+        self._proc = RenderProcess()
+        self._connect_process()
+        self._environment_state = "pending"  # loaded again after the first frame
+        self._send_init()
+        if self._pending_material is not None:
+            self.set_material(self._pending_material)
+        if self._uniforms or self._textures:
+            self._post("values", dict(self._uniforms), dict(self._textures))
+        if self._compare is not None:
+            self._apply_compare()
+            self._do("set_split", self._split)
+
+    def _connect_process(self) -> None:
+        bridge, proc = self._bridge, self._proc
+        proc.bind(lambda *a: _emit(bridge.frame, *a), lambda *a: _emit(bridge.started, *a),
+                  lambda *a: _emit(bridge.ended, *a))
+        _PROCESSES.add(proc)
+        self.destroyed.connect(lambda *_: proc.stop())
 
     def _post(self, op: str, *args, then: Callable[[Any], None] | None = None,
               failed: Callable[[BaseException], None] | None = None, frame: bool = True,
@@ -183,6 +217,8 @@ class ViewportWidget(QWidget):
 
             def done(f) -> None:
                 exc = f.exception()
+                if isinstance(exc, RendererStopped):  # said once, by `ended`
+                    return
                 try:
                     if exc is not None:
                         if failed is not None:
@@ -324,6 +360,7 @@ class ViewportWidget(QWidget):
         """Draw no material (another document: the previous one's program is not its own)."""
         self._pending_material = None
         self._pending_uniforms = None
+        self._uniforms, self._textures = {}, {}
         self._has_material = False
         self._do("clear_material")
 
@@ -348,6 +385,8 @@ class ViewportWidget(QWidget):
 
     def set_values(self, uniforms: dict[str, Any], textures: dict[str, Path | None]) -> None:
         self._pending_uniforms = uniforms
+        self._uniforms.update(uniforms)
+        self._textures.update(textures)
         self._post("values", uniforms, dict(textures),
                    then=lambda problems: [self.statusMessage.emit(m) for m in problems])
 
