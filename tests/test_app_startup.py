@@ -16,7 +16,7 @@ def test_the_first_frame_comes_before_the_environment_and_the_library(qtbot):
     view = w.viewport.view
     seen: list[tuple[str, bool, bool]] = []
     view.frameDrawn.connect(lambda: seen.append(
-        (view.renderer.environment_name, view.environment_ready, w.library.listed)))
+        (view.frame_info.environment_name, view.environment_ready, w.library.listed)))
     w.resize(1400, 880)
     w.show()
     qtbot.waitUntil(lambda: (view.environment_ready and w.library.listed) or bool(view.problem),

@@ -12,7 +12,7 @@ from matedit.compiler.emit import Entry, entry_text
 from matedit.ibl import BakeSettings
 from matedit.io.document import FileResolver, load
 from matedit.render import Renderer
-from matedit.render.deferred import may_be_translucent, writes_lobes
+from matedit.render.paths import may_be_translucent, writes_lobes
 from matedit.resources import graphs_dir, shaders_dir
 
 MATERIALS = sorted((graphs_dir() / "materials").glob("*.json"))

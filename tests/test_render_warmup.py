@@ -14,7 +14,8 @@ import pytest
 from matedit.compiler import compile_document
 from matedit.compiler.emit import Entry
 from matedit.io.document import load
-from matedit.render.deferred import SPLIT_SUM_ONLY, wants_forward
+from matedit.render.deferred import SPLIT_SUM_ONLY
+from matedit.render.paths import wants_forward
 from matedit.render.warmup import ViewportState, WarmupClient
 from matedit.resources import graphs_dir
 

@@ -263,7 +263,7 @@ class ViewportWidget(QWidget):
     def _first_frame_deferred(self) -> bool:
         """Whether the material waiting for GL takes the deferred path: its first frame then
         warms what the renderer's start-up frame of a constant material would."""
-        from matedit.render.deferred import wants_forward
+        from matedit.render.paths import wants_forward
         from matedit.shading.views import is_attribute_view
 
         cm = self._pending_material

@@ -9,8 +9,8 @@ import moderngl
 
 from matedit.compiler.api import CompiledMaterial
 from matedit.glsl.layout import BINDINGS
-from matedit.render.deferred import may_be_translucent
 from matedit.render.fullscreen import set_uniform
+from matedit.render.paths import may_be_translucent
 from matedit.render.textures import TextureCache
 
 MIN_PARAMS_BYTES = 16  # a material without parameters still binds a buffer
@@ -50,7 +50,7 @@ class MaterialResources:
     @property
     def opaque(self) -> bool:
         """Whether every fragment the material draws has opacity 1 with the current values
-        (matedit.render.deferred.may_be_translucent, conservative): then the nearest surface
+        (matedit.render.paths.may_be_translucent, conservative): then the nearest surface
         alone shows, as in the G-buffer. False before the first material."""
         if self._opaque is None:
             self._opaque = self.compiled is not None and \

@@ -9,8 +9,6 @@ Deferred, a material draws its GBUFFER entry; forward, its FORWARD entry with sp
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import moderngl
 
 from matedit.compiler.api import CompiledMaterial
@@ -18,6 +16,7 @@ from matedit.compiler.emit import Entry
 from matedit.glsl.layout import BINDINGS
 from matedit.render.deferred import ENERGY_COMPENSATION, SPLIT_SUM_ONLY
 from matedit.render.fullscreen import set_uniform
+from matedit.render.paths import MaterialStatus
 from matedit.shading.views import view_defines
 
 # uniform blocks and samplers a program may declare -> their binding (matedit/glsl/layout.py)
@@ -26,13 +25,6 @@ _BLOCKS = (("LightsBlock", "LIGHTS"), ("IblBlock", "IBL"), ("FrameBlock", "FRAME
 _SAMPLERS = (("uPrefilteredEnv", "PREFILTERED_ENV"), ("uBrdfLut", "BRDF_LUT"),
              ("uEnvironment", "ENVIRONMENT"), ("uEnvDistribution", "ENV_DISTRIBUTION"),
              ("uAnisotropyLut", "ANISOTROPY_LUT"))
-
-
-@dataclass
-class MaterialStatus:
-    ok: bool
-    errors: list[tuple[str, str]] = field(default_factory=list)  # (node id, message)
-    log: str = ""
 
 
 def failure(compiled: CompiledMaterial, exc: Exception) -> MaterialStatus:

@@ -18,11 +18,11 @@ import numpy as np
 
 from matedit.compiler.api import CompiledMaterial, compile_ir
 from matedit.compiler.ir import MaterialIR, Scope
-from matedit.render.deferred import wants_forward
 from matedit.render.frames import Accumulator, SceneTargets, r2_offset
 from matedit.render.fullscreen import FullscreenQuad
 from matedit.render.material import MaterialResources
 from matedit.render.mesh import GpuMesh, mesh_from_spec
+from matedit.render.paths import wants_forward
 from matedit.render.programs import MaterialStatus, ProgramCache
 from matedit.render.scene import ScenePass
 from matedit.render.settings import MODES, PreviewSettings
