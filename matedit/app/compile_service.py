@@ -129,7 +129,10 @@ class MaterialCompiler(QObject):
         state = self.viewport_state() if self.viewport_state is not None else None
         if state is not None and self.worker.warming and not self.worker.warm_up_started:
             self.worker.prepare_warm_up()  # ready for the next edits
-        self.worker.submit(doc, self.controller.resolver, VIEWPORT_TARGET, state)
+        # the controller's analysis, when it is of this very document as it is now: the
+        # worker does not validate the graph again
+        analysis = self.controller.current_analysis if doc is self.controller.document else None
+        self.worker.submit(doc, self.controller.resolver, VIEWPORT_TARGET, state, analysis)
 
     def _finished(self, result) -> None:
         """A worker's result, on the UI thread: the same outcome as a synchronous compile."""
@@ -195,7 +198,10 @@ class MaterialCompiler(QObject):
         t0 = time.perf_counter()
         shown = self._viewport_document()
         try:
-            cm = compile_document(shown, self.controller.resolver, VIEWPORT_TARGET)
+            analysis = self.controller.current_analysis \
+                if shown is self.controller.document else None
+            cm = compile_document(shown, self.controller.resolver, VIEWPORT_TARGET,
+                                  analysis=analysis)
         except CompileError as exc:
             self.diagnostics = list(exc.diagnostics)
             self.last_compile_ms = (time.perf_counter() - t0) * 1e3

@@ -37,12 +37,17 @@ class CompileResult:
     ms: float = 0.0
 
 
-def compile_snapshot(doc, resolver, target: str, compile_fn=None):
-    """Compile `doc` for `target` and warm its deferred variant: the work of the worker."""
+def compile_snapshot(doc, resolver, target: str, compile_fn=None, analysis=None):
+    """Compile `doc` for `target` and warm its deferred variant: the work of the worker.
+    `analysis`: the editor's analysis of the document the snapshot was taken of, made since
+    its last change (DocumentController.current_analysis): the graph is not validated again."""
     from matedit.compiler import compile_document
     from matedit.compiler.emit import Entry
 
-    cm = (compile_fn or compile_document)(doc, resolver, target)
+    if compile_fn is not None:
+        cm = compile_fn(doc, resolver, target)
+    else:
+        cm = compile_document(doc, resolver, target, analysis=analysis)
     cm.variant(Entry.GBUFFER)  # the program the deferred viewport links
     return cm
 
@@ -89,9 +94,10 @@ class CompileWorker(QObject):
     def pending(self) -> bool:
         return self._delivered < self.generation
 
-    def submit(self, doc, resolver, target: str, viewport=None) -> int:
+    def submit(self, doc, resolver, target: str, viewport=None, analysis=None) -> int:
         """Queue a compile of a snapshot of `doc`; returns its generation. `viewport` (a
-        matedit.render.warmup.ViewportState, taken now on the UI thread) asks for a warm-up."""
+        matedit.render.warmup.ViewportState, taken now on the UI thread) asks for a warm-up;
+        `analysis` is `doc`'s current one (compile_snapshot)."""
         self.generation += 1
         gen = self.generation
         if self._future is not None:
@@ -99,17 +105,19 @@ class CompileWorker(QObject):
         snapshot = snapshot_document(doc)
         fn = self.compile_fn
         viewport = viewport if self.warming else None
-        future = self._pool.submit(self._run, gen, snapshot, resolver, target, fn, viewport)
+        future = self._pool.submit(self._run, gen, snapshot, resolver, target, fn, viewport,
+                                   analysis)
         future.add_done_callback(lambda f: None if f.cancelled() else self._done.emit(f.result()))
         self._future = future
         return gen
 
-    def _run(self, gen: int, doc, resolver, target: str, fn, viewport=None) -> CompileResult:
+    def _run(self, gen: int, doc, resolver, target: str, fn, viewport=None,
+             analysis=None) -> CompileResult:
         from matedit.compiler import CompileError
 
         t0 = time.perf_counter()
         try:
-            cm = compile_snapshot(doc, resolver, target, fn)
+            cm = compile_snapshot(doc, resolver, target, fn, analysis)
         except CompileError as exc:
             return CompileResult(gen, None, list(exc.diagnostics),
                                  ms=(time.perf_counter() - t0) * 1e3)

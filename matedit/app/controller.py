@@ -20,6 +20,7 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 from matedit.graph.commands import Command, CommandError, Macro, SetSetting, SetValue
 from matedit.graph.model import ChangeEvent, ChangeKind, MaterialDocument
 from matedit.graph.validate import Analysis, analyse
+from matedit.io import document as documents
 from matedit.io.document import FileResolver
 
 
@@ -130,6 +131,9 @@ class DocumentController(QObject):
         self.resolver = FileResolver()
         self.document = document or MaterialDocument()
         self.analysis: Analysis | None = None
+        self._revision = 0  # counts changes to the document (events, replace, swap)
+        # the revision `analysis` was made of, and the function files read by then
+        self._analysed_revision: tuple[int, int] = (-1, -1)
         self._debounce = QTimer(self)
         self._debounce.setSingleShot(True)
         self._debounce.setInterval(150)
@@ -141,6 +145,7 @@ class DocumentController(QObject):
 
     # --- documents -------------------------------------------------------------------------
     def replace(self, document: MaterialDocument) -> None:
+        self._revision += 1
         self.document.graph.unsubscribe(self._on_event)
         self.document = document
         self.document.graph.subscribe(self._on_event)
@@ -153,6 +158,7 @@ class DocumentController(QObject):
         """Shows another open document with its own undo history (a document tab): nothing
         of either is lost, and the one swapped out can be swapped back as it was."""
         self._debounce.stop()
+        self._revision += 1
         self.document.graph.unsubscribe(self._on_event)
         old = self.undo_stack
         self.document, self.undo_stack = document, undo_stack
@@ -223,6 +229,7 @@ class DocumentController(QObject):
                 self.valuesChanged.emit(MANY_VALUES)
 
     def _on_event(self, event: ChangeEvent) -> None:
+        self._revision += 1
         self.changed.emit(event)
         if event.kind == ChangeKind.STRUCTURAL:
             self._debounce.start()
@@ -246,7 +253,17 @@ class DocumentController(QObject):
         self._debounce.stop()
         self._settle()
 
+    @property
+    def current_analysis(self) -> Analysis | None:
+        """`analysis` when it was made of the document as it is now (no change since, and no
+        function file read anew since: one changed on disk), else None: a compile can take
+        it instead of validating the graph again."""
+        fresh = self._analysed_revision == (self._revision, documents.LOADS)
+        return self.analysis if fresh else None
+
     def _settle(self) -> None:
         self.analysis = analyse(self.document, self.resolver)
+        # after it: the files it read for the first time are those it was made of
+        self._analysed_revision = (self._revision, documents.LOADS)
         self.analysed.emit(self.analysis)
         self.structureChanged.emit()

@@ -171,6 +171,7 @@ class _Inputs:
     resolver: Any
     out_types: dict
     selection: frozenset
+    analysis: Any = None  # the editor's, when current (not validated again)
 
 
 class NodePreviews(QObject):
@@ -211,7 +212,8 @@ class NodePreviews(QObject):
         a = self.controller.analysis
         out_types = {nid: dict(t) for nid, t in a.out_types.items()} if a is not None else {}
         return _Inputs(snapshot_document(self.controller.document), self.controller.resolver,
-                       out_types, frozenset(self._selection))
+                       out_types, frozenset(self._selection),
+                       getattr(self.controller, "current_analysis", None))
 
     def images(self) -> dict[str, QImage]:
         """The thumbnails of the document as it is now, evaluated on this thread."""
@@ -222,7 +224,7 @@ class NodePreviews(QObject):
         if doc.is_function or len(doc.graph.nodes) > MAX_NODES:
             return {}
         try:
-            ir = lower_document(doc, inputs.resolver)
+            ir = lower_document(doc, inputs.resolver, inputs.analysis)
             probe: dict = {}
             surface, inside = preview_sphere()
             textures = {t.name: self.textures.get(t.path, t.srgb) for t in ir.textures}

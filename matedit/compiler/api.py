@@ -8,7 +8,7 @@ import hashlib
 import re
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from matedit.compiler import ops
 from matedit.compiler.emit import Entry, SourceMap, fragment_source, std140_layout, vertex_source
@@ -19,6 +19,9 @@ from matedit.compiler.targets import FIRST_TEXTURE_BINDING, MATERIAL_BINDING, TA
 from matedit.glsl.include import LINE_STRIDE, Assembly
 from matedit.graph.model import MaterialDocument
 from matedit.graph.ports import FunctionResolver
+
+if TYPE_CHECKING:
+    from matedit.graph.validate import Analysis
 
 _LOC = re.compile(r"(\d+):(\d+)\(\d+\)|ERROR: (\d+):(\d+):|(\d+)\((\d+)\) :")
 
@@ -161,9 +164,10 @@ def prune(ir: MaterialIR) -> None:
     ir.textures = [t for t in ir.textures if t.name in used]
 
 
-def lower_and_optimise(doc: MaterialDocument, resolver: FunctionResolver | None) -> MaterialIR:
+def lower_and_optimise(doc: MaterialDocument, resolver: FunctionResolver | None,
+                       analysis: Analysis | None = None) -> MaterialIR:
     with _no_gc():
-        ir = lower_document(doc, resolver)
+        ir = lower_document(doc, resolver, analysis)
         for scope in [*ir.functions, ir.main]:
             optimise(scope)
         prune(ir)
@@ -175,8 +179,10 @@ ENERGY_COMPENSATION_DEFINE = "MATEDIT_ENERGY_COMPENSATION"
 
 def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = None,
                      target: str = "glsl330", mode: str | Entry = Entry.FORWARD,
-                     ir: MaterialIR | None = None) -> CompiledMaterial:
-    """Compile for one target; raises CompileError (with diagnostics) for a bad graph."""
+                     ir: MaterialIR | None = None,
+                     analysis: Analysis | None = None) -> CompiledMaterial:
+    """Compile for one target; raises CompileError (with diagnostics) for a bad graph.
+    `analysis`: the document's current analysis, when the caller has it (the editor)."""
     if target not in TARGETS:
         raise ValueError(f"unknown target {target!r} (expected {', '.join(TARGETS)})")
     if resolver is None:
@@ -184,7 +190,7 @@ def compile_document(doc: MaterialDocument, resolver: FunctionResolver | None = 
 
         resolver = FileResolver()
     with _no_gc():  # one pause for the whole compile: the collector runs once, after it
-        ir = ir if ir is not None else lower_and_optimise(doc, resolver)
+        ir = ir if ir is not None else lower_and_optimise(doc, resolver, analysis)
         if isinstance(doc.preview, dict) and doc.preview.get("energy_compensation") is True \
                 and ENERGY_COMPENSATION_DEFINE not in ir.defines:
             ir.defines.append(ENERGY_COMPENSATION_DEFINE)  # the material's option (shading)

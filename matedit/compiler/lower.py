@@ -587,7 +587,11 @@ def _coat_written(layer: frozenset) -> frozenset:
 
 
 def _check(doc: MaterialDocument, resolver, top: bool = True) -> Analysis:
-    a = analyse(doc, resolver, calls=top)  # the top document's check covers every callee
+    # the top document's check covers every callee
+    return _checked(analyse(doc, resolver, calls=top))
+
+
+def _checked(a: Analysis) -> Analysis:
     errors = [d for d in a.diagnostics if d.severity == Severity.ERROR]
     if errors:
         raise CompileError(errors)
@@ -619,14 +623,17 @@ def lower_function(ctx: _Ctx, doc: MaterialDocument) -> Scope:
     return scope
 
 
-def lower_document(doc: MaterialDocument, resolver: FunctionResolver | None) -> MaterialIR:
-    """Validate and lower a material document; raises CompileError with diagnostics."""
+def lower_document(doc: MaterialDocument, resolver: FunctionResolver | None,
+                   analysis: Analysis | None = None) -> MaterialIR:
+    """Validate and lower a material document; raises CompileError with diagnostics.
+    `analysis`: the document's analysis (graph.validate.analyse with its calls), made of the
+    document as it is, which the editor has already: not made again."""
     if doc.is_function:
         raise CompileError([Diagnostic(Severity.ERROR, "a material function is compiled through "
                                        "the materials that call it", None, None,
                                        str(doc.path) if doc.path else None)])
     ctx = _Ctx(resolver)
-    a = _check(doc, resolver)
+    a = _check(doc, resolver) if analysis is None else _checked(analysis)
     scope = Scope(name="evaluateMaterial", source=str(doc.path or doc.name))
     low = _Lowerer(ctx, doc, a, top=True, scope=scope)
     try:

@@ -384,6 +384,9 @@ def clear_document_cache() -> None:
         _documents.clear()
 
 
+LOADS = 0  # function files FileResolver has read (not from its cache) in this process
+
+
 class FileResolver:
     """Finds material functions relative to the file that uses them. Files that loaded are
     cached for the whole process by path, size and mtime (`_documents`): the document a
@@ -415,6 +418,8 @@ class FileResolver:
                 if hit is not None and hit[0] == signature:
                     _documents.move_to_end(p)
                     return hit[1]
+        global LOADS
+        LOADS += 1
         try:
             doc = load(p)
         except FormatError as exc:
