@@ -311,7 +311,10 @@ class ViewportWidget(QWidget):
             p.end()
             return
         p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform)
-        p.drawImage(QRectF(self.rect()), self._image)
+        target = self._image_rect()
+        if target != QRectF(self.rect()):
+            p.fillRect(self.rect(), QColor("#17191e"))
+        p.drawImage(target, self._image)
         if self.problem:
             p.fillRect(self.rect().adjusted(0, self.height() - 28, 0, 0), QColor(23, 25, 30, 220))
             p.setPen(QColor("#e0a0a0"))
@@ -326,6 +329,18 @@ class ViewportWidget(QWidget):
             self.frameDrawn.emit()
             if self._environment_state == "pending" and self.running:
                 self._load_environment()  # once the first frame is on screen
+
+    def _image_rect(self) -> QRectF:
+        """Where the picture goes: the whole view, or while a picture of the new size is on
+        its way (a resize), the last one scaled with its proportions kept, centred, the rest
+        cleared to the view's background (a sphere stays round)."""
+        r = QRectF(self.rect())
+        size = self._image.deviceIndependentSize()
+        if abs(size.width() - r.width()) < 1 and abs(size.height() - r.height()) < 1:
+            return r
+        scale = min(r.width() / max(size.width(), 1), r.height() / max(size.height(), 1))
+        w, h = size.width() * scale, size.height() * scale
+        return QRectF(r.x() + (r.width() - w) / 2, r.y() + (r.height() - h) / 2, w, h)
 
     def current_image(self) -> QImage:
         """The picture on screen (RGB888), a null image before the first frame."""
