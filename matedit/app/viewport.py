@@ -93,10 +93,10 @@ class ViewportWidget(QWidget):
     # GL work between two looks at the messages while reference mode accumulates (ms; None:
     # matedit.render.server.BUDGET_MS)
     slice_budget_ms: float | None = None
-    # start the render process when the widget is made, not when it is first shown (the
-    # editor's window: its start-up overlaps the window's; tests that never show a window
-    # set it off)
-    launch_early = True
+    # start the render process when the widget is made rather than when it is first shown
+    # (off: a window never shown starts none; the editor's first viewport takes the process
+    # `matedit` launched before it imported Qt, render_client.prelaunch)
+    launch_early = False
     MAX_RESTARTS = 3  # a render process that dies (a driver crash) is started again so often
 
     def __init__(self, parent=None) -> None:
