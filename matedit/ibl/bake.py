@@ -171,7 +171,7 @@ def cache_paths(env: Environment, settings: BakeSettings,
     folder = _cache_dir(cache_dir)
     key = cache.make_key(
         "ibl", env=env.content_hash(), settings=asdict(settings), growth=PREFILTER_GROWTH,
-        lut_channels=LUT_CHANNELS,
+        lut_channels=LUT_CHANNELS, prefilter=gpu.PREFILTER_SCHEME,
     )
     lut = cache.make_key("brdf-lut", size=settings.lut_size, samples=settings.lut_samples,
                          method="quadrature", channels=LUT_CHANNELS)
