@@ -24,8 +24,8 @@ Progress = Callable[[float, str], None]
 
 # Rougher mips get this many times more samples per mip, up to the second factor (see
 # gpu.Baker.prefilter). With the source-mip selection (filtered importance sampling) wide
-# lobes converge with few samples: (2, 4) measured 0.7-1.3 % mean error at roughness >= 1/3
-# for half the time of (4, 16) (benchmarks/bench_ibl.py).
+# lobes converge with few samples: with the default lod_bias, (2, 4) measured 0.5-0.9 %
+# mean relative error at roughness >= 1/3, 4 % at 1/6 (benchmarks/bench_ibl.py).
 PREFILTER_GROWTH = (2, 4)
 # Channels of the environment BRDF LUT: A, B and the Charlie sheen's albedo (brdf_lut.frag);
 # in the cache keys, so entries of the two-channel LUT are never read as this one.
@@ -39,15 +39,16 @@ class BakeSettings:
     size: face size of mip 0 (a power of two, 8 to 4096). levels: number of prefiltered
     mips, mip m for roughness m / (levels - 1); None means down to 4 x 4 faces
     (log2(size) - 1). samples: GGX samples per texel of prefiltered mip 1; each rougher
-    mip takes 2 times more, up to 4 times (`PREFILTER_GROWTH`). lod_bias: extra
-    source-mip blur of each sample (filtered importance sampling). lut_size, lut_samples:
+    mip takes 2 times more, up to 4 times (`PREFILTER_GROWTH`). lod_bias: offset of
+    each sample's source mip (filtered importance sampling; positive blurs more, negative
+    less: `gpu.DEFAULT_LOD_BIAS`). lut_size, lut_samples:
     the environment BRDF LUT (see matedit/ibl/lut.py).
     """
 
     size: int = 256
     samples: int = 256
     levels: int | None = None
-    lod_bias: float = 0.5
+    lod_bias: float = gpu.DEFAULT_LOD_BIAS
     lut_size: int = 128
     lut_samples: int = 1024
 
