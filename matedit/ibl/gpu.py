@@ -50,9 +50,10 @@ def _gauss_legendre01(n: int) -> tuple[np.ndarray, np.ndarray]:
     return ((x + 1.0) * 0.5).astype(np.float32), (w * 0.5).astype(np.float32)
 
 
-def samples_for_mip(samples: int, mip: int, growth: int = 4, max_growth: int = 16) -> int:
+def samples_for_mip(samples: int, mip: int, growth: int = 4, max_growth: int = 16,
+                    grow_after: int = 1) -> int:
     """GGX samples a texel at prefiltered mip `mip` >= 1 (see `Baker.prefilter`)."""
-    return int(samples * min(growth ** max(mip - 1, 0), max_growth))
+    return int(samples * min(growth ** max(mip - grow_after, 0), max_growth))
 
 
 def ggx_sample_table(samples: int, roughness: float, source_size: int,
@@ -252,12 +253,14 @@ class Baker:
         progress: Progress | None = None,
         growth: int = 4,
         max_growth: int = 16,
+        grow_after: int = 1,
     ) -> list[np.ndarray]:
         """Mips 0..levels-1 of the prefiltered environment; mip m is for roughness m/(levels-1).
 
         Mip 0 (roughness 0, a mirror) is the source itself, copied exactly. Mip 1 takes
-        `samples` GGX samples a texel; each rougher mip, with a quarter of the texels and
-        a wider lobe, takes `growth` times more, up to `max_growth` times `samples`. The
+        `samples` GGX samples a texel, and so do mips up to `grow_after`; each rougher mip,
+        with a quarter of the texels, takes `growth` times more, up to `max_growth` times
+        `samples`. The
         samples of a mip are one table for all texels (`ggx_sample_table`), and a mip is
         one draw over its six faces (more when the sample set exceeds TABLE_ROWS).
         """
@@ -273,8 +276,9 @@ class Baker:
         prog["SampleTable"].binding = 0
         self.ctx.enable_direct(GL_TEXTURE_CUBE_MAP_SEAMLESS)
         # Work per mip is proportional to its texel count times its samples.
-        work = [6 * max(1, n >> m) ** 2 * samples_for_mip(samples, m, growth, max_growth)
-                for m in range(1, levels)]
+        counts = [samples_for_mip(samples, m, growth, max_growth, grow_after)
+                  for m in range(1, levels)]
+        work = [6 * max(1, n >> m) ** 2 * counts[m - 1] for m in range(1, levels)]
         done = 0
         try:
             src.use(location=0)
@@ -282,8 +286,7 @@ class Baker:
             self._set(prog, "uMaxSourceLod", float(int(math.log2(n))))
             for m in range(1, levels):
                 size = max(1, n >> m)
-                count = samples_for_mip(samples, m, growth, max_growth)
-                rows, nol_sum = ggx_sample_table(count, m / (levels - 1), n, lod_bias)
+                rows, nol_sum = ggx_sample_table(counts[m - 1], m / (levels - 1), n, lod_bias)
                 self._set(prog, "uScale", 1.0 / max(nol_sum, 1e-30))
                 mip = np.zeros((6, size, size, 3), dtype=np.float32)
                 # Partial sums of TABLE_ROWS samples each, already scaled, add up.
