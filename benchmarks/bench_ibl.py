@@ -122,7 +122,7 @@ def run_matedit(path: Path, out: Path, size: int, samples: int, lut_size: int) -
         cube = baker.equirect_to_cube(env.equirect, size)
         mips = baker.prefilter(
             cube, settings.levels, samples, settings.lod_bias, growth=PREFILTER_GROWTH[0],
-            max_growth=PREFILTER_GROWTH[1],
+            max_growth=PREFILTER_GROWTH[1], grow_after=PREFILTER_GROWTH[2],
         )
         t_prefilter = time.perf_counter()
         sh_irradiance(cube)

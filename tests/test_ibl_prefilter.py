@@ -149,3 +149,55 @@ def test_uploaded_cube_holds_each_mip_at_its_level(ctx):
     np.testing.assert_allclose(got[1], (7.0, 8.0, 9.0))
     np.testing.assert_allclose(got[2], 3.0)
     np.testing.assert_allclose(got[3], 3.0)  # clamped to the last level, M - 1
+
+
+def test_sample_table_is_the_reflected_ggx_sample_set():
+    """prefilter_ggx.frag's table against the numpy twin of sampling.glsl: for N = V = +Z
+    (whose tangent frame is the identity) row i is L = reflect(-N, H_i) for the Hammersley
+    point i, kept where NoL > 0, with its filtered-importance-sampling source lod."""
+    from matedit.ibl.gpu import ggx_sample_table
+    from matedit.shading.sampling import hammersley, importanceSampleGGX
+
+    n, roughness, size, bias = 64, 0.4, 32, 0.25
+    rows, nol_sum = ggx_sample_table(n, roughness, size, bias)
+    a = roughness * roughness
+    N = np.array([0.0, 0.0, 1.0])
+    H = importanceSampleGGX(hammersley(np.arange(n), n), a, N)
+    L = 2.0 * H[:, 2:3] * H - N
+    keep = L[:, 2] > 0.0
+    assert 0 < keep.sum() < n  # at this roughness some samples fall below the horizon
+    np.testing.assert_allclose(rows[:, :3], L[keep], atol=1e-6)
+    assert nol_sum == pytest.approx(L[keep, 2].sum(), rel=1e-9)
+    # lod = 0.5 log2(omega_s / omega_p) + bias: omega_s = 1 / (n pdf) with pdf(L) = D / 4,
+    # omega_p = (2 / size)^2, the solid angle of a face-centre texel
+    cos_h = H[keep, 2]
+    d = a * a / (np.pi * ((a * a - 1.0) * cos_h**2 + 1.0) ** 2)
+    lod = 0.5 * np.log2((4.0 / (n * d)) / (2.0 / size) ** 2) + bias
+    np.testing.assert_allclose(rows[:, 3], lod, atol=1e-5)
+
+
+def test_default_settings_match_brute_force_on_a_small_bright_spot(ctx, baker):
+    """The bake's defaults (BakeSettings: samples, lod_bias, growth) on a sun-like source, a
+    Gaussian spot of 0.03 rad 800 times its background, against brute force: filtered
+    importance sampling must neither blur the spot away nor alias it."""
+    from matedit.ibl import BakeSettings
+    from matedit.ibl.bake import PREFILTER_GROWTH
+
+    settings = BakeSettings()
+    n = 128
+    faces = blob_faces(n, sigma=0.03)
+    mips = baker.prefilter(faces, levels=6, samples=settings.samples,
+                           lod_bias=settings.lod_bias, growth=PREFILTER_GROWTH[0],
+                           max_growth=PREFILTER_GROWTH[1], grow_after=PREFILTER_GROWTH[2])
+    rng = np.random.default_rng(3)
+    for m in range(1, 6):
+        dirs = face_directions(mips[m].shape[1]).reshape(-1, 3)
+        idx = rng.choice(len(dirs), size=min(200, len(dirs)), replace=False)
+        ref = brute_force_prefilter(faces, dirs[idx], m / 5)
+        got = mips[m].reshape(-1, 3)[idx]
+        peak = np.abs(got - ref).max() / ref.max()
+        mean = (np.abs(got - ref) / ref).mean()
+        print(f"mip {m}: max error {peak:.3f} of the peak, mean relative {mean:.4f}")
+        # measured <= 0.048 of the peak, <= 0.8 % mean relative; with lod_bias 0 (too little
+        # blur: aliasing) 0.076 of the peak
+        assert peak < 0.07 and mean < 0.012, f"mip {m}: {peak:.3f} of the peak, mean {mean:.4f}"

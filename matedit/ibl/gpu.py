@@ -15,6 +15,7 @@ import numpy as np
 
 from matedit.glsl.include import assemble
 from matedit.resources import shaders_dir
+from matedit.shading.sampling import hammersley
 
 GL_TEXTURE_CUBE_MAP_SEAMLESS = 0x884F
 
@@ -23,6 +24,27 @@ LUT_S_NODES = 4
 LUT_PHI_NODES = 8
 
 Progress = Callable[[float, str], None]
+
+# Rows of prefilter_ggx.frag's sample table (a std140 block of vec4: 16 KiB, the least
+# GL_MAX_UNIFORM_BLOCK_SIZE that OpenGL 3.3 allows); larger sample sets take several draws.
+TABLE_ROWS = 1024
+# Part of the bake cache's key (matedit/ibl/bake.py): bump when the prefilter's numerics
+# change in Python (the sample table, the sample counts) rather than in a shader's text.
+PREFILTER_SCHEME = 4
+# BakeSettings' default source-mip offset of each sample (ggx_sample_table). Mean relative
+# error over the levels against brute force on the studio of benchmarks/bench_ibl.py (256
+# samples at mip 1, growth (2, 4); worst texel in brackets): bias 0.5 0.017 (0.47), 0.25
+# 0.012 (0.38), 0 0.0095 (0.30). Less blur helps there, but a small bright source (a sun)
+# wants some: on a Gaussian spot of 0.03 rad, 0.25 keeps every level's error within 5 % of
+# the peak, like 0.5.
+DEFAULT_LOD_BIAS = 0.25
+# Mips up to this roughness read the nearest source mip of each sample's lod (bilinearly)
+# instead of two (trilinear): on llvmpipe 40 % less time for mip 1, about 70 % of the work.
+# A narrow lobe's samples mostly sit at lods near 0, and the error hardly moved (studio,
+# roughness 1/6: mean 0.044 vs 0.042; the Gaussian spot of test_ibl_prefilter.py, roughness
+# 1/5: 2.9 % vs 2.7 % of its peak); at roughness 0.4 and beyond nearest made the spot's
+# error up to three times larger.
+NEAREST_MIP_ROUGHNESS = 0.2
 
 
 class BakeShaderError(RuntimeError):
@@ -34,9 +56,49 @@ def _gauss_legendre01(n: int) -> tuple[np.ndarray, np.ndarray]:
     return ((x + 1.0) * 0.5).astype(np.float32), (w * 0.5).astype(np.float32)
 
 
-def samples_for_mip(samples: int, mip: int, growth: int = 4, max_growth: int = 16) -> int:
+def samples_for_mip(samples: int, mip: int, growth: int = 4, max_growth: int = 16,
+                    grow_after: int = 1) -> int:
     """GGX samples a texel at prefiltered mip `mip` >= 1 (see `Baker.prefilter`)."""
-    return int(samples * min(growth ** max(mip - 1, 0), max_growth))
+    return int(samples * min(growth ** max(mip - grow_after, 0), max_growth))
+
+
+def ggx_sample_table(samples: int, roughness: float, source_size: int,
+                     lod_bias: float) -> tuple[np.ndarray, float]:
+    """The GGX sample set of one prefiltered mip, for prefilter_ggx.frag.
+
+    Returns (rows, nol_sum): rows (k, 4) float32, one per sample of the `samples`-point
+    Hammersley set whose L is above the horizon, (L.x, L.y, L.z, lod0) with L in the tangent
+    frame of N (L.z = NoL, the sample's weight), and the float64 sum of those weights.
+    With N = V = R (docs/shading.md#image-based-lighting) the half vector H of a point is
+    importanceSampleGGX's around N and L = reflect(-N, H), the same in every texel's frame.
+
+    lod0 is the sample's source mip (filtered importance sampling, Colbert and Krivanek,
+    GPU Gems 3, ch. 20) where the source texel is a face centre's, (2 / source_size)^2 sr:
+    0.5 log2(omega_s / omega_p) + lod_bias with omega_s = 1 / (samples pdf) the sample's
+    share of the sphere, pdf = D(NoH) NoH / (4 VoH) = D / 4 as NoH = VoH; the shader adds
+    -1.5 log2(max |L|), the texel solid angle's variation over a face.
+    """
+    a = float(roughness) ** 2
+    xi = hammersley(np.arange(samples), samples)
+    # sampling.glsl importanceSampleGGX, in float64: cos and sin of theta_h, azimuth phi
+    phi = 2.0 * np.pi * xi[:, 0]
+    a2y = a * a * xi[:, 1]
+    denom = np.maximum((1.0 - xi[:, 1]) + a2y, 1e-30)
+    cos_h = np.sqrt((1.0 - xi[:, 1]) / denom)
+    sin_h = np.sqrt(a2y / denom)
+    # L = 2 (N.H) H - N
+    nol = 2.0 * cos_h * cos_h - 1.0
+    keep = nol > 0.0
+    lx = 2.0 * cos_h * sin_h * np.cos(phi)
+    ly = 2.0 * cos_h * sin_h * np.sin(phi)
+    # GGX D (Karis 2013, eq 3), a = roughness^2
+    a2 = a * a
+    d = a2 / (np.pi * (cos_h * cos_h * (a2 - 1.0) + 1.0) ** 2)
+    omega_s = 1.0 / (samples * 0.25 * np.maximum(d, 1e-300))
+    omega_p = 4.0 / float(source_size) ** 2
+    lod0 = 0.5 * np.log2(omega_s / omega_p) + lod_bias
+    rows = np.stack([lx, ly, nol, lod0], axis=-1)[keep].astype(np.float32)
+    return rows, float(nol[keep].sum())
 
 
 class Baker:
@@ -50,6 +112,7 @@ class Baker:
         self._programs: dict[tuple[str, str], moderngl.Program] = {}
         self._vaos: dict[tuple[str, str], moderngl.VertexArray] = {}
         self._default_fbo: moderngl.Framebuffer | None = None
+        self._table: moderngl.Buffer | None = None
 
     def close(self) -> None:
         for vao in self._vaos.values():
@@ -58,6 +121,9 @@ class Baker:
             prog.release()
         self._vaos.clear()
         self._programs.clear()
+        if self._table is not None:
+            self._table.release()
+            self._table = None
 
     def __enter__(self) -> Baker:
         return self
@@ -111,6 +177,22 @@ class Baker:
             tex.release()
         return np.frombuffer(data, dtype=np.float32).reshape(height, width, 4).copy()
 
+    def _draw_faces(self, prog: moderngl.Program, vao: moderngl.VertexArray,
+                    size: int) -> np.ndarray:
+        """Run `vao` for the six faces of a size x size cube, as many side by side in one
+        target as the driver allows (uniforms uFaceBase and uSize); (6, size, size, 3)."""
+        info = self.ctx.info
+        widest = min(int(info["GL_MAX_TEXTURE_SIZE"]), int(info["GL_MAX_VIEWPORT_DIMS"][0]))
+        per_draw = max(1, min(6, widest // size))
+        out = np.empty((6, size, size, 3), dtype=np.float32)
+        self._set(prog, "uSize", size)
+        for base in range(0, 6, per_draw):
+            count = min(per_draw, 6 - base)
+            self._set(prog, "uFaceBase", base)
+            strip = self._draw(vao, count * size, size)[..., :3]
+            out[base:base + count] = strip.reshape(size, count, size, 3).transpose(1, 0, 2, 3)
+        return out
+
     @staticmethod
     def _set(prog: moderngl.Program, name: str, value) -> None:
         if name in prog:  # the driver may drop uniforms a variant does not use
@@ -150,13 +232,8 @@ class Baker:
         self.ctx.enable_direct(GL_TEXTURE_CUBE_MAP_SEAMLESS)
         tex.use(location=0)
         self._set(prog, "uSource", 0)
-        self._set(prog, "uSize", size)
         self._set(prog, "uSuper", supersample)
-        out = np.empty((6, size, size, 3), dtype=np.float32)
-        for face in range(6):
-            self._set(prog, "uFace", face)
-            out[face] = self._draw(vao, size, size)[..., :3]
-        return out
+        return self._draw_faces(prog, vao, size)
 
     def cube_texture(self, faces: np.ndarray, mipmaps: bool = True) -> moderngl.TextureCube:
         """Upload faces (6, n, n, 3) as an RGB32F cube map, optionally with a full mip chain."""
@@ -178,16 +255,20 @@ class Baker:
         faces: np.ndarray,
         levels: int,
         samples: int,
-        lod_bias: float = 1.0,
+        lod_bias: float = DEFAULT_LOD_BIAS,
         progress: Progress | None = None,
         growth: int = 4,
         max_growth: int = 16,
+        grow_after: int = 1,
     ) -> list[np.ndarray]:
         """Mips 0..levels-1 of the prefiltered environment; mip m is for roughness m/(levels-1).
 
         Mip 0 (roughness 0, a mirror) is the source itself, copied exactly. Mip 1 takes
-        `samples` GGX samples a texel; each rougher mip, with a quarter of the texels and
-        a wider lobe, takes `growth` times more, up to `max_growth` times `samples`.
+        `samples` GGX samples a texel, and so do mips up to `grow_after`; each rougher mip,
+        with a quarter of the texels, takes `growth` times more, up to `max_growth` times
+        `samples`. The
+        samples of a mip are one table for all texels (`ggx_sample_table`), and a mip is
+        one draw over its six faces (more when the sample set exceeds TABLE_ROWS).
         """
         n = faces.shape[1]
         mips = [np.ascontiguousarray(faces[..., :3], dtype=np.float32)]
@@ -195,30 +276,39 @@ class Baker:
             return mips
         src = self.cube_texture(faces)
         prog, vao = self._vao("prefilter_ggx.frag")
+        if self._table is None:
+            self._table = self.ctx.buffer(reserve=TABLE_ROWS * 16)
+        self._table.bind_to_uniform_block(0)
+        prog["SampleTable"].binding = 0
         self.ctx.enable_direct(GL_TEXTURE_CUBE_MAP_SEAMLESS)
-        # Work per mip is proportional to its texel count: report progress by it.
-        total = sum(6 * max(1, n >> m) ** 2 for m in range(1, levels))
+        # Work per mip is proportional to its texel count times its samples.
+        counts = [samples_for_mip(samples, m, growth, max_growth, grow_after)
+                  for m in range(1, levels)]
+        work = [6 * max(1, n >> m) ** 2 * counts[m - 1] for m in range(1, levels)]
         done = 0
         try:
             src.use(location=0)
             self._set(prog, "uSource", 0)
-            self._set(prog, "uSourceSize", float(n))
             self._set(prog, "uMaxSourceLod", float(int(math.log2(n))))
-            self._set(prog, "uLodBias", float(lod_bias))
             for m in range(1, levels):
                 size = max(1, n >> m)
                 roughness = m / (levels - 1)
-                self._set(prog, "uSamples", samples_for_mip(samples, m, growth, max_growth))
-                self._set(prog, "uSize", size)
-                self._set(prog, "uRoughness", roughness)
-                mip = np.empty((6, size, size, 3), dtype=np.float32)
-                for face in range(6):
-                    self._set(prog, "uFace", face)
-                    mip[face] = self._draw(vao, size, size)[..., :3]
-                    done += size * size
-                    if progress:
-                        progress(done / total, f"prefilter mip {m}/{levels - 1}")
+                rows, nol_sum = ggx_sample_table(counts[m - 1], roughness, n, lod_bias)
+                nearest = roughness <= NEAREST_MIP_ROUGHNESS
+                src.filter = (moderngl.LINEAR_MIPMAP_NEAREST if nearest
+                              else moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+                self._set(prog, "uScale", 1.0 / max(nol_sum, 1e-30))
+                mip = np.zeros((6, size, size, 3), dtype=np.float32)
+                # Partial sums of TABLE_ROWS samples each, already scaled, add up.
+                for start in range(0, len(rows), TABLE_ROWS):
+                    chunk = rows[start:start + TABLE_ROWS]
+                    self._table.write(np.ascontiguousarray(chunk).tobytes())
+                    self._set(prog, "uCount", len(chunk))
+                    mip += self._draw_faces(prog, vao, size)
                 mips.append(mip)
+                done += work[m - 1]
+                if progress:
+                    progress(done / sum(work), f"prefilter mip {m}/{levels - 1}")
         finally:
             src.release()
         return mips

@@ -56,10 +56,10 @@ def sh_basis(dirs: np.ndarray) -> np.ndarray:
 def project_radiance(faces: np.ndarray) -> np.ndarray:
     """SH coefficients (9, 3) of the radiance in a cube map (6, n, n, >=3)."""
     n = faces.shape[1]
-    basis = sh_basis(face_directions(n))  # (6, n, n, 9)
-    weights = texel_solid_angles(n)[None, :, :, None] * basis
-    rgb = np.asarray(faces[..., :3], dtype=np.float64)
-    return np.einsum("fijk,fijc->kc", weights, rgb)
+    basis = sh_basis(face_directions(n).reshape(-1, 3))  # (6 n n, 9)
+    omega = np.broadcast_to(texel_solid_angles(n), (6, n, n)).reshape(-1, 1)
+    rgb = np.asarray(faces[..., :3], dtype=np.float64).reshape(-1, 3) * omega
+    return basis.T @ rgb  # one matrix product: sum over texels of Y_k * L_c * dOmega
 
 
 def irradiance_coefficients(radiance_sh: np.ndarray) -> np.ndarray:

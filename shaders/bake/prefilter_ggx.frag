@@ -1,50 +1,48 @@
-// GGX prefiltering of one face of one mip of the specular environment (split sum, left factor).
+// GGX prefiltering of one mip of the specular environment (split sum, left factor).
+// Faces uFaceBase, uFaceBase + 1, ... lie side by side in the target, uSize texels wide each.
+//
+// Karis 2013, "Real Shading in Unreal Engine 4", PrefilterEnvMap: N = V = R. With N = V every
+// sample's L, NoL and pdf are the same in N's tangent frame whatever N is, so they come from a
+// table made once a mip (matedit/ibl/gpu.py, ggx_sample_table); the source mip of each sample
+// follows from its pdf and the texel solid angle at L (filtered importance sampling, Colbert
+// and Krivanek, GPU Gems 3, ch. 20), of which only the texel's max |L|^3 depends on N.
 #include "common.glsl"
 #include "sampling.glsl"
 #include "bake/cubemap.glsl"
 
+#define TABLE_ROWS 1024
+
 uniform samplerCube uSource;   // the environment, with a full mip chain
-uniform float uSourceSize;     // face size of the source's level 0
 uniform float uMaxSourceLod;   // its last mip level
-uniform float uLodBias;        // extra blur in source mips (filtered importance sampling)
-uniform int uFace;
+uniform int uFaceBase;         // the face at x = 0
 uniform int uSize;             // face size of the mip being written
-uniform float uRoughness;      // perceptual roughness of this mip
-uniform int uSamples;
+uniform int uCount;            // table rows used, at most TABLE_ROWS
+uniform float uScale;          // 1 / (sum of NoL over the whole sample set)
+
+// Row i: (L.x, L.y, L.z = NoL, lod of the sample where the source texel is a face centre's),
+// L in the frame (T, B, N) of tangentFrame.
+layout(std140) uniform SampleTable {
+    vec4 uTable[TABLE_ROWS];
+};
 
 out vec4 fragColor;
 
-float bakeD_GGX(float NoH, float a) {
-    // Karis 2013, eq 3: GGX / Trowbridge-Reitz, a = roughness^2
-    float a2 = a * a;
-    float d = NoH * NoH * (a2 - 1.0) + 1.0;
-    return a2 / (PI * d * d);
-}
-
 void main() {
-    // Karis 2013, "Real Shading in Unreal Engine 4", PrefilterEnvMap (N = V = R), with the source
-    // mip chosen from each sample's pdf and texel solid angle (Colbert and Krivanek, GPU Gems 3, ch. 20)
-    vec2 st = gl_FragCoord.xy / float(uSize);
-    vec3 N = normalize(cubeFaceDirection(uFace, st));
-    vec3 V = N;
-    float a = uRoughness * uRoughness;
-    uint n = uint(uSamples);
+    int column = int(gl_FragCoord.x) / uSize;
+    vec2 st = vec2(gl_FragCoord.x - float(column * uSize), gl_FragCoord.y) / float(uSize);
+    vec3 N = normalize(cubeFaceDirection(uFaceBase + column, st));
+    vec3 T;
+    vec3 B;
+    tangentFrame(N, T, B);
     vec3 sum = vec3(0.0);
-    float weight = 0.0;
-    for (uint i = 0u; i < n; ++i) {
-        vec3 H = importanceSampleGGX(hammersley(i, n), a, N);
-        float VoH = dot(V, H);
-        vec3 L = 2.0 * VoH * H - V;
-        float NoL = dot(N, L);
-        if (NoL > 0.0) {
-            // pdf of L = D NoH / (4 VoH), and NoH == VoH here because N == V
-            float pdf = 0.25 * bakeD_GGX(VoH, a);
-            float omegaS = 1.0 / (float(n) * pdf);
-            float omegaP = cubeTexelSolidAngle(L, uSourceSize);
-            float lod = clamp(0.5 * log2(omegaS / omegaP) + uLodBias, 0.0, uMaxSourceLod);
-            sum += textureLod(uSource, L, lod).rgb * NoL;
-            weight += NoL;
-        }
+    for (int i = 0; i < uCount; ++i) {
+        vec4 s = uTable[i];
+        vec3 L = T * s.x + B * s.y + N * s.z;
+        // cubeTexelSolidAngle(L, size) = 4 ma^3 / size^2: its 0.5 log2 apart from the table's
+        vec3 aL = abs(L);
+        float ma = max(aL.x, max(aL.y, aL.z));
+        float lod = clamp(s.w - 1.5 * log2(ma), 0.0, uMaxSourceLod);
+        sum += textureLod(uSource, L, lod).rgb * s.z;
     }
-    fragColor = vec4(sum / max(weight, 1e-20), 1.0);
+    fragColor = vec4(sum * uScale, 1.0);
 }

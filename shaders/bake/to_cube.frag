@@ -1,5 +1,6 @@
-// Resample an environment (equirect image or another cube map) onto one face of a cube map,
+// Resample an environment (equirect image or another cube map) onto the faces of a cube map,
 // averaging a uSuper x uSuper grid of samples per output texel so a larger source is not aliased.
+// Faces uFaceBase, uFaceBase + 1, ... lie side by side in the target, uSize texels wide each.
 #include "common.glsl"
 #include "bake/cubemap.glsl"
 
@@ -8,7 +9,7 @@ uniform samplerCube uSource;
 #else
 uniform sampler2D uSource;
 #endif
-uniform int uFace;
+uniform int uFaceBase;
 uniform int uSize;
 uniform int uSuper;
 
@@ -28,12 +29,14 @@ vec3 sourceRadiance(vec3 d) {
 }
 
 void main() {
-    vec2 texel = floor(gl_FragCoord.xy);
+    int column = int(gl_FragCoord.x) / uSize;
+    int face = uFaceBase + column;
+    vec2 texel = floor(gl_FragCoord.xy) - vec2(float(column * uSize), 0.0);
     vec3 sum = vec3(0.0);
     for (int j = 0; j < uSuper; ++j) {
         for (int i = 0; i < uSuper; ++i) {
             vec2 st = (texel + (vec2(i, j) + 0.5) / float(uSuper)) / float(uSize);
-            sum += sourceRadiance(cubeFaceDirection(uFace, st));
+            sum += sourceRadiance(cubeFaceDirection(face, st));
         }
     }
     fragColor = vec4(sum / float(uSuper * uSuper), 1.0);
