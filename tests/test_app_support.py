@@ -96,7 +96,14 @@ def wait_for_renderer(qtbot, window, timeout: int = 30000):
 
 
 def settle(qtbot, window, ms: int = 5) -> None:
-    """Run the debounced recompile now and let queued UI work happen."""
-    for tab in window.tabs.all_tabs():
+    """Run the debounced recompile now, let queued UI work happen, and wait for the node
+    thumbnails (evaluated on a worker thread) to be on the canvas."""
+    tabs = window.tabs.all_tabs()
+    for tab in tabs:
         tab.controller.flush()
+    for tab in tabs:
+        if tab.previews is not None:
+            tab.previews.flush()
+    qtbot.waitUntil(lambda: all(t.previews is None or t.previews.idle for t in tabs),
+                    timeout=60000)
     qtbot.wait(ms)

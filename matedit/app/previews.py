@@ -280,6 +280,17 @@ class NodePreviews(QObject):
 
         future.add_done_callback(done)
 
+    @property
+    def idle(self) -> bool:
+        """No evaluation under way or waiting for its timer."""
+        return not self._busy and not self._timer.isActive()
+
+    def flush(self) -> None:
+        """Starts the evaluation an edit has scheduled now (tests, like the controller's)."""
+        if self._timer.isActive():
+            self._timer.stop()
+            self.refresh()
+
     def _apply(self, gen: int, images: dict) -> None:
         self._busy = False
         if gen != self._generation:  # an edit came meanwhile: evaluate that instead
