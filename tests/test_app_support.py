@@ -20,12 +20,10 @@ os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
 pytest.importorskip("PySide6")
 pytest.importorskip("pytestqt")
 
-from PySide6.QtCore import QCoreApplication, QSettings, QStandardPaths, Qt  # noqa: E402
+from PySide6.QtCore import QSettings, QStandardPaths  # noqa: E402
 
-from matedit.app.app import configure_application_names, configure_gl  # noqa: E402
+from matedit.app.app import configure_application_names  # noqa: E402
 
-configure_gl()
-QCoreApplication.setAttribute(Qt.ApplicationAttribute.AA_ShareOpenGLContexts)
 configure_application_names()
 QStandardPaths.setTestModeEnabled(True)
 # Recovery files of this test run only: other runs on the machine clear theirs.

@@ -1,6 +1,7 @@
 """Regenerate tests/data/sample_renders/: the pre-lobe samples and their reference renders.
 
     python tools/sample_references.py --tree OLD_TREE [--repeat]
+    python tools/sample_references.py --tree TREE --renders-only [--repeat]
 
 OLD_TREE is a checkout of the commit before the lobes beyond the talk (issue 23), e.g.
 `git worktree add /tmp/old 0fd033b`. The tool copies that tree's graphs/materials,
@@ -14,6 +15,11 @@ tests/data/sample_renders/renders.npz, one array a sample stem.
 --repeat renders every sample a second time and prints the largest difference between
 the two runs (it is 0 where the renderer is deterministic, as tests/test_sample_renders_
 stable.py assumes).
+
+--renders-only keeps the stored graphs and renders them again with TREE's `matedit render`:
+for a change that moves every frame on purpose while the shading stays the talk's (issue 29's
+new prefiltering of the environment: the tree before it still matched 0fd033b's frames to
+1e-5, and the new bake is checked against brute force by tests/test_ibl_prefilter.py).
 
 tests/test_sample_renders_stable.py renders the same stored graphs through the same command
 with the current tree and compares.
@@ -76,15 +82,18 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--tree", required=True, type=Path, help="the pre-lobe checkout")
     ap.add_argument("--repeat", action="store_true", help="render twice and report the spread")
+    ap.add_argument("--renders-only", action="store_true",
+                    help="keep the stored graphs; only render them again with TREE")
     args = ap.parse_args(argv)
     tree = args.tree.resolve()
     if not (tree / "matedit" / "__init__.py").is_file():
         raise SystemExit(f"{tree}: not a matedit checkout")
     graphs = DATA / "graphs"
-    if graphs.exists():
-        shutil.rmtree(graphs)
-    for sub in ("materials", "layers", "functions"):
-        shutil.copytree(tree / "graphs" / sub, graphs / sub)
+    if not args.renders_only:
+        if graphs.exists():
+            shutil.rmtree(graphs)
+        for sub in ("materials", "layers", "functions"):
+            shutil.copytree(tree / "graphs" / sub, graphs / sub)
     frames: dict[str, np.ndarray] = {}
     with tempfile.TemporaryDirectory() as tmp:
         env = render_env(tree, str(Path(tmp) / "cache"))
