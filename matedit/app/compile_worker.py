@@ -6,9 +6,10 @@ optimises it and writes the GLSL of the viewport's entry variants (FORWARD, and 
 deferred preview). With `warm_up` on and the viewport's state
 (matedit.render.warmup.ViewportState) the worker then has that program linked and drawn once in
 a headless context of a helper process (matedit.render.warmup), so that the driver's compiled
-shaders are in Mesa's shader cache before the viewport's render process asks for them (the
-render process keeps the link and the JIT off the UI thread either way; with the warm-up the
-edit reaches the screen sooner: benchmarks/bench_ui_block.py measures both).
+shaders are in Mesa's shader cache before the viewport's render process asks for them. It is
+off by default: the render process keeps the link and the JIT off the UI thread either way, and
+on a quiet machine the warm-up made the edit no sooner (benchmarks/bench_ui_block.py measures
+both; 2026-12-05: edit to pixels 325 ms without, 360 ms with) for a process more.
 The result comes back to the UI thread as a queued Qt signal; the viewport sends the program
 to its render process (matedit.render.server), which links it and swaps it in, drawing the
 last good program until then. Each request has a generation number: a newer request supersedes
@@ -69,14 +70,14 @@ def viewport_textures(cm, doc) -> dict:
 class CompileWorker(QObject):
     """One background thread; `finished(CompileResult)` arrives on the UI thread.
 
-    `warm_up` (default on; nothing is warmed while MESA_SHADER_CACHE_DISABLE is set) has the
-    viewport's programs warmed after each compile when `submit` is given the viewport's
+    `warm_up` (default off; nothing is warmed while MESA_SHADER_CACHE_DISABLE is set) has
+    the viewport's programs warmed after each compile when `submit` is given the viewport's
     state (asked from that thread, done in matedit.render.warmup's child process); `warmed`
     lists (generation, asking thread, WarmReply), for tests."""
 
     finished = Signal(object)
     _done = Signal(object)  # emitted on the worker thread, delivered queued
-    warm_up = True  # per instance too (tests, benchmarks/bench_ui_block.py)
+    warm_up = False  # per instance too (tests, benchmarks/bench_ui_block.py)
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
