@@ -29,8 +29,7 @@ class Layer:
 
 LAYERS: tuple[Layer, ...] = (
     # the version; where shaders/, graphs/ and ui/ are; user folders; this table
-    Layer("base", ("matedit", "matedit.resources", "matedit.dirs", "matedit.layers",
-                   "matedit.gl_wait"),
+    Layer("base", ("matedit", "matedit.resources", "matedit.dirs", "matedit.layers"),
           ("platformdirs",)),
     # port types and the one implicit conversion; the float32 rule; identifiers
     Layer("types", ("matedit.graph.types", "matedit.graph.numbers", "matedit.graph.names")),

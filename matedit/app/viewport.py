@@ -120,7 +120,6 @@ class ViewportWidget(QWidget):
         self._textures: dict[str, Path | None] = {}
         self._pending_material = None  # the last material posted (what the first frame shows)
         self._has_material = False
-        self._pending_uniforms: dict[str, Any] | None = None
         self._mesh = "sphere"
         self._environment = "studio"
         # the environment is baked (or loaded from the cache) after the first frame, so that
@@ -219,14 +218,11 @@ class ViewportWidget(QWidget):
                 exc = f.exception()
                 if isinstance(exc, RendererStopped):  # said once, by `ended`
                     return
-                try:
-                    if exc is not None:
-                        if failed is not None:
-                            bridge.call.emit(lambda: failed(exc))
-                    elif then is not None:
-                        bridge.call.emit(lambda: then(f.result()))
-                except RuntimeError:  # the viewport has gone meanwhile: nobody to tell
-                    pass
+                if exc is not None:
+                    if failed is not None:
+                        _emit(bridge.call, lambda: failed(exc))
+                elif then is not None:
+                    _emit(bridge.call, lambda: then(f.result()))
 
             future.add_done_callback(done)
         return future
@@ -270,7 +266,7 @@ class ViewportWidget(QWidget):
         if cm is None or is_attribute_view(self._view):
             return False
         try:
-            return not wants_forward(cm, self._pending_uniforms)
+            return not wants_forward(cm, self._uniforms)
         except Exception:  # whatever it is, the renderer warms itself as it always did
             return False
 
@@ -356,12 +352,10 @@ class ViewportWidget(QWidget):
             return None
         from matedit.render.warmup import ViewportState
 
-        cm = self._pending_material
-        forced = bool(cm is not None and getattr(cm, "preview", {}).get("energy_compensation"))
         return ViewportState(samples=4, deferred=True,  # as the render process's renderer
                              environment=str(self._environment),  # the one it has or gets
                              mode=self._mode, mesh=self._mesh,
-                             energy_compensation=self.settings.energy_compensation or forced,
+                             energy_compensation=self.settings.energy_compensation,
                              show_background=self.settings.show_background)
 
     @property
@@ -374,7 +368,6 @@ class ViewportWidget(QWidget):
     def clear_material(self) -> None:
         """Draw no material (another document: the previous one's program is not its own)."""
         self._pending_material = None
-        self._pending_uniforms = None
         self._uniforms, self._textures = {}, {}
         self._has_material = False
         self._do("clear_material")
@@ -399,7 +392,6 @@ class ViewportWidget(QWidget):
         self._do("set_material", compiled, then=applied, failed=failed)
 
     def set_values(self, uniforms: dict[str, Any], textures: dict[str, Path | None]) -> None:
-        self._pending_uniforms = uniforms
         self._uniforms.update(uniforms)
         self._textures.update(textures)
         self._post("values", uniforms, dict(textures),
@@ -526,10 +518,7 @@ class ViewportWidget(QWidget):
 
         def report(fraction: float) -> None:  # on the client's reader thread
             if progress is not None:
-                try:
-                    bridge.call.emit(lambda: progress(fraction))
-                except RuntimeError:  # the viewport has gone meanwhile
-                    pass
+                _emit(bridge.call, lambda: progress(fraction))
 
         future = self._post("environment", spec, True, progress=report)
         loop = QEventLoop()

@@ -22,7 +22,6 @@ from collections.abc import Callable
 import moderngl
 import numpy as np
 
-from matedit.gl_wait import finish
 from matedit.render.deferred import GBuffer
 from matedit.render.fullscreen import FullscreenQuad, render_program, set_uniform
 from matedit.render.slicing import BandPlanner
@@ -211,7 +210,7 @@ class Accumulator:
                 scene(IBL_MODE_SPLIT_SUM, (0.0, 0.0), band)
             else:
                 scene(IBL_MODE_REFERENCE, r2_offset(self.frames), band)
-            finish(self.ctx)  # the band's real cost (the driver works asynchronously)
+            self.ctx.finish()  # the band's real cost (the driver works asynchronously)
             ms = (clock() - t0) * 1e3
             planner.record(band, ms)
             spent += ms
