@@ -14,10 +14,10 @@ from functools import cache
 
 from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, Op, Param, Splat, SurfaceUV, Uni, Var
-from matedit.compiler.schedule import Entry, LocalNames, Schedule, ScopePlan, SourceMap, Writer
+from matedit.compiler.schedule import ENTRY_OUTPUT_TYPES, Entry, LocalNames, Schedule, ScopePlan, SourceMap, Writer
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING, Target
 from matedit.glsl import layout as _layout
-from matedit.glsl.include import Assembly, assemble
+from matedit.glsl.include import Assembly, assemble, packing_prelude
 from matedit.graph import nodes
 from matedit.graph.types import PortType
 
@@ -291,13 +291,16 @@ def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap
     for i, decl in enumerate(_VARYINGS):
         w.add(varying(target, "in", i, decl))
     for i, name in enumerate(plan.outputs):
-        w.add(f"layout(location = {i}) out vec4 {name};")
+        w.add(f"layout(location = {i}) out {ENTRY_OUTPUT_TYPES.get(name, 'vec4')} {name};")
     for scope in plan.scopes:
         _scope(w, scope)
     w.add(entry_text(plan.entry, tuple(plan.extra_defines)))
     includes = [f"{unit}.glsl" for unit in plan.units]
     lines = "\n".join(f"#define {d} 1" for d in plan.defines)
     lines += "".join(f"\n#define {_define_line(d)}" for d in plan.extra_defines)
+    head = prelude(target)
+    if plan.entry == Entry.GBUFFER:  # shaders/gbuffer.glsl packs halves
+        head = "\n".join(x for x in (packing_prelude(target.version), head) if x)
     asm = assemble("\n".join(w.lines), target.version, includes, "<material>",
-                   prelude=prelude(target) + "\n" + lines)
+                   prelude=head + "\n" + lines)
     return asm, SourceMap(w.map, len(asm.sources) - 1)

@@ -139,8 +139,9 @@ class Entry(Enum):
     `shaders/entry/<value>.frag.glsl`).
 
     FORWARD: attributes and `shadeSurface` in one shader (what `compile` exports).
-    GBUFFER: the attributes and the world-space shading normal into four float targets, for the
-    preview's deferred lighting pass (shaders/render/lighting.frag).
+    GBUFFER: the attributes, the world-space shading normal and the position, packed into three
+    targets (matedit/render/deferred.py), for the preview's deferred lighting pass
+    (shaders/render/lighting.frag).
     ATTRIBUTES: the raw MaterialAttributes into four float targets (tests, `bake`).
     """
 
@@ -157,12 +158,15 @@ class Entry(Enum):
 # Output variables of each entry (location order); the entry file writes them.
 ENTRY_OUTPUTS = {
     Entry.FORWARD: ("fragColor",),
-    Entry.GBUFFER: ("gbuffer0", "gbuffer1", "gbuffer2", "gbuffer3"),
+    Entry.GBUFFER: ("gbuffer0", "gbuffer1", "gbuffer2"),
     Entry.ATTRIBUTES: ("out0", "out1", "out2", "out3"),
 }
+# The GLSL type of an output variable that is not a vec4 (the G-buffer's packed targets:
+# matedit/render/deferred.py).
+ENTRY_OUTPUT_TYPES = {"gbuffer0": "uvec4", "gbuffer1": "uvec4", "gbuffer2": "float"}
 # Library units every material needs, and those an entry needs beyond the material's own.
 BASE_UNITS = ("common", "material", "nodes/context")
-ENTRY_UNITS = {Entry.FORWARD: ("surface",), Entry.GBUFFER: (), Entry.ATTRIBUTES: ()}
+ENTRY_UNITS = {Entry.FORWARD: ("surface",), Entry.GBUFFER: ("gbuffer",), Entry.ATTRIBUTES: ()}
 
 ATTRIBUTE_VIEW = "MATEDIT_ATTRIBUTE_VIEW"  # =<ATTRIBUTE_VIEW_*> of shaders/attribute_view.glsl
 # A caller's define: a name (defined as 1), or NAME=<integer> (a view's mask or number).

@@ -28,6 +28,17 @@ _ERROR_LOC = re.compile(
 )
 # Lines per source string in the encoded `#line` numbers (files are far shorter).
 LINE_STRIDE = 100_000
+# packHalf2x16 and friends are GLSL 4.20 (ESSL 3.00): at GLSL 3.30 a shader that uses them
+# (shaders/gbuffer.glsl) has this ahead of every declaration, in its prelude.
+PACKING_EXTENSION = "#extension GL_ARB_shading_language_packing : require"
+
+
+def packing_prelude(version: str) -> str:
+    """PACKING_EXTENSION where `version` (a #version argument) lacks the packing functions,
+    else nothing."""
+    if version.endswith(" es") or int(version.split()[0]) >= 420:
+        return ""
+    return PACKING_EXTENSION
 
 
 def _line_directive(line: int, source: int) -> str:

@@ -1,23 +1,32 @@
-"""The deferred preview: the material's GBUFFER program fills multisampled float targets, and
+"""The deferred preview: the material's GBUFFER program fills three multisampled targets, and
 one lighting program (shaders/render/lighting.frag), linked once a variant for the renderer's
 lifetime, shades them in a full-screen pass over the background (drawn first into a one-sample
 texture), writing every sample; see that file for how edges are anti-aliased.
 
-G-buffer layout (GBUFFER entry, shaders/entry/gbuffer.frag.glsl), RGBA float32 each:
-  0: baseColor.rgb, metallic      1: world-space shading normal, roughness
-  2: emissive.rgb, cavity         3: world position (m), coverage (1 drawn, 0 cleared)
-Float32 keeps every value the material computed exactly, so the lighting pass sees the same
-arguments shadeSurface gets in the FORWARD entry.
+G-buffer layout (GBUFFER entry, shaders/entry/gbuffer.frag.glsl; packing: shaders/gbuffer.glsl):
+  0, RGBA32UI: x, y, z  world position (m), float32 bits: exact
+               w        world-space shading normal, octahedral, 16 bits a coordinate (angular
+                        error below 1e-4 rad); never 0, so a cleared 0 means "not covered"
+  1, RGBA32UI: halves   baseColor.r|g, baseColor.b|metallic, emissive.r|g, emissive.b|cavity:
+                        relative error at most 2^-11 (11-bit significand), clamped to +-65504
+  2, R32F:              roughness, float32: exact
+Fewer and narrower targets than four RGBA float32 ones: llvmpipe's JIT at a new material
+program's first draw, and its fill of every frame, grow with the targets' number and size (the
+structural edit's latency). The lighting pass sees the forward entry's shadeSurface arguments up
+to those roundings. Cleared targets (0) read as no coverage.
 """
 
 from __future__ import annotations
 
 import moderngl
 
-from matedit.render.fullscreen import FullscreenQuad, render_program, set_uniform
+from matedit.glsl.include import packing_prelude
+from matedit.render.fullscreen import GLSL_VERSION, FullscreenQuad, render_program, set_uniform
 from matedit.resources import shaders_dir
 
-GBUFFER_TARGETS = 4
+# (components, moderngl dtype) of each target, in location order (the layout above)
+GBUFFER_FORMATS = ((4, "u4"), (4, "u4"), (1, "f4"))
+GBUFFER_TARGETS = len(GBUFFER_FORMATS)
 GBUFFER_FIRST_UNIT = 8  # texture units of the G-buffer in the lighting pass
 SPLIT_SUM_ONLY = "MATEDIT_SPLIT_SUM_ONLY"
 ENERGY_COMPENSATION = "MATEDIT_ENERGY_COMPENSATION"
@@ -28,8 +37,8 @@ class GBuffer:
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int], samples: int,
                  depth: moderngl.Renderbuffer) -> None:
-        self.textures = [ctx.texture(size, 4, dtype="f4", samples=samples)
-                         for _ in range(GBUFFER_TARGETS)]
+        self.textures = [ctx.texture(size, components, dtype=dtype, samples=samples)
+                         for components, dtype in GBUFFER_FORMATS]
         self.fbo = ctx.framebuffer(self.textures, depth)
 
     def release(self) -> None:
@@ -62,7 +71,8 @@ class LightingPass:
             defines = ([SPLIT_SUM_ONLY] if split_sum_only else []) + \
                       ([ENERGY_COMPENSATION] if compensation else []) + \
                       (["MATEDIT_EDGES_ONCE"] if edges_once else [])
-            lines = [f"#define {d} 1" for d in defines]
+            lines = [packing_prelude(GLSL_VERSION)]  # shaders/gbuffer.glsl unpacks halves
+            lines += [f"#define {d} 1" for d in defines]
             if int(lobes) != 127:
                 lines.append(f"#define MATEDIT_LOBES {int(lobes)}")
             lines.append(f"#define MATEDIT_GBUFFER_SAMPLES {self.samples}")

@@ -8,6 +8,8 @@ import numpy as np
 
 from matedit.glsl.include import assemble
 
+GLSL_VERSION = "330 core"  # of every program built from shaders/render/
+
 
 def read_shader(name: str) -> str:
     from matedit.resources import shaders_dir
@@ -18,11 +20,11 @@ def read_shader(name: str) -> str:
 def render_program(ctx: moderngl.Context, vert: str, frag: str, prelude: str = "",
                    roots=None, vertex_prelude: bool = True) -> moderngl.Program:
     """Links two files of `shaders/render/` (their includes resolved against `roots`, default
-    the shaders folder), `prelude` (#define lines only) ahead of the fragment shader and, with
+    the shaders folder), `prelude` (#define and #extension lines only) ahead of the fragment shader and, with
     `vertex_prelude`, of the vertex shader."""
-    v = assemble(read_shader(vert), "330 core", [], "<vertex>", roots,
+    v = assemble(read_shader(vert), GLSL_VERSION, [], "<vertex>", roots,
                  prelude if vertex_prelude else "")
-    f = assemble(read_shader(frag), "330 core", [], "<fragment>", roots, prelude)
+    f = assemble(read_shader(frag), GLSL_VERSION, [], "<fragment>", roots, prelude)
     return ctx.program(vertex_shader=v.text, fragment_shader=f.text)
 
 

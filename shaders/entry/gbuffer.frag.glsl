@@ -1,6 +1,7 @@
 // GBUFFER entry: the preview's deferred material pass. Writes what shadeSurface needs (the
-// attributes, the world-space shading normal, the position) to four float targets; the
-// lighting pass (shaders/render/lighting.frag) shades them. Leading comment lines are
+// attributes, the world-space shading normal, the position) to three targets, packed by
+// shaders/gbuffer.glsl; the lighting pass (shaders/render/lighting.frag) unpacks and shades
+// them. Layout and precision: matedit/render/deferred.py. Leading comment lines are
 // documentation, not emitted.
 void main() {
     nodeSetupSurface(v_position, gl_FrontFacing ? v_normal : -v_normal, v_tangent, v_uv,
@@ -13,9 +14,11 @@ void main() {
 #ifdef MATERIAL_HAS_NORMAL
     N = tangentToWorldNormal(m.normal, T, B, g_surface.normal);
 #endif
-    // layout: matedit/render/deferred.py (float32, values kept exactly)
-    gbuffer0 = vec4(m.baseColor, m.metallic);
-    gbuffer1 = vec4(N, m.roughness);
-    gbuffer2 = vec4(m.emissive, m.cavity);
-    gbuffer3 = vec4(g_surface.position, 1.0);  // w: coverage (cleared to 0)
+    // position: float32 bits (exact); w: the normal, which is also the coverage (cleared to 0)
+    gbuffer0 = uvec4(floatBitsToUint(g_surface.position), gbufferPackNormal(N));
+    gbuffer1 = uvec4(gbufferPackHalf2(m.baseColor.r, m.baseColor.g),
+                     gbufferPackHalf2(m.baseColor.b, m.metallic),
+                     gbufferPackHalf2(m.emissive.r, m.emissive.g),
+                     gbufferPackHalf2(m.emissive.b, m.cavity));
+    gbuffer2 = m.roughness;  // float32 (exact)
 }
