@@ -212,15 +212,42 @@ def frames_forward_deferred(ctx, material: CompiledMaterial, sizes=(512, 1024),
     return rows
 
 
+_COVERAGE_FRAG = """#version 330 core
+uniform usampler2DMS uGBuffer0;  // w: the packed normal, 0 where not covered (deferred.py)
+uniform int uSamples;
+out vec4 color;
+void main() {
+    int covered = 0;
+    for (int s = 0; s < uSamples; s++) {
+        if (texelFetch(uGBuffer0, ivec2(gl_FragCoord.xy), s).w != 0u) covered++;
+    }
+    color = vec4(float(covered) / float(uSamples));
+}
+"""
+_COVERAGE_VERT = """#version 330 core
+void main() {
+    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+"""
+
+
 def _resolve_coverage(ctx, gbuffer, size: int) -> bytes:
-    """The G-buffer's coverage channel resolved (average of samples): 0 < c < 1 at a
-    silhouette pixel."""
-    tex = ctx.texture((size, size), 4, dtype="f4")
+    """The G-buffer's coverage averaged over the samples (its integer targets cannot be
+    resolved by a blit): 0 < c < 1 at a silhouette pixel."""
+    tex = ctx.texture((size, size), 1, dtype="f4")
     fbo = ctx.framebuffer([tex])
-    ctx.copy_framebuffer(fbo, ctx.framebuffer([gbuffer.textures[3]]))
-    raw = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32)[3::4].tobytes()
-    fbo.release()
-    tex.release()
+    prog = ctx.program(vertex_shader=_COVERAGE_VERT, fragment_shader=_COVERAGE_FRAG)
+    prog["uSamples"].value = gbuffer.textures[0].samples
+    gbuffer.textures[0].use(location=0)
+    prog["uGBuffer0"].value = 0
+    vao = ctx.vertex_array(prog, [])
+    fbo.use()
+    ctx.disable(ctx.DEPTH_TEST | ctx.BLEND)
+    vao.render(mode=ctx.TRIANGLES, vertices=3)
+    raw = fbo.read(components=1, dtype="f4")
+    for x in (vao, prog, fbo, tex):
+        x.release()
     return raw
 
 

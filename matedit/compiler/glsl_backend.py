@@ -14,7 +14,15 @@ from functools import cache
 
 from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, Op, Param, Splat, SurfaceUV, Uni, Var
-from matedit.compiler.schedule import ENTRY_OUTPUT_TYPES, Entry, LocalNames, Schedule, ScopePlan, SourceMap, Writer
+from matedit.compiler.schedule import (
+    ENTRY_OUTPUT_TYPES,
+    Entry,
+    LocalNames,
+    Schedule,
+    ScopePlan,
+    SourceMap,
+    Writer,
+)
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING, Target
 from matedit.glsl import layout as _layout
 from matedit.glsl.include import Assembly, assemble, packing_prelude

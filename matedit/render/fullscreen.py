@@ -20,8 +20,8 @@ def read_shader(name: str) -> str:
 def render_program(ctx: moderngl.Context, vert: str, frag: str, prelude: str = "",
                    roots=None, vertex_prelude: bool = True) -> moderngl.Program:
     """Links two files of `shaders/render/` (their includes resolved against `roots`, default
-    the shaders folder), `prelude` (#define and #extension lines only) ahead of the fragment shader and, with
-    `vertex_prelude`, of the vertex shader."""
+    the shaders folder), `prelude` (#define and #extension lines only) ahead of the fragment
+    shader and, with `vertex_prelude`, of the vertex shader."""
     v = assemble(read_shader(vert), GLSL_VERSION, [], "<vertex>", roots,
                  prelude if vertex_prelude else "")
     f = assemble(read_shader(frag), GLSL_VERSION, [], "<fragment>", roots, prelude)
