@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from matedit.glsl.include import assemble
+from matedit.glsl.include import assemble, packing_prelude
 from matedit.resources import shaders_dir
 
 FILES = sorted(p.name for p in shaders_dir().glob("*.glsl")) + sorted(
@@ -25,6 +25,8 @@ TARGETS = {
 
 def _wrapped(name: str, target: str):
     version, prelude, out_decl, _ = TARGETS[target]
+    if name == "gbuffer.glsl":  # packs halves: at 330 its includers enable the extension
+        prelude = "\n".join(x for x in (packing_prelude(version), prelude) if x)
     body = f"{out_decl}\nvoid main() {{\n    color = vec4(0.0);\n}}\n"
     return assemble(body, version=version, includes=[name], prelude=prelude)
 
