@@ -18,12 +18,19 @@ from matedit.resources import graphs_dir, shaders_dir
 MATERIALS = sorted((graphs_dir() / "materials").glob("*.json"))
 SMALL = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
 SIZE = (64, 64)
-# Deferred against forward, |a - b| / max(1, |b|) on every pixel of the resolved image: the
-# G-buffer holds float32 copies of what the forward shader passes to shadeSurface, and edge
-# pixels are lit per sample, so the bound is float rounding (measured: at most 4.8e-7, in
-# reference and difference modes, where frames are summed; split sum: at most 6e-8, and
-# exactly 0 on all but a few pixels). Interior and edge pixels are held to the same bound.
+# Deferred against forward, |a - b| / max(1, |b|) on every pixel of the resolved image. The
+# G-buffer holds float32 copies of what the forward shader passes to shadeSurface, and
+# silhouette pixels are lit per sample, so there the bound is float rounding (measured: at most
+# 4.8e-7 in reference and difference modes, where frames are summed; split sum 6e-8).
 REL = 1e-6
+# Where two triangles of one smooth surface meet inside a pixel, the deferred pass lights
+# sample 0 once for the pixel (shaders/render/lighting.frag, sameAsFirst) where the forward
+# pass lights each triangle's fragment and averages: those pixels differ by the variation of
+# the shading over a fraction of a pixel. Measured on the samples at 64 px (a pixel spans a
+# lot of the sphere there): worst pixel 0.032 (hammered_copper's bump), worst image mean
+# 2.7e-4; materials without per-pixel normals are exact.
+REL_PIXEL = 0.06
+REL_MEAN = 1e-3
 
 
 def flat_material(opacity=None, roughness=0.4):
@@ -118,7 +125,8 @@ def test_deferred_equals_forward_split_sum(pair, path):
     # too (the G-buffer holds the talk's fields): the two must still agree
     assert pair["deferred"].is_forward == writes_lobes(cm.ir) and pair["forward"].is_forward
     assert b.max() > 0.05
-    assert _rel(a, b).max() <= REL
+    assert _rel(a, b).max() <= REL_PIXEL
+    assert _rel(a, b).mean() <= REL_MEAN
 
 
 @pytest.mark.parametrize("mode", ["reference", "difference"])
@@ -127,13 +135,14 @@ def test_deferred_equals_forward_reference_and_difference(pair, mode):
                           FileResolver())
     a, b = _both(pair, cm, mode)
     assert np.abs(b).max() > 0.01
-    assert _rel(a, b).max() <= REL
+    assert _rel(a, b).max() <= REL_PIXEL
+    assert _rel(a, b).mean() <= REL_MEAN
 
 
 def test_silhouettes_are_antialiased_like_forward(pair):
     """Edge pixels mix the background and the surface in the proportion of covered samples:
     with a black background and no gizmos, a silhouette pixel is strictly between 0 and the
-    surface; the deferred values equal the forward ones there too."""
+    surface; the deferred values equal the forward ones there (lit per sample in both)."""
     for r in pair.values():
         r.show_background = False
         r.show_gizmos = False
@@ -151,7 +160,8 @@ def test_silhouettes_are_antialiased_like_forward(pair):
     dark = lum[edge] < 0.6 * np.median(lum[inside & ~edge])
     assert dark.sum() > 10
     assert _rel(a, b)[edge].max() <= REL
-    assert _rel(a, b)[inside & ~edge].max() <= REL
+    assert _rel(a, b)[inside & ~edge].max() <= REL_PIXEL
+    assert _rel(a, b)[inside & ~edge].mean() <= REL_MEAN
 
 
 def test_energy_compensation_and_gizmos_match(pair):
@@ -162,7 +172,8 @@ def test_energy_compensation_and_gizmos_match(pair):
     finally:
         for r in pair.values():
             r.set_energy_compensation(False)
-    assert _rel(a, b).max() <= REL
+    assert _rel(a, b).max() <= REL_PIXEL
+    assert _rel(a, b).mean() <= REL_MEAN
 
 
 # --- programs ---------------------------------------------------------------------------------

@@ -3,11 +3,14 @@
 // in a full-screen pass. Linked once per variant, whatever the material.
 //
 // Anti-aliasing: the G-buffer is multisampled like the forward target, and the pass runs once a
-// pixel. A pixel whose samples all hold the same values (inside a triangle, or all background)
-// is shaded once; a pixel whose samples differ (a silhouette, or two triangles meeting) is
+// pixel. A pixel whose samples all show the same surface (inside a triangle, all background, or
+// two triangles of one smooth surface meeting in it: sameAsFirst) is shaded once from sample 0;
+// a pixel whose samples differ (a silhouette, an occlusion edge, a crease, a material seam) is
 // shaded per sample from each sample's own values, uncovered samples taking the background,
-// and the average is written. Every sample of the target gets the pixel's colour, so the
-// resolve gives what the forward pass's resolve gives: the average of the samples' colours.
+// and the average is written. Every sample of the target gets the pixel's colour. Lighting
+// every triangle edge per sample, as the forward pass does, took a third of the whole frame
+// on the sample sphere at 512 px, for differences of a fraction of a pixel's shading
+// (tests/test_render_deferred.py states the bounds).
 #include "surface.glsl"
 
 in vec2 v_ndc;
@@ -23,19 +26,51 @@ uniform vec3 uCameraPosition;   // eye in world space (m), FrameBlock's cameraPo
 #define MATEDIT_GBUFFER_SAMPLES 4
 #endif
 
+// Two samples "show the same surface" when they agree on coverage and, where covered, their
+// positions lie within EDGE_POSITION of the distance to the eye, their normals within
+// EDGE_NORMAL_COS, and their material values within EDGE_VALUE (emissive: relative above 1).
+// That is two triangles of one smooth surface meeting inside the pixel (each fragment shaded
+// at the pixel centre, so they differ only by extrapolation): one shading of sample 0 stands
+// for both, as a one-sample render would. Silhouettes, occlusion edges, creases and material
+// seams differ by more and are shaded per sample. Thresholds: about a third of a pixel's
+// footprint at 512 px and a 45-degree field of view, one degree, 1/512.
+const float EDGE_POSITION = 5e-4;
+const float EDGE_NORMAL_COS = 0.99985;
+const float EDGE_VALUE = 1.0 / 512.0;
+
 bool sameAsFirst(ivec2 p, int s) {
-    // matedit deferred pass: exact equality, the values are float32 copies
-    return texelFetch(uGBuffer0, p, s) == texelFetch(uGBuffer0, p, 0)
-        && texelFetch(uGBuffer1, p, s) == texelFetch(uGBuffer1, p, 0)
-        && texelFetch(uGBuffer2, p, s) == texelFetch(uGBuffer2, p, 0)
-        && texelFetch(uGBuffer3, p, s) == texelFetch(uGBuffer3, p, 0);
+    // matedit deferred pass: the sample within the thresholds above of sample 0
+    vec4 a3 = texelFetch(uGBuffer3, p, 0);
+    vec4 b3 = texelFetch(uGBuffer3, p, s);
+    if ((a3.w < 0.5) != (b3.w < 0.5)) return false;
+    if (a3.w < 0.5) return true;
+    if (distance(a3.xyz, b3.xyz) > EDGE_POSITION * distance(a3.xyz, uCameraPosition)) {
+        return false;
+    }
+    vec4 a1 = texelFetch(uGBuffer1, p, 0);
+    vec4 b1 = texelFetch(uGBuffer1, p, s);
+    if (dot(a1.xyz, b1.xyz) < EDGE_NORMAL_COS || abs(a1.w - b1.w) > EDGE_VALUE) return false;
+    vec4 d0 = abs(texelFetch(uGBuffer0, p, s) - texelFetch(uGBuffer0, p, 0));
+    vec4 a2 = texelFetch(uGBuffer2, p, 0);
+    vec4 d2 = abs(texelFetch(uGBuffer2, p, s) - a2);
+    return all(lessThanEqual(d0, vec4(EDGE_VALUE)))
+        && all(lessThanEqual(d2.rgb, EDGE_VALUE * max(vec3(1.0), abs(a2.rgb))))
+        && d2.a <= EDGE_VALUE;
 }
 
 bool isEdge(ivec2 p) {
-    // matedit deferred pass: a pixel whose samples do not all agree
+    // matedit deferred pass: a pixel whose samples do not all show the same surface
 #ifdef MATEDIT_EDGES_ONCE
     return false;  // benchmarks/bench_render.py: the cost of lighting edges per sample
 #endif
+    // Inside one triangle every sample holds a copy of one fragment: equal positions (and
+    // coverage) settle most pixels with one target's fetches.
+    vec4 first = texelFetch(uGBuffer3, p, 0);
+    bool copies = true;
+    for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
+        copies = copies && texelFetch(uGBuffer3, p, s) == first;
+    }
+    if (copies) return false;
     for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
         if (!sameAsFirst(p, s)) return true;
     }
