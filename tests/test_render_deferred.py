@@ -18,16 +18,24 @@ from matedit.resources import graphs_dir, shaders_dir
 MATERIALS = sorted((graphs_dir() / "materials").glob("*.json"))
 SMALL = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
 SIZE = (64, 64)
-# Deferred against forward, |a - b| / max(1, |b|) on every pixel of the resolved image: the
+# Deferred against forward, |a - b| / max(1, |b|) on every pixel of the resolved image. The
 # G-buffer (matedit/render/deferred.py) holds the position and roughness as float32 copies, but
 # baseColor, metallic, emissive and cavity as halves (11-bit significand: relative rounding
 # 2^-12, about 2.4e-4) and the normal octahedral in 16 bits a coordinate (about 3e-5 rad).
 # Shading amplifies those roundings: (1 - metallic) near metallic 1, and a low roughness's
 # narrow highlight against the normal's quantisation (with float32 copies the bound was 1e-6).
-# Measured: at most 7.3e-3 (split sum, a few highlight pixels; most pixels below 5e-4), 6.0e-3
-# in reference mode, 5.8e-3 in difference mode. Edge pixels are lit per sample as before and
-# held to the same bound.
+# Measured with the packing alone: at most 7.3e-3 (split sum, a few highlight pixels; most
+# pixels below 5e-4), 6.0e-3 in reference mode, 5.8e-3 in difference mode. Silhouette pixels
+# are lit per sample and held to this bound.
 REL = 1e-2
+# Where two triangles of one smooth surface meet inside a pixel, the deferred pass lights
+# sample 0 once for the pixel (shaders/render/lighting.frag, sameAsFirst) where the forward
+# pass lights each triangle's fragment and averages: those pixels differ by the variation of
+# the shading over a fraction of a pixel. Measured on the samples at 64 px (a pixel spans a
+# lot of the sphere there), packing included: worst pixel 0.032 (hammered_copper's bump),
+# worst image mean 2.7e-4.
+REL_PIXEL = 0.06
+REL_MEAN = 1e-3
 
 
 def flat_material(opacity=None, roughness=0.4):
@@ -123,7 +131,8 @@ def test_deferred_equals_forward_split_sum(pair, path):
     # too (the G-buffer holds the talk's fields): the two must still agree
     assert pair["deferred"].is_forward == writes_lobes(cm.ir) and pair["forward"].is_forward
     assert b.max() > 0.05
-    assert _rel(a, b).max() <= REL
+    assert _rel(a, b).max() <= REL_PIXEL
+    assert _rel(a, b).mean() <= REL_MEAN
 
 
 @pytest.mark.parametrize("mode", ["reference", "difference"])
@@ -132,13 +141,14 @@ def test_deferred_equals_forward_reference_and_difference(pair, mode):
                           FileResolver())
     a, b = _both(pair, cm, mode)
     assert np.abs(b).max() > 0.01
-    assert _rel(a, b).max() <= REL
+    assert _rel(a, b).max() <= REL_PIXEL
+    assert _rel(a, b).mean() <= REL_MEAN
 
 
 def test_silhouettes_are_antialiased_like_forward(pair):
     """Edge pixels mix the background and the surface in the proportion of covered samples:
     with a black background and no gizmos, a silhouette pixel is strictly between 0 and the
-    surface; the deferred values equal the forward ones there too."""
+    surface; the deferred values equal the forward ones there (lit per sample in both)."""
     for r in pair.values():
         r.show_background = False
         r.show_gizmos = False
@@ -156,7 +166,8 @@ def test_silhouettes_are_antialiased_like_forward(pair):
     dark = lum[edge] < 0.6 * np.median(lum[inside & ~edge])
     assert dark.sum() > 10
     assert _rel(a, b)[edge].max() <= REL
-    assert _rel(a, b)[inside & ~edge].max() <= REL
+    assert _rel(a, b)[inside & ~edge].max() <= REL_PIXEL
+    assert _rel(a, b)[inside & ~edge].mean() <= REL_MEAN
 
 
 def test_energy_compensation_and_gizmos_match(pair):
@@ -167,7 +178,8 @@ def test_energy_compensation_and_gizmos_match(pair):
     finally:
         for r in pair.values():
             r.set_energy_compensation(False)
-    assert _rel(a, b).max() <= REL
+    assert _rel(a, b).max() <= REL_PIXEL
+    assert _rel(a, b).mean() <= REL_MEAN
 
 
 # --- programs ---------------------------------------------------------------------------------

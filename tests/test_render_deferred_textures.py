@@ -8,7 +8,7 @@ import os
 
 import numpy as np
 import pytest
-from test_render_deferred import REL
+from test_render_deferred import REL_MEAN, REL_PIXEL
 from test_shading_colorspace import texture_material, write_png
 
 from matedit.compiler import compile_document
@@ -74,4 +74,6 @@ def test_textured_material_deferred_equals_forward(gl_ctx, textured):
             r.release()
     a, b = out[True], out[False]
     assert b.max() > 0.05
-    assert (np.abs(a - b) / np.maximum(1.0, np.abs(b))).max() <= REL
+    rel = np.abs(a - b) / np.maximum(1.0, np.abs(b))
+    # test_render_deferred's bounds: triangles of one surface meeting in a pixel are lit once
+    assert rel.max() <= REL_PIXEL and rel.mean() <= REL_MEAN

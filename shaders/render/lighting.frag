@@ -3,11 +3,14 @@
 // in a full-screen pass. Linked once per variant, whatever the material.
 //
 // Anti-aliasing: the G-buffer is multisampled like the forward target, and the pass runs once a
-// pixel. A pixel whose samples all hold the same values (inside a triangle, or all background)
-// is shaded once; a pixel whose samples differ (a silhouette, or two triangles meeting) is
+// pixel. A pixel whose samples all show the same surface (inside a triangle, all background, or
+// two triangles of one smooth surface meeting in it: sameAsFirst) is shaded once from sample 0;
+// a pixel whose samples differ (a silhouette, an occlusion edge, a crease, a material seam) is
 // shaded per sample from each sample's own values, uncovered samples taking the background,
-// and the average is written. Every sample of the target gets the pixel's colour, so the
-// resolve gives what the forward pass's resolve gives: the average of the samples' colours.
+// and the average is written. Every sample of the target gets the pixel's colour. Lighting
+// every triangle edge per sample, as the forward pass does, took a third of the whole frame
+// on the sample sphere at 512 px, for differences of a fraction of a pixel's shading
+// (tests/test_render_deferred.py states the bounds).
 #include "surface.glsl"
 #include "gbuffer.glsl"
 
@@ -24,18 +27,58 @@ uniform vec3 uCameraPosition;   // eye in world space (m), FrameBlock's cameraPo
 #define MATEDIT_GBUFFER_SAMPLES 4
 #endif
 
+// Two samples "show the same surface" when they agree on coverage and, where covered, their
+// positions lie within EDGE_POSITION of the distance to the eye, their normals within
+// EDGE_NORMAL_COS, and their material values within EDGE_VALUE (emissive: relative above 1).
+// That is two triangles of one smooth surface meeting inside the pixel (each fragment shaded
+// at the pixel centre, so they differ only by extrapolation): one shading of sample 0 stands
+// for both, as a one-sample render would. Silhouettes, occlusion edges, creases and material
+// seams differ by more and are shaded per sample. Thresholds: about a third of a pixel's
+// footprint at 512 px and a 45-degree field of view, one degree, 1/512.
+const float EDGE_POSITION = 5e-4;
+const float EDGE_NORMAL_COS = 0.99985;
+const float EDGE_VALUE = 1.0 / 512.0;
+
+bool sameHalves(uint a, uint b, vec2 scale) {
+    // two packed pairs of G-buffer values within EDGE_VALUE * scale of each other
+    return all(lessThanEqual(abs(gbufferUnpackHalf2(a) - gbufferUnpackHalf2(b)),
+                             EDGE_VALUE * scale));
+}
+
 bool sameAsFirst(ivec2 p, int s) {
-    // matedit deferred pass: exact equality of the stored bits (what the lighting reads)
-    return texelFetch(uGBuffer0, p, s) == texelFetch(uGBuffer0, p, 0)
-        && texelFetch(uGBuffer1, p, s) == texelFetch(uGBuffer1, p, 0)
-        && texelFetch(uGBuffer2, p, s).r == texelFetch(uGBuffer2, p, 0).r;
+    // matedit deferred pass: the sample within the thresholds above of sample 0
+    uvec4 a0 = texelFetch(uGBuffer0, p, 0);
+    uvec4 b0 = texelFetch(uGBuffer0, p, s);
+    bool covered = gbufferCovered(a0.w);
+    if (covered != gbufferCovered(b0.w)) return false;
+    if (!covered) return true;
+    vec3 P = uintBitsToFloat(a0.xyz);
+    if (distance(P, uintBitsToFloat(b0.xyz)) > EDGE_POSITION * distance(P, uCameraPosition)
+        || dot(gbufferUnpackNormal(a0.w), gbufferUnpackNormal(b0.w)) < EDGE_NORMAL_COS
+        || abs(texelFetch(uGBuffer2, p, s).r - texelFetch(uGBuffer2, p, 0).r) > EDGE_VALUE) {
+        return false;
+    }
+    uvec4 a1 = texelFetch(uGBuffer1, p, 0);
+    uvec4 b1 = texelFetch(uGBuffer1, p, s);
+    vec2 emissiveScale = max(vec2(1.0), abs(gbufferUnpackHalf2(a1.z)));
+    return sameHalves(a1.x, b1.x, vec2(1.0)) && sameHalves(a1.y, b1.y, vec2(1.0))
+        && sameHalves(a1.z, b1.z, emissiveScale)
+        && sameHalves(a1.w, b1.w, vec2(max(1.0, abs(gbufferUnpackHalf2(a1.w).x)), 1.0));
 }
 
 bool isEdge(ivec2 p) {
-    // matedit deferred pass: a pixel whose samples do not all agree
+    // matedit deferred pass: a pixel whose samples do not all show the same surface
 #ifdef MATEDIT_EDGES_ONCE
     return false;  // benchmarks/bench_render.py: the cost of lighting edges per sample
 #endif
+    // Inside one triangle every sample holds a copy of one fragment: equal positions, normal
+    // and coverage (one target's samples) settle most pixels.
+    uvec4 first = texelFetch(uGBuffer0, p, 0);
+    bool copies = true;
+    for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
+        copies = copies && texelFetch(uGBuffer0, p, s) == first;
+    }
+    if (copies) return false;
     for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
         if (!sameAsFirst(p, s)) return true;
     }
