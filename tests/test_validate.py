@@ -5,7 +5,7 @@ from __future__ import annotations
 from graphs_util import function, link, material, node, simple_material
 
 from matedit.graph.model import Link
-from matedit.graph.validate import Severity, check_connect, validate
+from matedit.graph.validate import Severity, analyse, check_connect, validate
 from matedit.io.document import FileResolver, save
 
 
@@ -88,6 +88,37 @@ def test_links_to_missing_nodes_and_ports():
     msgs = [e.message for e in errors(d)]
     assert any("missing node 'ghost'" in m for m in msgs)
     assert any("no output 'nope'" in m for m in msgs)
+
+
+class _InOrder(set):
+    """A set of links that iterates in the order given (a set's order is its hashes')."""
+
+    def __init__(self, links):
+        super().__init__(links)
+        self.order = list(links)
+
+    def __iter__(self):
+        return iter(self.order)
+
+
+def test_links_are_checked_as_in_link_order_whatever_the_sets_order():
+    """Of two links into one input the first in link order (source, port, destination, port)
+    stays, and the links' diagnostics come in that order."""
+    d = simple_material()
+    node(d, "r2", "scalar_parameter", {"name": "rough2"}, {"value": 0.2})
+    link(d, "r2", "value", "m", "a")  # after r's link into m.a
+    link(d, "ghost", "value", "m", "b")
+    link(d, "col", "nope", "make", "metallic")
+    links = sorted(d.graph.links)
+    for order in (links, links[::-1]):
+        d.graph.links = _InOrder(order)
+        a = analyse(d, FileResolver())
+        assert a.incoming["m"]["a"] == Link("r", "value", "m", "a")
+        assert [(e.node_id, e.port, e.message) for e in a.diagnostics] == [
+            ("col", "nope", "node col has no output 'nope'"),
+            ("m", "b", "link refers to missing node 'ghost'"),
+            ("m", "a", "input has more than one link"),
+        ]
 
 
 def test_bad_value_names_node_and_field():

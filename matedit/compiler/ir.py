@@ -16,10 +16,14 @@ from matedit.graph.types import PortType
 
 
 class Expr:
-    """An operand. The frozen subclasses write their two fields into `__dict__` in their own
-    `__init__` (dataclass keeps a class's own): the generated one sets each through
-    `object.__setattr__`, twice the cost, and a large graph makes thousands of them."""
+    """An operand. The subclasses are frozen and slotted: one small object each, with no
+    `__dict__` (a large graph makes tens of thousands of them, and each dict more is memory
+    to fill, for the cyclic collector to walk, and to free). The two-field ones set their
+    fields in their own `__init__` (dataclass keeps a class's own) through the slots'
+    descriptors (`_slot_setters`): the generated one goes through `object.__setattr__`, half
+    again the cost."""
 
+    __slots__ = ()
     type: PortType
 
     def key(self) -> str:
@@ -27,63 +31,64 @@ class Expr:
         raise NotImplementedError
 
 
-@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
+def _slot_setters(cls: type, *fields: str) -> tuple[Any, ...]:
+    """The `__set__` of each field's slot: what a frozen class's own `__init__` writes with."""
+    return tuple(cls.__dict__[f].__set__ for f in fields)
+
+
+@dataclass(frozen=True, slots=True, init=False)  # its own __init__ (see Expr)
 class Var(Expr):
     name: str
     type: PortType
 
     def __init__(self, name: str, type: PortType) -> None:
-        d = self.__dict__  # frozen: the fields are set once, here
-        d["name"] = name
-        d["type"] = type
+        _set_var(self, name)
+        _set_var_type(self, type)
 
     def key(self) -> str:
         return self.name
 
 
-@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
+@dataclass(frozen=True, slots=True, init=False)  # its own __init__ (see Expr)
 class Param(Expr):
     name: str
     type: PortType
 
     def __init__(self, name: str, type: PortType) -> None:
-        d = self.__dict__
-        d["name"] = name
-        d["type"] = type
+        _set_param(self, name)
+        _set_param_type(self, type)
 
     def key(self) -> str:
         return self.name
 
 
-@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
+@dataclass(frozen=True, slots=True, init=False)  # its own __init__ (see Expr)
 class Lit(Expr):
     value: Any  # float or tuple of floats, or None for MaterialAttributes defaults
     type: PortType
 
     def __init__(self, value: Any, type: PortType) -> None:
-        d = self.__dict__
-        d["value"] = value
-        d["type"] = type
+        _set_lit(self, value)
+        _set_lit_type(self, type)
 
     def key(self) -> str:
         return f"lit:{self.type}:{self.value!r}"
 
 
-@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
+@dataclass(frozen=True, slots=True, init=False)  # its own __init__ (see Expr)
 class Uni(Expr):
     name: str
     type: PortType
 
     def __init__(self, name: str, type: PortType) -> None:
-        d = self.__dict__
-        d["name"] = name
-        d["type"] = type
+        _set_uni(self, name)
+        _set_uni_type(self, type)
 
     def key(self) -> str:
         return self.name
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SurfaceUV(Expr):
     type: PortType = PortType.VEC2
 
@@ -91,27 +96,33 @@ class SurfaceUV(Expr):
         return "surface:uv"  # no `node.port` name has a colon
 
 
-@dataclass(frozen=True, init=False)  # its own __init__ (see Expr)
+@dataclass(frozen=True, slots=True, init=False)  # its own __init__ (see Expr)
 class Splat(Expr):
     expr: Expr
     type: PortType
 
     def __init__(self, expr: Expr, type: PortType) -> None:
-        d = self.__dict__
-        d["expr"] = expr
-        d["type"] = type
+        _set_splat(self, expr)
+        _set_splat_type(self, type)
 
     def key(self) -> str:
         return f"{self.type}({self.expr.key()})"
 
 
-@dataclass(init=False)  # its own __init__
+_set_var, _set_var_type = _slot_setters(Var, "name", "type")
+_set_param, _set_param_type = _slot_setters(Param, "name", "type")
+_set_lit, _set_lit_type = _slot_setters(Lit, "value", "type")
+_set_uni, _set_uni_type = _slot_setters(Uni, "name", "type")
+_set_splat, _set_splat_type = _slot_setters(Splat, "expr", "type")
+
+
+@dataclass(slots=True, init=False)  # its own __init__
 class Op:
     """One evaluation: a catalogue node kind, or one of the compiler's own ops.
 
     `kind` is a node kind from the registry or a compiler op (`matedit.compiler.ops`: mask,
     append, set_attributes, weight, blend, call); either way its implementations are the row
-    `ops.implementation(kind)`.
+    `ops.implementation(kind)`. Slotted, as the operands are (see Expr): one object an op.
     """
 
     var: str  # stem of the output names
@@ -120,6 +131,9 @@ class Op:
     args: list[Expr]
     outs: list[tuple[str, PortType]]
     data: dict[str, Any] = field(default_factory=dict)
+    # out_vars(), once made (None until then): no field of the op's value
+    _out_vars: dict[str, Var] | None = field(default=None, init=False, repr=False,
+                                             compare=False)
 
     def __init__(self, var: str, node: str, kind: str, args: list[Expr],
                  outs: list[tuple[str, PortType]], data: dict[str, Any] | None = None,
@@ -127,22 +141,20 @@ class Op:
         # the generated __init__'s work, without its default-factory sentinel test
         self.var, self.node, self.kind, self.args, self.outs = var, node, kind, args, outs
         self.data = {} if data is None else data
-        if out_vars is not None:  # what out_vars() would make, made by the caller already
-            self.__dict__["_out_vars"] = out_vars
+        self._out_vars = out_vars  # what out_vars() would make, where the caller made it
 
     def out(self, port: str) -> Var:
-        cache = self.__dict__.get("_out_vars")
+        cache = self._out_vars
         if cache is None:
             cache = self.out_vars()
         return cache[port]
 
     def out_vars(self) -> dict[str, Var]:
         """Each output's variable, by port, in `outs` order (made once, then kept)."""
-        cache = self.__dict__.get("_out_vars")
+        cache = self._out_vars
         if cache is None:
             var = self.var
-            cache = {name: Var(f"{var}.{name}", t) for name, t in self.outs}
-            self.__dict__["_out_vars"] = cache
+            cache = self._out_vars = {name: Var(f"{var}.{name}", t) for name, t in self.outs}
         return cache
 
     def key(self) -> str:

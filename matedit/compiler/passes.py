@@ -143,8 +143,15 @@ def fold_and_merge(scope: Scope) -> None:
         kept.append(op)
     scope.ops = kept
     scope.outputs = [(n, t, _subst(e, table)) for n, t, e in scope.outputs]
-    scope.sockets = {k: table.get(e.name, e) if type(e) is Var else _subst(e, table)
-                     for k, e in scope.sockets.items()}
+    # the sockets in place (values only: no new dict of every socket, most of them unchanged)
+    sockets = scope.sockets
+    for socket, e in sockets.items():
+        if type(e) is Var:
+            new = get(e.name)
+            if new is not None:
+                sockets[socket] = new
+        elif type(e) is Splat:
+            sockets[socket] = _subst(e, table)
 
 
 def optimise(scope: Scope) -> None:

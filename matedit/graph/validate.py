@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from enum import Enum
 from graphlib import CycleError
-from operator import attrgetter
+from operator import attrgetter, itemgetter
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -209,38 +209,55 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
         except ValueError as exc:
             diags.append(error(str(exc), nid, None, f))
 
-    # Links: ends exist, ports exist, one link per input.
+    # Links: ends exist, ports exist, one link per input. Walked in the set's order with the
+    # answer of a walk in sorted order: of two links into one input the smaller stays, and the
+    # diagnostics are sorted by their link. Sorting every link cost more a link the larger the
+    # graph (a tenth of the analysis of 10,000 nodes); nothing reads the order of an input's
+    # links in `incoming`.
     incoming: dict[str, dict[str, Link]] = {nid: {} for nid in gnodes}
-    good_links: list[Link] = []
-    for link in sorted(graph.links):
+    edges: list[tuple[str, str]] = []  # (src, dst) of each link kept
+    link_diags: list[tuple[Link, Diagnostic]] = []
+    for link in graph.links:
         src, src_port, dst, dst_port = link
         if src not in gnodes or dst not in gnodes:
             missing = src if src not in gnodes else dst
-            diags.append(error(f"link refers to missing node {missing!r}",
-                               dst if dst in gnodes else None, dst_port, f))
+            link_diags.append((link, error(f"link refers to missing node {missing!r}",
+                                           dst if dst in gnodes else None, dst_port, f)))
             continue
         # NodePorts.output and .input, inlined (two lookups a link)
         src_ports = ports.get(src)
         if src_ports is not None and src_port not in src_ports._by_output:
-            diags.append(error(f"node {src} has no output {src_port!r}", src, src_port, f))
+            link_diags.append((link, error(f"node {src} has no output {src_port!r}", src,
+                                           src_port, f)))
             continue
         dst_ports = ports.get(dst)
         if dst_ports is not None and dst_port not in dst_ports._by_input:
-            diags.append(error(f"node {dst} has no input {dst_port!r}", dst, dst_port, f))
+            link_diags.append((link, error(f"node {dst} has no input {dst_port!r}", dst,
+                                           dst_port, f)))
             continue
         into = incoming[dst]
-        if dst_port in into:
-            diags.append(error("input has more than one link", dst, dst_port, f))
+        other = into.get(dst_port)
+        if other is not None:
+            if link < other:  # the first in sorted order stays
+                into[dst_port], link = link, other
+            link_diags.append((link, error("input has more than one link", dst, dst_port, f)))
             continue
         into[dst_port] = link
-        good_links.append(link)
+        edges.append((src, dst))
+    if link_diags:
+        link_diags.sort(key=itemgetter(0))  # one diagnostic a link at most
+        diags.extend(d for _, d in link_diags)
+        # a link that stayed in place of another came after it: its edge, not the other's
+        edges = [(l.src, l.dst) for into in incoming.values() for l in into.values()]
 
     # Cycles.
-    edges = [(l.src, l.dst) for l in good_links]
     order: list[str] = []
     try:
-        order = stable_order(gnodes, edges)
+        order = stable_order(gnodes, edges)  # the same whatever the edges' order
     except CycleError:
+        # the cycle named is the one networkx finds first: the edges in link order
+        edges = [(l.src, l.dst) for l in sorted(l for into in incoming.values()
+                                                for l in into.values())]
         cycle = _cycle(gnodes, edges)
         path = " -> ".join([a for a, _ in cycle] + [cycle[0][0]])
         diags.append(error(f"cycle: {path}", cycle[0][0], None, f))
@@ -276,11 +293,16 @@ def analyse(doc: MaterialDocument, resolver: FunctionResolver | None = None, *,
             diags.append(error(str(exc), nid, None, f))
             continue
         in_types[nid], out_types[nid] = ins, outs
+        wrong: list[tuple[Link, Diagnostic]] | None = None
         for port, t in connected.items():
             if t != ins[port]:  # an equal type always converts
                 reason = conversion_reason(t, ins[port])
                 if reason:
-                    diags.append(error(reason, nid, port, f))
+                    wrong = wrong or []
+                    wrong.append((into[port], error(reason, nid, port, f)))
+        if wrong:
+            wrong.sort(key=itemgetter(0))  # in their links' order (`into` is in none)
+            diags.extend(d for _, d in wrong)
         values = node.values
         d = registry[node.kind]
         for spec in p.inputs:
