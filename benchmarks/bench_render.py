@@ -213,13 +213,13 @@ def frames_forward_deferred(ctx, material: CompiledMaterial, sizes=(512, 1024),
 
 
 _COVERAGE_FRAG = """#version 330 core
-uniform usampler2DMS uGBuffer0;  // w: the packed normal, 0 where not covered (deferred.py)
+uniform sampler2DMS uGBuffer2;  // g: the coverage, 1 where drawn (deferred.py)
 uniform int uSamples;
 out vec4 color;
 void main() {
     int covered = 0;
     for (int s = 0; s < uSamples; s++) {
-        if (texelFetch(uGBuffer0, ivec2(gl_FragCoord.xy), s).w != 0u) covered++;
+        if (texelFetch(uGBuffer2, ivec2(gl_FragCoord.xy), s).g > 0.5) covered++;
     }
     color = vec4(float(covered) / float(uSamples));
 }
@@ -233,14 +233,14 @@ void main() {
 
 
 def _resolve_coverage(ctx, gbuffer, size: int) -> bytes:
-    """The G-buffer's coverage averaged over the samples (its integer targets cannot be
-    resolved by a blit): 0 < c < 1 at a silhouette pixel."""
+    """The G-buffer's coverage (target 2's second channel) averaged over the samples: 0 < c < 1
+    at a silhouette pixel."""
     tex = ctx.texture((size, size), 1, dtype="f4")
     fbo = ctx.framebuffer([tex])
     prog = ctx.program(vertex_shader=_COVERAGE_VERT, fragment_shader=_COVERAGE_FRAG)
     prog["uSamples"].value = gbuffer.textures[0].samples
-    gbuffer.textures[0].use(location=0)
-    prog["uGBuffer0"].value = 0
+    gbuffer.textures[2].use(location=0)
+    prog["uGBuffer2"].value = 0
     vao = ctx.vertex_array(prog, [])
     fbo.use()
     ctx.disable(ctx.DEPTH_TEST | ctx.BLEND)

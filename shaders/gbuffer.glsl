@@ -18,8 +18,7 @@ vec2 gbufferUnpackHalf2(uint bits) {
 
 // A unit vector, octahedral-encoded (Cigolle et al. 2014, "A Survey of Efficient
 // Representations for Independent Unit Vectors"), 16 bits a coordinate (round(e * 32767),
-// as packSnorm2x16) offset to 1..65535: a cleared 0 never encodes a normal, so it is the
-// coverage flag (gbufferCovered).
+// as packSnorm2x16) offset to 1..65535.
 uint gbufferPackNormal(vec3 n) {
     n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
     vec2 e = n.xy;
@@ -39,7 +38,9 @@ vec3 gbufferUnpackNormal(uint bits) {
     return normalize(n);
 }
 
-// Whether the material was drawn at a sample: the normal's word of gbuffer0 (cleared to 0).
-bool gbufferCovered(uint normalBits) {
-    return normalBits != 0u;
+// Whether the material was drawn at a sample: the coverage channel of gbuffer2, 1 where drawn,
+// cleared to 0 (a float target: GL leaves clearing an integer one by glClear undefined, so
+// the integer targets' values at an uncovered sample are never read).
+bool gbufferCovered(vec2 roughnessCoverage) {
+    return roughnessCoverage.y > 0.5;
 }

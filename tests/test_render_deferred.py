@@ -94,7 +94,7 @@ def test_entries_are_glsl_files_and_forward_is_what_compile_exports():
     gb = cm.variant(Entry.GBUFFER)
     assert "shadeSurface" not in gb.fragment_text and "LightsBlock" not in gb.fragment_text
     # the packed G-buffer (matedit/render/deferred.py): two uint targets and a float one
-    for i, t in enumerate(("uvec4", "uvec4", "float")):
+    for i, t in enumerate(("uvec4", "uvec4", "vec2")):
         assert f"layout(location = {i}) out {t} gbuffer{i};" in gb.fragment_text
     attrs = compile_document(doc, FileResolver(), mode=Entry.ATTRIBUTES)
     assert attrs.fragment_text == compile_document(doc, FileResolver(),

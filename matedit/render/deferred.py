@@ -6,14 +6,15 @@ texture), writing every sample; see that file for how edges are anti-aliased.
 G-buffer layout (GBUFFER entry, shaders/entry/gbuffer.frag.glsl; packing: shaders/gbuffer.glsl):
   0, RGBA32UI: x, y, z  world position (m), float32 bits: exact
                w        world-space shading normal, octahedral, 16 bits a coordinate (angular
-                        error below 1e-4 rad); never 0, so a cleared 0 means "not covered"
+                        error below 1e-4 rad)
   1, RGBA32UI: halves   baseColor.r|g, baseColor.b|metallic, emissive.r|g, emissive.b|cavity:
                         relative error at most 2^-11 (11-bit significand), clamped to +-65504
-  2, R32F:              roughness, float32: exact
+  2, RG32F:             roughness, float32: exact; coverage, 1 where the mesh was drawn
 Fewer and narrower targets than four RGBA float32 ones: llvmpipe's JIT at a new material
 program's first draw, and its fill of every frame, grow with the targets' number and size (the
 structural edit's latency). The lighting pass sees the forward entry's shadeSurface arguments up
-to those roundings. Cleared targets (0) read as no coverage.
+to those roundings. The targets are cleared to 0; only the float one's coverage is read where the
+mesh was not drawn (GL leaves a glClear of an integer target undefined).
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from matedit.render.fullscreen import GLSL_VERSION, FullscreenQuad, render_progr
 from matedit.resources import shaders_dir
 
 # (components, moderngl dtype) of each target, in location order (the layout above)
-GBUFFER_FORMATS = ((4, "u4"), (4, "u4"), (1, "f4"))
+GBUFFER_FORMATS = ((4, "u4"), (4, "u4"), (2, "f4"))
 GBUFFER_TARGETS = len(GBUFFER_FORMATS)
 GBUFFER_FIRST_UNIT = 8  # texture units of the G-buffer in the lighting pass
 SPLIT_SUM_ONLY = "MATEDIT_SPLIT_SUM_ONLY"

@@ -14,11 +14,13 @@ void main() {
 #ifdef MATERIAL_HAS_NORMAL
     N = tangentToWorldNormal(m.normal, T, B, g_surface.normal);
 #endif
-    // position: float32 bits (exact); w: the normal, which is also the coverage (cleared to 0)
+    // position: float32 bits (exact); w: the normal, octahedral
     gbuffer0 = uvec4(floatBitsToUint(g_surface.position), gbufferPackNormal(N));
     gbuffer1 = uvec4(gbufferPackHalf2(m.baseColor.r, m.baseColor.g),
                      gbufferPackHalf2(m.baseColor.b, m.metallic),
                      gbufferPackHalf2(m.emissive.r, m.emissive.g),
                      gbufferPackHalf2(m.emissive.b, m.cavity));
-    gbuffer2 = m.roughness;  // float32 (exact)
+    // roughness, float32 (exact); the coverage, 1 (the float target is cleared to 0: GL leaves
+    // a plain clear of an integer target undefined)
+    gbuffer2 = vec2(m.roughness, 1.0);
 }

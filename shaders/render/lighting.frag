@@ -17,9 +17,9 @@
 in vec2 v_ndc;
 layout(location = 0) out vec4 fragColor;
 // the G-buffer, packed (shaders/gbuffer.glsl; layout: matedit/render/deferred.py)
-uniform usampler2DMS uGBuffer0;  // world position (m, float32 bits), normal + coverage
+uniform usampler2DMS uGBuffer0;  // world position (m, float32 bits), normal
 uniform usampler2DMS uGBuffer1;  // halves: baseColor, metallic, emissive, cavity
-uniform sampler2DMS uGBuffer2;   // roughness (float32)
+uniform sampler2DMS uGBuffer2;   // roughness (float32), coverage (1 where drawn)
 uniform sampler2D uBackground;  // the environment behind the mesh, one sample a pixel
 uniform vec3 uCameraPosition;   // eye in world space (m), FrameBlock's cameraPosition.xyz
 
@@ -47,15 +47,17 @@ bool sameHalves(uint a, uint b, vec2 scale) {
 
 bool sameAsFirst(ivec2 p, int s) {
     // matedit deferred pass: the sample within the thresholds above of sample 0
+    vec2 a2 = texelFetch(uGBuffer2, p, 0).rg;
+    vec2 b2 = texelFetch(uGBuffer2, p, s).rg;
+    bool covered = gbufferCovered(a2);
+    if (covered != gbufferCovered(b2)) return false;
+    if (!covered) return true;
     uvec4 a0 = texelFetch(uGBuffer0, p, 0);
     uvec4 b0 = texelFetch(uGBuffer0, p, s);
-    bool covered = gbufferCovered(a0.w);
-    if (covered != gbufferCovered(b0.w)) return false;
-    if (!covered) return true;
     vec3 P = uintBitsToFloat(a0.xyz);
     if (distance(P, uintBitsToFloat(b0.xyz)) > EDGE_POSITION * distance(P, uCameraPosition)
         || dot(gbufferUnpackNormal(a0.w), gbufferUnpackNormal(b0.w)) < EDGE_NORMAL_COS
-        || abs(texelFetch(uGBuffer2, p, s).r - texelFetch(uGBuffer2, p, 0).r) > EDGE_VALUE) {
+        || abs(a2.x - b2.x) > EDGE_VALUE) {
         return false;
     }
     uvec4 a1 = texelFetch(uGBuffer1, p, 0);
@@ -71,12 +73,15 @@ bool isEdge(ivec2 p) {
 #ifdef MATEDIT_EDGES_ONCE
     return false;  // benchmarks/bench_render.py: the cost of lighting edges per sample
 #endif
-    // Inside one triangle every sample holds a copy of one fragment: equal positions, normal
-    // and coverage (one target's samples) settle most pixels.
-    uvec4 first = texelFetch(uGBuffer0, p, 0);
+    // Inside one triangle every sample holds a copy of one fragment: equal roughness and
+    // coverage, and equal positions and normals where covered, settle most pixels.
+    vec2 first2 = texelFetch(uGBuffer2, p, 0).rg;
+    bool covered = gbufferCovered(first2);
+    uvec4 first0 = texelFetch(uGBuffer0, p, 0);
     bool copies = true;
     for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
-        copies = copies && texelFetch(uGBuffer0, p, s) == first;
+        copies = copies && texelFetch(uGBuffer2, p, s).rg == first2
+                 && (!covered || texelFetch(uGBuffer0, p, s) == first0);
     }
     if (copies) return false;
     for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
@@ -108,13 +113,13 @@ void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     vec3 background = texelFetch(uBackground, p, 0).rgb;
     if (!isEdge(p)) {
-        fragColor = vec4(gbufferCovered(texelFetch(uGBuffer0, p, 0).w) ? shadeSample(p, 0)
-                                                                       : background, 1.0);
+        fragColor = vec4(gbufferCovered(texelFetch(uGBuffer2, p, 0).rg) ? shadeSample(p, 0)
+                                                                        : background, 1.0);
         return;
     }
     vec3 sum = vec3(0.0);
     for (int s = 0; s < MATEDIT_GBUFFER_SAMPLES; s++) {
-        sum += gbufferCovered(texelFetch(uGBuffer0, p, s).w) ? shadeSample(p, s) : background;
+        sum += gbufferCovered(texelFetch(uGBuffer2, p, s).rg) ? shadeSample(p, s) : background;
     }
     fragColor = vec4(sum / float(MATEDIT_GBUFFER_SAMPLES), 1.0);
 }
