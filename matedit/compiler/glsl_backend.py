@@ -14,15 +14,7 @@ from functools import cache
 
 from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, Op, Param, Splat, SurfaceUV, Uni, Var
-from matedit.compiler.schedule import (
-    ENTRY_OUTPUT_TYPES,
-    Entry,
-    LocalNames,
-    Schedule,
-    ScopePlan,
-    SourceMap,
-    Writer,
-)
+from matedit.compiler.schedule import Entry, LocalNames, Schedule, ScopePlan, SourceMap, Writer
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING, Target
 from matedit.glsl import layout as _layout
 from matedit.glsl.include import Assembly, assemble, packing_prelude
@@ -282,6 +274,11 @@ def entry_text(entry: Entry, defines: tuple[str, ...] = ()) -> str:
     text = "\n".join(_strip_preview_blocks(lines, tuple(defines))).rstrip("\n")
     _ENTRY_TEXTS[key] = (st.st_mtime_ns, st.st_size, text)
     return text
+
+
+# The GLSL type of an entry's output variable that is not a vec4 (the G-buffer's packed
+# targets: matedit/render/deferred.py).
+ENTRY_OUTPUT_TYPES = {"gbuffer0": "uvec4", "gbuffer1": "uvec4", "gbuffer2": "vec2"}
 
 
 def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap]:

@@ -161,9 +161,6 @@ ENTRY_OUTPUTS = {
     Entry.GBUFFER: ("gbuffer0", "gbuffer1", "gbuffer2"),
     Entry.ATTRIBUTES: ("out0", "out1", "out2", "out3"),
 }
-# The GLSL type of an output variable that is not a vec4 (the G-buffer's packed targets:
-# matedit/render/deferred.py).
-ENTRY_OUTPUT_TYPES = {"gbuffer0": "uvec4", "gbuffer1": "uvec4", "gbuffer2": "vec2"}
 # Library units every material needs, and those an entry needs beyond the material's own.
 BASE_UNITS = ("common", "material", "nodes/context")
 ENTRY_UNITS = {Entry.FORWARD: ("surface",), Entry.GBUFFER: ("gbuffer",), Entry.ATTRIBUTES: ()}
