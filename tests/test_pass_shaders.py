@@ -8,7 +8,7 @@ import subprocess
 
 import pytest
 
-from matedit.glsl.include import assemble
+from matedit.glsl.include import assemble, packing_prelude
 from matedit.resources import shaders_dir
 
 GLSLANG = shutil.which("glslangValidator")
@@ -17,8 +17,11 @@ STAGES = sorted(p for d in ("render", "bake") for p in (shaders_dir() / d).iterd
 
 
 def _text(path) -> str:
-    # bake shaders may rely on defines set by their caller; give them the common ones
-    return assemble(path.read_text(), "330 core", [], path.name).text
+    # bake shaders may rely on defines set by their caller; give them the common ones. The
+    # lighting pass unpacks the G-buffer with GLSL 4.20's packing functions: at 330 its caller
+    # (matedit/render/deferred.py) enables the extension in the prelude, as here.
+    return assemble(path.read_text(), "330 core", [], path.name,
+                    prelude=packing_prelude("330 core")).text
 
 
 @pytest.mark.skipif(GLSLANG is None, reason="glslangValidator not installed (glslang-tools)")

@@ -108,9 +108,11 @@ def test_cavity_multiplies_all_lighting_not_emissive(gl_ctx, mode):
             frames[key] = r.read_hdr()
         lit = frames["full"]
         assert lit.max() > 0.1
-        assert np.allclose(frames["third"], lit / 3, rtol=1e-4, atol=1e-5)
+        # the deferred preview's G-buffer holds cavity and emissive as halves: 1/3 rounds by
+        # 2.4e-4 relative, 0.2 by 2.4e-4 (matedit/render/deferred.py); 0.5 and 1 are exact
+        assert np.allclose(frames["third"], lit / 3, rtol=5e-4, atol=1e-5)
         assert np.allclose(frames["both"], 0.5 * lit + frames["emis"], rtol=1e-4, atol=1e-5)
         covered = frames["emis"][frames["emis"].sum(axis=2) > 0]
-        assert np.allclose(covered.max(axis=0), [0.2, 0.4, 0.8], atol=1e-5)
+        assert np.allclose(covered.max(axis=0), [0.2, 0.4, 0.8], rtol=5e-4, atol=1e-5)  # halves
     finally:
         r.release()
