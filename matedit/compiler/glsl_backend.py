@@ -304,7 +304,7 @@ def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap
     lines = "\n".join(f"#define {d} 1" for d in plan.defines)
     lines += "".join(f"\n#define {_define_line(d)}" for d in plan.extra_defines)
     head = prelude(target)
-    if plan.entry == Entry.GBUFFER:  # shaders/gbuffer.glsl packs halves
+    if "gbuffer" in plan.units:  # shaders/gbuffer.glsl packs halves: the extension at 330
         head = "\n".join(x for x in (packing_prelude(target.version), head) if x)
     asm = assemble("\n".join(w.lines), target.version, includes, "<material>",
                    prelude=head + "\n" + lines)

@@ -45,27 +45,31 @@ bool sameHalves(uint a, uint b, vec2 scale) {
                              EDGE_VALUE * scale));
 }
 
-bool sameAsFirst(ivec2 p, int s) {
+// Sample 0's values, read once a pixel for the comparisons of the other samples with it.
+struct FirstSample {
+    uvec4 g0;
+    uvec4 g1;
+    vec2 g2;
+    vec3 emissiveScale;  // the emissive comparison's scale: max(1, |emissive|)
+};
+
+bool sameAsFirst(ivec2 p, int s, FirstSample a) {
     // matedit deferred pass: the sample within the thresholds above of sample 0
-    vec2 a2 = texelFetch(uGBuffer2, p, 0).rg;
     vec2 b2 = texelFetch(uGBuffer2, p, s).rg;
-    bool covered = gbufferCovered(a2);
+    bool covered = gbufferCovered(a.g2);
     if (covered != gbufferCovered(b2)) return false;
     if (!covered) return true;
-    uvec4 a0 = texelFetch(uGBuffer0, p, 0);
     uvec4 b0 = texelFetch(uGBuffer0, p, s);
-    vec3 P = uintBitsToFloat(a0.xyz);
+    vec3 P = uintBitsToFloat(a.g0.xyz);
     if (distance(P, uintBitsToFloat(b0.xyz)) > EDGE_POSITION * distance(P, uCameraPosition)
-        || dot(gbufferUnpackNormal(a0.w), gbufferUnpackNormal(b0.w)) < EDGE_NORMAL_COS
-        || abs(a2.x - b2.x) > EDGE_VALUE) {
+        || dot(gbufferUnpackNormal(a.g0.w), gbufferUnpackNormal(b0.w)) < EDGE_NORMAL_COS
+        || abs(a.g2.x - b2.x) > EDGE_VALUE) {
         return false;
     }
-    uvec4 a1 = texelFetch(uGBuffer1, p, 0);
     uvec4 b1 = texelFetch(uGBuffer1, p, s);
-    vec2 emissiveScale = max(vec2(1.0), abs(gbufferUnpackHalf2(a1.z)));
-    return sameHalves(a1.x, b1.x, vec2(1.0)) && sameHalves(a1.y, b1.y, vec2(1.0))
-        && sameHalves(a1.z, b1.z, emissiveScale)
-        && sameHalves(a1.w, b1.w, vec2(max(1.0, abs(gbufferUnpackHalf2(a1.w).x)), 1.0));
+    return sameHalves(a.g1.x, b1.x, vec2(1.0)) && sameHalves(a.g1.y, b1.y, vec2(1.0))
+        && sameHalves(a.g1.z, b1.z, a.emissiveScale.rg)
+        && sameHalves(a.g1.w, b1.w, vec2(a.emissiveScale.b, 1.0));
 }
 
 bool isEdge(ivec2 p) {
@@ -75,17 +79,21 @@ bool isEdge(ivec2 p) {
 #endif
     // Inside one triangle every sample holds a copy of one fragment: equal roughness and
     // coverage, and equal positions and normals where covered, settle most pixels.
-    vec2 first2 = texelFetch(uGBuffer2, p, 0).rg;
-    bool covered = gbufferCovered(first2);
-    uvec4 first0 = texelFetch(uGBuffer0, p, 0);
+    FirstSample a;
+    a.g2 = texelFetch(uGBuffer2, p, 0).rg;
+    a.g0 = texelFetch(uGBuffer0, p, 0);
+    bool covered = gbufferCovered(a.g2);
     bool copies = true;
     for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
-        copies = copies && texelFetch(uGBuffer2, p, s).rg == first2
-                 && (!covered || texelFetch(uGBuffer0, p, s) == first0);
+        copies = copies && texelFetch(uGBuffer2, p, s).rg == a.g2
+                 && (!covered || texelFetch(uGBuffer0, p, s) == a.g0);
     }
     if (copies) return false;
+    a.g1 = texelFetch(uGBuffer1, p, 0);
+    a.emissiveScale = max(vec3(1.0), abs(vec3(gbufferUnpackHalf2(a.g1.z),
+                                              gbufferUnpackHalf2(a.g1.w).x)));
     for (int s = 1; s < MATEDIT_GBUFFER_SAMPLES; s++) {
-        if (!sameAsFirst(p, s)) return true;
+        if (!sameAsFirst(p, s, a)) return true;
     }
     return false;
 }
