@@ -8,7 +8,7 @@ import pytest
 from graphs_util import link, material, node
 
 from matedit.compiler import compile_document
-from matedit.compiler.emit import Entry, entry_text
+from matedit.compiler.emit import PREVIEW_DEFINES, Entry, entry_text
 from matedit.ibl import BakeSettings
 from matedit.io.document import FileResolver, load
 from matedit.render import Renderer
@@ -199,7 +199,7 @@ def test_a_structural_edit_links_only_the_gbuffer_program(pair):
     assert r.lighting.link_count == lighting  # the lighting program is shared
     prog = r._program
     linked = [k for k, p in r._programs.items() if p is prog]
-    assert linked == [compile_document(d).variant(Entry.GBUFFER).structure_hash]
+    assert linked == [compile_document(d).variant(Entry.GBUFFER, PREVIEW_DEFINES).structure_hash]
 
 
 def test_translucent_materials_fall_back_to_forward_and_back(pair):

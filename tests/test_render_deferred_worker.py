@@ -119,10 +119,10 @@ def test_a_newer_edit_supersedes_a_pending_one(window, qtbot):
 
 
 def _viewport_program_hash(renderer) -> str:
-    from matedit.compiler.emit import Entry
+    from matedit.compiler.emit import PREVIEW_DEFINES, Entry
 
     assert not renderer.is_forward  # the sample is opaque: the deferred GBUFFER entry
-    return renderer._compiled.variant(Entry.GBUFFER).structure_hash
+    return renderer._compiled.variant(Entry.GBUFFER, PREVIEW_DEFINES).structure_hash
 
 
 def test_the_warm_up_runs_off_the_ui_thread_before_the_viewport_swaps(window, qtbot,

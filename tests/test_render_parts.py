@@ -16,7 +16,7 @@ from test_render_deferred import SMALL, flat_material
 from test_shading_colorspace import write_png
 
 from matedit.compiler import compile_document
-from matedit.compiler.emit import Entry
+from matedit.compiler.emit import PREVIEW_DEFINES, Entry
 from matedit.glsl.layout import FRAME_BLOCK, IBL_BLOCK
 from matedit.graph import nodes
 from matedit.ibl import bake
@@ -39,9 +39,10 @@ def test_program_cache_links_each_variant_once(gl_ctx):
     cache = ProgramCache(gl_ctx)
     try:
         expected = {  # (forward, compensation) -> the variant the preview draws with
-            (False, False): cm.variant(Entry.GBUFFER),
-            (True, False): cm.variant(Entry.FORWARD, (SPLIT_SUM_ONLY,)),
-            (True, True): cm.variant(Entry.FORWARD, (SPLIT_SUM_ONLY, ENERGY_COMPENSATION)),
+            (False, False): cm.variant(Entry.GBUFFER, PREVIEW_DEFINES),
+            (True, False): cm.variant(Entry.FORWARD, (SPLIT_SUM_ONLY, *PREVIEW_DEFINES)),
+            (True, True): cm.variant(Entry.FORWARD, (SPLIT_SUM_ONLY, ENERGY_COMPENSATION,
+                                                     *PREVIEW_DEFINES)),
         }
         for (forward, compensation), variant in expected.items():
             prog = cache.material(cm, forward, compensation)

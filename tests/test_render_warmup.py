@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from matedit.compiler import compile_document
-from matedit.compiler.emit import Entry
+from matedit.compiler.emit import PREVIEW_DEFINES, Entry
 from matedit.io.document import load
 from matedit.render.deferred import SPLIT_SUM_ONLY
 from matedit.render.paths import wants_forward
@@ -37,8 +37,8 @@ def client():
 
 def _expected(cm, deferred: bool = True) -> str:
     if deferred and not wants_forward(cm):
-        return cm.variant(Entry.GBUFFER).structure_hash
-    return cm.variant(Entry.FORWARD, (SPLIT_SUM_ONLY,)).structure_hash
+        return cm.variant(Entry.GBUFFER, PREVIEW_DEFINES).structure_hash
+    return cm.variant(Entry.FORWARD, (SPLIT_SUM_ONLY, *PREVIEW_DEFINES)).structure_hash
 
 
 def test_the_child_draws_the_viewports_variant_in_another_process(client):

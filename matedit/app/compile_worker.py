@@ -43,13 +43,13 @@ def compile_snapshot(doc, resolver, target: str, compile_fn=None, analysis=None)
     `analysis`: the editor's analysis of the document the snapshot was taken of, made since
     its last change (DocumentController.current_analysis): the graph is not validated again."""
     from matedit.compiler import compile_document
-    from matedit.compiler.emit import Entry
+    from matedit.compiler.emit import PREVIEW_DEFINES, Entry
 
     if compile_fn is not None:
         cm = compile_fn(doc, resolver, target)
     else:
         cm = compile_document(doc, resolver, target, analysis=analysis)
-    cm.variant(Entry.GBUFFER)  # the program the deferred viewport links
+    cm.variant(Entry.GBUFFER, PREVIEW_DEFINES)  # the program the deferred viewport links
     return cm
 
 

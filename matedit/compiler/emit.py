@@ -17,6 +17,8 @@ from matedit.compiler.glsl_backend import FRAME_BLOCK, entry_text, float_literal
 from matedit.compiler.ir import MaterialIR
 from matedit.compiler.schedule import (
     ENTRY_OUTPUTS,
+    PREVIEW_DEFINES,
+    SKIP_HIDDEN_LAYERS,
     Entry,
     SourceMap,
     has_defines,
@@ -26,13 +28,15 @@ from matedit.compiler.schedule import (
 from matedit.compiler.targets import Target
 from matedit.glsl.include import Assembly
 
-__all__ = ["ENTRY_OUTPUTS", "FRAME_BLOCK", "Entry", "SourceMap", "entry_text", "float_literal",
-           "fragment_source", "has_defines", "std140_layout", "vertex_source"]
+__all__ = ["ENTRY_OUTPUTS", "FRAME_BLOCK", "PREVIEW_DEFINES", "SKIP_HIDDEN_LAYERS", "Entry",
+           "SourceMap", "entry_text", "float_literal", "fragment_source", "has_defines",
+           "std140_layout", "vertex_source"]
 
 
 def fragment_source(ir: MaterialIR, target: Target, mode: str | Entry = Entry.FORWARD,
                     defines: tuple[str, ...] | list[str] = ()) -> tuple[Assembly, SourceMap]:
     """The fragment stage of one entry; `defines` are extra feature defines after the
-    material's own (the preview's MATEDIT_SPLIT_SUM_ONLY, MATEDIT_ENERGY_COMPENSATION)."""
+    material's own (the preview's MATEDIT_SPLIT_SUM_ONLY, MATEDIT_ENERGY_COMPENSATION,
+    MATEDIT_SKIP_HIDDEN_LAYERS)."""
     return glsl_backend.fragment_source(schedule(ir, mode, defines), target)
 

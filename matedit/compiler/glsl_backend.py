@@ -14,10 +14,18 @@ from functools import cache
 
 from matedit.compiler import ops
 from matedit.compiler.ir import Expr, Lit, Op, Param, Splat, SurfaceUV, Uni, Var
-from matedit.compiler.schedule import Entry, LocalNames, Schedule, ScopePlan, SourceMap, Writer
+from matedit.compiler.schedule import (
+    Entry,
+    LayerGuard,
+    LocalNames,
+    Schedule,
+    ScopePlan,
+    SourceMap,
+    Writer,
+)
 from matedit.compiler.targets import FIRST_TEXTURE_BINDING, FRAME_BINDING, MATERIAL_BINDING, Target
 from matedit.glsl import layout as _layout
-from matedit.glsl.include import Assembly, assemble, packing_prelude
+from matedit.glsl.include import Assembly, assemble, derivative_prelude, packing_prelude
 from matedit.graph import nodes
 from matedit.graph.types import PortType
 
@@ -127,6 +135,24 @@ def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
     return f"{decls} {fn}({', '.join(args + [n for n, _ in outs])});"
 
 
+def _guarded_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames,
+                  guard: LayerGuard) -> str:
+    """A layer's call evaluated only where its weight shows in the quad (schedule.
+    hidden_layer_guards): its outputs start as the default attributes or zeros."""
+    d, _, _ = _row(op)
+    taken = names.taken
+    args = [taken[a.name] if type(a) is Var else expr(a, names) for a in op.args]
+    decls = " ".join(
+        f"{TYPE_NAMES[t]} {n} = "
+        f"{'defaultMaterialAttributes()' if t == PortType.MATERIAL else TYPE_NAMES[t] + '(0.0)'};"
+        for n, t in outs)
+    fn = d.glsl if d is not None else op.data.get("function")
+    call = f"{fn}({', '.join(args + [n for n, _ in outs])});"
+    ws = [taken[a.name] if type(a) is Var else expr(a, names) for a in guard.args]
+    weight = ws[0] if guard.function is None else f"{guard.function}({', '.join(ws)})"
+    return f"    {decls} if (layerShows({weight})) {{ {call} }}"
+
+
 def _scope(w: Writer, plan: ScopePlan) -> None:
     scope, names = plan.scope, plan.names
     if plan.main:
@@ -154,6 +180,8 @@ def _scope(w: Writer, plan: ScopePlan) -> None:
             type_name = TYPE_NAMES[t]
             value = fmt.format(args, type_name, ", ".join(args) if joined else "", op.data)
             text = f"    {type_name} {name} = {value};"
+        elif id(op) in plan.guards:
+            text = _guarded_line(op, outs, names, plan.guards[id(op)])
         else:
             text = "    " + op_line(op, outs, names)
         if "\n" in text:
@@ -306,6 +334,8 @@ def fragment_source(plan: Schedule, target: Target) -> tuple[Assembly, SourceMap
     head = prelude(target)
     if "gbuffer" in plan.units:  # shaders/gbuffer.glsl packs halves: the extension at 330
         head = "\n".join(x for x in (packing_prelude(target.version), head) if x)
+    if "layer_guard" in plan.units:  # fine derivatives: the extension at 330, where offered
+        head = "\n".join(x for x in (derivative_prelude(target.version), head) if x)
     asm = assemble("\n".join(w.lines), target.version, includes, "<material>",
                    prelude=head + "\n" + lines)
     return asm, SourceMap(w.map, len(asm.sources) - 1)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 from matedit.compiler import ops
-from matedit.compiler.ir import Expr, MaterialIR, Op, Scope, Splat, Var
+from matedit.compiler.ir import Expr, Lit, MaterialIR, Op, Scope, Splat, Var
 from matedit.glsl.layout import BINDINGS, Block, Member
 from matedit.graph import nodes
 from matedit.graph.types import PortType
@@ -95,19 +95,116 @@ class ScopePlan:
     main: bool
     names: LocalNames
     steps: list[tuple[Op, list[tuple[str, PortType]]]]  # each op, its outputs' local names
+    # id(op) -> where that layer shows (`hidden_layer_guards`)
+    guards: dict[int, LayerGuard] = field(default_factory=dict)
 
     @property
     def source(self) -> str:
         return self.scope.source
 
 
-def plan_scope(scope: Scope, main: bool) -> ScopePlan:
+# The preview's define that asks for hidden-layer guards (`hidden_layer_guards`). Exported
+# shaders never carry it: their text stays the graph's, one branch-free evaluation.
+SKIP_HIDDEN_LAYERS = "MATEDIT_SKIP_HIDDEN_LAYERS"
+# What every variant the viewport links carries (the renderer's programs and the compile
+# worker, which warms the same GBUFFER variant off the UI thread).
+PREVIEW_DEFINES = (SKIP_HIDDEN_LAYERS,)
+# Blends that give their base exactly where the weight is 0, whatever finite attributes the
+# layer holds: the compiler's stack blends and the catalogue's Layer Blend (mask) node, whose
+# weight is their third operand; the Layer Blend (height) node, whose weight is
+# heightBlendWeight of its heights and contrast (shaders/nodes/height_blend.glsl).
+_WEIGHT_BLENDS = frozenset((ops.BLEND, ops.COAT, ops.FILM, nodes.kind_for(nodes.Role.MASK_BLEND)))
+_HEIGHT_BLEND = nodes.kind_for(nodes.Role.HEIGHT_BLEND)
+# Outputs a guarded call may have besides the one the blend reads: types with a zero value.
+_GUARDABLE = frozenset((PortType.FLOAT, PortType.VEC2, PortType.VEC3, PortType.VEC4,
+                        PortType.MATERIAL))
+
+
+@dataclass(frozen=True)
+class LayerGuard:
+    """Where a guarded layer shows: `function` of `args` (the blend's operands) is its
+    weight; `function` None: the single operand is the weight itself."""
+
+    function: str | None
+    args: tuple[Expr, ...]
+
+
+def _blend_guard(op: Op) -> LayerGuard | None:
+    if op.kind in _WEIGHT_BLENDS and len(op.args) == 3:
+        weight = op.args[2]
+        return None if isinstance(weight, Lit) else LayerGuard(None, (weight,))
+    if op.kind == _HEIGHT_BLEND and len(op.args) == 5:
+        return LayerGuard("heightBlendWeight", tuple(op.args[2:]))
+    return None
+
+
+def hidden_layer_guards(scope: Scope) -> tuple[list[Op], dict[int, LayerGuard]]:
+    """The scope's ops in emission order, and the layer evaluations to guard by their weight.
+
+    A layer is a material function call whose attributes only one blend reads, a blend that
+    gives the stack below exactly where its weight is 0 whatever finite attributes the layer
+    holds (`_WEIGHT_BLENDS`, the height blend). Such a call is moved to just before its blend
+    (its operands are all defined by then), and the back end evaluates it only where the
+    weight is non-zero somewhere in the pixel's 2x2 quad; elsewhere the layer holds the
+    default attributes, which the blend then ignores. A rusted or mossy stack costs its upper
+    layers only where they show, and derivatives inside a layer stay defined (the branch is
+    uniform across each quad). Exact: no pixel changes."""
+    uses: dict[str, int] = {}
+    for op in scope.ops:
+        for a in op.args:
+            while type(a) is Splat:
+                a = a.expr
+            if type(a) is Var:
+                uses[a.name] = uses.get(a.name, 0) + 1
+    for _, _, e in scope.outputs:
+        while type(e) is Splat:
+            e = e.expr
+        if type(e) is Var:
+            uses[e.name] = uses.get(e.name, 0) + 2  # never a guarded layer's
+    producer: dict[str, Op] = {}
+    for op in scope.ops:
+        for v in op.out_vars().values():
+            producer[v.name] = op
+    moved: dict[int, Op] = {}  # id(blend) -> the call emitted just before it
+    guards: dict[int, LayerGuard] = {}
+    for op in scope.ops:
+        guard = _blend_guard(op)
+        if guard is None:
+            continue
+        value = op.args[1]
+        if type(value) is not Var:
+            continue
+        call = producer.get(value.name)
+        if call is None or call.kind != ops.CALL or id(call) in guards:
+            continue
+        if any(t not in _GUARDABLE for _, t in call.outs):
+            continue
+        if uses.get(value.name) != 1 or any(
+                uses.get(v.name, 0) for v in call.out_vars().values() if v.name != value.name):
+            continue
+        guards[id(call)] = guard
+        moved[id(op)] = call
+    if not guards:
+        return scope.ops, guards
+    order: list[Op] = []
+    for op in scope.ops:
+        if id(op) in guards:
+            continue
+        call = moved.get(id(op))
+        if call is not None:
+            order.append(call)
+        order.append(op)
+    return order, guards
+
+
+def plan_scope(scope: Scope, main: bool, guard_layers: bool = False) -> ScopePlan:
     names = LocalNames()
     for p, _ in scope.params:
         names.used.add(p)
     steps = []
     visit, taken, used = names.visit, names.taken, names.used
-    for op in scope.ops:
+    order, guards = hidden_layer_guards(scope) if guard_layers else (scope.ops, {})
+    for op in order:
         for a in op.args:
             if type(a) is Var:  # names.visit of the common operand
                 if a.name not in taken:
@@ -131,7 +228,7 @@ def plan_scope(scope: Scope, main: bool) -> ScopePlan:
         steps.append((op, outs))
     for _, _, e in scope.outputs:
         names.visit(e)
-    return ScopePlan(scope, main, names, steps)
+    return ScopePlan(scope, main, names, steps, guards)
 
 
 class Entry(Enum):
@@ -194,13 +291,16 @@ def schedule(ir: MaterialIR, mode: str | Entry = Entry.FORWARD,
     for d in defines:
         if not _DEFINE.fullmatch(d):
             raise ValueError(f"not a define name: {d!r}")
-    scopes = [plan_scope(s, main=False) for s in ir.functions]
-    scopes.append(plan_scope(ir.main, main=True))
+    guard = SKIP_HIDDEN_LAYERS in defines
+    scopes = [plan_scope(s, main=False, guard_layers=guard) for s in ir.functions]
+    scopes.append(plan_scope(ir.main, main=True, guard_layers=guard))
     # the library file of each node kind used, and those the compiler's own ops need
     needed = {f"nodes/{k}" for k in ir.node_kinds if nodes.REGISTRY[k].glsl}
     kinds = {op.kind for s in [ir.main, *ir.functions] for op in s.ops}
     for kind in kinds:
         needed.update(ops.implementation(kind).units)
+    if any(s.guards for s in scopes):
+        needed.add("layer_guard")
     units = [*BASE_UNITS, *sorted(needed), *ENTRY_UNITS[entry]]
     if entry == Entry.FORWARD and any(d.partition("=")[0] == ATTRIBUTE_VIEW for d in defines):
         units.append("attribute_view")  # the viewport's attribute views (preview only)

@@ -41,6 +41,18 @@ def packing_prelude(version: str) -> str:
     return PACKING_EXTENSION
 
 
+DERIVATIVE_EXTENSION = "#extension GL_ARB_derivative_control : enable"
+
+
+def derivative_prelude(version: str) -> str:
+    """DERIVATIVE_EXTENSION where `version` is desktop GLSL before 4.50 (dFdxFine is core
+    from 4.50; ESSL 3.00 has no fine derivatives), else nothing. `enable`, not `require`:
+    where the driver lacks it, shaders/layer_guard.glsl evaluates every layer."""
+    if version.endswith(" es") or int(version.split()[0]) >= 450:
+        return ""
+    return DERIVATIVE_EXTENSION
+
+
 def _line_directive(line: int, source: int) -> str:
     """`#line` making the next line `line` of source string `source`, source also encoded."""
     return f"#line {source * LINE_STRIDE + line} {source}"

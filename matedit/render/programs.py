@@ -12,7 +12,7 @@ from __future__ import annotations
 import moderngl
 
 from matedit.compiler.api import CompiledMaterial
-from matedit.compiler.emit import Entry
+from matedit.compiler.emit import PREVIEW_DEFINES, SKIP_HIDDEN_LAYERS, Entry
 from matedit.glsl.layout import BINDINGS
 from matedit.render.deferred import ENERGY_COMPENSATION, SPLIT_SUM_ONLY
 from matedit.render.fullscreen import set_uniform
@@ -48,9 +48,10 @@ def bind_program(prog: moderngl.Program) -> None:
 
 
 def forward_defines(split_sum_only: bool, compensation: bool) -> tuple[str, ...]:
-    """The preview's defines of a FORWARD variant."""
+    """The preview's defines of a FORWARD variant (its layers guarded as the G-buffer's are:
+    matedit.compiler.schedule.hidden_layer_guards)."""
     return ((SPLIT_SUM_ONLY,) if split_sum_only else ()) + \
-        ((ENERGY_COMPENSATION,) if compensation else ())
+        ((ENERGY_COMPENSATION,) if compensation else ()) + PREVIEW_DEFINES
 
 
 class ProgramCache:
@@ -69,8 +70,16 @@ class ProgramCache:
         variant = compiled.variant(entry, tuple(defines))
         prog = self.table.get(variant.structure_hash)
         if prog is None:
-            prog = self.ctx.program(vertex_shader=variant.vertex_text,
-                                    fragment_shader=variant.fragment_text)
+            try:
+                prog = self.ctx.program(vertex_shader=variant.vertex_text,
+                                        fragment_shader=variant.fragment_text)
+            except moderngl.Error:
+                if SKIP_HIDDEN_LAYERS not in defines:
+                    raise
+                # a driver that names GL_ARB_derivative_control at GLSL 3.30 but refuses
+                # its functions there (the extension asks for 4.00): every layer evaluated
+                return self.get(compiled, entry,
+                                tuple(d for d in defines if d != SKIP_HIDDEN_LAYERS))
             self.link_count += 1
             self._bind(prog)
             self.table[variant.structure_hash] = prog
@@ -113,7 +122,7 @@ class ProgramCache:
                  ) -> tuple[Entry, tuple[str, ...]]:
         if forward:
             return Entry.FORWARD, forward_defines(True, compensation) + view_defines(view)
-        return Entry.GBUFFER, ()
+        return Entry.GBUFFER, PREVIEW_DEFINES
 
     def release(self, forget=None) -> None:
         for p in self.table.values():
