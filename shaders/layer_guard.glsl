@@ -13,7 +13,8 @@
 // 3.00, coarse derivatives only, or no extension) every layer is evaluated.
 
 bool layerShows(float w) {
-#if __VERSION__ >= 450 || defined(GL_ARB_derivative_control)
+    // Whether the weight is non-zero anywhere in the quad (derivatives: GLSL 4.50, 8.14.1)
+#if __VERSION__ >= 450 || (defined(MATEDIT_DERIVATIVE_CONTROL) && defined(GL_ARB_derivative_control))
     float row = abs(w) + abs(dFdxFine(w));
     // NaN compares unequal: a layer whose weight is not a number is evaluated
     return !(row + abs(dFdyFine(row)) == 0.0);

@@ -159,3 +159,19 @@ def test_guarded_variants_pass_glslang(target, tmp_path):
             args += ["-V", "-o", str(tmp_path / "m.spv")]
         r = subprocess.run(args, capture_output=True, text=True)
         assert r.returncode == 0, f"{target} {entry.value}:\n{r.stdout[-3000:]}"
+
+
+def test_mesa_takes_the_fine_derivative_branch_at_330(ctx):
+    """The guard's 3.30 path is live on the preview's driver (else it would evaluate every
+    layer and skip nothing): the prelude's define and the extension's macro are both there
+    and dFdxFine compiles."""
+    from matedit.glsl.include import assemble, derivative_prelude
+
+    body = ("out vec4 color;\nvoid main() {\n"
+            "#if defined(MATEDIT_DERIVATIVE_CONTROL) && defined(GL_ARB_derivative_control)\n"
+            "    color = vec4(dFdxFine(gl_FragCoord.x));\n#else\n#error no fine derivatives\n"
+            "#endif\n}\n")
+    asm = assemble(body, version="330 core", includes=[], prelude=derivative_prelude("330 core"))
+    ctx.program(vertex_shader="#version 330 core\nvoid main() { gl_Position = vec4(0.0); }\n",
+                fragment_shader=asm.text).release()
+    assert derivative_prelude("450") == "" and derivative_prelude("300 es") == ""

@@ -50,7 +50,7 @@ def test_program_cache_links_each_variant_once(gl_ctx):
         # deferred, the compensation option lives in the lighting pass: the same GBUFFER program
         assert cache.material(cm, False, True) is cache.material(cm, False, False)
         reference = cache.reference(cm, True)
-        full = cm.variant(Entry.FORWARD, (ENERGY_COMPENSATION,))
+        full = cm.variant(Entry.FORWARD, (ENERGY_COMPENSATION, *PREVIEW_DEFINES))
         assert cache.table[full.structure_hash] is reference
         assert cache.link_count == len(cache.table) == 4
         for (forward, compensation) in expected:  # all cached now

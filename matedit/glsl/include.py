@@ -41,7 +41,10 @@ def packing_prelude(version: str) -> str:
     return PACKING_EXTENSION
 
 
-DERIVATIVE_EXTENSION = "#extension GL_ARB_derivative_control : enable"
+# GL_ARB_derivative_control's macro is defined wherever a compiler knows the extension, its
+# functions only once enabled: the define says this prelude enabled it.
+DERIVATIVE_EXTENSION = ("#extension GL_ARB_derivative_control : enable\n"
+                        "#define MATEDIT_DERIVATIVE_CONTROL 1")
 
 
 def derivative_prelude(version: str) -> str:

@@ -6,6 +6,7 @@
 // 0, where GLSL's smoothstep is undefined (edge0 >= edge1). The preview's hidden-layer guard
 // (layer_guard.glsl) reads it too.
 float heightBlendWeight(float base_height, float layer_height, float contrast) {
+    // Height blend weight: a smoothstep of the height difference, width 2 c
     float c = max(contrast, 1e-5);
     return smoothstep(-c, c, layer_height - base_height);
 }
