@@ -175,3 +175,24 @@ def test_mesa_takes_the_fine_derivative_branch_at_330(ctx):
     ctx.program(vertex_shader="#version 330 core\nvoid main() { gl_Position = vec4(0.0); }\n",
                 fragment_shader=asm.text).release()
     assert derivative_prelude("450") == "" and derivative_prelude("300 es") == ""
+
+
+def test_a_material_that_fails_either_way_reports_the_guarded_variants_log(ctx, monkeypatch):
+    """The fallback relinks without guards; when that fails too, the error raised is the
+    guarded variant's, so the caller locates it in the text it holds (ProgramCache.link)."""
+    import moderngl
+
+    from matedit.render.programs import ProgramCache
+
+    cm = _sample("worn_painted_steel")
+    cache = ProgramCache(ctx, bind=lambda prog: None)
+    tried = []
+
+    def refuse_all(vertex_shader, fragment_shader):
+        tried.append("layerShows(" in fragment_shader)
+        raise moderngl.Error("guarded" if tried[-1] else "unguarded")
+
+    monkeypatch.setattr(ctx, "program", refuse_all)
+    with pytest.raises(moderngl.Error, match="^guarded$"):
+        cache.get(cm, Entry.GBUFFER, PREVIEW_DEFINES)
+    assert tried == [True, False]

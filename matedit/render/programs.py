@@ -73,13 +73,18 @@ class ProgramCache:
             try:
                 prog = self.ctx.program(vertex_shader=variant.vertex_text,
                                         fragment_shader=variant.fragment_text)
-            except moderngl.Error:
+            except moderngl.Error as exc:
                 if SKIP_HIDDEN_LAYERS not in defines:
                     raise
                 # a driver that names GL_ARB_derivative_control at GLSL 3.30 but refuses
-                # its functions there (the extension asks for 4.00): every layer evaluated
-                return self.get(compiled, entry,
-                                tuple(d for d in defines if d != SKIP_HIDDEN_LAYERS))
+                # its functions there (the extension asks for 4.00): every layer evaluated.
+                # A material that fails either way reports this variant's log, which its
+                # caller locates in this variant's text.
+                try:
+                    return self.get(compiled, entry,
+                                    tuple(d for d in defines if d != SKIP_HIDDEN_LAYERS))
+                except moderngl.Error:
+                    raise exc from None
             self.link_count += 1
             self._bind(prog)
             self.table[variant.structure_hash] = prog
