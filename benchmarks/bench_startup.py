@@ -12,15 +12,20 @@ of the first frame with the environment's image-based lighting (the editor bakes
 it once its first frame is on screen), then quits. The parent reads the clock just before it
 starts the child, so the figure covers interpreter start, imports, window construction, GL
 and renderer start-up, compile, link, JIT and the first draw.
-One Xvfb server (xvfb-run) hosts all launches so that its own start-up is not counted. The
-launches share one fresh HOME (settings, recovery files, IBL cache) and one fresh, empty
-Mesa shader cache (MESA_SHADER_CACHE_DIR inside it; MESA_SHADER_CACHE_DISABLE is dropped for
-them): the first launch is the cold one (empty caches: the studio environment is baked, every
-shader compiled), the next ones are warm (both caches filled by the launches before).
-Python's bytecode cache is on for them, in a fresh folder in that HOME (PYTHONPYCACHEPREFIX; a
-PYTHONDONTWRITEBYTECODE of the environment is dropped): the cold launch writes it, the warm ones
-read it, as a user's machine does (an installed matedit comes with its bytecode). `matedit
-validate` is timed the same way, its warm-up run writing the bytecode.
+One Xvfb server (xvfb-run) hosts all launches so that its own start-up is not counted.
+Python's bytecode cache is on for them, in one fresh folder (PYTHONPYCACHEPREFIX; a
+PYTHONDONTWRITEBYTECODE of the environment is dropped). Three kinds of launch, in this order:
+- cold (the start-up goal's): a fresh HOME (settings, recovery files, IBL cache), a fresh
+  empty Mesa shader cache (MESA_SHADER_CACHE_DIR; MESA_SHADER_CACHE_DISABLE is dropped) and
+  the empty bytecode folder: the studio environment is baked, every shader compiled, and
+  Python compiles every module it imports, the standard library's and numpy's included
+  (their installed bytecode is not under the prefix);
+- cold with installed bytecode (for comparison): another fresh HOME and Mesa shader cache,
+  the bytecode written by the launch before, as on a user's machine, where matedit, Python
+  and numpy come with their bytecode (a wheel or the .deb compiles it at install, the bundle
+  carries it);
+- warm: that second HOME again, every cache filled.
+`matedit validate` is timed with the bytecode folder too, its warm-up run writing it.
 """
 
 from __future__ import annotations
@@ -148,20 +153,30 @@ def editor_child(timeout_s: float = 90.0) -> int:
 # -- the launcher (runs under xvfb-run) ---------------------------------------------------------
 
 
-def launch_editor(repeat: int) -> int:
-    """Starts the editor child `repeat + 1` times (the first into an empty cache)."""
-    home = Path(tempfile.mkdtemp(prefix="matedit-bench-home-"))
+def _home_env(home: Path, pycache: Path) -> dict:
+    """The launch environment of one HOME: its settings, caches and Mesa shader cache."""
     env = dict(os.environ, HOME=str(home), XDG_CONFIG_HOME=str(home / ".config"),
                XDG_DATA_HOME=str(home / ".local/share"), XDG_CACHE_HOME=str(home / ".cache"))
     env.pop("MATEDIT_CACHE_DIR", None)
     env.pop("MESA_SHADER_CACHE_DISABLE", None)  # warm launches have their shaders cached
     env["MESA_SHADER_CACHE_DIR"] = str(home / "mesa-shader-cache")
-    env = bytecode_env(env, home / "pycache")  # the first launch writes it, as the IBL's
+    return bytecode_env(env, pycache)
+
+
+def launch_editor(repeat: int) -> int:
+    """Starts the editor child `repeat + 2` times: cold (every cache empty, bytecode too),
+    cold with the bytecode the first wrote (a fresh HOME and Mesa shader cache), then
+    `repeat` warm ones in the second launch's HOME."""
+    tmp = Path(tempfile.mkdtemp(prefix="matedit-bench-home-"))
+    pycache = tmp / "pycache"
+    cold_env = _home_env(tmp / "cold", pycache)
+    env = _home_env(tmp / "home", pycache)
     runs = []
     try:
-        for _ in range(repeat + 1):
+        for i in range(repeat + 2):
             t0 = time.monotonic()
-            proc = subprocess.run([sys.executable, str(HERE), "--editor-child"], env=env,
+            proc = subprocess.run([sys.executable, str(HERE), "--editor-child"],
+                                  env=cold_env if i == 0 else env,
                                   capture_output=True, text=True, timeout=180, cwd=ROOT)
             line = next((x for x in proc.stdout.splitlines() if x.startswith("STARTUP ")), None)
             if line is None:
@@ -170,7 +185,7 @@ def launch_editor(repeat: int) -> int:
             marks = json.loads(line[len("STARTUP "):])
             runs.append({k: (v - t0 if isinstance(v, float) else v) for k, v in marks.items()})
     finally:
-        shutil.rmtree(home, ignore_errors=True)
+        shutil.rmtree(tmp, ignore_errors=True)
     print("EDITOR " + json.dumps(runs), flush=True)
     return 0
 
@@ -190,9 +205,9 @@ def editor_times(repeat: int = 3) -> dict:
     if line is None:
         return {"skipped": "editor launcher failed: " + (proc.stderr or proc.stdout)[-800:]}
     runs = json.loads(line[len("EDITOR "):])
-    cold, warm = runs[0], runs[1:]
+    cold, installed, warm = runs[0], runs[1], runs[2:]
     ok = [r for r in warm if "material_frame" in r]
-    result = {"cold": cold, "warm": warm, "runs": len(warm)}
+    result = {"cold": cold, "cold_installed": installed, "warm": warm, "runs": len(warm)}
     if ok:
         result["material_frame"] = statistics.median(r["material_frame"] for r in ok)
         result["first_frame"] = statistics.median(r["first_frame"] for r in ok)
