@@ -149,6 +149,9 @@ def hidden_layer_guards(scope: Scope) -> tuple[list[Op], dict[int, LayerGuard]]:
     default attributes, which the blend then ignores. A rusted or mossy stack costs its upper
     layers only where they show, and derivatives inside a layer stay defined (the branch is
     uniform across each quad). Exact: no pixel changes."""
+    blends = [op for op in scope.ops if op.kind in _WEIGHT_BLENDS or op.kind == _HEIGHT_BLEND]
+    if not blends:  # most scopes of a large graph: nothing to count
+        return scope.ops, {}
     uses: dict[str, int] = {}
     for op in scope.ops:
         for a in op.args:
@@ -167,7 +170,7 @@ def hidden_layer_guards(scope: Scope) -> tuple[list[Op], dict[int, LayerGuard]]:
             producer[v.name] = op
     moved: dict[int, Op] = {}  # id(blend) -> the call emitted just before it
     guards: dict[int, LayerGuard] = {}
-    for op in scope.ops:
+    for op in blends:
         guard = _blend_guard(op)
         if guard is None:
             continue
