@@ -121,7 +121,7 @@ def test_guarded_glsl330_links_on_mesa_and_falls_back_where_refused(ctx, monkeyp
 
     cm = _sample("worn_painted_steel")
     cache = ProgramCache(ctx, bind=lambda prog: None)
-    prog, variant = cache.get(cm, Entry.GBUFFER, PREVIEW_DEFINES)
+    _, variant = cache.get(cm, Entry.GBUFFER, PREVIEW_DEFINES)
     assert "if (layerShows(" in variant.fragment_text
     assert "#extension GL_ARB_derivative_control : enable" in variant.fragment_text
     real = ctx.program
@@ -135,7 +135,7 @@ def test_guarded_glsl330_links_on_mesa_and_falls_back_where_refused(ctx, monkeyp
 
     cache2 = ProgramCache(ctx, bind=lambda prog: None)
     monkeypatch.setattr(ctx, "program", refuse_guards)
-    prog2, variant2 = cache2.get(cm, Entry.GBUFFER, PREVIEW_DEFINES)
+    _, variant2 = cache2.get(cm, Entry.GBUFFER, PREVIEW_DEFINES)
     assert "layerShows(" not in variant2.fragment_text
     cache.release()
     cache2.release()
