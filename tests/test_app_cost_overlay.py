@@ -74,3 +74,45 @@ def test_cost_overlay_tints_nodes_and_tooltips_carry_the_figures(qtbot):
     assert not action.isChecked()
     qtbot.waitUntil(lambda: not canvas.scene().costs, timeout=5_000)
     assert all(i.cost is None for i in canvas.scene().node_items.values())
+
+
+def test_the_worker_thread_holds_no_qt_object_and_the_answer_arrives_on_the_ui_thread(
+        qtbot, monkeypatch):
+    """The worker runs a static function of a document copy and leaves its answer for the
+    overlay's timer: a thread holding the overlay could drop the last reference to a closed
+    window and destroy its widgets off the UI thread (a crash in the next test's Qt calls)."""
+    import threading
+
+    from PySide6.QtCore import QObject
+
+    from matedit.app.canvas import cost_overlay
+    from matedit.io.document import load
+
+    started = threading.Event()
+    release = threading.Event()
+    seen_threads = []
+
+    def slow_compute(doc):
+        seen_threads.append(threading.current_thread())
+        started.set()
+        release.wait(30)
+        return {"instructions": 10, "nodes": [{"id": "n", "instructions": 10.0,
+                                               "samples": 0.0}]}
+
+    monkeypatch.setattr(cost_overlay.CostOverlay, "compute", staticmethod(slow_compute))
+    owner = QObject()
+    doc = load(EDITOR_SAMPLE)
+    overlay = cost_overlay.CostOverlay(owner, lambda: doc)
+    got = []
+    overlay.ready.connect(lambda costs: got.append((threading.current_thread(), costs)))
+    overlay.set_active(True)
+    assert started.wait(30)
+    worker, = [t for t in threading.enumerate() if t.name == "matedit-cost-overlay"]
+    held = [worker._target, *worker._args]  # what the thread keeps alive
+    assert not any(isinstance(x, QObject) for x in held)
+    assert getattr(worker._target, "__self__", None) is None
+    release.set()
+    qtbot.waitUntil(lambda: bool(got), timeout=10_000)
+    assert got[0][0] is threading.main_thread() and set(got[0][1]) == {"n"}
+    assert seen_threads[0] is not threading.main_thread()
+    owner.deleteLater()

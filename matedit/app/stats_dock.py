@@ -73,7 +73,8 @@ class StatsService(CostOverlay):
     """The overlay's worker asked for every target and the permutations: `report` is
     glsl450's figures with `targets` (all of them) and `permutations` added."""
 
-    def compute(self, doc) -> dict:
+    @staticmethod
+    def compute(doc) -> dict:
         from matedit.interop.stats import material_stats, permutations
         from matedit.io.document import FileResolver
 

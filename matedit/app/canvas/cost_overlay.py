@@ -2,7 +2,12 @@
 material's instructions, the figures in its tooltip. The figures are `matedit stats`'s for
 glsl450 (`matedit.commands.stats.material_stats`: glslang and spirv-opt, a second or two),
 computed on a worker thread from a copy of the document, one at a time; a request made while
-one runs waits for it and supersedes it (the older answer is dropped)."""
+one runs waits for it and supersedes it (the older answer is dropped).
+
+The worker thread holds no Qt object and calls no Qt: it runs the class's `compute` (a static
+function of the document copy) and leaves its answer in a list the overlay's timer polls on the
+UI thread. A thread that held the overlay could drop the last reference to a closed window and
+destroy its widgets off the UI thread."""
 
 from __future__ import annotations
 
@@ -35,6 +40,15 @@ def node_costs(report: dict) -> dict[str, tuple[float, str]]:
     return out
 
 
+def _work(compute, doc, answer: list) -> None:
+    """The worker thread: `compute(doc)` or the exception it raised, appended to `answer`."""
+    try:
+        result: object = compute(doc)
+    except Exception as exc:  # a graph that does not compile, a missing tool
+        result = exc
+    answer.append(result)
+
+
 class CostOverlay(QObject):
     """Computes the figures for a canvas's document off the UI thread; `ready` carries them
     (node id -> (tint, text)), `failed` a one-line reason."""
@@ -42,7 +56,7 @@ class CostOverlay(QObject):
     ready = Signal(dict)
     computed = Signal(object)  # the report itself (one target's figures), after `ready`
     failed = Signal(str)
-    _done = Signal(int, object)  # from the worker thread: generation, report or exception
+    POLL_MS = 50  # how often the UI thread looks for the worker's answer while one runs
 
     def __init__(self, parent: QObject, document) -> None:
         super().__init__(parent)
@@ -56,7 +70,11 @@ class CostOverlay(QObject):
         self._timer.setSingleShot(True)
         self._timer.setInterval(400)  # edits in a burst: one computation after them
         self._timer.timeout.connect(self.request)
-        self._done.connect(self._finished)
+        self._answer: list = []  # the running worker's answer, once it has one
+        self._answer_gen = 0
+        self._poll = QTimer(self)
+        self._poll.setInterval(self.POLL_MS)
+        self._poll.timeout.connect(self._collect)
 
     def set_active(self, on: bool) -> None:
         self.active = on
@@ -87,22 +105,24 @@ class CostOverlay(QObject):
             return
         work = document_copy(doc)
         self._busy = True
-        threading.Thread(target=self._work, args=(gen, work), daemon=True,
-                         name="matedit-cost-overlay").start()
+        self._answer, self._answer_gen = [], gen
+        threading.Thread(target=_work, args=(type(self).compute, work, self._answer),
+                         daemon=True, name="matedit-cost-overlay").start()
+        self._poll.start()
 
-    def compute(self, doc) -> dict:
+    @staticmethod
+    def compute(doc) -> dict:
         """The report, on the worker thread: glsl450's figures (`StatsService` adds more)."""
         from matedit.interop.stats import material_stats
         from matedit.io.document import FileResolver
 
         return material_stats(doc, FileResolver(), [TARGET])[TARGET]
 
-    def _work(self, gen: int, doc) -> None:
-        try:
-            result: object = self.compute(doc)
-        except Exception as exc:  # a graph that does not compile, a missing tool
-            result = exc
-        self._done.emit(gen, result)
+    def _collect(self) -> None:
+        if not self._answer:
+            return
+        self._poll.stop()
+        self._finished(self._answer_gen, self._answer[0])
 
     def _finished(self, gen: int, result: object) -> None:
         self._busy = False
