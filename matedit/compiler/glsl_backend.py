@@ -130,9 +130,15 @@ def op_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames) -> str:
             sets = " ".join(f"{name}.{f} = {a};" for f, a in zip(op.data[impl.assigns], args[1:]))
             line += " " + sets
         return line
-    fn = d.glsl if d is not None else op.data.get("function")
     decls = " ".join(f"{TYPE_NAMES[t]} {n};" for n, t in outs)
-    return f"{decls} {fn}({', '.join(args + [n for n, _ in outs])});"
+    return f"{decls} {_call_text(d, op, args, outs)}"
+
+
+def _call_text(d, op: Op, args: list[str], outs: list[tuple[str, PortType]]) -> str:
+    """The call that fills an op's outputs through `out` parameters: the catalogue kind's
+    GLSL function, or the material function the op names."""
+    fn = d.glsl if d is not None else op.data.get("function")
+    return f"{fn}({', '.join(args + [n for n, _ in outs])});"
 
 
 def _guarded_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames,
@@ -146,8 +152,7 @@ def _guarded_line(op: Op, outs: list[tuple[str, PortType]], names: LocalNames,
         f"{TYPE_NAMES[t]} {n} = "
         f"{'defaultMaterialAttributes()' if t == PortType.MATERIAL else TYPE_NAMES[t] + '(0.0)'};"
         for n, t in outs)
-    fn = d.glsl if d is not None else op.data.get("function")
-    call = f"{fn}({', '.join(args + [n for n, _ in outs])});"
+    call = _call_text(d, op, args, outs)
     ws = [taken[a.name] if type(a) is Var else expr(a, names) for a in guard.args]
     weight = ws[0] if guard.function is None else f"{guard.function}({', '.join(ws)})"
     return f"    {decls} if (layerShows({weight})) {{ {call} }}"

@@ -165,6 +165,14 @@ class Op:
         return f"{self.kind}|{data}|{','.join([a.key() for a in self.args])}"
 
 
+def expr_vars(e: Expr):
+    """The names of the variables an operand reads (a Var, or one under Splats)."""
+    if isinstance(e, Var):
+        yield e.name
+    elif isinstance(e, Splat):
+        yield from expr_vars(e.expr)
+
+
 @dataclass
 class UniformInfo:
     name: str

@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from matedit.compiler import ops
-from matedit.compiler.ir import Expr, Lit, Op, Scope, Splat, Var
+from matedit.compiler.ir import Expr, Lit, Op, Scope, Splat, Var, expr_vars
 from matedit.graph.nodes import is_impure
 from matedit.graph.types import PortType
 
@@ -52,18 +52,11 @@ def _to_lit(value, t: PortType) -> Lit | None:
     return Lit(tuple(float(x) for x in arr), t)
 
 
-def _vars(e: Expr):
-    if isinstance(e, Var):
-        yield e.name
-    elif isinstance(e, Splat):
-        yield from _vars(e.expr)
-
-
 def remove_unused(scope: Scope) -> None:
     """Drops ops whose outputs reach no scope output."""
     live: set[str] = set()
     for _, _, e in scope.outputs:
-        live.update(_vars(e))
+        live.update(expr_vars(e))
     kept = []
     for op in reversed(scope.ops):
         for v in op.out_vars().values():
@@ -76,7 +69,7 @@ def remove_unused(scope: Scope) -> None:
             if type(a) is Var:
                 live.add(a.name)
             else:
-                live.update(_vars(a))
+                live.update(expr_vars(a))
     kept.reverse()
     scope.ops = kept
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 from matedit.compiler import ops
-from matedit.compiler.ir import Expr, Lit, MaterialIR, Op, Scope, Splat, Var
+from matedit.compiler.ir import Expr, Lit, MaterialIR, Op, Scope, Splat, Var, expr_vars
 from matedit.glsl.layout import BINDINGS, Block, Member
 from matedit.graph import nodes
 from matedit.graph.types import PortType
@@ -155,15 +155,11 @@ def hidden_layer_guards(scope: Scope) -> tuple[list[Op], dict[int, LayerGuard]]:
     uses: dict[str, int] = {}
     for op in scope.ops:
         for a in op.args:
-            while type(a) is Splat:
-                a = a.expr
-            if type(a) is Var:
-                uses[a.name] = uses.get(a.name, 0) + 1
+            for name in expr_vars(a):
+                uses[name] = uses.get(name, 0) + 1
     for _, _, e in scope.outputs:
-        while type(e) is Splat:
-            e = e.expr
-        if type(e) is Var:
-            uses[e.name] = uses.get(e.name, 0) + 2  # never a guarded layer's
+        for name in expr_vars(e):
+            uses[name] = uses.get(name, 0) + 2  # never a guarded layer's
     producer: dict[str, Op] = {}
     for op in scope.ops:
         for v in op.out_vars().values():

@@ -33,12 +33,15 @@ LINE_STRIDE = 100_000
 PACKING_EXTENSION = "#extension GL_ARB_shading_language_packing : require"
 
 
+def _desktop_before(version: str, core: int) -> bool:
+    """Whether `version` (a #version argument) is desktop GLSL older than `core`."""
+    return not version.endswith(" es") and int(version.split()[0]) < core
+
+
 def packing_prelude(version: str) -> str:
     """PACKING_EXTENSION where `version` (a #version argument) lacks the packing functions,
     else nothing."""
-    if version.endswith(" es") or int(version.split()[0]) >= 420:
-        return ""
-    return PACKING_EXTENSION
+    return PACKING_EXTENSION if _desktop_before(version, 420) else ""
 
 
 # GL_ARB_derivative_control's macro is defined wherever a compiler knows the extension, its
@@ -51,9 +54,7 @@ def derivative_prelude(version: str) -> str:
     """DERIVATIVE_EXTENSION where `version` is desktop GLSL before 4.50 (dFdxFine is core
     from 4.50; ESSL 3.00 has no fine derivatives), else nothing. `enable`, not `require`:
     where the driver lacks it, shaders/layer_guard.glsl evaluates every layer."""
-    if version.endswith(" es") or int(version.split()[0]) >= 450:
-        return ""
-    return DERIVATIVE_EXTENSION
+    return DERIVATIVE_EXTENSION if _desktop_before(version, 450) else ""
 
 
 def _line_directive(line: int, source: int) -> str:
