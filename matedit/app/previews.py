@@ -174,6 +174,41 @@ class _Inputs:
     analysis: Any = None  # the editor's, when current (not validated again)
 
 
+def _evaluate(textures: TextureCache, inputs: _Inputs) -> dict[str, QImage]:
+    """The thumbnails of `inputs`, on the worker thread. A module function of plain data:
+    the work item holds no QObject, so a canvas closed meanwhile is never released (and
+    deleted) on the worker thread."""
+    doc = inputs.doc
+    if doc.is_function or len(doc.graph.nodes) > MAX_NODES:
+        return {}
+    try:
+        ir = lower_document(doc, inputs.resolver, inputs.analysis)
+        probe: dict = {}
+        surface, inside = preview_sphere()
+        images = {t.name: textures.get(t.path, t.srgb) for t in ir.textures}
+        evaluate(ir, surface, textures={k: v for k, v in images.items() if v is not None},
+                 probe=probe)
+    except (CompileError, LookupError, ValueError, KeyError, TypeError,
+            FloatingPointError):
+        return {}
+    out: dict[str, QImage] = {}
+    for nid, node in doc.graph.nodes.items():
+        d = nodes.get(node.kind)
+        shown = d.thumbnail if d is not None else Thumbnail.NEVER  # NodeDef.thumbnail
+        if shown == Thumbnail.NEVER or (shown == Thumbnail.SELECTED
+                                         and nid not in inputs.selection):
+            continue
+        for port, t in inputs.out_types.get(nid, {}).items():
+            if t.is_numeric or t == PortType.MATERIAL:
+                value = probe.get(f"{nid}.{port}")
+                if value is not None:
+                    img = to_image(value, inside)
+                    if img is not None:
+                        out[nid] = img
+                break
+    return out
+
+
 class NodePreviews(QObject):
     """Keeps the thumbnails of one material canvas up to date. The evaluation runs on a
     worker thread (one at a time; a result older than the last edit is dropped), so that an
@@ -217,38 +252,7 @@ class NodePreviews(QObject):
 
     def images(self) -> dict[str, QImage]:
         """The thumbnails of the document as it is now, evaluated on this thread."""
-        return self._images(self._inputs())
-
-    def _images(self, inputs: _Inputs) -> dict[str, QImage]:
-        doc = inputs.doc
-        if doc.is_function or len(doc.graph.nodes) > MAX_NODES:
-            return {}
-        try:
-            ir = lower_document(doc, inputs.resolver, inputs.analysis)
-            probe: dict = {}
-            surface, inside = preview_sphere()
-            textures = {t.name: self.textures.get(t.path, t.srgb) for t in ir.textures}
-            evaluate(ir, surface, textures={k: v for k, v in textures.items() if v is not None},
-                     probe=probe)
-        except (CompileError, LookupError, ValueError, KeyError, TypeError,
-                FloatingPointError):
-            return {}
-        out: dict[str, QImage] = {}
-        for nid, node in doc.graph.nodes.items():
-            d = nodes.get(node.kind)
-            shown = d.thumbnail if d is not None else Thumbnail.NEVER  # NodeDef.thumbnail
-            if shown == Thumbnail.NEVER or (shown == Thumbnail.SELECTED
-                                             and nid not in inputs.selection):
-                continue
-            for port, t in inputs.out_types.get(nid, {}).items():
-                if t.is_numeric or t == PortType.MATERIAL:
-                    value = probe.get(f"{nid}.{port}")
-                    if value is not None:
-                        img = to_image(value, inside)
-                        if img is not None:
-                            out[nid] = img
-                    break
-        return out
+        return _evaluate(self.textures, self._inputs())
 
     def _selected(self, ids: list) -> None:
         self._selection = set(ids)
@@ -265,7 +269,7 @@ class NodePreviews(QObject):
             return
         self._busy = True
         gen, inputs = self._generation, self._inputs()
-        future = _pool().submit(self._images, inputs)
+        future = _pool().submit(_evaluate, self.textures, inputs)
         delivery = self._delivery
 
         def done(f) -> None:
