@@ -99,6 +99,42 @@ def frame_vs_floor(renderer, ctx, material: CompiledMaterial, sizes=(512, 1024),
     return rows
 
 
+def promoted_vs_floor(ctx, material: CompiledMaterial, sizes=(512, 1024),
+                      frames: int = 5) -> list[tuple[int, float, float]]:
+    """As frame_vs_floor, for the frames the viewport draws once idle after an edit: the
+    material and the floor promoted to the forward path (Renderer.promote_forward, whose
+    image and program are the forward renderer's: tests/test_render_promote.py), each on a
+    renderer of its own (a structural edit, as switching materials is, ends a promotion)."""
+    import statistics
+
+    from matedit.render import Renderer
+
+    rows = []
+    for size in sizes:
+        rs = {name: Renderer(ctx, (size, size), environment="studio")
+              for name in ("material", "floor")}
+        try:
+            for name, m in (("material", material), ("floor", floor_material())):
+                rs[name].set_material(m)
+                rs[name].render()  # the deferred program, as after the structural edit
+                if not rs[name].promote_forward():
+                    raise RuntimeError(f"{name}: not promoted")
+                rs[name].render()  # the forward program's link and JIT
+            times: dict[str, list[float]] = {"material": [], "floor": []}
+            for _ in range(frames):
+                for name, r in rs.items():
+                    t = time.perf_counter()
+                    r.render()
+                    ctx.finish()
+                    times[name].append(time.perf_counter() - t)
+            rows.append((size, statistics.median(times["material"]),
+                         statistics.median(times["floor"])))
+        finally:
+            for r in rs.values():
+                r.release()
+    return rows
+
+
 def structural_edit(renderer, ctx, doc, repeat: int = 3) -> tuple[float, float, float, float]:
     """Median (compile, GL link, first frame, total) seconds of a structural edit to `doc`:
     compile, link a new program (the program cache is cleared first), draw, finish."""

@@ -93,6 +93,9 @@ class ViewportWidget(QWidget):
     # GL work between two looks at the messages while reference mode accumulates (ms; None:
     # matedit.render.server.BUDGET_MS)
     slice_budget_ms: float | None = None
+    # once idle a while after a structural edit, the render process draws the material
+    # forward (matedit.render.server.FORWARD_WHEN_IDLE_S; Renderer.promote_forward)
+    forward_when_idle = True
     # start the render process when the widget is made rather than when it is first shown
     # (off: a window never shown starts none; the editor's first viewport takes the process
     # `matedit` launched before it imported Qt, render_client.prelaunch)
@@ -153,10 +156,14 @@ class ViewportWidget(QWidget):
             self._send_init()
 
     def _send_init(self) -> None:
+        from matedit.render.server import FORWARD_WHEN_IDLE_S
+
         s = self.settings
+        idle = FORWARD_WHEN_IDLE_S if self.forward_when_idle else None
         try:
             self._proc.start({
                 "size": self._size_px(), "warm_up": not self._first_frame_deferred(),
+                "forward_when_idle_s": idle,
                 "mesh": self._mesh, "mode": self._mode, "exposure": self._exposure,
                 "view": self._view, "lights": self._lights, "budget_ms": self.slice_budget_ms,
                 "settings": (s.environment_intensity, s.show_background, s.background_blur,

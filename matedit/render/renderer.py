@@ -47,6 +47,10 @@ class Renderer(PreviewSettings):
         # (FORWARD entry) for materials that write opacity, or when asked
         self.deferred = bool(deferred) and samples >= 2
         self.is_forward = True  # the current material's path
+        # structure hash of the material drawn forward once the editor was idle
+        # (promote_forward), and of one whose forward program failed to link (not tried again)
+        self._promoted: str | None = None
+        self._not_promoted: str | None = None
         self.bake_settings = bake_settings
         self.environment_name = ""  # none until set_environment
         self.environment_warnings: list[str] = []
@@ -143,9 +147,13 @@ class Renderer(PreviewSettings):
         """Structural edit: link (or reuse) the material's program, its GBUFFER entry when
         deferred; keep the last good one on failure."""
         values = {u.name: u.default for u in compiled.ir.uniforms}
+        promoted = self._promoted
+        if promoted != compiled.structure_hash:
+            self._promoted = None  # a new program: the deferred one, quick to link and JIT
         forward = self._forward(compiled, values)
         prog = self.programs.link(compiled, forward, self.energy_compensation, self.view)
         if isinstance(prog, MaterialStatus):  # located in the variant that failed
+            self._promoted = promoted  # the last good material is still drawn
             return prog
         self._program, self.is_forward = prog, forward
         self.material.load(compiled, values)
@@ -188,9 +196,50 @@ class Renderer(PreviewSettings):
 
     def _forward(self, compiled: CompiledMaterial, values: dict) -> bool:
         """The path a material takes: forward when not deferred, when the material wants it
-        (translucent, lobes beyond the talk) or in an attribute view (FORWARD entry only)."""
+        (translucent, lobes beyond the talk), in an attribute view (FORWARD entry only), or
+        once promoted (promote_forward) while the view is the lit one (a lobe view is a
+        variant of the lighting pass, linked once)."""
         return not self.deferred or is_attribute_view(self.view) or \
-            wants_forward(compiled, values)
+            wants_forward(compiled, values) or \
+            (self._promoted == compiled.structure_hash and self.view == "lit")
+
+    @property
+    def promoted(self) -> bool:
+        """Whether the current material is drawn forward by promote_forward."""
+        c = self._compiled
+        return c is not None and self._promoted == c.structure_hash
+
+    @property
+    def can_promote(self) -> bool:
+        """Whether promote_forward would try something: a material on the deferred path, in
+        split-sum mode without an A/B split, not refused before."""
+        c = self._compiled
+        return (self.deferred and c is not None and self._program is not None
+                and not self.is_forward and self.mode == "splitsum" and self.view == "lit"
+                and self.compare is None and self._not_promoted != c.structure_hash)
+
+    def promote_forward(self) -> bool:
+        """The current material drawn forward from now on, until the next structural edit.
+        On llvmpipe a forward frame takes about half a deferred one's time at the editor's
+        viewport size (no G-buffer to fill, clear and read back, no per-sample edge test),
+        while the deferred program is the quicker to link and JIT after a structural edit:
+        the render server draws an edit's first frames deferred and asks for this once it has
+        been idle a while (matedit.render.server). Reference and difference modes keep
+        drawing the deferred program (their lighting pass is linked). Returns whether the
+        path changed (False: nothing to promote, or the forward program failed to link,
+        which is not tried again for this material)."""
+        if not self.can_promote:
+            return False
+        c = self._compiled
+        try:
+            prog = self.programs.material(c, True, self.energy_compensation, self.view)
+        except moderngl.Error:
+            self._not_promoted = c.structure_hash
+            return False
+        self._promoted = c.structure_hash
+        self._program, self.is_forward = prog, True
+        self.reset_accumulation()
+        return True
 
     def set_view(self, view: str) -> None:
         """The viewport's view (matedit.shading.views; ValueError for an unknown one): a lobe
@@ -294,6 +343,11 @@ class Renderer(PreviewSettings):
                                  (self._program, self.is_forward, self.material,
                                   _clip(whole, cut, w))) if p[3] is not None]
         for program, forward, material, rect in parts:
+            if forward and self.mode != "splitsum" and material is self.material \
+                    and self.promoted:
+                # promoted for split-sum frames only: the deferred program (linked first)
+                program, forward = self.programs.material(
+                    material.compiled, False, self.energy_compensation, self.view), False
             if ibl_mode == IBL_MODE_REFERENCE and forward and material.compiled is not None:
                 program = self.programs.reference(material.compiled, self.energy_compensation,
                                                   fallback=program, view=self.view)

@@ -18,7 +18,11 @@ The protocol, over stdin and stdout (matedit.render.pipe):
 After the messages that have arrived it draws a frame when one was asked for; reference and
 difference mode accumulate in bands of `budget_ms` (Renderer.advance), reading the messages
 between bands, and send their picture when a frame is complete or DISPLAY_INTERVAL_S after the
-last one. The process ends when its stdin closes. No Qt here.
+last one. Once it has been idle FORWARD_WHEN_IDLE_S (the init's "forward_when_idle_s"; None:
+never) with a material on the deferred path, it draws that material forward from then on
+(Renderer.promote_forward: a frame in about half the time, for the program's link and JIT
+once); the next structural edit draws deferred again. The process ends when its stdin closes.
+No Qt here.
 """
 
 from __future__ import annotations
@@ -38,6 +42,9 @@ from matedit.render.pipe import recv, send
 
 DISPLAY_INTERVAL_S = 0.25  # reference accumulation sends its progress this often
 BUDGET_MS = 40.0  # GL work between two looks at the messages while accumulating
+# Idle time before a deferred material is drawn forward (the viewport's; its link and JIT
+# then hold the server for a few hundred ms, so not while an artist is still at work)
+FORWARD_WHEN_IDLE_S = 1.0
 KEPT = 64  # objects returned by calls that the server keeps for the editor to read
 SERVER_ENV = "MATEDIT_RENDER_SERVER"  # set for a frozen bundle's child: serve, not the CLI
 
@@ -129,6 +136,7 @@ class Server:
         self._fbo: Any = None
         self._dirty = False
         self._last_shown = 0.0
+        self.forward_when_idle_s: float | None = None  # init's "forward_when_idle_s"
         self._message_id = 0  # the message being served (its progress replies name it)
         self.kept: dict[int, Any] = {}  # objects calls returned, read further by the editor
         self.keys = itertools.count(1)
@@ -162,6 +170,8 @@ class Server:
         from matedit.render.renderer import Renderer
 
         self.budget_ms = float(init.get("budget_ms") or BUDGET_MS)
+        idle = init.get("forward_when_idle_s")
+        self.forward_when_idle_s = None if idle is None else max(0.0, float(idle))
         if self.ctx is None:
             self.prepare()
         r = Renderer(self.ctx, size=tuple(init["size"]), samples=4, environment=None,
@@ -194,9 +204,16 @@ class Server:
         send(self.out, ("started", "", list(self.r.lights)))
         while True:
             busy = self._dirty or bool(self.r.needs_redraw)
+            idle = None if busy or not self.r.can_promote else self.forward_when_idle_s
             try:
-                message = self.inbox.get_nowait() if busy else self.inbox.get()
+                if busy:
+                    message = self.inbox.get_nowait()
+                else:
+                    message = self.inbox.get() if idle is None else self.inbox.get(timeout=idle)
             except queue.Empty:
+                if not busy:  # idle long enough: the material forward, and its frame
+                    self._dirty = self.r.promote_forward()
+                    continue
                 message = ()
             if message is None:
                 return
