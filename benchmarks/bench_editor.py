@@ -4,7 +4,9 @@ Run: .venv/bin/python benchmarks/bench_editor.py   (starts a virtual X server wh
 no DISPLAY; prints medians, passes or fails nothing)
 
 - parameter edit -> next frame: a SetValue through the controller (what a slider step does)
-  until the viewport has drawn the frame showing it; never relinks.
+  until the viewport has drawn the frame showing it; never relinks. Then the same once the
+  viewport has been idle (its render process draws the material forward by then:
+  matedit.render.server.FORWARD_WHEN_IDLE_S).
 - structural edit -> new program: a constant folded into the shader changes (so every edit
   is a program the cache has not seen), from the edit through validation, compile and link
   to the first frame drawn with it. The 150 ms debounce that batches structural edits while
@@ -97,6 +99,27 @@ def main() -> int:
         paint_ms.append(view.last_frame_time * 1e3)
     relinks = view.renderer.link_count - links0
 
+    # The same edits once the viewport has been idle: the render process has drawn the
+    # material forward since (matedit.render.server.FORWARD_WHEN_IDLE_S, one link)
+    from matedit.render.server import FORWARD_WHEN_IDLE_S
+
+    for _ in range(5):  # (asking the renderer is a message: it waits in between)
+        end = time.perf_counter() + FORWARD_WHEN_IDLE_S + 1.5
+        while time.perf_counter() < end:
+            app.processEvents()
+            time.sleep(0.02)
+        promoted = bool(view.renderer.promoted)
+        if promoted:
+            break
+    wait_shown(app, view)
+    idle_ms, idle_paint_ms = [], []
+    for i in range(N_VALUE):
+        t = time.perf_counter()
+        w.controller.push(SetValue("amount", "value", 0.2 + 0.6 * (i % 2)))
+        wait_shown(app, view)
+        idle_ms.append((time.perf_counter() - t) * 1e3)
+        idle_paint_ms.append(view.last_frame_time * 1e3)
+
     # A constant feeding the rust edge width (e1.b): its value is folded into the code.
     g = w.controller.document.graph
     w.controller.push_all([AddNode(Node("bench_k", "constant", (-450, 400),
@@ -124,6 +147,9 @@ def main() -> int:
     print(f"  parameter edit -> next frame       {med(value_ms):8.1f} ms median "
           f"(min {min(value_ms):.1f}, {N_VALUE} edits, {relinks} relinks)")
     print(f"    of which the renderer's frame    {med(paint_ms):8.1f} ms median")
+    print(f"  the same once idle ({'drawn forward' if promoted else 'not promoted'})"
+          f"{'':7s}{med(idle_ms):8.1f} ms median (min {min(idle_ms):.1f})")
+    print(f"    of which the renderer's frame    {med(idle_paint_ms):8.1f} ms median")
     print(f"  structural edit -> new program     {med(struct_ms):8.1f} ms median "
           f"(min {min(struct_ms):.1f}, {N_STRUCT} edits; compile {med(compile_ms):.1f} ms of it)")
     print(f"    + debounce while editing         {w.controller._debounce.interval():8d} ms")
