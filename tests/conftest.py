@@ -60,6 +60,23 @@ def _release_qt_gl() -> None:
 _SESSION_GL: dict = {}
 
 
+def _collect_qt_garbage() -> None:
+    """After a GUI test, on the UI thread: the widgets it closed deleted (deleteLater) and
+    the Python wrappers left in reference cycles collected. Otherwise the cyclic collector may
+    run next on a worker thread still busy from that test (a cost overlay's `matedit stats`),
+    which would delete those widgets off the UI thread while the next test restyles every
+    widget (QApplication.setStyle): a segfault seen twice in the suite."""
+    import gc
+
+    from PySide6.QtCore import QCoreApplication, QEvent
+
+    if QCoreApplication.instance() is None:
+        return
+    for _ in range(2):  # a collection can schedule more deleteLater calls
+        QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
+        gc.collect()
+
+
 @pytest.fixture(autouse=True)
 def _thread_free_of_egl_for_qt(request):
     """GUI tests get a thread with no EGL context current (Qt's viewport needs GLX there);
@@ -69,6 +86,7 @@ def _thread_free_of_egl_for_qt(request):
         return
     _release_egl_thread()
     yield
+    _collect_qt_garbage()
     _release_qt_gl()
     ctx = _SESSION_GL.get("ctx")
     if ctx is not None:
