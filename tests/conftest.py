@@ -78,6 +78,18 @@ def _collect_qt_garbage() -> None:
 
 
 @pytest.fixture(autouse=True)
+def _viewport_keeps_its_first_path(request, monkeypatch):
+    """GUI tests count links and compare pictures of one path: the viewport's promotion to
+    the forward path once idle (Renderer.promote_forward, matedit.render.server) is off for
+    them unless a test turns it on (tests/test_app_viewport.py does)."""
+    if "qtbot" in request.fixturenames:
+        from matedit.app.viewport import ViewportWidget
+
+        monkeypatch.setattr(ViewportWidget, "forward_when_idle", False)
+    yield
+
+
+@pytest.fixture(autouse=True)
 def _thread_free_of_egl_for_qt(request):
     """GUI tests get a thread with no EGL context current (Qt's viewport needs GLX there);
     afterwards the headless context is made current again for the GL tests that follow."""

@@ -59,6 +59,51 @@ def test_viewport_draws_and_a_parameter_edit_changes_it_without_relinking(window
     assert view.renderer.link_count == links and recompiles == []
 
 
+def test_an_idle_viewport_draws_forward_and_a_structural_edit_goes_back(qtbot, request,
+                                                                         monkeypatch):
+    """The render process draws the material forward once idle (FORWARD_WHEN_IDLE_S): the
+    picture stays the same to the eye; the next structural edit is drawn deferred."""
+    import time
+
+    from matedit.app.viewport import ViewportWidget
+    from matedit.render.server import FORWARD_WHEN_IDLE_S
+
+    monkeypatch.setattr(ViewportWidget, "forward_when_idle", True)
+    request.getfixturevalue("app_env")
+    w = make_window(qtbot, SAMPLE, show=True)
+    wait_for_renderer(qtbot, w)
+    settle(qtbot, w)
+    view = w.viewport.view
+    before = frame(qtbot, view)
+    assert not view.renderer.is_forward
+    promoted = False
+    end = time.monotonic() + 60
+    while not promoted and time.monotonic() < end:
+        qtbot.wait(int((FORWARD_WHEN_IDLE_S + 0.5) * 1000))  # asking is a message: wait first
+        promoted = view.renderer.promoted
+    assert promoted and view.renderer.is_forward
+    after = frame(qtbot, view)
+    assert np.abs(after - before).max() <= 3 / 255  # the forward path's picture: the same
+    d = w.controller.document
+    node = next(n for n in d.graph.nodes.values() if n.kind == "scalar_parameter")
+    assert w.controller.push(SetValue(node.id, "value", 0.77))  # a value: still forward
+    frame(qtbot, view)
+    assert view.renderer.is_forward
+    w.controller.push(Connect(Link(node.id, "value", *_free_float_input(d))))
+    settle(qtbot, w)
+    qtbot.waitUntil(lambda: not view.renderer.promoted, timeout=60000)
+    assert not view.renderer.is_forward
+
+
+def _free_float_input(d) -> tuple[str, str]:
+    """(node id, input) of an unconnected float input of a maths node in `d`."""
+    linked = {(lk.dst, lk.dst_port) for lk in d.graph.links}
+    for nid, n in d.graph.nodes.items():
+        if n.kind in ("add", "multiply", "subtract") and (nid, "b") not in linked:
+            return nid, "b"
+    raise AssertionError("no free maths input in the sample")
+
+
 def test_a_broken_edit_keeps_the_last_good_image(window, qtbot):
     view = window.viewport.view
     good = frame(qtbot, view)

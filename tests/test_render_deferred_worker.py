@@ -121,7 +121,9 @@ def test_a_newer_edit_supersedes_a_pending_one(window, qtbot):
 def _viewport_program_hash(renderer) -> str:
     from matedit.compiler.emit import PREVIEW_DEFINES, Entry
 
-    assert not renderer.is_forward  # the sample is opaque: the deferred GBUFFER entry
+    # the sample is opaque: the edit's program is the deferred GBUFFER entry (drawn forward
+    # since where the viewport has been idle: Renderer.promote_forward)
+    assert not renderer.is_forward or renderer.promoted
     return renderer._compiled.variant(Entry.GBUFFER, PREVIEW_DEFINES).structure_hash
 
 
