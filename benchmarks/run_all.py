@@ -566,12 +566,12 @@ def frame_section(rep: Report, gl: dict, goals: list) -> None:
     rep.table(["size", "worn_painted_steel (ms)", "floor (ms)", "ratio",
                "once idle: worn_painted_steel (ms)", "once idle: floor (ms)", "ratio"],
               "lrrrrrr", rows)
-    rep.add()
     rep.add("*Once idle*: the frames the viewport draws after it has been idle a while after a "
             "structural edit (matedit.render.server.FORWARD_WHEN_IDLE_S): the material, and "
             "the floor, promoted to the forward path (`Renderer.promote_forward`), measured "
             "the same way on a renderer of each size. The first columns, and the goal's "
             "verdict, are the deferred frames an edit's first pictures take.")
+    rep.add()
     worst = max(f["material"] / f["floor"] for f in gl["frames"])
     goals.append(["frame time vs floor", "≤ 1.2×", f"{worst:.2f}× (worst size)",
                   verdict(worst <= GOALS["frame_ratio"])])
