@@ -111,7 +111,7 @@ def test_the_render_server_promotes_once_idle_and_only_when_asked():
             end = time.monotonic() + 60
             while idle is not None and not proc.call("get", "promoted") and \
                     time.monotonic() < end:
-                time.sleep(0.05)
+                time.sleep(0.3)  # asking is a message: the server must be left idle a while
             if idle is None:
                 time.sleep(0.5)
             promoted = proc.call("get", "promoted")
