@@ -68,6 +68,21 @@ def wait_shown(app, view, timeout: float = 30.0) -> None:
             raise TimeoutError("no frame drawn")
 
 
+def value_edits(app, w, view) -> tuple[list[float], list[float]]:
+    """N_VALUE slider steps on the sample's `amount`: (edit -> frame shown, the renderer's
+    frame) in ms, each."""
+    from matedit.graph.commands import SetValue
+
+    edit_ms, frame_ms = [], []
+    for i in range(N_VALUE):
+        t = time.perf_counter()
+        w.controller.push(SetValue("amount", "value", 0.2 + 0.6 * (i % 2)))
+        wait_shown(app, view)
+        edit_ms.append((time.perf_counter() - t) * 1e3)
+        frame_ms.append(view.last_frame_time * 1e3)
+    return edit_ms, frame_ms
+
+
 def main() -> int:
     display = start_display()
     from PySide6.QtCore import QStandardPaths
@@ -77,7 +92,7 @@ def main() -> int:
 
     app = make_application()
     import matedit.app.main_window  # noqa: F401 - imported before the clock starts
-    from matedit.graph.commands import AddNode, Connect, SetSetting, SetValue
+    from matedit.graph.commands import AddNode, Connect, SetSetting
     from matedit.graph.model import Link, Node
 
     t0 = time.perf_counter()
@@ -90,13 +105,7 @@ def main() -> int:
     size = view.renderer.size
     links0 = view.renderer.link_count
 
-    value_ms, paint_ms = [], []
-    for i in range(N_VALUE):
-        t = time.perf_counter()
-        w.controller.push(SetValue("amount", "value", 0.2 + 0.6 * (i % 2)))
-        wait_shown(app, view)
-        value_ms.append((time.perf_counter() - t) * 1e3)
-        paint_ms.append(view.last_frame_time * 1e3)
+    value_ms, paint_ms = value_edits(app, w, view)
     relinks = view.renderer.link_count - links0
 
     # The same edits once the viewport has been idle: the render process has drawn the
@@ -112,13 +121,7 @@ def main() -> int:
         if promoted:
             break
     wait_shown(app, view)
-    idle_ms, idle_paint_ms = [], []
-    for i in range(N_VALUE):
-        t = time.perf_counter()
-        w.controller.push(SetValue("amount", "value", 0.2 + 0.6 * (i % 2)))
-        wait_shown(app, view)
-        idle_ms.append((time.perf_counter() - t) * 1e3)
-        idle_paint_ms.append(view.last_frame_time * 1e3)
+    idle_ms, idle_paint_ms = value_edits(app, w, view)
 
     # A constant feeding the rust edge width (e1.b): its value is folded into the code.
     g = w.controller.document.graph
@@ -147,8 +150,8 @@ def main() -> int:
     print(f"  parameter edit -> next frame       {med(value_ms):8.1f} ms median "
           f"(min {min(value_ms):.1f}, {N_VALUE} edits, {relinks} relinks)")
     print(f"    of which the renderer's frame    {med(paint_ms):8.1f} ms median")
-    print(f"  the same once idle ({'drawn forward' if promoted else 'not promoted'})"
-          f"{'':7s}{med(idle_ms):8.1f} ms median (min {min(idle_ms):.1f})")
+    label = f"the same once idle ({'drawn forward' if promoted else 'not promoted'})"
+    print(f"  {label:<35s}{med(idle_ms):8.1f} ms median (min {min(idle_ms):.1f})")
     print(f"    of which the renderer's frame    {med(idle_paint_ms):8.1f} ms median")
     print(f"  structural edit -> new program     {med(struct_ms):8.1f} ms median "
           f"(min {min(struct_ms):.1f}, {N_STRUCT} edits; compile {med(compile_ms):.1f} ms of it)")

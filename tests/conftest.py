@@ -135,3 +135,21 @@ def rng(request):
     import numpy as np
 
     return np.random.default_rng(zlib.crc32(request.node.name.encode()))
+
+
+@pytest.fixture(scope="module")
+def render_pair(gl_ctx):
+    """A forward and a deferred Renderer, 64 px, 4x MSAA, the studio environment baked small,
+    8 reference samples a frame (enough to compare the paths, quick): {"forward", "deferred"}."""
+    from matedit.ibl import BakeSettings
+    from matedit.render import Renderer
+
+    small = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
+    rs = {name: Renderer(gl_ctx, (64, 64), samples=4, environment="studio", bake_settings=small,
+                         deferred=(name == "deferred"))
+          for name in ("forward", "deferred")}
+    for r in rs.values():
+        r.set_reference_samples(8)
+    yield rs
+    for r in rs.values():
+        r.release()

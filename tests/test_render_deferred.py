@@ -9,15 +9,12 @@ from graphs_util import link, material, node
 
 from matedit.compiler import compile_document
 from matedit.compiler.emit import PREVIEW_DEFINES, Entry, entry_text
-from matedit.ibl import BakeSettings
 from matedit.io.document import FileResolver, load
 from matedit.render import Renderer
 from matedit.render.paths import may_be_translucent, writes_lobes
 from matedit.resources import graphs_dir, shaders_dir
 
 MATERIALS = sorted((graphs_dir() / "materials").glob("*.json"))
-SMALL = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
-SIZE = (64, 64)
 # Deferred against forward, |a - b| / max(1, |b|) on every pixel of the resolved image. The
 # G-buffer (matedit/render/deferred.py) holds the position and roughness as float32 copies, but
 # baseColor, metallic, emissive and cavity as halves (11-bit significand: relative rounding
@@ -53,21 +50,9 @@ def flat_material(opacity=None, roughness=0.4):
     return d
 
 
-@pytest.fixture(scope="module")
-def pair(gl_ctx):
-    rs = {name: Renderer(gl_ctx, SIZE, samples=4, environment="studio", bake_settings=SMALL,
-                         deferred=(name == "deferred"))
-          for name in ("forward", "deferred")}
-    for r in rs.values():
-        r.set_reference_samples(8)  # 8 a frame, one frame: enough to compare, quick
-    yield rs
-    for r in rs.values():
-        r.release()
-
-
-def _both(pair, compiled, mode="splitsum"):
+def _both(render_pair, compiled, mode="splitsum"):
     out = {}
-    for name, r in pair.items():
+    for name, r in render_pair.items():
         r.mode = mode
         status = r.set_material(compiled)
         assert status.ok, status.errors
@@ -123,39 +108,40 @@ def test_every_entry_of_every_sample_links(gl_ctx):
 # --- deferred = forward -----------------------------------------------------------------------
 
 @pytest.mark.parametrize("path", MATERIALS, ids=[p.stem for p in MATERIALS])
-def test_deferred_equals_forward_split_sum(pair, path):
+def test_deferred_equals_forward_split_sum(render_pair, path):
 
     cm = compile_document(load(path), FileResolver())
-    a, b = _both(pair, cm)
+    a, b = _both(render_pair, cm)
     # a material with lobes beyond the talk takes the forward path in the deferred renderer
     # too (the G-buffer holds the talk's fields): the two must still agree
-    assert pair["deferred"].is_forward == writes_lobes(cm.ir) and pair["forward"].is_forward
+    assert render_pair["deferred"].is_forward == writes_lobes(cm.ir)
+    assert render_pair["forward"].is_forward
     assert b.max() > 0.05
     assert _rel(a, b).max() <= REL_PIXEL
     assert _rel(a, b).mean() <= REL_MEAN
 
 
 @pytest.mark.parametrize("mode", ["reference", "difference"])
-def test_deferred_equals_forward_reference_and_difference(pair, mode):
+def test_deferred_equals_forward_reference_and_difference(render_pair, mode):
     cm = compile_document(load(graphs_dir() / "materials" / "worn_painted_steel.json"),
                           FileResolver())
-    a, b = _both(pair, cm, mode)
+    a, b = _both(render_pair, cm, mode)
     assert np.abs(b).max() > 0.01
     assert _rel(a, b).max() <= REL_PIXEL
     assert _rel(a, b).mean() <= REL_MEAN
 
 
-def test_silhouettes_are_antialiased_like_forward(pair):
+def test_silhouettes_are_antialiased_like_forward(render_pair):
     """Edge pixels mix the background and the surface in the proportion of covered samples:
     with a black background and no gizmos, a silhouette pixel is strictly between 0 and the
     surface; the deferred values equal the forward ones there (lit per sample in both)."""
-    for r in pair.values():
+    for r in render_pair.values():
         r.show_background = False
         r.show_gizmos = False
     try:
-        a, b = _both(pair, compile_document(flat_material(roughness=0.2)))
+        a, b = _both(render_pair, compile_document(flat_material(roughness=0.2)))
     finally:
-        for r in pair.values():
+        for r in render_pair.values():
             r.show_background = r.show_gizmos = True
     lum = b.sum(axis=2)
     inside = lum > 0
@@ -170,13 +156,13 @@ def test_silhouettes_are_antialiased_like_forward(pair):
     assert _rel(a, b)[inside & ~edge].mean() <= REL_MEAN
 
 
-def test_energy_compensation_and_gizmos_match(pair):
-    for r in pair.values():
+def test_energy_compensation_and_gizmos_match(render_pair):
+    for r in render_pair.values():
         r.set_energy_compensation(True)
     try:
-        a, b = _both(pair, compile_document(flat_material(roughness=0.9)))
+        a, b = _both(render_pair, compile_document(flat_material(roughness=0.9)))
     finally:
-        for r in pair.values():
+        for r in render_pair.values():
             r.set_energy_compensation(False)
     assert _rel(a, b).max() <= REL_PIXEL
     assert _rel(a, b).mean() <= REL_MEAN
@@ -184,8 +170,8 @@ def test_energy_compensation_and_gizmos_match(pair):
 
 # --- programs ---------------------------------------------------------------------------------
 
-def test_a_structural_edit_links_only_the_gbuffer_program(pair):
-    r = pair["deferred"]
+def test_a_structural_edit_links_only_the_gbuffer_program(render_pair):
+    r = render_pair["deferred"]
     r.mode = "splitsum"
     r.set_material(compile_document(flat_material(roughness=0.3)))
     r.render()
@@ -202,11 +188,11 @@ def test_a_structural_edit_links_only_the_gbuffer_program(pair):
     assert linked == [compile_document(d).variant(Entry.GBUFFER, PREVIEW_DEFINES).structure_hash]
 
 
-def test_translucent_materials_fall_back_to_forward_and_back(pair):
+def test_translucent_materials_fall_back_to_forward_and_back(render_pair):
     cm = compile_document(flat_material(opacity=1.0))
     assert not may_be_translucent(cm.ir)
     assert may_be_translucent(cm.ir, {"p_alpha": 0.5})
-    r = pair["deferred"]
+    r = render_pair["deferred"]
     r.mode = "splitsum"
     r.set_material(cm)
     assert not r.is_forward
@@ -214,7 +200,7 @@ def test_translucent_materials_fall_back_to_forward_and_back(pair):
     assert r.is_forward
     r.render()
     a = r.read_linear().copy()
-    f = pair["forward"]
+    f = render_pair["forward"]
     f.mode = "splitsum"
     f.set_material(cm)
     f.set_uniforms({"p_alpha": 0.5})

@@ -8,16 +8,11 @@ import time
 
 import moderngl
 import numpy as np
-import pytest
 from graphs_util import link, material, node
 
 from matedit.compiler import compile_document
-from matedit.ibl import BakeSettings
-from matedit.render import Renderer
 
-SMALL = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)
-SIZE = (64, 48)
-
+SIZE = (64, 48)  # the render server's viewport
 
 def _material(roughness=0.4, extra=False):
     d = material()
@@ -32,26 +27,14 @@ def _material(roughness=0.4, extra=False):
     return d
 
 
-@pytest.fixture(scope="module")
-def pair(gl_ctx):
-    rs = {name: Renderer(gl_ctx, SIZE, samples=4, environment="studio", bake_settings=SMALL,
-                         deferred=(name == "deferred"))
-          for name in ("forward", "deferred")}
-    for r in rs.values():
-        r.set_reference_samples(8)
-    yield rs
-    for r in rs.values():
-        r.release()
-
-
 def _image(r, mode="splitsum"):
     r.mode = mode
     r.render_converged()
     return r.read_linear().copy()
 
 
-def test_promoted_material_draws_the_forward_image_until_the_next_structural_edit(pair):
-    r, f = pair["deferred"], pair["forward"]
+def test_promoted_material_draws_the_forward_image_until_the_next_structural_edit(render_pair):
+    r, f = render_pair["deferred"], render_pair["forward"]
     cm = compile_document(_material())
     r.set_material(cm)
     f.set_material(cm)
@@ -78,8 +61,8 @@ def test_promoted_material_draws_the_forward_image_until_the_next_structural_edi
 
 
 def test_promotion_waits_for_the_lit_split_sum_view_and_a_link_failure_is_not_retried(
-        pair, monkeypatch):
-    r = pair["deferred"]
+        render_pair, monkeypatch):
+    r = render_pair["deferred"]
     r.set_material(compile_document(_material(roughness=0.2)))
     r.mode = "reference"
     assert not r.can_promote and not r.promote_forward()

@@ -206,10 +206,7 @@ class Server:
             busy = self._dirty or bool(self.r.needs_redraw)
             idle = None if busy or not self.r.can_promote else self.forward_when_idle_s
             try:
-                if busy:
-                    message = self.inbox.get_nowait()
-                else:
-                    message = self.inbox.get() if idle is None else self.inbox.get(timeout=idle)
+                message = self.inbox.get_nowait() if busy else self.inbox.get(timeout=idle)
             except queue.Empty:
                 if not busy:  # idle long enough: the material forward, and its frame
                     self._dirty = self.r.promote_forward()
