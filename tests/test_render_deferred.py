@@ -9,12 +9,14 @@ from graphs_util import link, material, node
 
 from matedit.compiler import compile_document
 from matedit.compiler.emit import PREVIEW_DEFINES, Entry, entry_text
+from matedit.ibl import BakeSettings
 from matedit.io.document import FileResolver, load
 from matedit.render import Renderer
 from matedit.render.paths import may_be_translucent, writes_lobes
 from matedit.resources import graphs_dir, shaders_dir
 
 MATERIALS = sorted((graphs_dir() / "materials").glob("*.json"))
+SMALL = BakeSettings(size=32, samples=64, lut_size=32, lut_samples=1024)  # test_render_parts
 # Deferred against forward, |a - b| / max(1, |b|) on every pixel of the resolved image. The
 # G-buffer (matedit/render/deferred.py) holds the position and roughness as float32 copies, but
 # baseColor, metallic, emissive and cavity as halves (11-bit significand: relative rounding
