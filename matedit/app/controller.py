@@ -116,6 +116,9 @@ class DocumentController(QObject):
       uniform and redraw), or `MANY_VALUES` after a macro of value edits (set them all).
     - `documentReplaced()`: a new document was opened or created.
     - `analysed(Analysis)`: validation results after each structural change.
+    - `batchEnded()`: after the last event of a macro (applied, undone or redone). A view
+      that rebuilds from the document (a panel, the selection's inspector) can wait for it
+      while `batching` instead of rebuilding on each of the macro's events.
     """
 
     changed = Signal(object)
@@ -124,6 +127,7 @@ class DocumentController(QObject):
     documentReplaced = Signal()
     analysed = Signal(object)
     undoStackReplaced = Signal(object)  # the stack that was the controller's (swap)
+    batchEnded = Signal()
 
     def __init__(self, document: MaterialDocument | None = None, parent=None) -> None:
         super().__init__(parent)
@@ -227,6 +231,12 @@ class DocumentController(QObject):
             self._batching = False
             if self._batched_values:
                 self.valuesChanged.emit(MANY_VALUES)
+            self.batchEnded.emit()
+
+    @property
+    def batching(self) -> bool:
+        """Inside a macro's events: `batchEnded` follows its last one."""
+        return self._batching
 
     def _on_event(self, event: ChangeEvent) -> None:
         self._revision += 1

@@ -100,6 +100,9 @@ class InspectorPanel(QScrollArea):
                 (c.documentReplaced, self._on_replaced)]
 
     def show_node(self, node_id: str | None) -> None:
+        if node_id is None and self.node_id is None and self._shown is None \
+                and self.widget() is not None:
+            return  # the hint shows already (a document opened: several "nothing selected")
         self.node_id = node_id
         self.rebuild()
 

@@ -456,10 +456,30 @@ class MaterialParameters(ParameterPanel):
         self.controller = controller
         self._signature: object = None
         self._params: dict = {}
-        controller.changed.connect(lambda _e: self.refresh())
-        controller.documentReplaced.connect(self.refresh)
+        self._pending = False  # a macro's events arrived: refreshed once, at its end
+        # Another document: rebuilt once control returns to the event loop, so opening a
+        # file into a new tab (an Untitled swapped in, then the file read into it) builds
+        # the rows once, in an event of their own
+        self._later = QTimer(self)
+        self._later.setSingleShot(True)
+        self._later.setInterval(0)
+        self._later.timeout.connect(self.refresh)
+        controller.changed.connect(self._changed)
+        controller.batchEnded.connect(self._batch_ended)
+        controller.documentReplaced.connect(self._later.start)
         self.valueEdited.connect(self._edit)
         self.refresh()
+
+    def _changed(self, _event) -> None:
+        if self.controller.batching:  # deleting or pasting many nodes: one rebuild, not one each
+            self._pending = True
+        else:
+            self.refresh()
+
+    def _batch_ended(self) -> None:
+        if self._pending:
+            self._pending = False
+            self.refresh()
 
     def refresh(self) -> None:
         from matedit.io.instance import material_parameters

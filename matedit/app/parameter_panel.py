@@ -41,6 +41,7 @@ from matedit.io.instance import ParameterInfo, sorted_groups
 OVERRIDDEN_STYLE = "QLabel { font-weight: bold; color: #f0b45a; }"
 LABEL_WIDTH = 110
 MARK_STYLE = "QFrame { background: #f0b45a; border: none; }"
+UNMARKED_STYLE = "QFrame { background: transparent; }"
 
 
 class CurveFloatField(FloatField):
@@ -96,9 +97,8 @@ class _Row(QWidget):
         lay = QHBoxLayout(self)
         lay.setContentsMargins(0, 0, 0, 0)
         lay.setSpacing(4)
-        self.mark = QFrame()
+        self.mark = QFrame()  # its colour: ParameterPanel._mark
         self.mark.setFixedWidth(3)
-        self.mark.setStyleSheet(MARK_STYLE)
         self.check = QCheckBox()
         self.check.setToolTip("Override the parent's value")
         self.reset = QToolButton()
@@ -221,7 +221,6 @@ class ParameterPanel(QScrollArea):
                 self._wire(row)
                 form.addRow(label, row)
                 self._mark(info.name, bool(overridden and info.name in overridden))
-            body.setVisible(head.isChecked())
 
             def toggled(on: bool, h=head, b=body) -> None:
                 b.setVisible(on)
@@ -230,6 +229,10 @@ class ParameterPanel(QScrollArea):
             head.toggled.connect(toggled)
             lay.addWidget(head)
             lay.addWidget(body)
+            # once parented: shown without a parent, it would be a window of its own for a
+            # moment (a native window made, the whole group polished as one: most of a
+            # rebuild's time)
+            body.setVisible(head.isChecked())
             self.groups[title] = (head, body)
         lay.addStretch(1)
         self.setWidget(host)
@@ -254,9 +257,14 @@ class ParameterPanel(QScrollArea):
         row.check.blockSignals(False)
         row.reset.setEnabled(overridden)
         row.mark.setVisible(self.instance_mode)
-        row.mark.setStyleSheet(MARK_STYLE if overridden else "QFrame { background: "
-                               "transparent; }")
-        label.setStyleSheet(OVERRIDDEN_STYLE if overridden else "")
+        # A style sheet of a widget's own makes every later reparenting and polish of it
+        # recompute its style: set only where it changes (none on a material's own rows)
+        mark = MARK_STYLE if overridden else (UNMARKED_STYLE if self.instance_mode else "")
+        if row.mark.styleSheet() != mark:
+            row.mark.setStyleSheet(mark)
+        text = OVERRIDDEN_STYLE if overridden else ""
+        if label.styleSheet() != text:
+            label.setStyleSheet(text)
         label.setProperty("overridden", overridden)
 
     def update_row(self, name: str, value: Any, overridden: bool | None = None) -> None:

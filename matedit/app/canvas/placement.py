@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+import numpy as np
 from PySide6.QtCore import QPointF, QRectF
 
 from matedit.app.canvas import constants as C
@@ -44,28 +45,55 @@ def taken_rects(scene, exclude: Iterable[str] = ()) -> list[QRectF]:
             if isinstance(it, NodeItem) and it.node_id not in skip]
 
 
-def _clear(rects: list[QRectF], taken: list[QRectF], dx: float, dy: float) -> bool:
-    for r in rects:
-        moved = r.translated(dx, dy).adjusted(-GAP, -GAP, GAP, GAP)
-        if any(moved.intersects(t) for t in taken):
-            return False
-    return True
+def _forbidden(rects: list[QRectF], taken: list[QRectF]) -> np.ndarray:
+    """(n, 4) open intervals of shifts, x0 < dx < x1 and y0 < dy < y1, each of which puts
+    one of `rects` (grown by GAP) over one `taken` rectangle: QRectF.intersects, an overlap
+    of non-zero area, as inequalities on the shift."""
+    r = np.array([(q.left(), q.top(), q.right(), q.bottom()) for q in rects], float)
+    t = np.array([(q.left(), q.top(), q.right(), q.bottom()) for q in taken], float)
+    x0 = t[None, :, 0] - r[:, None, 2] - GAP  # left of t, minus the moved right edge
+    x1 = t[None, :, 2] - r[:, None, 0] + GAP
+    y0 = t[None, :, 1] - r[:, None, 3] - GAP
+    y1 = t[None, :, 3] - r[:, None, 1] + GAP
+    f = np.stack([x0, x1, y0, y1], -1).reshape(-1, 4)
+    return f[(f[:, 1] > f[:, 0]) & (f[:, 3] > f[:, 2])]  # empty rectangles hit nothing
+
+
+def _ring(ring: int) -> np.ndarray:
+    """The grid shifts on the square ring `ring` steps out, nearest first; at equal distance
+    below, then right, of the asked-for place."""
+    k = np.arange(-ring, ring + 1, dtype=float)
+    inner = k[1:-1]  # the columns' corners are the rows' ends
+    pts = np.concatenate([np.stack([k, np.full_like(k, -ring)], 1),
+                          np.stack([k, np.full_like(k, ring)], 1),
+                          np.stack([np.full_like(inner, -ring), inner], 1),
+                          np.stack([np.full_like(inner, ring), inner], 1)]) * STEP
+    order = np.lexsort((-pts[:, 0], -pts[:, 1], pts[:, 0] ** 2 + pts[:, 1] ** 2))
+    return pts[order]
 
 
 def free_offset(rects: list[QRectF], taken: list[QRectF]) -> QPointF:
     """The smallest shift that keeps every one of `rects` GAP clear of every `taken` one
-    (the rects move together: a pasted group keeps its shape)."""
-    if not rects or _clear(rects, taken, 0.0, 0.0):
+    (the rects move together: a pasted group keeps its shape). The shifts a ring offers are
+    tested at once against every pair's forbidden interval (a pasted copy of a whole graph
+    searches thousands of shifts against hundreds of pairs)."""
+    if not rects or not taken:
+        return QPointF(0.0, 0.0)
+    f = _forbidden(rects, taken)
+
+    def clear(pts: np.ndarray) -> np.ndarray:
+        dx, dy = pts[:, None, 0], pts[:, None, 1]
+        hit = (dx > f[:, 0]) & (dx < f[:, 1]) & (dy > f[:, 2]) & (dy < f[:, 3])
+        return ~hit.any(axis=1)
+
+    if clear(np.zeros((1, 2)))[0]:
         return QPointF(0.0, 0.0)
     for ring in range(1, MAX_RINGS + 1):
-        d = ring * STEP
-        spots = {(x * STEP, y * STEP) for x in range(-ring, ring + 1)
-                 for y in (-ring, ring)} | {(x * STEP, y * STEP) for x in (-ring, ring)
-                                            for y in range(-ring, ring + 1)}
-        # nearest first; at equal distance below, then right, of the asked-for place
-        for dx, dy in sorted(spots, key=lambda p: (p[0] ** 2 + p[1] ** 2, -p[1], -p[0])):
-            if abs(dx) <= d and abs(dy) <= d and _clear(rects, taken, dx, dy):
-                return QPointF(dx, dy)
+        pts = _ring(ring)
+        ok = np.flatnonzero(clear(pts))
+        if len(ok):
+            dx, dy = pts[ok[0]]
+            return QPointF(float(dx), float(dy))
     return QPointF(0.0, 0.0)
 
 

@@ -125,6 +125,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self._palette_pos = QPointF()
         self._palette_anchor: tuple[str, str, bool, str] | None = None
         self._selecting = False
+        self._selection_pending = False  # changed during a macro: announced at its end
         self._last_ids: list[str] = []
         self._rename_edit: QLineEdit | None = None
 
@@ -133,6 +134,7 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self._scene.rebuilt.connect(self.minimap.invalidate)
         controller.changed.connect(lambda _ev: self.minimap.invalidate())
         controller.documentReplaced.connect(self._document_replaced)
+        controller.batchEnded.connect(self._batch_ended)
         self.horizontalScrollBar().valueChanged.connect(self.minimap.update)
         self.verticalScrollBar().valueChanged.connect(self.minimap.update)
         self.minimap.invalidate()
@@ -460,10 +462,18 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
     def _selection_changed(self) -> None:
         if self._selecting:
             return
+        if self.controller.batching:  # each deleted item deselects: the inspector once
+            self._selection_pending = True
+            return
+        self._selection_pending = False
         ids = self._scene.selected_node_ids()
         if ids != self._last_ids:
             self._last_ids = ids
             self.selectionChangedIds.emit(list(ids))
+
+    def _batch_ended(self) -> None:
+        if self._selection_pending:
+            self._selection_changed()
 
     def _document_replaced(self) -> None:
         self._wire = None

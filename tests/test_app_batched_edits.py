@@ -1,0 +1,120 @@
+"""A macro of many edits (delete everything, duplicate everything, undo either) costs the UI
+thread one rebuild of each panel, not one per node: the parameters panel and the selection's
+inspector wait for the controller's `batchEnded`. And the free space a pasted group is moved
+into is the same shift a plain search finds. Real widgets under Xvfb; counted, never timed
+(benchmarks/bench_ui_block.py times these actions)."""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("QT_QPA_PLATFORM", "xcb")
+
+import random  # noqa: E402
+
+import pytest  # noqa: E402
+from PySide6.QtCore import QPointF, QRectF  # noqa: E402
+
+from matedit.app.canvas import placement  # noqa: E402
+
+pytestmark = pytest.mark.gui
+
+
+def _plain_offset(rects: list[QRectF], taken: list[QRectF]) -> QPointF:
+    """The search written out: every ring's grid shifts nearest first (below, then right, at
+    equal distance), each rect grown by GAP against every taken one."""
+    def clear(dx: float, dy: float) -> bool:
+        return not any(r.translated(dx, dy).adjusted(-placement.GAP, -placement.GAP,
+                                                      placement.GAP, placement.GAP).intersects(t)
+                       for r in rects for t in taken)
+
+    if not rects or clear(0.0, 0.0):
+        return QPointF(0.0, 0.0)
+    for ring in range(1, placement.MAX_RINGS + 1):
+        spots = {(x, y) for x in range(-ring, ring + 1) for y in (-ring, ring)} | \
+            {(x, y) for x in (-ring, ring) for y in range(-ring, ring + 1)}
+        for x, y in sorted(spots, key=lambda p: (p[0] ** 2 + p[1] ** 2, -p[1], -p[0])):
+            if clear(x * placement.STEP, y * placement.STEP):
+                return QPointF(x * placement.STEP, y * placement.STEP)
+    return QPointF(0.0, 0.0)
+
+
+def test_free_offset_finds_the_plain_searchs_shift():
+    rng = random.Random(7)
+    for case in range(60):
+        def rect() -> QRectF:
+            return QRectF(rng.uniform(-300, 300), rng.uniform(-300, 300), rng.uniform(80, 260),
+                          rng.uniform(40, 200))
+
+        taken = [rect() for _ in range(rng.randint(0, 25))]
+        if case % 3 == 0:  # a pasted copy of the taken nodes themselves, as Ctrl+D of all
+            rects = [QRectF(t) for t in taken[: rng.randint(1, max(1, len(taken)))]] or [rect()]
+        else:
+            rects = [rect() for _ in range(rng.randint(1, 6))]
+        if case % 7 == 0 and taken:  # touching edges: no overlap of non-zero area
+            t = taken[0]
+            rects = [QRectF(t.right() + placement.GAP, t.top(), 50, 50)]
+        got = placement.free_offset(rects, taken)
+        want = _plain_offset(rects, taken)
+        assert (got.x(), got.y()) == (want.x(), want.y()), case
+
+
+@pytest.fixture
+def window(qtbot, tmp_path, monkeypatch):
+    from graphs_util import EDITOR_SAMPLE
+
+    from matedit.app.main_window import MainWindow
+
+    monkeypatch.setenv("HOME", str(tmp_path))
+    w = MainWindow(EDITOR_SAMPLE, restore_layout=False)
+    qtbot.addWidget(w)
+    w.actions.ask_save_changes = lambda name: "discard"
+    return w
+
+
+def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, monkeypatch):
+    from matedit.app.inspector import InspectorPanel as Inspector
+    from matedit.app.parameter_panel import ParameterPanel
+
+    w = window
+    canvas = w.canvas
+    builds = {"parameters": 0, "inspector": 0}
+    real_set, real_rebuild = ParameterPanel.set_parameters, Inspector.rebuild
+
+    def counted_set(self, *a, **k):
+        builds["parameters"] += 1
+        return real_set(self, *a, **k)
+
+    def counted_rebuild(self, *a, **k):
+        builds["inspector"] += 1
+        return real_rebuild(self, *a, **k)
+
+    monkeypatch.setattr(ParameterPanel, "set_parameters", counted_set)
+    monkeypatch.setattr(Inspector, "rebuild", counted_rebuild)
+    graph = w.controller.document.graph
+    everything = sorted(graph.nodes)
+    panel = w.instances.parameters_panel
+    params_before = set(panel.rows)
+    assert params_before
+    assert len(everything) > 5
+
+    canvas.select_nodes(everything)
+    builds.update(parameters=0, inspector=0)
+    assert canvas.delete_selection()
+    assert not graph.nodes
+    # one rebuild each where there used to be one per deleted node
+    assert builds["parameters"] <= 1 and builds["inspector"] <= 1, builds
+    w.controller.undo_stack.undo()
+    assert sorted(graph.nodes) == everything
+    assert builds["parameters"] <= 2 and builds["inspector"] <= 2, builds
+
+    canvas.select_nodes(everything)
+    builds.update(parameters=0, inspector=0)
+    copies = canvas.duplicate_selection()
+    assert len(copies) == len(everything)
+    assert builds["parameters"] <= 1 and builds["inspector"] <= 1, builds
+    # the panels show the document as it is after the macro
+    assert set(canvas.selected_ids()) == set(copies)
+    assert params_before < set(panel.rows)  # the copies' parameters, under free names
+    w.controller.undo_stack.undo()
+    assert set(panel.rows) == params_before
