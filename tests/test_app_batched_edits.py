@@ -72,7 +72,8 @@ def window(qtbot, tmp_path, monkeypatch):
     return w
 
 
-def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, monkeypatch):
+def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, monkeypatch,
+                                                                      qtbot):
     from matedit.app.inspector import InspectorPanel as Inspector
     from matedit.app.parameter_panel import ParameterPanel
 
@@ -102,19 +103,22 @@ def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, mo
     builds.update(parameters=0, inspector=0)
     assert canvas.delete_selection()
     assert not graph.nodes
+    qtbot.wait(20)  # the Parameters dock's rows are built in an event after the macro's
     # one rebuild each where there used to be one per deleted node
     assert builds["parameters"] <= 1 and builds["inspector"] <= 1, builds
     w.controller.undo_stack.undo()
     assert sorted(graph.nodes) == everything
+    qtbot.wait(20)
     assert builds["parameters"] <= 2 and builds["inspector"] <= 2, builds
 
     canvas.select_nodes(everything)
     builds.update(parameters=0, inspector=0)
     copies = canvas.duplicate_selection()
     assert len(copies) == len(everything)
+    qtbot.wait(20)
     assert builds["parameters"] <= 1 and builds["inspector"] <= 1, builds
     # the panels show the document as it is after the macro
     assert set(canvas.selected_ids()) == set(copies)
-    assert params_before < set(panel.rows)  # the copies' parameters, under free names
+    qtbot.waitUntil(lambda: params_before < set(panel.rows))  # the copies', under free names
     w.controller.undo_stack.undo()
-    assert set(panel.rows) == params_before
+    qtbot.waitUntil(lambda: set(panel.rows) == params_before)

@@ -457,9 +457,9 @@ class MaterialParameters(ParameterPanel):
         self._signature: object = None
         self._params: dict = {}
         self._pending = False  # a macro's events arrived: refreshed once, at its end
-        # Another document: rebuilt once control returns to the event loop, so opening a
-        # file into a new tab (an Untitled swapped in, then the file read into it) builds
-        # the rows once, in an event of their own
+        # Another document, or a macro's end: rebuilt once control returns to the event
+        # loop, so opening a file into a new tab (an Untitled swapped in, then the file read
+        # into it) builds the rows once, and the rows' build is an event of its own
         self._later = QTimer(self)
         self._later.setSingleShot(True)
         self._later.setInterval(0)
@@ -477,9 +477,9 @@ class MaterialParameters(ParameterPanel):
             self.refresh()
 
     def _batch_ended(self) -> None:
-        if self._pending:
+        if self._pending:  # after the macro's own event, in one of its own
             self._pending = False
-            self.refresh()
+            self._later.start()
 
     def refresh(self) -> None:
         from matedit.io.instance import material_parameters
