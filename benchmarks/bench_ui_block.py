@@ -1,5 +1,6 @@
 """How long the UI thread is blocked, in the real editor window: by a structural edit, during
-reference accumulation, a slider drag, an environment change and a resize.
+reference accumulation, a slider drag, an environment change, a resize, opening a file and
+deleting, undoing and duplicating a whole graph.
 
 Run: .venv/bin/python benchmarks/bench_ui_block.py [--edits N] [--cases-only] [--json]
 (starts a virtual X server when there is no DISPLAY; prints figures, passes or fails nothing)
@@ -31,7 +32,12 @@ writing its own `ui_block_max_ms`:
 - environment: the environment chooser to Sky, back to Studio and to Sky again (each change
   through `EnvironmentChoice.choose`, the first may bake; the IBL cache is the user's), until
   the frame after each;
-- resize: the window between 1600x1000 and 1400x900, RESIZES times, until the frame after each.
+- resize: the window between 1600x1000 and 1400x900, RESIZES times, until the frame after each;
+- open: File > Open of each of OPEN_SAMPLES in turn (a new tab each, as a material opened over
+  a saved one), until the frame of its material and OPEN_SETTLE_MS after (the panels'
+  rebuilds and the compile's delivery);
+- delete: every node of the open material selected and deleted (one macro), then undone, then
+  every node duplicated (Ctrl+D), each until the frame after it and EDIT_SETTLE_MS after.
 """
 
 from __future__ import annotations
@@ -52,7 +58,10 @@ REFERENCE_SAMPLES = 512  # 16 frames of 32 samples: converges within the window 
 REFERENCE_WINDOW_S = 120.0
 SLIDER_STEPS = 30
 RESIZES = 6
-CASES = ("reference", "slider", "environment", "resize")
+CASES = ("reference", "slider", "environment", "resize", "open", "delete")
+OPEN_SAMPLES = ("car_paint", "chrome_rubber_grip", "mossy_stone", "worn_painted_steel")
+OPEN_SETTLE_MS = 1500  # the compile, its delivery and the first frame of the new program
+EDIT_SETTLE_MS = 1000
 
 
 def child(warm: bool, edits: int) -> dict:
@@ -364,6 +373,48 @@ def cases_child(only: tuple[str, ...] = CASES) -> dict:
         out["cases"]["resize"] = {"ui_block_max_ms": max(x["block_ms"] for x in runs),
                                   "runs": runs}
 
+    w.actions.ask_save_changes = lambda name: "discard"  # tabs left unsaved: not asked
+    if "open" in only:
+        from matedit.resources import graphs_dir
+
+        runs = []
+        for name in OPEN_SAMPLES:
+            t0 = time.perf_counter()
+            w.open_material(graphs_dir() / "materials" / f"{name}.json")
+            t_call = time.perf_counter()
+            wait_shown()
+            spin(OPEN_SETTLE_MS)
+            t1 = time.perf_counter()
+            runs.append({"sample": name, "block_ms": ticks.longest(t0, t1),
+                         "call_ms": (t_call - t0) * 1e3})
+            spin(200)
+        out["cases"]["open"] = {"ui_block_max_ms": max(x["block_ms"] for x in runs),
+                                "runs": runs}
+
+    if "delete" in only:
+        canvas = w.canvas
+        graph = w.controller.document.graph  # the last material opened, or the sample
+        nodes = len(graph.nodes)
+        runs = []
+        for step in ("delete", "undo", "duplicate"):
+            canvas.select_nodes(sorted(graph.nodes))
+            spin(200)
+            t0 = time.perf_counter()
+            if step == "delete":
+                canvas.delete_selection()
+            elif step == "undo":
+                w.controller.undo_stack.undo()
+            else:
+                canvas.duplicate_selection()
+            wait_shown()
+            spin(EDIT_SETTLE_MS)
+            t1 = time.perf_counter()
+            runs.append({"step": step, "block_ms": ticks.longest(t0, t1),
+                         "nodes": len(graph.nodes)})
+            spin(200)
+        out["cases"]["delete"] = {"ui_block_max_ms": max(x["block_ms"] for x in runs),
+                                  "nodes": nodes, "runs": runs}
+
     ticks.timer.stop()
     return _finish(w, app, display, out)
 
@@ -399,7 +450,7 @@ def main(argv=None) -> int:
     ap.add_argument("--edits", type=int, default=8)
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--cases-only", action="store_true",
-                    help="only reference, slider, environment and resize")
+                    help="only the cases (reference, slider, environment, resize, open, delete)")
     ap.add_argument("--only", default=",".join(CASES),
                     help="with --child cases: comma-separated cases to run")
     ap.add_argument("--child", choices=("warm", "cold", "cases"))

@@ -794,7 +794,8 @@ def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
         rep.add(f"The other cases (benchmarks/bench_ui_block.py `--child cases`, no warm-up "
                 f"child), viewport {c['viewport'][0]}×{c['viewport'][1]} px: reference "
                 "accumulation from the mode chooser until converged, a slider drag, "
-                "environment changes, window resizes.")
+                "environment changes, window resizes, opening samples, deleting every node, "
+                "undoing that and duplicating every node.")
         rep.add()
         rows = []
         for name, r in c["cases"].items():
@@ -807,6 +808,12 @@ def ui_block_section(rep: Report, ub: dict, goals: list) -> None:
                         "50 ms")
             elif name == "slider":
                 what = f"{r['edits']} value edits over {r['drag_ms']:.0f} ms"
+            elif name == "open":
+                what = "File › Open, each: " + ", ".join(
+                    f"{x['sample']} {x['block_ms']:.0f}" for x in r["runs"]) + " ms"
+            elif name == "delete":
+                what = (f"all {r['nodes']} nodes of the last one opened: " + ", ".join(
+                    f"{x['step']} {x['block_ms']:.0f}" for x in r["runs"]) + " ms")
             else:
                 what = "each: " + ", ".join(f"{x['block_ms']:.0f}" for x in r["runs"]) + " ms"
             rows.append([name, f"**{r['ui_block_max_ms']:.0f}**", what])

@@ -382,9 +382,10 @@ class LayersPanel(QWidget):
             self.refresh_values()
 
     def _rebuild_all(self) -> None:
-        """Another document: every row built again."""
+        """Another document: every row built again, once control is back in the event loop
+        (opening a file into a new tab replaces the document twice in one event)."""
         self._built = None
-        self.rebuild()
+        self._timer.start()
 
     def rebuild(self) -> None:
         """The rows, built again only when what they show has changed (the stack, its layers
