@@ -95,6 +95,7 @@ def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, mo
     graph = w.controller.document.graph
     everything = sorted(graph.nodes)
     panel = w.instances.parameters_panel
+    qtbot.waitUntil(lambda: panel.settled)
     params_before = set(panel.rows)
     assert params_before
     assert len(everything) > 5
@@ -119,6 +120,6 @@ def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, mo
     assert builds["parameters"] <= 1 and builds["inspector"] <= 1, builds
     # the panels show the document as it is after the macro
     assert set(canvas.selected_ids()) == set(copies)
-    qtbot.waitUntil(lambda: params_before < set(panel.rows))  # the copies', under free names
+    qtbot.waitUntil(lambda: panel.settled and params_before < set(panel.rows))  # the copies', under free names
     w.controller.undo_stack.undo()
-    qtbot.waitUntil(lambda: set(panel.rows) == params_before)
+    qtbot.waitUntil(lambda: panel.settled and set(panel.rows) == params_before)

@@ -145,7 +145,8 @@ def test_material_parameters_dock_is_grouped_and_edits_by_command(qtbot):
     w = make_window(qtbot, MASTER)
     panel = w.instances.parameters_panel
     # built for the opened document once control is back in the event loop
-    qtbot.waitUntil(lambda: [g for g, _ in panel.group_order()] == ["Paint", "Rust"])
+    qtbot.waitUntil(lambda: panel.settled)
+    assert [g for g, _ in panel.group_order()] == ["Paint", "Rust"]
     panel.rows["wear_amount"].field.edited.emit(0.75, None)
     node = w.controller.document.graph.nodes["wear_amt"]
     assert node.values["value"] == 0.75

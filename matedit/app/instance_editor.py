@@ -447,6 +447,11 @@ class Instances:
 
 # --- a material's own parameters, grouped (the Parameters dock) ---------------------------
 
+# The Parameters dock builds its rows this many to a turn of the event loop (~3 ms each on the
+# UI thread: a material with dozens of parameters would otherwise block it for a frame or more)
+ROWS_PER_TURN = 6
+
+
 class MaterialParameters(ParameterPanel):
     """The open material's parameters, grouped and ordered; edits are undoable commands
     (values as uniforms, a switch as a structural edit)."""
@@ -463,12 +468,26 @@ class MaterialParameters(ParameterPanel):
         self._later = QTimer(self)
         self._later.setSingleShot(True)
         self._later.setInterval(0)
-        self._later.timeout.connect(self.refresh)
+        # then a timer of 1 ms (a real timer: a zero one is a posted call, run before any
+        # timer): the Layers panel's rows (built on a zero timer after a document or a
+        # macro) and these are two short blocks, with input, paints and timers handled
+        # between them, not one long one
+        self._then = QTimer(self)
+        self._then.setSingleShot(True)
+        self._then.setInterval(1)
+        self._then.timeout.connect(self.refresh)
+        self._later.timeout.connect(self._then.start)
         controller.changed.connect(self._changed)
         controller.batchEnded.connect(self._batch_ended)
         controller.documentReplaced.connect(self._later.start)
         self.valueEdited.connect(self._edit)
         self.refresh()
+
+    @property
+    def settled(self) -> bool:
+        """The rows show the document as it is (no rebuild waiting or under way)."""
+        return not (self._pending or self._later.isActive() or self._then.isActive()
+                    or self.building)
 
     def _changed(self, _event) -> None:
         if self.controller.batching:  # deleting or pasting many nodes: one rebuild, not one each
@@ -492,7 +511,7 @@ class MaterialParameters(ParameterPanel):
         base = Path(doc.path).parent if doc.path else None
         if signature != self._signature:
             self._signature = signature
-            self.set_parameters(params, values, None, base)
+            self.set_parameters(params, values, None, base, per_turn=ROWS_PER_TURN)
         else:
             for n, v in values.items():
                 self.update_row(n, v)

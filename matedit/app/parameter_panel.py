@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QFormLayout,
@@ -179,15 +179,37 @@ class ParameterPanel(QScrollArea):
         self.groups: dict[str, tuple[QToolButton, QWidget]] = {}
         self.instance_mode = False
         self._base: Path | None = None
+        # rows still to build (set_parameters with `per_turn`): name -> (form, info, value,
+        # overridden), in display order, a few each turn of the event loop
+        self._queued: dict[str, tuple[QFormLayout, ParameterInfo, Any, bool]] = {}
+        self._per_turn = 0
+        self._turn = QTimer(self)
+        self._turn.setSingleShot(True)
+        self._turn.setInterval(1)  # a real timer: input, paints and other timers run between
+        self._turn.timeout.connect(self._build_queued)
+        self._live: set[str] | None = None
         self.setWidget(QWidget())
 
+    @property
+    def building(self) -> bool:
+        """Rows are still being built (a few each turn of the event loop)."""
+        return bool(self._queued)
+
     def set_parameters(self, params: dict[str, ParameterInfo], values: dict[str, Any],
-                       overridden: set[str] | None = None, base: Path | None = None) -> None:
-        """Rebuild. `overridden` None: a material's own parameters (no override column)."""
+                       overridden: set[str] | None = None, base: Path | None = None,
+                       per_turn: int = 0) -> None:
+        """Rebuild. `overridden` None: a material's own parameters (no override column).
+        `per_turn` > 0: the groups at once, their rows that many at a time, each batch in a
+        turn of the event loop of its own (a row costs the UI thread ~3 ms; a material with
+        dozens of parameters would block it for longer than a frame); `building` until then."""
         self.instance_mode = overridden is not None
         self._base = base
         self.rows.clear()
         self.labels.clear()
+        self._queued.clear()
+        self._turn.stop()
+        self._per_turn = per_turn
+        self._live = None  # set_live again for these rows
         collapsed = {g for g, (b, _) in self.groups.items() if not b.isChecked()}
         self.groups.clear()
         host = QWidget()
@@ -210,17 +232,8 @@ class ParameterPanel(QScrollArea):
             form = QFormLayout(body)
             form.setContentsMargins(14, 0, 0, 6)
             for info in infos:
-                row = _Row(info, values.get(info.name, info.default), base, self.instance_mode)
-                label = QLabel(info.name.replace("_", " "))
-                label.setMinimumWidth(LABEL_WIDTH)  # one column across groups
-                tip = info.settings.get("tooltip") or ""
-                label.setToolTip(f"{tip}\n({info.name}, {info.type})" if tip
-                                 else f"{info.name} ({info.type})")
-                self.rows[info.name] = row
-                self.labels[info.name] = label
-                self._wire(row)
-                form.addRow(label, row)
-                self._mark(info.name, bool(overridden and info.name in overridden))
+                self._queued[info.name] = (form, info, values.get(info.name, info.default),
+                                           bool(overridden and info.name in overridden))
 
             def toggled(on: bool, h=head, b=body) -> None:
                 b.setVisible(on)
@@ -235,7 +248,34 @@ class ParameterPanel(QScrollArea):
             body.setVisible(head.isChecked())
             self.groups[title] = (head, body)
         lay.addStretch(1)
+        if per_turn <= 0:
+            self._build_queued(len(self._queued))
         self.setWidget(host)
+        if self._queued:
+            self._build_queued()
+
+    def _build_queued(self, count: int = 0) -> None:
+        """The next `count` queued rows (default: `per_turn`); the rest in a later turn."""
+        for _ in range(count or self._per_turn):
+            if not self._queued:
+                break
+            name = next(iter(self._queued))
+            form, info, value, overridden = self._queued.pop(name)
+            row = _Row(info, value, self._base, self.instance_mode)
+            label = QLabel(info.name.replace("_", " "))
+            label.setMinimumWidth(LABEL_WIDTH)  # one column across groups
+            tip = info.settings.get("tooltip") or ""
+            label.setToolTip(f"{tip}\n({info.name}, {info.type})" if tip
+                             else f"{info.name} ({info.type})")
+            self.rows[name] = row
+            self.labels[name] = label
+            self._wire(row)
+            form.addRow(label, row)
+            self._mark(name, overridden)
+            if self._live is not None:
+                self._show_live(name)
+        if self._queued:
+            self._turn.start()
 
     def _wire(self, row: _Row) -> None:
         name = row.info.name
@@ -271,6 +311,11 @@ class ParameterPanel(QScrollArea):
         """Show a value (and override state) without emitting edits."""
         row = self.rows.get(name)
         if row is None:
+            queued = self._queued.get(name)
+            if queued is not None:  # built later with this value
+                form, info, _, was = queued
+                self._queued[name] = (form, info, value,
+                                      was if overridden is None else overridden)
             return
         row.show_value(value, self._base)
         if overridden is not None:
@@ -278,17 +323,22 @@ class ParameterPanel(QScrollArea):
 
     def set_live(self, live: set[str] | None) -> None:
         """Greys out parameters a static switch compiled out (None: all live)."""
-        for name, row in self.rows.items():
-            on = live is None or name in live
-            row.field.setEnabled(on)
-            self.labels[name].setEnabled(on)
-            row.field.setToolTip("" if on else "compiled out by a static switch")
-            for w in (row.field, self.labels[name]):
-                effect = None
-                if not on:
-                    effect = QGraphicsOpacityEffect(w)
-                    effect.setOpacity(0.35)
-                w.setGraphicsEffect(effect)
+        self._live = live
+        for name in self.rows:
+            self._show_live(name)
+
+    def _show_live(self, name: str) -> None:
+        row, live = self.rows[name], self._live
+        on = live is None or name in live
+        row.field.setEnabled(on)
+        self.labels[name].setEnabled(on)
+        row.field.setToolTip("" if on else "compiled out by a static switch")
+        for w in (row.field, self.labels[name]):
+            effect = None
+            if not on:
+                effect = QGraphicsOpacityEffect(w)
+                effect.setOpacity(0.35)
+            w.setGraphicsEffect(effect)
 
     def is_marked(self, name: str) -> bool:
         return bool(self.labels[name].property("overridden"))
