@@ -120,6 +120,7 @@ def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, mo
     assert builds["parameters"] <= 1 and builds["inspector"] <= 1, builds
     # the panels show the document as it is after the macro
     assert set(canvas.selected_ids()) == set(copies)
-    qtbot.waitUntil(lambda: panel.settled and params_before < set(panel.rows))  # the copies', under free names
+    # the copies' parameters, under free names
+    qtbot.waitUntil(lambda: panel.settled and params_before < set(panel.rows))
     w.controller.undo_stack.undo()
     qtbot.waitUntil(lambda: panel.settled and set(panel.rows) == params_before)
