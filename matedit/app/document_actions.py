@@ -230,14 +230,17 @@ class DocumentActions(QObject):
             self.show_error("Cannot open file", f"{path}: {type(exc).__name__}: {exc}")
         return None
 
-    def open(self, path: str | os.PathLike, ask: bool = True, offer: bool = True) -> bool:
+    def open(self, path: str | os.PathLike, ask: bool = True, offer: bool = True,
+             doc: MaterialDocument | None = None) -> bool:
         """Opens a material (the current one is kept if the file is bad); `offer`: ask about
-        the file's recovery file, if there is one. An instance opens in its own editor."""
+        the file's recovery file, if there is one. An instance opens in its own editor.
+        `doc`: the file as the caller has just read it (not read again); when the controller
+        shows it already (a tab made for it), it is not replaced again."""
         from matedit.io.instance import is_instance_file  # instances open in their editor
 
-        if is_instance_file(path) and self.open_instance is not None:
+        if doc is None and is_instance_file(path) and self.open_instance is not None:
             return self.open_instance(str(path)) is not None
-        doc = self.read(path)
+        doc = doc if doc is not None else self.read(path)
         if doc is None:
             return False
         if doc.is_function:  # a function opens in a canvas tab; the material stays
@@ -253,7 +256,8 @@ class DocumentActions(QObject):
         if ask:  # leaving a document the artist has just saved or discarded
             self.discard_recovery()
         recovered = self._offer_recovery(Path(path)) if offer else None
-        self.controller.replace(recovered or doc)
+        if recovered is not None or self.controller.document is not doc:
+            self.controller.replace(recovered or doc)
         if recovered is not None:
             self.controller.undo_stack.resetClean()  # recovered work is unsaved
         self.add_recent(Path(path))

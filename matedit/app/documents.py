@@ -247,24 +247,22 @@ class DocumentTabs(QObject):
         if at >= 0:
             self.activate(at)
             return True
-        if is_instance_file(path) or self._is_function(path) or \
+        if is_instance_file(path) or \
                 self.current.editor is None and self._session_of_controller().untouched:
             return self.actions.open(path)
-        previous = self.index
-        self.new_tab()
-        if self.actions.open(path, ask=False):
-            return True
-        self._drop(self.index, previous)  # a bad file: the new tab goes again
-        return False
-
-    @staticmethod
-    def _is_function(path: Path) -> bool:
-        from matedit.io.document import FormatError, load
-
-        try:
-            return load(path).is_function
-        except (FormatError, OSError, ValueError):
+        doc = self.actions.read(path)  # a bad file: said here, and no tab opens
+        if doc is None:
             return False
+        if doc.is_function:
+            return self.actions.open(path, doc=doc)
+        previous = self.index
+        # the tab shows the document at once (an Untitled shown first, then replaced, built
+        # every panel twice and compiled an empty material on the way)
+        self.new_tab(doc)
+        if self.actions.open(path, ask=False, doc=doc):
+            return True
+        self._drop(self.index, previous)
+        return False
 
     def open_dialog(self) -> bool:
         path = self.actions.ask_open_path()
