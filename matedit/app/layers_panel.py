@@ -166,6 +166,7 @@ class _LayerRow(QWidget):
         top.addWidget(self.cost)
         top.addWidget(self.name, 1)
         self.blend = QComboBox()
+        extra: str | None = None  # a blend function file's path: its own list
         if is_base:
             self.blend.addItem("base")
             self.blend.setEnabled(False)
@@ -183,7 +184,8 @@ class _LayerRow(QWidget):
             QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
         self.blend.setMinimumContentsLength(6)
         view = self.blend.view()
-        view.setMinimumWidth(panel.blend_list_width(self.blend))
+        view.setMinimumWidth(view.sizeHintForColumn(0) + 24 if is_base
+                             else panel.blend_list_width(extra, view))
         lay.addLayout(top)
         row = QHBoxLayout()
         lab = QLabel("blend")
@@ -409,13 +411,12 @@ class LayersPanel(QWidget):
         self._blend_models[extra] = model
         return model
 
-    def blend_list_width(self, combo: QComboBox) -> int:
-        """The width a row's blend list opens at: its longest title's (measured once)."""
-        model = combo.model()
-        key = next((k for k, m in self._blend_models.items() if m is model), "")
-        width = self._blend_widths.get(key)
+    def blend_list_width(self, extra: str | None, view) -> int:
+        """The width the blend list of `blend_model(extra)`, shown in `view`, opens at: its
+        longest title's, measured once."""
+        width = self._blend_widths.get(extra)
         if width is None:
-            width = self._blend_widths[key] = combo.view().sizeHintForColumn(0) + 24
+            width = self._blend_widths[extra] = view.sizeHintForColumn(0) + 24
         return width
 
     def _rebuild_all(self) -> None:
