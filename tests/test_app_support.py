@@ -86,8 +86,10 @@ def wait_for_renderer(qtbot, window, timeout: int = 30000):
     leaves until after the first frame (matedit.app.startup)."""
     view = window.viewport.view
     startup = getattr(window, "startup", None)
+    library = getattr(window, "library", None)
     qtbot.waitUntil(lambda: (view.renderer is not None and view.environment_ready
-                             and (startup is None or startup.done))
+                             and (startup is None or startup.done)
+                             and (library is None or library.listed))
                     or bool(view.problem), timeout=timeout)
     assert view.renderer is not None, view.problem
     return view.renderer

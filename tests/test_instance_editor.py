@@ -186,3 +186,54 @@ def test_presentation_settings_shape_the_fields(qtbot):
     assert isinstance(panel.rows["tint"].field, _ColourVector)
     assert "how shiny" in panel.labels["gloss"].toolTip()
     assert not panel.rows["gloss"].check.isVisibleTo(panel)  # a material: no override column
+
+
+def _listing(library) -> list[tuple[str, str, str]]:
+    return [(it.data(0, 0x0101), it.text(0), it.toolTip(0)) for it in library.items()]
+
+
+def test_the_library_lists_in_turns_and_thumbnails_one_a_turn(window, qtbot, monkeypatch):
+    """The start-up listing reads a few files a turn of the event loop, with the timer's
+    events between turns, and fills the same tree as `refresh`; the instances' thumbnails
+    come one a turn, not all in one stretch."""
+    import time
+
+    from PySide6.QtCore import QTimer
+
+    import matedit.app.instance_editor as ie
+    import matedit.app.library as lib
+
+    library = window.library
+    library.refresh()
+    expected = _listing(library)
+    turns = []
+    monkeypatch.setattr(lib, "LIST_BUDGET_S", 0.002)  # several turns on any machine
+    real_turn = lib.LibraryPanel._list_turn
+    monkeypatch.setattr(lib.LibraryPanel, "_list_turn",
+                        lambda self: (turns.append(time.perf_counter()), real_turn(self)))
+    made = []
+    real_thumb = ie._thumbnail
+    monkeypatch.setattr(ie, "_thumbnail",
+                        lambda it, f: (made.append(time.perf_counter()), real_thumb(it, f)))
+    ticks = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(0)
+    library.listed = False
+    library.list_in_turns()
+    assert not library.listed and library._listing is not None
+    qtbot.waitUntil(lambda: library.listed, timeout=20000)
+    qtbot.waitUntil(lambda: len(made) >= 6, timeout=20000)  # the six instances of graphs/
+    timer.stop()
+    assert len(turns) >= 3
+    assert _listing(library) == expected
+    # between two turns, and between two thumbnails, the loop ran other events
+    for stamps in (turns, made[:6]):
+        for a, b in zip(stamps, stamps[1:]):
+            assert any(a < t < b for t in ticks), (a, b)
+
+    # a listing under way is finished at once when the tree is asked for
+    library.listed = False
+    library.list_in_turns()
+    assert library.items("material") and library.listed and library._listing is None
+    assert _listing(library) == expected

@@ -174,3 +174,37 @@ def test_no_compile_or_validation_changes_a_cached_document(sample):
         analyse(doc, FileResolver())
         assert problems(sample, FileResolver()) == []
     assert {p: document.dumps(d) for p, (_, d) in document._documents.items()} == cached
+
+
+def test_the_library_listing_shares_the_cache_with_compiles(sample, reads):
+    """`load_shared` (the Library's reads) fills the cache a compile reads through, for
+    function files only; a material is read each time (it is edited, so never shared), and a
+    function file changed since is read again."""
+    import time
+
+    from matedit.io.document import load_shared
+
+    root = sample.parent.parent
+    functions = sorted((root / "functions").glob("*.json")) + \
+        sorted((root / "layers").glob("*.json"))
+    for path in functions:
+        assert load_shared(path).is_function
+    material = load_shared(sample)
+    assert not material.is_function and load_shared(sample) is not material
+    reads["read"].clear()
+    compile_document(load(sample), FileResolver())
+    assert reads["read"] == [sample.name]  # the material itself; no function read again
+    assert load_shared(functions[0]) is load_shared(functions[0])
+
+    rust = _wear_file(sample)
+    old = load_shared(rust)
+    raw = json.loads(rust.read_text())
+    raw["description"] = "changed since the listing"
+    rust.write_text(json.dumps(raw))
+    past = time.time_ns() - 10 * 10**9  # older than _RACY_NS, so cached again
+    os.utime(rust, ns=(past, past))
+    reads["read"].clear()
+    new = load_shared(rust)
+    assert new is not old and new.description == "changed since the listing"
+    assert reads["read"] == ["rust.json"]
+    assert FileResolver().resolve(str(rust), None) is new

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import copy
 import os
+from collections import deque
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -565,12 +566,36 @@ def attach_instances(material_items: list[QTreeWidgetItem], files: list[Path],
             it.setData(0, path_role, str(f.resolve()))
             it.setData(0, kind_role, "instance")
             it.setToolTip(0, f"Instance of {Path(doc.parent).name}\n{doc.description}\n{f}")
-            QTimer.singleShot(0, lambda it=it, f=f: _thumbnail(it, f))  # after start-up
+            _queue_thumbnail(it, f)
             by_path[str(f.resolve())] = it
             added.append(it)
             pending.remove((f, doc))
             progress = True
     return added
+
+
+_THUMBNAILS: deque[tuple[QTreeWidgetItem, Path]] = deque()
+
+
+def _queue_thumbnail(item: QTreeWidgetItem, path: Path) -> None:
+    """The item's thumbnail, made later from the event loop: one a turn, on a 1 ms timer (a
+    thumbnail takes 15-25 ms; zero-delay calls would all run in one stretch, no tick or paint
+    between them)."""
+    _THUMBNAILS.append((item, path))
+    if len(_THUMBNAILS) == 1:
+        QTimer.singleShot(1, _next_thumbnail)
+
+
+def _next_thumbnail() -> None:
+    if not _THUMBNAILS:
+        return
+    item, path = _THUMBNAILS[0]
+    try:
+        _thumbnail(item, path)
+    finally:
+        _THUMBNAILS.popleft()
+        if _THUMBNAILS:
+            QTimer.singleShot(1, _next_thumbnail)
 
 
 def _thumbnail(item: QTreeWidgetItem, path: Path) -> None:

@@ -7,9 +7,11 @@ on top). User folders are remembered in QSettings.
 
 from __future__ import annotations
 
+import time
+from collections.abc import Iterator
 from pathlib import Path
 
-from PySide6.QtCore import QMimeData, QSettings, Qt, Signal
+from PySide6.QtCore import QMimeData, QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QHBoxLayout,
@@ -24,7 +26,7 @@ from PySide6.QtWidgets import (
 from matedit.app import file_dialogs
 from matedit.app.layers_panel import LAYER_MIME
 from matedit.app.theme import icon
-from matedit.io.document import FormatError, load
+from matedit.io.document import FormatError, load_shared
 from matedit.resources import graphs_dir
 
 PATH_ROLE = Qt.ItemDataRole.UserRole
@@ -34,12 +36,14 @@ SECTIONS = (("Materials", "materials", "material"), ("Layers", "layers", "layer"
 USER_FOLDERS_KEY = "library/folders"
 # folders of the built-in library that hold matedit's own templates, not samples for artists
 INTERNAL = frozenset({"interop"})
+# reading a turn of `LibraryPanel.list_in_turns` (a file takes about 1 ms to classify)
+LIST_BUDGET_S = 0.006
 
 
 def classify(path: Path) -> tuple[str, str, str] | None:
     """(kind, title, description) of a graph file; kind is material, layer or function."""
     try:
-        doc = load(path)
+        doc = load_shared(path)  # a function read here is not read again by a compile
     except FormatError:
         return None
     title = doc.name or path.stem.replace("_", " ").title()
@@ -110,9 +114,16 @@ class LibraryPanel(QWidget):
         # the main window has it done once its viewport shows the first frame
         self.files: list[Path] = []
         self.listed = False
+        self._listing: Iterator[tuple[str, Path]] | None = None  # list_in_turns under way
+        self._sections: dict[str, QTreeWidgetItem] = {}
+        self._roots: list[Path] = []
+        self._turn = QTimer(self)
+        self._turn.setSingleShot(True)
+        self._turn.timeout.connect(self._list_turn)
 
     def ensure_listed(self) -> None:
-        """The tree filled, if no `refresh` has filled it yet."""
+        """The tree filled, if no `refresh` has filled it yet (a listing in turns under way
+        is finished at once)."""
         if not self.listed:
             self.refresh()
 
@@ -137,36 +148,71 @@ class LibraryPanel(QWidget):
 
     # --- tree ------------------------------------------------------------------------------
     def refresh(self) -> None:
-        self.listed = True
+        """Reads every file of the library's folders now and fills the tree."""
+        self._listing = None  # a listing in turns under way is replaced
+        listing = self._begin()
+        for origin, path in listing:
+            self._add(origin, path)
+        self._end()
+
+    def list_in_turns(self) -> None:
+        """Fills the tree as `refresh` does, a few files a turn of the event loop (at most
+        about LIST_BUDGET_S of reading a turn, on a 1 ms timer, so that ticks and paints run
+        between turns): the start-up step. `listed` turns true, and `refreshed` is emitted,
+        at its end; a `refresh` or `ensure_listed` meanwhile reads the rest at once."""
+        if self.listed or self._listing is not None:
+            return
+        self._listing = iter(self._begin())
+        self._turn.start(1)
+
+    def _list_turn(self) -> None:
+        listing = self._listing
+        if listing is None:
+            return
+        end = time.perf_counter() + LIST_BUDGET_S
+        for origin, path in listing:
+            self._add(origin, path)
+            if time.perf_counter() > end:
+                self._turn.start(1)
+                return
+        self._listing = None
+        self._end()
+
+    def _begin(self) -> list[tuple[str, Path]]:
+        """Clears the tree to its sections; (origin, path) of each file to classify."""
         self.tree.clear()
-        sections = {}
+        self._sections = {}
         for title, _sub, kind in SECTIONS:
             top = QTreeWidgetItem(self.tree, [title])
             top.setIcon(0, icon(kind))
             top.setFlags(top.flags() & ~Qt.ItemFlag.ItemIsDragEnabled)
-            sections[kind] = top
+            top.setExpanded(True)
+            self._sections[kind] = top
         roots = [("", graphs_dir())] + [(p.name, p) for p in self.user_folders()]
-        for origin, root in roots:
-            if not root.is_dir():
-                continue
-            for path in sorted(root.rglob("*.json")):
-                if not origin and path.relative_to(root).parts[0] in INTERNAL:
-                    continue
-                info = classify(path)
-                if info is None:
-                    continue
-                kind, title, desc = info
-                it = QTreeWidgetItem(sections[kind], [title + (f"  ({origin})" if origin else "")])
-                it.setIcon(0, icon(kind))
-                it.setData(0, PATH_ROLE, str(path.resolve()))
-                it.setData(0, KIND_ROLE, kind)
-                tip = f"{desc}\n{path}" if desc else str(path)
-                if kind == "layer":
-                    tip += "\nDrag onto the Layers panel, or double-click, to add it"
-                it.setToolTip(0, tip)
-        self.files = [p for _, r in roots if r.is_dir() for p in sorted(r.rglob("*.json"))]
+        self._roots = [root for _, root in roots if root.is_dir()]
+        return [(origin, path) for origin, root in roots if root.is_dir()
+                for path in sorted(root.rglob("*.json"))
+                if origin or path.relative_to(root).parts[0] not in INTERNAL]
+
+    def _add(self, origin: str, path: Path) -> None:
+        info = classify(path)
+        if info is None:
+            return
+        kind, title, desc = info
+        it = QTreeWidgetItem(self._sections[kind], [title + (f"  ({origin})" if origin else "")])
+        it.setIcon(0, icon(kind))
+        it.setData(0, PATH_ROLE, str(path.resolve()))
+        it.setData(0, KIND_ROLE, kind)
+        tip = f"{desc}\n{path}" if desc else str(path)
+        if kind == "layer":
+            tip += "\nDrag onto the Layers panel, or double-click, to add it"
+        it.setToolTip(0, tip)
+
+    def _end(self) -> None:
+        self.listed = True
+        self.files = [p for r in self._roots for p in sorted(r.rglob("*.json"))]
         self.refreshed.emit(self.files)
-        for top in sections.values():
+        for top in self._sections.values():
             top.setExpanded(True)
         self.filter(self.search.text())
 

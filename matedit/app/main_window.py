@@ -93,7 +93,7 @@ class MainWindow(QMainWindow):
         self.actions.open_recovered_material = self.documents.open_recovered
         self.actions.open_function = lambda p: self.tabs.open_function(p, self.tabs.material)
         self.actions.preview_settings = self.viewport.document_preview
-        self.startup = after_first_frame(self.viewport.view, self.library.ensure_listed)
+        self.startup = after_first_frame(self.viewport.view, self.library.list_in_turns)
         if start:
             self.actions.start(path, sample_path() if sample else None)
             self.compiler.recompile()

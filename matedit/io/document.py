@@ -413,11 +413,9 @@ class FileResolver:
             recent = self._recent.get(p)
             if recent is not None and recent[0] == signature:
                 return recent[1]
-            with _documents_lock:
-                hit = _documents.get(p)
-                if hit is not None and hit[0] == signature:
-                    _documents.move_to_end(p)
-                    return hit[1]
+            hit = _cached(p, signature)
+            if hit is not None:
+                return hit
         global LOADS
         LOADS += 1
         try:
@@ -426,12 +424,49 @@ class FileResolver:
             raise LookupError(f"{ref}: {exc.reason}") from None
         if not doc.is_function:
             raise LookupError(f"{ref} is a material, not a material function")
-        if signature is not None and time.time_ns() - signature[3] < _RACY_NS:
+        if signature is not None and not _keep(p, signature, doc):
             self._recent[p] = (signature, doc)
-        elif signature is not None:
-            with _documents_lock:
-                _documents[p] = (signature, doc)
-                _documents.move_to_end(p)
-                while len(_documents) > _DOCUMENT_CACHE_SIZE:
-                    _documents.popitem(last=False)
         return doc
+
+
+def _cached(p: Path, signature: tuple[int, int, int, int]) -> MaterialDocument | None:
+    """The shared document read from real path `p` when the file still has `signature`."""
+    with _documents_lock:
+        hit = _documents.get(p)
+        if hit is not None and hit[0] == signature:
+            _documents.move_to_end(p)
+            return hit[1]
+    return None
+
+
+def _keep(p: Path, signature: tuple[int, int, int, int], doc: MaterialDocument) -> bool:
+    """Keeps a function `doc` read from real path `p` in the shared cache; False (not kept)
+    for a file modified too recently to trust its signature (_RACY_NS)."""
+    if time.time_ns() - signature[3] < _RACY_NS:
+        return False
+    with _documents_lock:
+        _documents[p] = (signature, doc)
+        _documents.move_to_end(p)
+        while len(_documents) > _DOCUMENT_CACHE_SIZE:
+            _documents.popitem(last=False)
+    return True
+
+
+def load_shared(path: str | Path) -> MaterialDocument:
+    """`load(path)` through the shared cache of function documents (`FileResolver`'s): a
+    function file read here is not read again by a compile, nor one a compile has read here.
+    The document returned may be shared, never to be changed by the caller (a listing that
+    only reads names and interfaces: matedit.app.library). Raises FormatError as `load`."""
+    p = Path(os.path.realpath(path))
+    try:
+        signature = _file_signature(p)
+    except OSError:
+        signature = None  # load says what is wrong with it
+    if signature is not None:
+        hit = _cached(p, signature)
+        if hit is not None:
+            return hit
+    doc = load(p)
+    if signature is not None and doc.is_function:
+        _keep(p, signature, doc)
+    return doc
