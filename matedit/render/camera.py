@@ -72,3 +72,35 @@ class OrbitCamera:
 
     def projection(self, aspect: float) -> np.ndarray:
         return perspective(self.fov, aspect, self.near, self.far)
+
+
+# a bound within this share of a half-turn of the view axis is taken as unbounded (the sphere
+# reaches beside the eye: its projection is not bounded on that side)
+_EDGE_ANGLE = math.radians(89.0)
+
+
+def sphere_screen_bounds(center, radius: float, view: np.ndarray, projection: np.ndarray
+                         ) -> tuple[float, float, float, float] | None:
+    """The rectangle (x0, y0, x1, y1) in normalised device coordinates that holds the
+    perspective projection of the sphere (`center` in world space, `radius`), clamped to the
+    screen (-1..1): on each axis the two planes through the eye tangent to the sphere bound
+    it (Mara and McGuire 2013, "2D Polyhedral Bounds of a Clipped, Perspective-Projected 3D
+    Sphere"). None when the sphere is not wholly in front of the near plane (the eye inside or
+    beside it): then nothing is known and the whole screen is the bound. An empty rectangle
+    (x0 >= x1 or y0 >= y1) when the sphere is off screen. `projection` is a `perspective`
+    matrix (P[0,0] and P[1,1] scale x/-z and y/-z; no skew)."""
+    c = view[:3, :3] @ np.asarray(center, dtype=np.float64) + view[:3, 3]
+    depth = -c[2]  # in front of the eye: positive
+    near = projection[2, 3] / (projection[2, 2] - 1.0)  # the near distance, from the matrix
+    if depth - radius <= near:  # reaching the near plane (or behind the eye)
+        return None
+    out = []
+    for axis, scale in ((0, projection[0, 0]), (1, projection[1, 1])):
+        d = math.hypot(c[axis], depth)
+        centre = math.atan2(c[axis], depth)
+        half = math.asin(min(1.0, radius / d))
+        lo, hi = centre - half, centre + half
+        out.append((-1.0 if lo <= -_EDGE_ANGLE else max(-1.0, scale * math.tan(lo)),
+                    1.0 if hi >= _EDGE_ANGLE else min(1.0, scale * math.tan(hi))))
+    (x0, x1), (y0, y1) = out
+    return x0, y0, x1, y1

@@ -60,6 +60,7 @@ class LightingPass:
         self._programs: dict[tuple[bool, bool, bool, int], moderngl.Program] = {}
         self.link_count = 0
         self.edges_once = False  # benchmarks only (see program)
+        self._copy: moderngl.Program | None = None  # copy_background's, linked on first use
 
     def program(self, split_sum_only: bool, compensation: bool, edges_once: bool = False,
                 lobes: int = 127) -> moderngl.Program:
@@ -88,6 +89,15 @@ class LightingPass:
             self._programs[key] = prog
         return prog
 
+    def copy_background(self, background: moderngl.Texture) -> None:
+        """`background` into every sample of the bound target (within its scissor): where the
+        lighting pass, drawn within the mesh's bound only, does not reach."""
+        if self._copy is None:
+            self._copy = render_program(self.ctx, "fullscreen.vert", "copy.frag")
+            self._copy["uSource"].value = GBUFFER_FIRST_UNIT + GBUFFER_TARGETS
+        background.use(location=GBUFFER_FIRST_UNIT + GBUFFER_TARGETS)
+        self._quad.draw(self._copy)
+
     def draw(self, gbuffer: GBuffer, background: moderngl.Texture, eye,
              split_sum_only: bool, compensation: bool, lobes: int = 127) -> None:
         """Shades the G-buffer over `background` into every sample of the bound target, with
@@ -104,3 +114,6 @@ class LightingPass:
         for prog in self._programs.values():
             prog.release()
         self._programs.clear()
+        if self._copy is not None:
+            self._copy.release()
+            self._copy = None

@@ -88,6 +88,24 @@ class SceneTargets:
         and the depth of the G-buffer pass is kept (for the gizmos)."""
         self._begin(self.msaa, None)
 
+    def narrow(self, rect: tuple[int, int, int, int]) -> bool:
+        """Scissors the multisampled target (bound by begin_lighting) to `rect` (x, y,
+        width, height in pixels) within the band being drawn; whether anything is left."""
+        x, y, w, h = rect
+        if self.scissor is not None:
+            bx, by, bw, bh = self.scissor
+            x0, y0 = max(x, bx), max(y, by)
+            x1, y1 = min(x + w, bx + bw), min(y + h, by + bh)
+            x, y, w, h = x0, y0, x1 - x0, y1 - y0
+        if w <= 0 or h <= 0:
+            return False
+        self.msaa.scissor = (x, y, w, h)
+        return True
+
+    def widen(self) -> None:
+        """The multisampled target's scissor back to the band (after `narrow`)."""
+        self.msaa.scissor = self.scissor
+
     def resolve(self) -> None:
         """The multisampled target into `resolved` (within the scissor band, if any: the
         blit follows GL's scissor test, which the last `_begin` set)."""

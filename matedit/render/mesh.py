@@ -567,6 +567,7 @@ class GpuMesh:
         self._vaos: dict[int, object] = {}
         self._closed: bool | None = None
         self._bounds: tuple[np.ndarray, np.ndarray] | None = None
+        self._sphere: tuple[np.ndarray, float] | None = None
 
     def vao(self, program):
         key = program.glo
@@ -603,6 +604,18 @@ class GpuMesh:
         # the farthest a point of the near plane's rectangle lies from the eye
         reach = camera.near * math.sqrt(1.0 + tan * tan * (1.0 + aspect * aspect))
         return gap > 2.0 * reach
+
+    def bounding_sphere(self) -> tuple[np.ndarray, float]:
+        """(centre, radius) of a sphere holding every vertex (so every triangle): the centre
+        of the bounding box and the farthest vertex from it, computed once."""
+        if self._sphere is None:
+            lo, hi = self._bounds if self._bounds is not None else self.data.bounds()
+            self._bounds = (lo, hi)
+            centre = (lo + hi) / 2.0
+            p = np.asarray(self.data.positions, dtype=np.float64).reshape(-1, 3)
+            radius = float(np.sqrt(((p - centre) ** 2).sum(axis=1).max())) if len(p) else 0.0
+            self._sphere = (centre, radius * (1.0 + 1e-6))
+        return self._sphere
 
     def forget(self, program) -> None:
         vao = self._vaos.pop(program.glo, None)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
+from matedit.render.camera import sphere_screen_bounds
 from matedit.render.deferred import ENERGY_COMPENSATION, LightingPass
 from matedit.render.environment import EnvironmentLighting
 from matedit.render.frames import SceneTargets
@@ -79,9 +80,21 @@ class ScenePass:
                 targets.begin_lighting()
                 compensation = view.energy_compensation or \
                     ENERGY_COMPENSATION in material.compiled.ir.defines
-                self.lighting.draw(targets.gbuffer, targets.background.color_attachments[0],
-                                   np.array(view.camera.eye, "f4"), not reference, compensation,
-                                   lobe_mask(getattr(view, "view", "lit")))
+                background = targets.background.color_attachments[0]
+                # Lit only where the mesh may be: llvmpipe runs the lighting's every branch
+                # for every pixel it rasterizes (a branch is a mask, never a jump), so the
+                # background around the mesh cost the lighting of a covered pixel. The
+                # rest of the target gets the background the pass would have written there.
+                rect = mesh_rect(mesh, view.camera, targets.size)
+                lit = True
+                if rect is not None:
+                    self.lighting.copy_background(background)
+                    lit = targets.narrow(rect)
+                if lit:
+                    self.lighting.draw(targets.gbuffer, background,
+                                       np.array(view.camera.eye, "f4"), not reference,
+                                       compensation, lobe_mask(getattr(view, "view", "lit")))
+                targets.widen()
         if view.show_gizmos:
             ctx.enable(moderngl.DEPTH_TEST)
             self.gizmos.draw(vp, view.lights)
@@ -91,3 +104,27 @@ class ScenePass:
     def release(self) -> None:
         for part in (self.lighting, self.gizmos, self.environment, self.uniforms):
             part.release()
+
+
+# pixels added around the mesh's rectangle (rounding, and samples within the border pixels)
+RECT_MARGIN_PX = 2
+
+
+def mesh_rect(mesh: GpuMesh, camera, size: tuple[int, int]) -> tuple[int, int, int, int] | None:
+    """The pixels (x, y, width, height; GL's window coordinates) that hold every sample the
+    mesh may cover, from its bounding sphere's projection (camera.sphere_screen_bounds); None
+    when they are not known to be fewer than the whole frame."""
+    w, h = size
+    centre, radius = mesh.bounding_sphere()
+    b = sphere_screen_bounds(centre, radius, camera.view_matrix(),
+                             camera.projection(w / max(1, h)))
+    if b is None:
+        return None
+    x0, y0, x1, y1 = b
+    px0 = max(0, int(np.floor((x0 + 1.0) * 0.5 * w)) - RECT_MARGIN_PX)
+    py0 = max(0, int(np.floor((y0 + 1.0) * 0.5 * h)) - RECT_MARGIN_PX)
+    px1 = min(w, int(np.ceil((x1 + 1.0) * 0.5 * w)) + RECT_MARGIN_PX)
+    py1 = min(h, int(np.ceil((y1 + 1.0) * 0.5 * h)) + RECT_MARGIN_PX)
+    if (px0, py0, px1, py1) == (0, 0, w, h):
+        return None
+    return px0, py0, max(0, px1 - px0), max(0, py1 - py0)
