@@ -1,7 +1,9 @@
 """The deferred preview: the material's GBUFFER program fills three multisampled targets, and
 one lighting program (shaders/render/lighting.frag), linked once a variant for the renderer's
-lifetime, shades them in a full-screen pass over the background (drawn first into a one-sample
-texture), writing every sample; see that file for how edges are anti-aliased.
+lifetime, shades them in a screen pass over the background (drawn first into a one-sample
+texture), writing every sample; see that file for how edges are anti-aliased. The pass covers
+the mesh's screen rectangle (matedit/render/scene.py, mesh_rect) and `copy_background` the
+rest of the target.
 
 G-buffer layout (GBUFFER entry, shaders/entry/gbuffer.frag.glsl; packing: shaders/gbuffer.glsl):
   0, RGBA32UI: x, y, z  world position (m), float32 bits: exact
