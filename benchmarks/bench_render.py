@@ -156,9 +156,12 @@ def structural_edit(renderer, ctx, doc, repeat: int = 3) -> tuple[float, float, 
 
 
 def parameter_edit(renderer, ctx, material: CompiledMaterial, repeat: int = 5,
-                   values: list[dict] | None = None) -> tuple[float, int]:
+                   values: list[dict] | None = None, plain: list[float] | None = None
+                   ) -> tuple[float, int]:
     """Median seconds from a parameter edit (set_uniforms) to the next finished frame, and the
-    number of program links the edits caused."""
+    number of program links the edits caused. With `plain` (a list), a plain frame is drawn
+    after each edit's and its time appended there: the two alternate, so that load on the
+    machine hits both alike."""
     renderer.set_material(material)
     renderer.render()
     ctx.finish()
@@ -172,6 +175,11 @@ def parameter_edit(renderer, ctx, material: CompiledMaterial, repeat: int = 5,
         renderer.render()
         ctx.finish()
         times.append(time.perf_counter() - t0)
+        if plain is not None:
+            t0 = time.perf_counter()
+            renderer.render()
+            ctx.finish()
+            plain.append(time.perf_counter() - t0)
     times.sort()
     return times[len(times) // 2], renderer.link_count - links
 
