@@ -124,3 +124,57 @@ def test_deleting_and_duplicating_everything_rebuilds_each_panel_once(window, mo
     qtbot.waitUntil(lambda: panel.settled and params_before < set(panel.rows))
     w.controller.undo_stack.undo()
     qtbot.waitUntil(lambda: panel.settled and set(panel.rows) == params_before)
+
+
+def test_another_documents_layer_rows_come_one_a_turn(window, monkeypatch, qtbot):
+    """Opening a layered material: the Layers panel builds its rows one a turn of the event
+    loop (a row is ~10 ms of the UI thread), with a timer's events between turns, top layer
+    first, selection kept; and the Parameters dock builds its first rows in a turn after
+    its own rebuild's."""
+    import time
+
+    from PySide6.QtCore import QTimer
+
+    import matedit.app.layers_panel as lp
+    from matedit.app.parameter_panel import ParameterPanel
+    from matedit.resources import graphs_dir
+
+    w = window
+    layers = w.layers
+    turns: list[float] = []
+    real = lp.LayersPanel._build_rows
+    monkeypatch.setattr(lp.LayersPanel, "_build_rows",
+                        lambda self, count=0: (turns.append(time.perf_counter()),
+                                               real(self, count)))
+    built: list[float] = []
+    refreshed: list[float] = []
+    real_built = ParameterPanel._build_queued
+    monkeypatch.setattr(ParameterPanel, "_build_queued",
+                        lambda self, count=0: (built.append(time.perf_counter()),
+                                               real_built(self, count)))
+    panel = w.instances.parameters_panel
+    real_refresh = type(panel).refresh
+    monkeypatch.setattr(type(panel), "refresh",
+                        lambda self, first_now=True: (refreshed.append(time.perf_counter()),
+                                                      real_refresh(self, first_now)))
+    qtbot.waitUntil(lambda: layers.settled and panel.settled, timeout=20000)
+    qtbot.wait(50)
+    for stamps in (turns, built, refreshed):
+        stamps.clear()
+    ticks: list[float] = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(0)
+    assert w.open_material(graphs_dir() / "materials" / "worn_painted_steel.json")
+    qtbot.waitUntil(lambda: layers.settled and panel.settled, timeout=20000)
+    timer.stop()
+    stack = layers.stack
+    assert stack is not None and len(stack.layers) == 3
+    assert len(turns) >= 3  # one row each
+    ids = [layers.list.item(i).data(0x0100) for i in range(layers.list.count())]
+    assert ids == layers.layer_ids_top_first()
+    for a, b in zip(turns, turns[1:]):
+        assert any(a < t < b for t in ticks), (a, b)
+    # the dock's one rebuild, then its first rows in a later turn
+    assert len(refreshed) == 1 and built and built[0] > refreshed[0]
+    assert any(refreshed[0] < t < built[0] for t in ticks)

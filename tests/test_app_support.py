@@ -107,3 +107,6 @@ def settle(qtbot, window, ms: int = 5) -> None:
     qtbot.waitUntil(lambda: all(t.previews is None or t.previews.idle for t in tabs),
                     timeout=60000)
     qtbot.wait(ms)
+    layers = getattr(window, "layers", None)  # its rows are built a few a turn
+    if layers is not None:
+        qtbot.waitUntil(lambda: layers.settled, timeout=10000)

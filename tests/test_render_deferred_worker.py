@@ -210,3 +210,30 @@ def test_no_warm_up_while_mesas_shader_cache_is_disabled(window, qtbot, monkeypa
     assert window.compiler.worker.warmed == []
     assert not window.compiler.worker.warm_up_started  # no child process either
     assert "p_uncached_name" in {u.name for u in delivered[0].ir.uniforms}
+
+
+def test_another_documents_first_compile_starts_after_the_event_that_opened_it(window, qtbot,
+                                                                              monkeypatch):
+    """Opening a file into a new tab: the worker gets the new document's compile only once
+    the opening event is over (its Python would otherwise share the interpreter lock with
+    that event's and stretch it), on a 1 ms timer; asking for the compiled material before
+    then starts it at once."""
+    from matedit.app.compile_worker import CompileWorker
+
+    c = window.compiler
+    submitted: list[str] = []
+    real = CompileWorker.submit
+    monkeypatch.setattr(CompileWorker, "submit",
+                        lambda self, doc, *a, **k: (submitted.append(doc.name or "?"),
+                                                    real(self, doc, *a, **k)))
+    assert window.open_material(graphs_dir() / "materials" / "worn_painted_steel.json")
+    assert submitted == [] and c._first.isActive()  # not inside the opening event
+    qtbot.waitUntil(lambda: len(submitted) == 1, timeout=5000)
+    qtbot.waitUntil(lambda: c.latest is not None, timeout=60000)
+    assert "p_rust_amount" in {u.name for u in c.latest.ir.uniforms}  # the worn sample's
+
+    # asked at once: the deferred compile is started and waited for
+    assert window.open_material(graphs_dir() / "materials" / "car_paint.json")
+    assert c._first.isActive()
+    current = c.current
+    assert current is not None and not c._first.isActive() and len(submitted) == 2

@@ -5,11 +5,11 @@ the UI thread, which every structural edit would otherwise pay for a panel nobod
 
 from __future__ import annotations
 
-from PySide6.QtCore import QTimer
 from PySide6.QtGui import QFont, QFontDatabase, QTextOption
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPlainTextEdit, QVBoxLayout, QWidget
 
 from matedit.app.compile_service import MaterialCompiler
+from matedit.app.turns import turns
 from matedit.compiler import TARGETS, CompileError
 
 STAGES = ("fragment", "vertex")
@@ -47,9 +47,6 @@ class CodeView(QWidget):
         compiler.compiled.connect(lambda _cm: self._changed())
         compiler.failed.connect(lambda _d: self._changed())
         self._stale = False
-        self._later = QTimer(self)
-        self._later.setSingleShot(True)
-        self._later.timeout.connect(self.ensure_current)
         self.refresh()
 
     def _changed(self) -> None:
@@ -57,7 +54,7 @@ class CodeView(QWidget):
         # delivery (setting the text costs 7-10 ms, added to whatever else that event does)
         self._stale = True
         if self.isVisible():
-            self._later.start(1)
+            turns().add(self, "refresh", self.ensure_current)
 
     def showEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().showEvent(event)

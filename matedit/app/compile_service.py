@@ -13,7 +13,7 @@ import time
 from collections.abc import Iterable
 from typing import Any
 
-from PySide6.QtCore import QObject, Signal
+from PySide6.QtCore import QObject, QTimer, Signal
 
 from matedit.app.controller import DocumentController
 from matedit.app.node_preview import PreviewTarget, preview_document
@@ -79,6 +79,15 @@ class MaterialCompiler(QObject):
         self._cache: dict[str, CompiledMaterial] = {}
         self.preview: PreviewTarget | None = None
         self.worker = None
+        # Another document's first compile starts on this timer, after the event that opened
+        # or showed it (the canvas built, the tab shown, its first paint): the worker thread's
+        # Python would otherwise take turns with that event's for the interpreter lock and
+        # stretch it (asynchronous only; `_settled` starts it at once when asked)
+        self._first = QTimer(self)
+        self._first.setSingleShot(True)
+        self._first.setInterval(1)
+        self._first.timeout.connect(self._submit)
+        self._defer_next = False
         controller.structureChanged.connect(self._structure_changed)
         controller.documentReplaced.connect(self._document_replaced)
 
@@ -90,11 +99,15 @@ class MaterialCompiler(QObject):
         self._current = self._last_good = None
         self._diagnostics = []
         self._cache.clear()
+        self._defer_next = True
         self.set_preview(None, recompile=False)
         self.documentChanged.emit()
 
     # what a pending compile will replace: wait for it first
     def _settled(self, name: str):
+        if self._first.isActive():  # asked before the deferred first compile started
+            self._first.stop()
+            self._submit()
         if self.worker is not None and self.worker.pending:
             self.worker.wait()
         return getattr(self, name)
@@ -114,9 +127,18 @@ class MaterialCompiler(QObject):
         return self._current or self._last_good
 
     def _structure_changed(self) -> None:
+        defer, self._defer_next = self._defer_next, False
         if not self.asynchronous:
             self.recompile()
             return
+        if defer:
+            self._first.start()
+            return
+        self._submit()
+
+    def _submit(self) -> None:
+        """The viewport's document to the compile worker (asynchronous)."""
+        self._first.stop()
         doc = self._viewport_document()
         if doc.is_function:
             self.recompile()

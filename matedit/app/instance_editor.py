@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import copy
 import os
-from collections import deque
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -41,6 +40,7 @@ from matedit.app.docks import add_dock
 from matedit.app.library import KIND_ROLE, PATH_ROLE, LibraryPanel
 from matedit.app.menus import insert_after
 from matedit.app.parameter_panel import ParameterPanel
+from matedit.app.turns import turns
 from matedit.app.viewport import ViewportWidget
 from matedit.compiler import CompileError, compile_document
 from matedit.io.document import FileResolver, FormatError
@@ -469,15 +469,11 @@ class MaterialParameters(ParameterPanel):
         self._later = QTimer(self)
         self._later.setSingleShot(True)
         self._later.setInterval(0)
-        # then a timer of 1 ms (a real timer: a zero one is a posted call, run before any
-        # timer): the Layers panel's rows (built on a zero timer after a document or a
-        # macro) and these are two short blocks, with input, paints and timers handled
+        # then a turn of the UI work queue (matedit.app.turns): the Layers panel's rows, the
+        # GLSL dock's text and these are short blocks, with input, paints and timers handled
         # between them, not one long one
-        self._then = QTimer(self)
-        self._then.setSingleShot(True)
-        self._then.setInterval(1)
-        self._then.timeout.connect(self.refresh)
-        self._later.timeout.connect(self._then.start)
+        self._later.timeout.connect(
+            lambda: turns().add(self, "refresh", lambda: self.refresh(first_now=False)))
         controller.changed.connect(self._changed)
         controller.batchEnded.connect(self._batch_ended)
         controller.documentReplaced.connect(self._later.start)
@@ -487,8 +483,8 @@ class MaterialParameters(ParameterPanel):
     @property
     def settled(self) -> bool:
         """The rows show the document as it is (no rebuild waiting or under way)."""
-        return not (self._pending or self._later.isActive() or self._then.isActive()
-                    or self.building)
+        return not (self._pending or self._later.isActive()
+                    or turns().pending(self, "refresh") or self.building)
 
     def _changed(self, _event) -> None:
         if self.controller.batching:  # deleting or pasting many nodes: one rebuild, not one each
@@ -501,7 +497,9 @@ class MaterialParameters(ParameterPanel):
             self._pending = False
             self._later.start()
 
-    def refresh(self) -> None:
+    def refresh(self, first_now: bool = True) -> None:
+        """The rows for the document as it is (ParameterPanel.set_parameters's `first_now`:
+        False from the deferred rebuild, whose first rows then come a turn later)."""
         from matedit.io.instance import material_parameters
 
         doc = self.controller.document
@@ -512,7 +510,8 @@ class MaterialParameters(ParameterPanel):
         base = Path(doc.path).parent if doc.path else None
         if signature != self._signature:
             self._signature = signature
-            self.set_parameters(params, values, None, base, per_turn=ROWS_PER_TURN)
+            self.set_parameters(params, values, None, base, per_turn=ROWS_PER_TURN,
+                                first_now=first_now)
         else:
             for n, v in values.items():
                 self.update_row(n, v)
@@ -574,28 +573,11 @@ def attach_instances(material_items: list[QTreeWidgetItem], files: list[Path],
     return added
 
 
-_THUMBNAILS: deque[tuple[QTreeWidgetItem, Path]] = deque()
-
-
 def _queue_thumbnail(item: QTreeWidgetItem, path: Path) -> None:
-    """The item's thumbnail, made later from the event loop: one a turn, on a 1 ms timer (a
-    thumbnail takes 15-25 ms; zero-delay calls would all run in one stretch, no tick or paint
-    between them)."""
-    _THUMBNAILS.append((item, path))
-    if len(_THUMBNAILS) == 1:
-        QTimer.singleShot(1, _next_thumbnail)
-
-
-def _next_thumbnail() -> None:
-    if not _THUMBNAILS:
-        return
-    item, path = _THUMBNAILS[0]
-    try:
-        _thumbnail(item, path)
-    finally:
-        _THUMBNAILS.popleft()
-        if _THUMBNAILS:
-            QTimer.singleShot(1, _next_thumbnail)
+    """The item's thumbnail, made later from the event loop: one a turn of the UI work queue
+    (matedit.app.turns; a thumbnail takes 15-25 ms, and zero-delay calls would all run in
+    one stretch, no tick or paint between them)."""
+    turns().add(None, f"thumbnail {id(item)}", lambda: _thumbnail(item, path))
 
 
 def _thumbnail(item: QTreeWidgetItem, path: Path) -> None:

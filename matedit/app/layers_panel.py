@@ -34,6 +34,7 @@ from matedit.app.controller import DocumentController
 from matedit.app.fields import FloatField
 from matedit.app.paths import reference_for
 from matedit.app.theme import icon
+from matedit.app.turns import turns
 from matedit.graph.commands import (
     AddNode,
     CommandError,
@@ -351,7 +352,12 @@ class LayersPanel(QWidget):
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.setInterval(0)
-        self._timer.timeout.connect(self.rebuild)
+        self._timer.timeout.connect(lambda: self.rebuild(per_turn=1))
+        # rows still to build (rebuild with `per_turn`): (layer, is the base, opacity, parked
+        # wires), top first, one a turn (a row costs ~10 ms; three of them were one 30 ms block)
+        self._rows_left: list[tuple] = []
+        self._per_turn = 0
+        self._keep_selected: str | None = None
         controller.changed.connect(self._on_change)
         controller.documentReplaced.connect(self._rebuild_all)
         self._built: tuple | None = None  # what the rows were built from
@@ -425,10 +431,14 @@ class LayersPanel(QWidget):
         self._built = None
         self._timer.start()
 
-    def rebuild(self) -> None:
+    def rebuild(self, per_turn: int = 0) -> None:
         """The rows, built again only when what they show has changed (the stack, its layers
-        or their settings: building a row's widgets costs ~15 ms, and a structural edit
-        anywhere in the graph comes here); opacity values are set in place."""
+        or their settings: building a row's widgets costs ~10 ms, and a structural edit
+        anywhere in the graph comes here); opacity values are set in place. `per_turn` > 0:
+        that many rows a turn of the UI work queue (matedit.app.turns: the rebuilds after
+        another document and after structural edits), `settled` once all are built."""
+        turns().cancel(self, "rows")
+        self._rows_left = []
         s = self.stack
         if s is not None:
             node = self.controller.document.graph.nodes[s.node_id]
@@ -439,7 +449,7 @@ class LayersPanel(QWidget):
             self._built = key
         else:
             self._built = None
-        selected = self.selected_layer()
+        self._keep_selected = self.selected_layer()
         self.list.clear()
         self.empty.setVisible(s is None)
         self.list.setVisible(s is not None)
@@ -451,21 +461,42 @@ class LayersPanel(QWidget):
         node = self.controller.document.graph.nodes[s.node_id]
         entries = node.settings.get("layers", [])
         values = node.values
-        for index in range(len(layers) - 1, -1, -1):
-            layer = layers[index]
-            opacity = values.get(f"{layer.id}_opacity", 1.0)
-            row = _LayerRow(self, layer, index == 0,
-                            float(opacity) if isinstance(opacity, (int, float)) else 1.0,
-                            parked_wires(entries[index]) if index == 0 else None)
+        for index in range(len(layers) - 1, -1, -1):  # the top layer first
+            opacity = values.get(f"{layers[index].id}_opacity", 1.0)
+            self._rows_left.append(
+                (layers[index], index == 0,
+                 float(opacity) if isinstance(opacity, (int, float)) else 1.0,
+                 parked_wires(entries[index]) if index == 0 else None))
+        self._per_turn = per_turn
+        if per_turn > 0:
+            turns().add(self, "rows", self._build_rows)
+        else:
+            self._build_rows(len(self._rows_left))
+
+    @property
+    def settled(self) -> bool:
+        """The rows show the document as it is (no rebuild waiting or under way)."""
+        return not (self._timer.isActive() or self._rows_left)
+
+    def _build_rows(self, count: int = 0) -> None:
+        """The next `count` rows still to build (default: the rebuild's `per_turn`)."""
+        for _ in range(count or self._per_turn):
+            if not self._rows_left:
+                break
+            layer, base, opacity, parked = self._rows_left.pop(0)
+            row = _LayerRow(self, layer, base, opacity, parked)
             item = QListWidgetItem()
             item.setData(Qt.ItemDataRole.UserRole, layer.id)
             item.setToolTip(f"{layer.name}: {layer.function}")
             self.list.addItem(item)
             self.list.setItemWidget(item, row)
             item.setSizeHint(row.sizeHint())  # once parented: the row polished once, as shown
-            if layer.id == selected:
+            if layer.id == self._keep_selected:
                 item.setSelected(True)
-        self._show_costs()
+        if self._rows_left:
+            turns().add(self, "rows", self._build_rows)
+        else:
+            self._show_costs()
 
     def set_costs(self, costs: dict[str, tuple[float, float]]) -> None:
         """Each layer's (instructions, share of the material's) in its row's cost column

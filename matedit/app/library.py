@@ -11,7 +11,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
-from PySide6.QtCore import QMimeData, QSettings, Qt, QTimer, Signal
+from PySide6.QtCore import QMimeData, QSettings, Qt, Signal
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QHBoxLayout,
@@ -26,6 +26,7 @@ from PySide6.QtWidgets import (
 from matedit.app import file_dialogs
 from matedit.app.layers_panel import LAYER_MIME
 from matedit.app.theme import icon
+from matedit.app.turns import turns
 from matedit.io.document import FormatError, load_shared
 from matedit.resources import graphs_dir
 
@@ -117,9 +118,6 @@ class LibraryPanel(QWidget):
         self._listing: Iterator[tuple[str, Path]] | None = None  # list_in_turns under way
         self._sections: dict[str, QTreeWidgetItem] = {}
         self._roots: list[Path] = []
-        self._turn = QTimer(self)
-        self._turn.setSingleShot(True)
-        self._turn.timeout.connect(self._list_turn)
 
     def ensure_listed(self) -> None:
         """The tree filled, if no `refresh` has filled it yet (a listing in turns under way
@@ -156,14 +154,14 @@ class LibraryPanel(QWidget):
         self._end()
 
     def list_in_turns(self) -> None:
-        """Fills the tree as `refresh` does, a few files a turn of the event loop (at most
-        about LIST_BUDGET_S of reading a turn, on a 1 ms timer, so that ticks and paints run
-        between turns): the start-up step. `listed` turns true, and `refreshed` is emitted,
-        at its end; a `refresh` or `ensure_listed` meanwhile reads the rest at once."""
+        """Fills the tree as `refresh` does, a few files a turn (at most about LIST_BUDGET_S
+        of reading a turn of the UI work queue, matedit.app.turns, so that ticks and paints
+        run between turns): the start-up step. `listed` turns true, and `refreshed` is
+        emitted, at its end; a `refresh` or `ensure_listed` meanwhile reads the rest at once."""
         if self.listed or self._listing is not None:
             return
         self._listing = iter(self._begin())
-        self._turn.start(1)
+        turns().add(self, "list", self._list_turn)
 
     def _list_turn(self) -> None:
         listing = self._listing
@@ -173,7 +171,7 @@ class LibraryPanel(QWidget):
         for origin, path in listing:
             self._add(origin, path)
             if time.perf_counter() > end:
-                self._turn.start(1)
+                turns().add(self, "list", self._list_turn)
                 return
         self._listing = None
         self._end()

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QFormLayout,
@@ -36,6 +36,7 @@ from matedit.app.fields import (
     TextureField,
     VectorField,
 )
+from matedit.app.turns import turns
 from matedit.io.instance import ParameterInfo, sorted_groups
 
 OVERRIDDEN_STYLE = "QLabel { font-weight: bold; color: #f0b45a; }"
@@ -183,10 +184,6 @@ class ParameterPanel(QScrollArea):
         # overridden), in display order, a few each turn of the event loop
         self._queued: dict[str, tuple[QFormLayout, ParameterInfo, Any, bool]] = {}
         self._per_turn = 0
-        self._turn = QTimer(self)
-        self._turn.setSingleShot(True)
-        self._turn.setInterval(1)  # a real timer: input, paints and other timers run between
-        self._turn.timeout.connect(self._build_queued)
         self._live: set[str] | None = None
         self.setWidget(QWidget())
 
@@ -197,17 +194,20 @@ class ParameterPanel(QScrollArea):
 
     def set_parameters(self, params: dict[str, ParameterInfo], values: dict[str, Any],
                        overridden: set[str] | None = None, base: Path | None = None,
-                       per_turn: int = 0) -> None:
+                       per_turn: int = 0, first_now: bool = True) -> None:
         """Rebuild. `overridden` None: a material's own parameters (no override column).
         `per_turn` > 0: the groups at once, their rows that many at a time, each batch in a
         turn of the event loop of its own (a row costs the UI thread ~3 ms; a material with
-        dozens of parameters would block it for longer than a frame); `building` until then."""
+        dozens of parameters would block it for longer than a frame); `building` until then.
+        The first batch is built now, or with `first_now` False in a turn of its own too
+        (a rebuild that is itself a deferred step: its own work and the first rows would
+        be one block)."""
         self.instance_mode = overridden is not None
         self._base = base
         self.rows.clear()
         self.labels.clear()
         self._queued.clear()
-        self._turn.stop()
+        turns().cancel(self, "rows")
         self._per_turn = per_turn
         self._live = None  # set_live again for these rows
         collapsed = {g for g, (b, _) in self.groups.items() if not b.isChecked()}
@@ -252,7 +252,10 @@ class ParameterPanel(QScrollArea):
             self._build_queued(len(self._queued))
         self.setWidget(host)
         if self._queued:
-            self._build_queued()
+            if first_now:
+                self._build_queued()
+            else:
+                turns().add(self, "rows", self._build_queued)
 
     def _build_queued(self, count: int = 0) -> None:
         """The next `count` queued rows (default: `per_turn`); the rest in a later turn."""
@@ -275,7 +278,7 @@ class ParameterPanel(QScrollArea):
             if self._live is not None:
                 self._show_live(name)
         if self._queued:
-            self._turn.start()
+            turns().add(self, "rows", self._build_queued)
 
     def _wire(self, row: _Row) -> None:
         name = row.info.name
