@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QEvent, QKeyCombination, QObject, Qt
-from PySide6.QtGui import QAction, QCursor, QKeySequence
+from PySide6.QtGui import QAction, QCursor, QKeyEvent, QKeySequence
 from PySide6.QtWidgets import QMenu, QToolBar, QWidget
 
 from matedit.app.theme import icon
@@ -203,6 +203,11 @@ class PaletteOnTab(QObject):
         self._canvas = canvas
 
     def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
+        # Every event of the application comes here (thousands when a document opens): the
+        # wrapper's class says whether it is a key event without reading its type (a
+        # Python enum made for each event); the others go on as they came.
+        if not isinstance(event, QKeyEvent):
+            return False
         if event.type() == QEvent.Type.KeyPress and event.key() == Qt.Key.Key_Tab and \
                 event.modifiers() == Qt.KeyboardModifier.NoModifier and \
                 isinstance(obj, QWidget) and obj.window() is self._window:
@@ -214,4 +219,4 @@ class PaletteOnTab(QObject):
                     not palette.isAncestorOf(obj):
                 canvas.open_palette()
                 return True
-        return super().eventFilter(obj, event)
+        return False
