@@ -19,7 +19,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QAction, QUndoCommand, QUndoStack
 from PySide6.QtWidgets import (
     QDockWidget,
@@ -463,28 +463,23 @@ class MaterialParameters(ParameterPanel):
         self._signature: object = None
         self._params: dict = {}
         self._pending = False  # a macro's events arrived: refreshed once, at its end
-        # Another document, or a macro's end: rebuilt once control returns to the event
-        # loop, so opening a file into a new tab (an Untitled swapped in, then the file read
-        # into it) builds the rows once, and the rows' build is an event of its own
-        self._later = QTimer(self)
-        self._later.setSingleShot(True)
-        self._later.setInterval(0)
-        # then a turn of the UI work queue (matedit.app.turns): the Layers panel's rows, the
-        # GLSL dock's text and these are short blocks, with input, paints and timers handled
-        # between them, not one long one
-        self._later.timeout.connect(
-            lambda: turns().add(self, "refresh", lambda: self.refresh(first_now=False)))
         controller.changed.connect(self._changed)
         controller.batchEnded.connect(self._batch_ended)
-        controller.documentReplaced.connect(self._later.start)
+        controller.documentReplaced.connect(self._refresh_later)
         self.valueEdited.connect(self._edit)
         self.refresh()
 
     @property
     def settled(self) -> bool:
         """The rows show the document as it is (no rebuild waiting or under way)."""
-        return not (self._pending or self._later.isActive()
-                    or turns().pending(self, "refresh") or self.building)
+        return not (self._pending or turns().pending(self, "refresh") or self.building)
+
+    def _refresh_later(self) -> None:
+        """Another document, or a macro's end: rebuilt in a turn of the UI work queue
+        (matedit.app.turns), so that opening a file into a new tab (the document replaced
+        twice in one event) builds the rows once, and the Layers panel's rows, the GLSL
+        dock's text and these are short blocks with input, paints and timers between them."""
+        turns().add(self, "refresh", lambda: self.refresh(first_now=False))
 
     def _changed(self, _event) -> None:
         if self.controller.batching:  # deleting or pasting many nodes: one rebuild, not one each
@@ -495,7 +490,7 @@ class MaterialParameters(ParameterPanel):
     def _batch_ended(self) -> None:
         if self._pending:  # after the macro's own event, in one of its own
             self._pending = False
-            self._later.start()
+            self._refresh_later()
 
     def refresh(self, first_now: bool = True) -> None:
         """The rows for the document as it is (ParameterPanel.set_parameters's `first_now`:

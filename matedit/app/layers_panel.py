@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from PySide6.QtCore import QMimeData, Qt, QTimer, Signal
+from PySide6.QtCore import QMimeData, Qt, Signal
 from PySide6.QtGui import QStandardItem, QStandardItemModel
 from PySide6.QtWidgets import (
     QAbstractItemView,
@@ -349,10 +349,6 @@ class LayersPanel(QWidget):
         el.addStretch(1)
         lay.addWidget(self.empty)
         self.list.itemSelectionChanged.connect(self._selected)
-        self._timer = QTimer(self)
-        self._timer.setSingleShot(True)
-        self._timer.setInterval(0)
-        self._timer.timeout.connect(lambda: self.rebuild(per_turn=1))
         # rows still to build (rebuild with `per_turn`): (layer, is the base, opacity, parked
         # wires), top first, one a turn (a row costs ~10 ms; three of them were one 30 ms block)
         self._rows_left: list[tuple] = []
@@ -382,7 +378,7 @@ class LayersPanel(QWidget):
         if event.kind == ChangeKind.STRUCTURAL and (
                 s is None or s.node_id in event.node_ids or event.what in ("node_added",
                                                                             "node_removed")):
-            self._timer.start()
+            self._rebuild_later()
         elif event.kind == ChangeKind.VALUE and s is not None and s.node_id in event.node_ids:
             self.refresh_values()
 
@@ -429,7 +425,12 @@ class LayersPanel(QWidget):
         """Another document: every row built again, once control is back in the event loop
         (opening a file into a new tab replaces the document twice in one event)."""
         self._built = None
-        self._timer.start()
+        self._rebuild_later()
+
+    def _rebuild_later(self) -> None:
+        """`rebuild` in a turn of the UI work queue (matedit.app.turns), its rows one a turn
+        after it; however many times asked before then, once."""
+        turns().add(self, "rebuild", lambda: self.rebuild(per_turn=1))
 
     def rebuild(self, per_turn: int = 0) -> None:
         """The rows, built again only when what they show has changed (the stack, its layers
@@ -437,6 +438,7 @@ class LayersPanel(QWidget):
         anywhere in the graph comes here); opacity values are set in place. `per_turn` > 0:
         that many rows a turn of the UI work queue (matedit.app.turns: the rebuilds after
         another document and after structural edits), `settled` once all are built."""
+        turns().cancel(self, "rebuild")  # this one shows the document as it is
         turns().cancel(self, "rows")
         self._rows_left = []
         s = self.stack
@@ -476,7 +478,7 @@ class LayersPanel(QWidget):
     @property
     def settled(self) -> bool:
         """The rows show the document as it is (no rebuild waiting or under way)."""
-        return not (self._timer.isActive() or self._rows_left)
+        return not (turns().pending(self, "rebuild") or self._rows_left)
 
     def _build_rows(self, count: int = 0) -> None:
         """The next `count` rows still to build (default: the rebuild's `per_turn`)."""

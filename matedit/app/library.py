@@ -117,7 +117,7 @@ class LibraryPanel(QWidget):
         self.listed = False
         self._listing: Iterator[tuple[str, Path]] | None = None  # list_in_turns under way
         self._sections: dict[str, QTreeWidgetItem] = {}
-        self._roots: list[Path] = []
+        self._files: list[Path] = []  # what the listing under way found (`_begin`)
 
     def ensure_listed(self) -> None:
         """The tree filled, if no `refresh` has filled it yet (a listing in turns under way
@@ -187,9 +187,10 @@ class LibraryPanel(QWidget):
             top.setExpanded(True)
             self._sections[kind] = top
         roots = [("", graphs_dir())] + [(p.name, p) for p in self.user_folders()]
-        self._roots = [root for _, root in roots if root.is_dir()]
-        return [(origin, path) for origin, root in roots if root.is_dir()
-                for path in sorted(root.rglob("*.json"))
+        found = [(origin, root, sorted(root.rglob("*.json"))) for origin, root in roots
+                 if root.is_dir()]
+        self._files = [path for _, _, paths in found for path in paths]
+        return [(origin, path) for origin, root, paths in found for path in paths
                 if origin or path.relative_to(root).parts[0] not in INTERNAL]
 
     def _add(self, origin: str, path: Path) -> None:
@@ -208,7 +209,7 @@ class LibraryPanel(QWidget):
 
     def _end(self) -> None:
         self.listed = True
-        self.files = [p for r in self._roots for p in sorted(r.rglob("*.json"))]
+        self.files = self._files  # every .json file of the folders, the internal ones too
         self.refreshed.emit(self.files)
         for top in self._sections.values():
             top.setExpanded(True)

@@ -592,12 +592,18 @@ class GpuMesh:
             self._closed = self.data.is_closed()
         return self._closed
 
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """MeshData.bounds, computed once."""
+        if self._bounds is None:
+            self._bounds = self.data.bounds()
+        return self._bounds
+
     def seen_from_outside(self, camera, aspect: float) -> bool:
         """Whether no point of the mesh's bounding box lies within the near plane's reach of
         `camera` (an OrbitCamera: eye, fov, near) at this aspect: then the eye is outside
         the mesh and nothing of it is clipped open by the near plane."""
-        lo, hi = self._bounds if self._bounds is not None else self.data.bounds()
-        self._bounds = (lo, hi)
+        lo, hi = self.bounds
         eye = np.asarray(camera.eye, dtype=np.float64)
         gap = float(np.linalg.norm(np.maximum(np.maximum(lo - eye, eye - hi), 0.0)))
         tan = math.tan(math.radians(camera.fov) / 2.0)
@@ -609,8 +615,7 @@ class GpuMesh:
         """(centre, radius) of a sphere holding every vertex (so every triangle): the centre
         of the bounding box and the farthest vertex from it, computed once."""
         if self._sphere is None:
-            lo, hi = self._bounds if self._bounds is not None else self.data.bounds()
-            self._bounds = (lo, hi)
+            lo, hi = self.bounds
             centre = (lo + hi) / 2.0
             p = np.asarray(self.data.positions, dtype=np.float64).reshape(-1, 3)
             radius = float(np.sqrt(((p - centre) ** 2).sum(axis=1).max())) if len(p) else 0.0
