@@ -182,6 +182,7 @@ def test_seen_from_outside():
     class _Mesh:  # GpuMesh's predicate without a context
         from matedit.render.mesh import GpuMesh as _G
         seen_from_outside = _G.seen_from_outside
+        bounds = _G.bounds
 
         def __init__(self, data):
             self.data, self._bounds = data, None
