@@ -195,6 +195,11 @@ class CanvasTabs(QWidget):
         if self.active is self.material:
             self.undo_group.setActiveStack(stack)
 
+    def defer_builds(self, on: bool) -> None:
+        """While a file opens, the material canvas builds its items in a turn of their own
+        (NodeScene.defer_rebuilds)."""
+        self.material.canvas.scene().defer_rebuilds = on
+
     def _material_replaced(self) -> None:
         self._retitle(self.material)
         QTimer.singleShot(0, self.material.canvas, self.material.canvas.frame_all)

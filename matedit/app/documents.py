@@ -64,6 +64,7 @@ class DocumentTabs(QObject):
     """The document tab bar and the sessions behind it (see the module docstring)."""
 
     switched = Signal()  # another document is active
+    opening = Signal(bool)  # True while `open` opens a file (the window defers what it can)
     undoStackChosen = Signal(object)  # the stack Edit › Undo should follow now
     message = Signal(str)
 
@@ -240,6 +241,13 @@ class DocumentTabs(QObject):
         """File › Open, Recent and a material dropped on the window: the tab that has it, or
         a new tab (the active one if it is an untouched Untitled). Functions open in a
         canvas tab, instances in a tab of their own."""
+        self.opening.emit(True)
+        try:
+            return self._open(path)
+        finally:
+            self.opening.emit(False)
+
+    def _open(self, path: str | Path) -> bool:
         from matedit.io.instance import is_instance_file
 
         path = Path(path)

@@ -448,9 +448,12 @@ class Instances:
 
 # --- a material's own parameters, grouped (the Parameters dock) ---------------------------
 
-# The Parameters dock builds its rows this many to a turn of the event loop (~3 ms each on the
-# UI thread: a material with dozens of parameters would otherwise block it for a frame or more)
-ROWS_PER_TURN = 6
+# The Parameters dock builds its rows this many to a turn of the event loop. A row costs the
+# UI thread 3-13 ms (its field's widgets), and Qt's layout and paint of the dock follow in the
+# same block: six a turn made blocks of 70-120 ms right after opening a file.
+ROWS_PER_TURN = 1
+# the settings that hold a parameter's value (a switch's, a texture's), not its presentation
+_VALUES = ("value", "path")
 
 
 class MaterialParameters(ParameterPanel):
@@ -500,7 +503,10 @@ class MaterialParameters(ParameterPanel):
         doc = self.controller.document
         params = material_parameters(doc) if not doc.is_function else {}
         values = {n: p.default for n, p in params.items()}
-        signature = [(n, p.type, p.node, repr(sorted(p.settings.items())))
+        # what the rows are made of; a switch's or a texture's current value (its setting
+        # `value` or `path`) is not: toggling one updates its row like any value
+        signature = [(n, p.type, p.node,
+                      repr(sorted((k, v) for k, v in p.settings.items() if k not in _VALUES)))
                      for n, p in params.items()]
         base = Path(doc.path).parent if doc.path else None
         if signature != self._signature:

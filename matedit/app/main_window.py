@@ -58,6 +58,7 @@ class MainWindow(QMainWindow):
 
         self.tabs = CanvasTabs(self.controller, self.actions, self.undo_group, self)
         self.documents = DocumentTabs(self.controller, self.actions, self)
+        self.documents.opening.connect(self.tabs.defer_builds)
         self.setCentralWidget(self.documents.over(self.tabs))
         self.panels: Panels = build_docks(self, self.compiler, self.controller,
                                           self.undo_group)

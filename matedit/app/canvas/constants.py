@@ -6,7 +6,7 @@ MaterialAttributes, square for textures), so they read without colour vision too
 
 from __future__ import annotations
 
-from functools import cache
+from functools import cache, lru_cache
 
 from PySide6.QtGui import QColor, QFont, QFontMetricsF
 
@@ -195,3 +195,17 @@ def metrics(which: str) -> QFontMetricsF:
     font = {"title": title_font, "subtitle": subtitle_font, "port": port_font,
             "comment": comment_font}[which]()
     return QFontMetricsF(font)
+
+
+@lru_cache(maxsize=8192)
+def text_width(which: str, text: str) -> float:
+    """The advance of `text` in font `which` (`metrics`' names): node layouts and every paint
+    ask for the same few port and title labels again and again, and each answer from Qt
+    shapes the text anew."""
+    return metrics(which).horizontalAdvance(text)
+
+
+@lru_cache(maxsize=8192)
+def overview_width(pixel_size: int, text: str) -> float:
+    """The advance of `text` in the zoomed-out title font of `pixel_size` (as `text_width`)."""
+    return overview_metrics(pixel_size).horizontalAdvance(text)

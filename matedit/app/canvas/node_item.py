@@ -9,6 +9,7 @@ a device-coordinate cache, so a frame of a big graph is mostly pixmap blits.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from html import escape
 
 from PySide6.QtCore import QPointF, QRectF, Qt
@@ -114,12 +115,12 @@ def measure(title: str, subtitle: str, inputs: list[PortRow], outputs: list[Port
     """
     in_rows, in_hidden = fold_rows(inputs, False, expanded)
     out_rows, out_hidden = fold_rows(outputs, True, expanded)
-    fm_t, fm_p = C.metrics("title"), C.metrics("port")
-    head = 2 * 8.0 + fm_t.horizontalAdvance(title)
+    width_of = C.text_width
+    head = 2 * 8.0 + width_of("title", title)
     if subtitle:
-        head = max(head, 16.0 + C.metrics("subtitle").horizontalAdvance(subtitle))
-    ins = [fm_p.horizontalAdvance(_row_label(p)) for p in in_rows]
-    outs = [fm_p.horizontalAdvance(_row_label(p)) for p in out_rows]
+        head = max(head, 16.0 + width_of("subtitle", subtitle))
+    ins = [width_of("port", _row_label(p)) for p in in_rows]
+    outs = [width_of("port", _row_label(p)) for p in out_rows]
     rows_w = 0.0
     for i in range(max(len(ins), len(outs))):
         a = ins[i] if i < len(ins) else 0.0
@@ -498,21 +499,7 @@ class NodeItem(QGraphicsRectItem):
         """The zoomed-out title: its pixel size (scene units) and its lines, wrapped to fit the
         node's body at zoom `lod` (the largest size that fits, else the smallest, elided)."""
         inner = self._overview_rect(lod)
-        hi, lo = C.overview_title_px(lod)
-        step = max(1, (hi - lo) // 4)
-        sizes = list(range(hi, lo, -step)) + [lo]
-        for px in sizes:
-            fm = C.overview_metrics(px)
-            lines = _wrap(self.title, fm, inner.width())
-            if (len(lines) * fm.lineSpacing() <= inner.height()
-                    and all(fm.horizontalAdvance(t) <= inner.width() for t in lines)):
-                return px, lines
-        fm = C.overview_metrics(lo)
-        room = max(1, int(inner.height() // fm.lineSpacing()))
-        lines = _wrap(self.title, fm, inner.width())
-        if len(lines) > room:
-            lines = lines[:room - 1] + [" ".join(lines[room - 1:])]
-        return lo, [fm.elidedText(t, Qt.TextElideMode.ElideRight, inner.width()) for t in lines]
+        return _overview_title(self.title, inner.width(), inner.height(), lod)
 
     def _overview_rect(self, lod: float) -> QRectF:
         pad = max(C.PORT_RADIUS + 1.0, 2.0 / max(lod, 1e-6))
@@ -547,8 +534,8 @@ class NodeItem(QGraphicsRectItem):
             for _, y in lay.headers:
                 painter.fillRect(QRectF(1.0, y - C.ROW_HEIGHT / 2 + 1, lay.width - 2.0,
                                         C.ROW_HEIGHT - 2), C.GROUP_HEADER_FILL)
-        in_w = [fm.horizontalAdvance(_row_label(r)) for r in lay.in_rows]
-        out_w = [fm.horizontalAdvance(_row_label(r)) for r in lay.out_rows]
+        in_w = [C.text_width("port", _row_label(r)) for r in lay.in_rows]
+        out_w = [C.text_width("port", _row_label(r)) for r in lay.out_rows]
         for rows, out, connected in ((lay.in_rows, False, self.connected_inputs),
                                      (lay.out_rows, True, self.connected_outputs)):
             other_w = in_w if out else out_w
@@ -594,11 +581,36 @@ class NodeItem(QGraphicsRectItem):
         painter.drawEllipse(pos, r, r)
 
 
-def _wrap(text: str, fm, width: float) -> list[str]:
-    """Greedy word wrap: as many words a line as fit in `width` (a long word keeps its line)."""
+@lru_cache(maxsize=4096)
+def _overview_title(title: str, width: float, height: float, lod: float
+                    ) -> tuple[int, tuple[str, ...]]:
+    """NodeItem.overview_title for a body of `width` x `height` inside its margins. Kept for
+    the next paint: the search over sizes asks Qt for the width of every trial line, and at
+    one zoom the nodes of one kind share their title and size (a duplicated graph all of
+    them)."""
+    hi, lo = C.overview_title_px(lod)
+    step = max(1, (hi - lo) // 4)
+    sizes = list(range(hi, lo, -step)) + [lo]
+    for px in sizes:
+        fm = C.overview_metrics(px)
+        lines = _wrap(title, px, width)
+        if (len(lines) * fm.lineSpacing() <= height
+                and all(C.overview_width(px, t) <= width for t in lines)):
+            return px, tuple(lines)
+    fm = C.overview_metrics(lo)
+    room = max(1, int(height // fm.lineSpacing()))
+    lines = _wrap(title, lo, width)
+    if len(lines) > room:
+        lines = lines[:room - 1] + [" ".join(lines[room - 1:])]
+    return lo, tuple(fm.elidedText(t, Qt.TextElideMode.ElideRight, width) for t in lines)
+
+
+def _wrap(text: str, pixel_size: int, width: float) -> list[str]:
+    """Greedy word wrap in the zoomed-out title font of `pixel_size`: as many words a line
+    as fit in `width` (a long word keeps its line)."""
     lines: list[str] = []
     for word in text.split():
-        if lines and fm.horizontalAdvance(lines[-1] + " " + word) <= width:
+        if lines and C.overview_width(pixel_size, lines[-1] + " " + word) <= width:
             lines[-1] += " " + word
         else:
             lines.append(word)

@@ -7,6 +7,8 @@ the port item itself draws only while highlighted (hover, or as a wire's target)
 
 from __future__ import annotations
 
+from functools import cache
+
 from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QPainter, QPen, QPolygonF
 from PySide6.QtWidgets import QGraphicsItem
@@ -17,9 +19,8 @@ from matedit.app.canvas import constants as C
 def port_shape(painter: QPainter, center: QPointF, type_name: str, radius: float,
                filled: bool) -> None:
     """Draw a port marker: a circle, or a diamond (MaterialAttributes), or a square (texture)."""
-    color = C.port_color(type_name)
-    painter.setPen(QPen(color, 1.4))
-    painter.setBrush(QBrush(color) if filled else QBrush(C.NODE_BODY))
+    painter.setPen(_port_pen(type_name))
+    painter.setBrush(_port_brush(type_name, filled))
     shape = C.PORT_SHAPES.get(type_name, "circle")
     x, y, r = center.x(), center.y(), radius
     if shape == "diamond":
@@ -30,6 +31,18 @@ def port_shape(painter: QPainter, center: QPointF, type_name: str, radius: float
         painter.drawRect(QRectF(x - r + 0.6, y - r + 0.6, 2 * r - 1.2, 2 * r - 1.2))
     else:
         painter.drawEllipse(center, r, r)
+
+
+@cache
+def _port_pen(type_name: str) -> QPen:
+    """The outline of a port of this type (made once: every node paint draws its ports)."""
+    return QPen(C.port_color(type_name), 1.4)
+
+
+@cache
+def _port_brush(type_name: str, filled: bool) -> QBrush:
+    """A port's fill: its type's colour where wired, the node's body where not."""
+    return QBrush(C.port_color(type_name)) if filled else QBrush(C.NODE_BODY)
 
 
 class PortItem(QGraphicsItem):

@@ -25,6 +25,7 @@ from matedit.app.canvas.port_item import PortItem
 from matedit.app.canvas.reroute_item import RerouteItem
 from matedit.app.canvas.wire_item import WireItem
 from matedit.app.controller import DocumentController
+from matedit.app.turns import turns
 from matedit.graph import nodes
 from matedit.graph.commands import MoveNodes, PutComment, SetSetting
 from matedit.graph.model import ChangeEvent, Link, Node
@@ -129,7 +130,12 @@ class NodeScene(QGraphicsScene):
         self.setBackgroundBrush(C.BACKGROUND)
         controller.changed.connect(self._on_changed)
         controller.analysed.connect(self._on_analysed)
-        controller.documentReplaced.connect(self.rebuild)
+        # Opening a file builds the items in a turn of the UI work queue of their own
+        # (`defer_rebuilds`, set by the window while it opens one): the open and the items
+        # with their first paint are then two short blocks of the UI thread, not one long one.
+        self.defer_rebuilds = False
+        self._rebuild_due = False
+        controller.documentReplaced.connect(self._document_replaced)
         self.rebuild()
 
     # --- queries -----------------------------------------------------------------------------
@@ -155,8 +161,27 @@ class NodeScene(QGraphicsScene):
         return rect
 
     # --- building ----------------------------------------------------------------------------
+    @property
+    def settled(self) -> bool:
+        """The items show the document (no rebuild waiting in the UI work queue)."""
+        return not self._rebuild_due
+
+    def _document_replaced(self) -> None:
+        if not self.defer_rebuilds:
+            self.rebuild()
+            return
+        # The old document's items go now (nothing may act on them against the new one);
+        # the new one's come in a later turn, built from the model as it is then.
+        self._drop_items()
+        self._rebuild_due = True
+        turns().add(self, "rebuild", self._build_items)
+
     def rebuild(self) -> None:
         """Drop every item and build them again from the model (a new document)."""
+        self._drop_items()
+        self._build_items()
+
+    def _drop_items(self) -> None:
         self.clear()
         self.node_items.clear()
         self.wire_items.clear()
@@ -165,6 +190,10 @@ class NodeScene(QGraphicsScene):
         self._wires_of.clear()
         self._node_errors.clear()
         self._previews.clear()
+
+    def _build_items(self) -> None:
+        turns().cancel(self, "rebuild")
+        self._rebuild_due = False
         g = self.graph
         for cid in sorted(g.comments):
             self._sync_comment(cid)
@@ -280,6 +309,8 @@ class NodeScene(QGraphicsScene):
 
     # --- model events ------------------------------------------------------------------------
     def _on_changed(self, ev: ChangeEvent) -> None:
+        if self._rebuild_due:  # the items are built from the model as it is by then
+            return
         what = ev.what
         if what == "node_added":
             self._add_node(ev.node_ids[0])
@@ -326,6 +357,8 @@ class NodeScene(QGraphicsScene):
 
     def _on_analysed(self, analysis: Analysis) -> None:
         """Resolved port types, diagnostics as badges, and wire colours from one analysis."""
+        if self._rebuild_due:  # the build applies the controller's latest analysis
+            return
         diags: dict[str, list[tuple[str, str]]] = {}
         bad_inputs: set[tuple[str, str]] = set()
         for d in analysis.diagnostics:

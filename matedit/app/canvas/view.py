@@ -132,6 +132,8 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         self._scene.selectionChanged.connect(self._selection_changed)
         self._scene.commentTextRequested.connect(self._edit_comment_text)
         self._scene.rebuilt.connect(self.minimap.invalidate)
+        self._frame_when_built = False  # frame_all asked while the items wait to be built
+        self._scene.rebuilt.connect(self._built)
         controller.changed.connect(lambda _ev: self.minimap.invalidate())
         controller.documentReplaced.connect(self._document_replaced)
         controller.batchEnded.connect(self._batch_ended)
@@ -152,8 +154,17 @@ class NodeCanvasView(CanvasDrops, QGraphicsView):
         return self.transform().m11()
 
     def frame_all(self) -> None:
-        """Zoom and scroll so every node and comment is in view."""
+        """Zoom and scroll so every node and comment is in view (once they are built, when
+        the scene builds them in a later turn: NodeScene.defer_rebuilds)."""
+        if not self._scene.settled:
+            self._frame_when_built = True
+            return
+        self._frame_when_built = False
         self._fit(self._scene.nodes_bounding_rect())
+
+    def _built(self) -> None:
+        if self._frame_when_built:
+            self.frame_all()
 
     def frame_selection(self) -> None:
         items = [it for it in self._scene.selectedItems()
