@@ -176,3 +176,39 @@ def test_an_instance_opens_in_a_tab_with_the_windows_undo_and_close(qtbot, two):
     assert docs.close()  # the instance's unsaved override: asked, discarded
     assert asked == [editor.name] and docs.count() == 1 and docs.index == 0
     assert w.controller.document.path == two[0]
+
+
+def test_opening_a_file_builds_the_canvas_in_a_turn_of_its_own(qtbot, two):
+    """The open returns with the old document's items gone and the new one's still to come
+    (a turn of the UI work queue of their own: the open, and the items with their first
+    paint, are two blocks of the UI thread, not one). An edit made in between is in the
+    items once built, and the view frames the graph once it is there."""
+    from matedit.app.canvas.node_item import NodeItem
+    from matedit.graph.commands import AddNode
+    from matedit.graph.model import Node
+
+    a, b = two
+    w = make_window(qtbot, a, show=True)
+    settle(qtbot, w)
+    canvas = w.canvas
+    scene = canvas.scene()
+    assert scene.settled and set(scene.node_items) == set(w.controller.document.graph.nodes)
+    assert w.open_material(b)
+    assert not scene.settled and scene.node_items == {}
+    assert not any(isinstance(it, NodeItem) for it in scene.items())
+    assert not scene.defer_rebuilds  # only while opening
+    extra = Node("late_node", "constant", (0.0, 900.0))
+    assert w.controller.push(AddNode(extra))  # before the items are built
+    qtbot.waitUntil(lambda: scene.settled, timeout=10000)
+    graph = w.controller.document.graph
+    assert set(scene.node_items) == set(graph.nodes) and "late_node" in scene.node_items
+    assert set(scene.wire_items) == set(graph.links)
+    # framed once built: every node in view
+    view_rect = canvas.mapToScene(canvas.viewport().rect()).boundingRect()
+    assert view_rect.contains(scene.nodes_bounding_rect())
+    # other edits to the canvas after the build go through as usual
+    w.controller.undo_stack.undo()
+    assert "late_node" not in scene.node_items
+    # switching tabs rebuilds at once, as before
+    w.documents.activate(0)
+    assert scene.settled and set(scene.node_items) == set(w.controller.document.graph.nodes)

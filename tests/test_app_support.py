@@ -110,3 +110,5 @@ def settle(qtbot, window, ms: int = 5) -> None:
     layers = getattr(window, "layers", None)  # its rows are built a few a turn
     if layers is not None:
         qtbot.waitUntil(lambda: layers.settled, timeout=10000)
+    # a file just opened: the canvas builds its items in a turn of their own
+    qtbot.waitUntil(lambda: all(t.canvas.scene().settled for t in tabs), timeout=10000)

@@ -237,3 +237,21 @@ def test_the_library_lists_in_turns_and_thumbnails_one_a_turn(window, qtbot, mon
     library.list_in_turns()
     assert library.items("material") and library.listed and library._listing is None
     assert _listing(library) == expected
+
+
+def test_toggling_a_switch_keeps_the_parameters_rows(qtbot):
+    """A switch's value is a setting of its node, but not part of what the rows are made of:
+    toggling it updates its row in place (no rebuild of the dock, row by row)."""
+    w = make_window(qtbot, MASTER)
+    panel = w.instances.parameters_panel
+    qtbot.waitUntil(lambda: panel.settled)
+    rows = dict(panel.rows)
+    switch = panel.rows["rust_on"].field
+    switch.setChecked(not switch.isChecked())
+    assert panel.settled and panel.rows == rows
+    assert panel.rows["rust_on"].field.isChecked() is \
+        w.controller.document.graph.nodes["rust_on"].settings["value"]
+    w.controller.undo_stack.undo()  # and back, shown in the same row
+    assert panel.rows == rows
+    assert panel.rows["rust_on"].field.isChecked() is \
+        w.controller.document.graph.nodes["rust_on"].settings["value"]

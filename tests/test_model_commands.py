@@ -217,3 +217,36 @@ def test_changing_a_layer_blend_keeps_the_mask_link(tmp_path):
     stack.set("b", blend="alpha").apply(d.graph)
     assert d.graph.incoming("stack", "b_contrast") is None  # the height-only port is gone
     assert d.graph.incoming("stack", "b_mask") is not None
+
+
+def test_a_cloned_node_shares_no_data_with_its_original():
+    """Node.clone copies file data (dicts, lists, tuples of plain values) itself, without
+    copy.deepcopy; anything else still gets a deep copy."""
+    from matedit.graph.model import Node, copy_data
+
+    class Box:
+        def __init__(self, v):
+            self.v = v
+
+        def __eq__(self, other):
+            return isinstance(other, Box) and other.v == self.v
+
+    n = Node("a", "color_ramp", (1.0, 2.0), settings={"stops": [[0.0, [1, 2, 3]], [1.0, [4]]],
+                                                      "pair": ([1], "x"), "box": Box([7])},
+             values={"value": [0.1, 0.2]}, label="L", extra={"future": {"k": [None, True]}},
+             muted=True)
+    c = n.clone()
+    assert c == n and c is not n
+    c.settings["stops"][0][1].append(9)
+    c.settings["pair"][0].append(2)
+    c.settings["box"].v.append(8)
+    c.values["value"][0] = 5.0
+    c.extra["future"]["k"].append(1)
+    assert n.settings["stops"] == [[0.0, [1, 2, 3]], [1.0, [4]]]
+    assert n.settings["pair"] == ([1], "x") and n.settings["box"].v == [7]
+    assert n.values == {"value": [0.1, 0.2]} and n.extra == {"future": {"k": [None, True]}}
+    assert (c.id, c.kind, c.position, c.label, c.muted) == ("a", "color_ramp", (1.0, 2.0),
+                                                            "L", True)
+    data = {"a": [1, 2.5, "s", None, False, (3, [4])]}
+    out = copy_data(data)
+    assert out == data and out["a"] is not data["a"] and out["a"][5][1] is not data["a"][5][1]
