@@ -192,10 +192,10 @@ def _listing(library) -> list[tuple[str, str, str]]:
     return [(it.data(0, 0x0101), it.text(0), it.toolTip(0)) for it in library.items()]
 
 
-def test_the_library_lists_in_turns_and_thumbnails_one_a_turn(window, qtbot, monkeypatch):
+def test_the_library_lists_in_turns_and_thumbnails_a_step_a_turn(window, qtbot, monkeypatch):
     """The start-up listing reads a few files a turn of the event loop, with the timer's
     events between turns, and fills the same tree as `refresh`; the instances' thumbnails
-    come one a turn, not all in one stretch."""
+    come a step a turn, not all in one stretch."""
     import time
 
     from PySide6.QtCore import QTimer
@@ -211,10 +211,17 @@ def test_the_library_lists_in_turns_and_thumbnails_one_a_turn(window, qtbot, mon
     real_turn = lib.LibraryPanel._list_turn
     monkeypatch.setattr(lib.LibraryPanel, "_list_turn",
                         lambda self: (turns.append(time.perf_counter()), real_turn(self)))
-    made = []
+    made, done = [], []  # when each step of a thumbnail ran; the thumbnails finished
     real_thumb = ie._thumbnail
-    monkeypatch.setattr(ie, "_thumbnail",
-                        lambda it, f: (made.append(time.perf_counter()), real_thumb(it, f)))
+
+    def traced(it, f):
+        for _ in real_thumb(it, f):
+            made.append(time.perf_counter())
+            yield
+        made.append(time.perf_counter())
+        done.append(it)
+
+    monkeypatch.setattr(ie, "_thumbnail", traced)
     ticks = []
     timer = QTimer()
     timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
@@ -223,12 +230,15 @@ def test_the_library_lists_in_turns_and_thumbnails_one_a_turn(window, qtbot, mon
     library.list_in_turns()
     assert not library.listed and library._listing is not None
     qtbot.waitUntil(lambda: library.listed, timeout=20000)
-    qtbot.waitUntil(lambda: len(made) >= 6, timeout=20000)  # the six instances of graphs/
+    qtbot.waitUntil(lambda: len(done) >= 6, timeout=20000)  # the six instances of graphs/
     timer.stop()
     assert len(turns) >= 3
     assert _listing(library) == expected
-    # between two turns, and between two thumbnails, the loop ran other events
-    for stamps in (turns, made[:6]):
+    assert all(not it.icon(0).isNull() for it in done)
+    # between two turns, and between two steps of the thumbnails (three each), the loop ran
+    # other events
+    assert len(made) == 3 * len(done)
+    for stamps in (turns, made):
         for a, b in zip(stamps, stamps[1:]):
             assert any(a < t < b for t in ticks), (a, b)
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import copy
 import os
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -575,14 +576,26 @@ def attach_instances(material_items: list[QTreeWidgetItem], files: list[Path],
 
 
 def _queue_thumbnail(item: QTreeWidgetItem, path: Path) -> None:
-    """The item's thumbnail, made later from the event loop: one a turn of the UI work queue
-    (matedit.app.turns; a thumbnail takes 15-25 ms, and zero-delay calls would all run in
-    one stretch, no tick or paint between them)."""
-    turns().add(None, f"thumbnail {id(item)}", lambda: _thumbnail(item, path))
+    """The item's thumbnail, made later from the event loop in steps, one a turn of the UI
+    work queue (matedit.app.turns): a thumbnail takes 35-70 ms on the UI thread of a 2-core
+    machine, too long for one block, and zero-delay calls would all run in one stretch."""
+    key = f"thumbnail {id(item)}"
+    steps = _thumbnail(item, path)
+
+    def step() -> None:
+        if next(steps, _DONE) is not _DONE:
+            turns().add(None, key, step)
+
+    turns().add(None, key, step)
 
 
-def _thumbnail(item: QTreeWidgetItem, path: Path) -> None:
-    """The instance's base colour on a sphere, from the CPU evaluator (no GL needed)."""
+_DONE = object()
+
+
+def _thumbnail(item: QTreeWidgetItem, path: Path) -> Iterator[None]:
+    """The instance's base colour on a sphere, from the CPU evaluator (no GL needed), in
+    three steps (each yields): the instance resolved, its material lowered, then evaluated
+    and set as the item's icon."""
     try:
         from PySide6.QtGui import QIcon, QPixmap
 
@@ -591,10 +604,13 @@ def _thumbnail(item: QTreeWidgetItem, path: Path) -> None:
         from matedit.compiler.lower import lower_document
 
         r = resolve(load_instance(path))
+        yield
+        ir = lower_document(r.document, FileResolver())
+        yield
         surf, inside = preview_sphere(24)
-        out = evaluate(lower_document(r.document, FileResolver()), surf)
+        out = evaluate(ir, surf)
         img = to_image(out["baseColor"], inside, 24)
         if img is not None:
             item.setIcon(0, QIcon(QPixmap.fromImage(img)))
     except Exception:  # decoration: a broken instance (or a refreshed-away item) shows none
-        pass
+        return
